@@ -1,0 +1,1 @@
+//! Baselines the recognizer is compared with (ICP).

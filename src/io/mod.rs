@@ -1,0 +1,5 @@
+//! Reading and writing files the program exchanges with other tools: CARMEN logs, atomic output
+//! files, MobileSim maps.
+
+pub mod atomic;
+pub mod carmen;

@@ -1,0 +1,18 @@
+//! placewords: long-term place recognition for a mobile robot with a 2D laser, by multi-level
+//! words of spatial densities, and the harness that proves it (worlds, a simulated Pioneer 3-DX,
+//! scenarios with doors that open and close, ground truth, precision/recall).
+//!
+//! Data flow: world file → [`spec`] → [`world::World`]; scenario → [`sim`] → laps of odometry,
+//! scans and truth; odometry and scans → [`recognizer`] → matches; matches and truth → [`eval`]
+//! → [`report`]. Real logs enter through [`io`].
+
+pub mod baseline;
+pub mod eval;
+pub mod geom;
+pub mod io;
+pub mod recognizer;
+pub mod report;
+pub mod scan;
+pub mod sim;
+pub mod spec;
+pub mod world;

@@ -1,0 +1,1 @@
+//! Output for people and machines: JSON reports, text and Markdown tables, SVG pictures.

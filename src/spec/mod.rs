@@ -1,0 +1,7 @@
+//! Files people write: the serde structures of world and scenario files, parsing from a string,
+//! and validation with located errors (`file:line:col: what is wrong; what to try`).
+
+pub mod diag;
+pub mod world;
+
+pub use diag::{Diagnostic, SpecError};
