@@ -1,0 +1,52 @@
+//! What the recognizer hands out: observations and matches. Evaluation scores these against
+//! truth it holds itself, by `Observation::input_index`.
+
+use crate::geom::OdomPose;
+use serde::Serialize;
+
+/// Index of an observation in the order the recognizer made them (global across runs).
+pub type ObsId = usize;
+
+/// One density observation, made each 0.10 m of odometric travel.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Observation {
+    pub id: ObsId,
+    /// Run the observation belongs to (counts `start_run` calls, the first run is 0).
+    pub run: usize,
+    /// Index of the `push` call (0-based, counted across runs) whose scan made it.
+    pub input_index: usize,
+    pub odom_pose: OdomPose,
+    /// Odometric travel since the recognizer was created, metres (keeps growing across runs).
+    pub travel_m: f64,
+    /// Free-space density Ψ in [0, 1].
+    pub psi: f64,
+}
+
+/// A word at a level of the multi-level word lists.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub struct WordRef {
+    pub level: usize,
+    pub index: usize,
+}
+
+/// Two observations the fine alignment put together: `query` is the newer one.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct AlignedPair {
+    pub query: ObsId,
+    pub past: ObsId,
+    pub query_odom: OdomPose,
+    pub past_odom: OdomPose,
+}
+
+/// A recognized revisit: an n-gram of current words matched to an n-gram of past words.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Match {
+    /// The level configuration that found it: 1 = level 0 only, 2 = levels 0-1, ...
+    pub levels: usize,
+    /// Number of word pairs in the n-gram.
+    pub ngram_len: usize,
+    /// Matched word pairs (current, past), oldest first.
+    pub word_pairs: Vec<(WordRef, WordRef)>,
+    /// Observation pairs after fine alignment.
+    pub pairs: Vec<AlignedPair>,
+}
