@@ -2,6 +2,7 @@
 //! and validation with located errors (`file:line:col: what is wrong; what to try`).
 
 pub mod diag;
+pub mod evaluation;
 pub mod world;
 
 pub use diag::{Diagnostic, SpecError};
