@@ -42,8 +42,26 @@ pub struct ExpectSpec {
 pub struct LevelExpectation {
     /// Level configuration: 1, 2 or 3 levels of words.
     pub levels: usize,
-    #[serde(flatten)]
-    pub expect: Expectation,
+    /// Minimum pair precision in [0, 1].
+    #[serde(default)]
+    pub min_precision: Option<f64>,
+    /// Minimum same-direction recall in [0, 1].
+    #[serde(default)]
+    pub min_recall: Option<f64>,
+    /// Maximum recognition time per lap, seconds.
+    #[serde(default)]
+    pub max_seconds_per_lap: Option<f64>,
+}
+
+impl LevelExpectation {
+    /// The thresholds alone.
+    pub fn expectation(&self) -> Expectation {
+        Expectation {
+            min_precision: self.min_precision,
+            min_recall: self.min_recall,
+            max_seconds_per_lap: self.max_seconds_per_lap,
+        }
+    }
 }
 
 /// Minimum precision and recall, and optionally a time budget.
