@@ -114,3 +114,517 @@ fn fmt_pose(p: &Pose2) -> String {
 fn fmt_stamp(ipc: f64, host: &str, logger: f64) -> String {
     format!("{ipc:.6} {host} {logger:.6}")
 }
+
+// ---------------------------------------------------------------------------------------------
+// Reader
+// ---------------------------------------------------------------------------------------------
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::Path;
+
+/// How strictly to read a log.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Skip malformed lines (and count them) instead of failing at the first one.
+    pub lenient: bool,
+}
+
+/// What a read produced.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LogReadout {
+    /// The understood messages, in file order.
+    pub records: Vec<LogRecord>,
+    /// Malformed lines skipped in lenient mode (always 0 in strict mode).
+    pub skipped_lines: usize,
+    /// The first skipped line's problem, located (lenient mode), to show the user.
+    pub first_skipped: Option<String>,
+    /// Lines whose message type the reader does not know (NEFF, SYNC, RAWLASER…), skipped silently.
+    pub unknown_lines: usize,
+    /// The `max_range` field of the first ROBOTLASER1 message, metres, if any.
+    pub robotlaser_max_range_m: Option<f64>,
+}
+
+/// Why a log could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum CarmenError {
+    #[error("{path}: cannot read: {source}; check the path and the file's permissions")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A line that is not a valid message of its type.
+    #[error("{path}:{line}:{col}: {message}")]
+    Malformed {
+        path: String,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    /// The gzip stream ended early or is corrupt.
+    #[error(
+        "{path}: the gzip stream is truncated or corrupt after line {line} ({source}); \
+         re-download or re-compress the log (`gzip -t` tests it), or unpack what is readable with `zcat`"
+    )]
+    Decompress {
+        path: String,
+        /// Last complete line read before the failure.
+        line: usize,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Reads a CARMEN log, plain text or gzip (detected by the magic bytes `1f 8b`).
+pub fn read_log(path: &Path, opts: ReadOptions) -> Result<LogReadout, CarmenError> {
+    let name = path.display().to_string();
+    let file = std::fs::File::open(path).map_err(|source| CarmenError::Io {
+        path: name.clone(),
+        source,
+    })?;
+    read_log_from(file, &name, opts)
+}
+
+/// Reads a log from any byte source, plain or gzip; `name` only names it in messages.
+pub fn read_log_from<R: Read>(
+    src: R,
+    name: &str,
+    opts: ReadOptions,
+) -> Result<LogReadout, CarmenError> {
+    let mut buf = BufReader::new(src);
+    let head = buf.fill_buf().map_err(|source| CarmenError::Io {
+        path: name.to_string(),
+        source,
+    })?;
+    let gz = head.len() >= 2 && head[0] == 0x1f && head[1] == 0x8b;
+    if gz {
+        let dec = BufReader::new(flate2::bufread::MultiGzDecoder::new(buf));
+        read_lines(dec, name, opts, true)
+    } else {
+        read_lines(buf, name, opts, false)
+    }
+}
+
+/// Parses a log held in a string; `name` only names it in messages.
+pub fn parse_log_str(src: &str, name: &str, opts: ReadOptions) -> Result<LogReadout, CarmenError> {
+    read_lines(src.as_bytes(), name, opts, false)
+}
+
+fn read_lines<R: BufRead>(
+    mut r: R,
+    name: &str,
+    opts: ReadOptions,
+    gz: bool,
+) -> Result<LogReadout, CarmenError> {
+    let mut out = LogReadout::default();
+    let mut line_no = 0usize;
+    let mut bytes = Vec::new();
+    loop {
+        bytes.clear();
+        match r.read_until(b'\n', &mut bytes) {
+            Ok(0) => break,
+            Ok(_) => {}
+            Err(source) => {
+                return Err(if gz {
+                    CarmenError::Decompress {
+                        path: name.to_string(),
+                        line: line_no,
+                        source,
+                    }
+                } else {
+                    CarmenError::Io {
+                        path: name.to_string(),
+                        source,
+                    }
+                });
+            }
+        }
+        line_no += 1;
+        let text = String::from_utf8_lossy(&bytes);
+        match parse_line(&text, &mut out) {
+            Ok(()) => {}
+            Err((col, message)) => {
+                if opts.lenient {
+                    out.skipped_lines += 1;
+                    if out.first_skipped.is_none() {
+                        out.first_skipped = Some(format!("{name}:{line_no}:{col}: {message}"));
+                    }
+                } else {
+                    return Err(CarmenError::Malformed {
+                        path: name.to_string(),
+                        line: line_no,
+                        col,
+                        message,
+                    });
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A whitespace-separated token with its 1-based character column.
+struct Tok<'a> {
+    col: usize,
+    s: &'a str,
+}
+
+fn tokenize(line: &str) -> Vec<Tok<'_>> {
+    let mut out = Vec::new();
+    let mut start: Option<(usize, usize)> = None; // (byte, col)
+    let mut col = 0usize;
+    for (i, ch) in line.char_indices() {
+        col += 1;
+        if ch.is_whitespace() {
+            if let Some((b, c)) = start.take() {
+                out.push(Tok {
+                    col: c,
+                    s: &line[b..i],
+                });
+            }
+        } else if start.is_none() {
+            start = Some((i, col));
+        }
+    }
+    if let Some((b, c)) = start {
+        out.push(Tok {
+            col: c,
+            s: &line[b..],
+        });
+    }
+    out
+}
+
+type LineErr = (usize, String);
+
+struct Fields<'a, 'b> {
+    toks: &'b [Tok<'a>],
+    kind: &'a str,
+    end_col: usize,
+}
+
+impl<'a> Fields<'a, '_> {
+    fn get(&self, i: usize, what: &str) -> Result<&Tok<'a>, LineErr> {
+        self.toks.get(i).ok_or_else(|| {
+            (
+                self.end_col,
+                format!(
+                    "{} line ends before field {} ({what}); the line is truncated or has too few values",
+                    self.kind, i
+                ),
+            )
+        })
+    }
+
+    fn num(&self, i: usize, what: &str) -> Result<f64, LineErr> {
+        let t = self.get(i, what)?;
+        match t.s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(v),
+            _ => Err((
+                t.col,
+                format!(
+                    "{} field {} ({what}) is `{}`, not a finite number; fix or remove the line, or read with --lenient",
+                    self.kind,
+                    i,
+                    clip(t.s)
+                ),
+            )),
+        }
+    }
+
+    fn count(&self, i: usize, what: &str) -> Result<usize, LineErr> {
+        let t = self.get(i, what)?;
+        t.s.parse::<usize>().map_err(|_| {
+            (
+                t.col,
+                format!(
+                    "{} field {} ({what}) is `{}`, not a whole number; fix or remove the line, or read with --lenient",
+                    self.kind,
+                    i,
+                    clip(t.s)
+                ),
+            )
+        })
+    }
+
+    fn pose(&self, i: usize, what: &str) -> Result<Pose2, LineErr> {
+        Ok(Pose2::new(
+            self.num(i, &format!("{what} x"))?,
+            self.num(i + 1, &format!("{what} y"))?,
+            self.num(i + 2, &format!("{what} theta"))?,
+        ))
+    }
+
+    /// `ipc_timestamp host logger_timestamp` at `i`, and that they end the line.
+    fn stamp(&self, i: usize) -> Result<(f64, String, f64), LineErr> {
+        let ipc = self.num(i, "ipc_timestamp")?;
+        let host = self.get(i + 1, "host")?.s.to_string();
+        let logger = self.num(i + 2, "logger_timestamp")?;
+        self.end(i + 3)?;
+        Ok((ipc, host, logger))
+    }
+
+    fn end(&self, n: usize) -> Result<(), LineErr> {
+        if let Some(t) = self.toks.get(n) {
+            return Err((
+                t.col,
+                format!(
+                    "{} line has {} extra value(s) after its last field (expected {} fields); \
+                     check the beam count, or read with --lenient",
+                    self.kind,
+                    self.toks.len() - n,
+                    n
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn clip(s: &str) -> String {
+    if s.chars().count() > 24 {
+        format!("{}…", s.chars().take(24).collect::<String>())
+    } else {
+        s.to_string()
+    }
+}
+
+fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
+    let toks = tokenize(line);
+    let Some(first) = toks.first() else {
+        return Ok(());
+    };
+    if first.s.starts_with('#') {
+        return Ok(());
+    }
+    let end_col = line.trim_end().chars().count() + 1;
+    let f = Fields {
+        toks: &toks,
+        kind: first.s,
+        end_col,
+    };
+    let rec = match first.s {
+        "FLASER" | "RLASER" => {
+            let n = f.count(1, "number of readings")?;
+            if toks.len() < n.saturating_add(2) {
+                return Err((
+                    end_col,
+                    format!(
+                        "{} announces {n} readings but the line has only {} values after the count; \
+                         the line is truncated or the count is wrong",
+                        first.s,
+                        toks.len() - 2
+                    ),
+                ));
+            }
+            let mut ranges = Vec::with_capacity(n);
+            for i in 0..n {
+                ranges.push(f.num(2 + i, "range")?);
+            }
+            let pose = f.pose(2 + n, "pose")?;
+            let odom = f.pose(5 + n, "odometry")?;
+            let (ipc, host, logger) = f.stamp(8 + n)?;
+            LogRecord::Laser(LaserRecord {
+                start_angle_rad: -std::f64::consts::FRAC_PI_2,
+                fov_rad: std::f64::consts::PI,
+                ranges_m: ranges,
+                pose,
+                odom,
+                ipc_timestamp: ipc,
+                host,
+                logger_timestamp: logger,
+            })
+        }
+        "ROBOTLASER1" => {
+            // laser_type start_angle fov angular_res max_range accuracy remission_mode
+            // num_readings r... num_remissions rem... laser_pose robot_pose tv rv
+            // forward_safety side_safety turn_axis timestamp host logger_timestamp
+            let _laser_type = f.num(1, "laser_type")?;
+            let start = f.num(2, "start_angle")?;
+            let fov = f.num(3, "fov")?;
+            let _res = f.num(4, "angular_res")?;
+            let max_range = f.num(5, "max_range")?;
+            let _acc = f.num(6, "accuracy")?;
+            let _rem_mode = f.num(7, "remission_mode")?;
+            let n = f.count(8, "num_readings")?;
+            if toks.len() < n.saturating_add(9) {
+                return Err((
+                    end_col,
+                    format!(
+                        "ROBOTLASER1 announces {n} readings but the line has only {} values after the count; \
+                         the line is truncated or the count is wrong",
+                        toks.len() - 9
+                    ),
+                ));
+            }
+            let mut ranges = Vec::with_capacity(n);
+            for i in 0..n {
+                ranges.push(f.num(9 + i, "range")?);
+            }
+            let k = 9 + n;
+            let m = f.count(k, "num_remissions")?;
+            if toks.len() < (k + 1).saturating_add(m) {
+                return Err((
+                    end_col,
+                    format!(
+                        "ROBOTLASER1 announces {m} remissions but the line has only {} values after that count; \
+                         the line is truncated or the count is wrong",
+                        toks.len() - k - 1
+                    ),
+                ));
+            }
+            for i in 0..m {
+                f.num(k + 1 + i, "remission")?;
+            }
+            let k = k + 1 + m;
+            let _laser_pose = f.pose(k, "laser pose")?;
+            let robot = f.pose(k + 3, "robot pose")?;
+            for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
+                .iter()
+                .enumerate()
+            {
+                f.num(k + 6 + j, what)?;
+            }
+            let (ipc, host, logger) = f.stamp(k + 11)?;
+            if out.robotlaser_max_range_m.is_none() && max_range > 0.0 {
+                out.robotlaser_max_range_m = Some(max_range);
+            }
+            LogRecord::Laser(LaserRecord {
+                start_angle_rad: start,
+                fov_rad: fov,
+                ranges_m: ranges,
+                pose: robot,
+                odom: robot,
+                ipc_timestamp: ipc,
+                host,
+                logger_timestamp: logger,
+            })
+        }
+        "ODOM" => {
+            let pose = f.pose(1, "pose")?;
+            let tv = f.num(4, "tv")?;
+            let rv = f.num(5, "rv")?;
+            let accel = f.num(6, "accel")?;
+            let (ipc, host, logger) = f.stamp(7)?;
+            LogRecord::Odom(OdomRecord {
+                pose,
+                tv_m_s: tv,
+                rv_rad_s: rv,
+                accel_m_s2: accel,
+                ipc_timestamp: ipc,
+                host,
+                logger_timestamp: logger,
+            })
+        }
+        "TRUEPOS" => {
+            let truth = f.pose(1, "true pose")?;
+            let odom = f.pose(4, "odometry")?;
+            let (ipc, host, logger) = f.stamp(7)?;
+            LogRecord::TruePos(TruePosRecord {
+                truth,
+                odom,
+                ipc_timestamp: ipc,
+                host,
+                logger_timestamp: logger,
+            })
+        }
+        "PARAM" => {
+            // `PARAM name value [ipc host logger]`; some loggers drop the ipc stamp
+            // (`PARAM name value host logger`), so only name and value are required.
+            let name = f.get(1, "parameter name")?.s.to_string();
+            let rest: Vec<&str> = toks[2..].iter().map(|t| t.s).collect();
+            let value = if rest.len() >= 4
+                && rest[rest.len() - 3].parse::<f64>().is_ok()
+                && rest[rest.len() - 1].parse::<f64>().is_ok()
+            {
+                rest[..rest.len() - 3].join(" ")
+            } else if let Some(v) = rest.first() {
+                v.to_string()
+            } else {
+                return Err((
+                    end_col,
+                    "PARAM line has a name but no value; add the value or remove the line".into(),
+                ));
+            };
+            LogRecord::Param { name, value }
+        }
+        _ => {
+            out.unknown_lines += 1;
+            return Ok(());
+        }
+    };
+    out.records.push(rec);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SAMPLE: &str = "# comment\n\nPARAM robot_front_laser_max 50 1.0 host 1.0\n\
+        PARAM robot_frontlaser_offset 0.0 nohost 0\n\
+        FLASER 3 1.0 2.0 3.0 0.1 0.2 0.3 0.1 0.2 0.3 10.5 h 10.6\n\
+        NEFF 10\n\
+        ODOM 1 2 0.5 0.1 0.2 0 11.0 h 11.0\n\
+        TRUEPOS 1 2 3 4 5 6 12.0 h 12.0\n\
+        ROBOTLASER1 0 -1.5 3.0 0.5 30 0.01 0 3 1 2 3 0 0 0 0 1 2 0.3 0.1 0.2 0 0 0 13.0 h 13.0\n";
+
+    #[test]
+    fn reads_every_kind() {
+        let r = parse_log_str(SAMPLE, "s.log", ReadOptions::default()).unwrap();
+        assert_eq!(r.records.len(), 6);
+        assert_eq!(r.unknown_lines, 1);
+        assert_eq!(
+            r.records[0],
+            LogRecord::Param {
+                name: "robot_front_laser_max".into(),
+                value: "50".into()
+            }
+        );
+        assert_eq!(
+            r.records[1],
+            LogRecord::Param {
+                name: "robot_frontlaser_offset".into(),
+                value: "0.0".into()
+            }
+        );
+        let LogRecord::Laser(l) = &r.records[2] else {
+            panic!()
+        };
+        assert_eq!(l.ranges_m, vec![1.0, 2.0, 3.0]);
+        assert_eq!(l.fov_rad, std::f64::consts::PI);
+        assert_eq!(l.ipc_timestamp, 10.5);
+        let LogRecord::Laser(rl) = &r.records[5] else {
+            panic!()
+        };
+        assert_eq!(rl.start_angle_rad, -1.5);
+        assert_eq!(rl.fov_rad, 3.0);
+        assert_eq!(rl.pose, Pose2::new(1.0, 2.0, 0.3));
+        assert_eq!(r.robotlaser_max_range_m, Some(30.0));
+    }
+
+    #[test]
+    fn bad_value_is_located() {
+        let src = "FLASER 2 1.0 x 0 0 0 0 0 0 1 h 1\n";
+        let e = parse_log_str(src, "a.log", ReadOptions::default()).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.starts_with("a.log:1:14: FLASER field 3 (range)"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn short_line_is_located_and_lenient_skips() {
+        let src = "ODOM 1 2\nODOM 1 2 0.5 0.1 0.2 0 11.0 h 11.0\nFLASER 5 1 2\n";
+        let e = parse_log_str(src, "a.log", ReadOptions::default()).unwrap_err();
+        assert!(
+            e.to_string().starts_with("a.log:1:9: ODOM line ends"),
+            "{e}"
+        );
+        let r = parse_log_str(src, "a.log", ReadOptions { lenient: true }).unwrap();
+        assert_eq!(r.skipped_lines, 2);
+        assert_eq!(r.records.len(), 1);
+        assert!(r.first_skipped.unwrap().starts_with("a.log:1:9:"));
+    }
+}

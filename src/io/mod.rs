@@ -3,3 +3,5 @@
 
 pub mod atomic;
 pub mod carmen;
+pub mod mobilesim;
+pub mod real_log;

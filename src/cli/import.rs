@@ -1,0 +1,49 @@
+//! `placewords world import FILE.map -o WORLD.toml`: a MobileSim line map → a world file.
+
+use clap::Args;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// MobileSim map (`.map`: header, `LINES` in millimetres, `Cairn: RobotHome`).
+    pub map: PathBuf,
+    /// World file to write (TOML). Written atomically.
+    #[arg(short, long)]
+    pub out: PathBuf,
+}
+
+pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
+    use anyhow::Context;
+    use placewords::io::mobilesim;
+    let name = args.map.display().to_string();
+    let src = std::fs::read_to_string(&args.map)
+        .with_context(|| format!("{name}: cannot read; check the path"))?;
+    let spec = match mobilesim::import_mobilesim(&src, &name) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("{e}");
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let text = mobilesim::world_to_toml(&spec, &name).context("cannot serialise the world")?;
+    placewords::io::atomic::write_atomic(&args.out, text.as_bytes())
+        .with_context(|| format!("{}: cannot write", args.out.display()))?;
+    let route = &spec.routes[0];
+    let n = route.waypoints_m.len();
+    let len: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (route.waypoints_m[i], route.waypoints_m[(i + 1) % n]);
+            ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
+        })
+        .sum();
+    println!(
+        "{}: {} walls, home ({:.2}, {:.2}), route `{}` of {n} waypoints ({len:.1} m); no doors (add them by hand)",
+        args.out.display(),
+        spec.walls.len(),
+        spec.robot_home.x_m,
+        spec.robot_home.y_m,
+        route.id
+    );
+    Ok(ExitCode::SUCCESS)
+}

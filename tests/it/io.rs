@@ -1,0 +1,412 @@
+//! Real logs and imported worlds: the CARMEN reader, log → run conversion, MobileSim import.
+
+use placewords::geom::{Pose2, Segment, Vec2};
+use placewords::io::carmen::{
+    CarmenError, LaserRecord, LogRecord, OdomRecord, ReadOptions, TruePosRecord, parse_log_str,
+    read_log, read_log_from, write_record,
+};
+use placewords::io::mobilesim::{import_mobilesim, world_to_toml};
+use placewords::io::real_log::{TruthSource, log_to_run, noise_free};
+use proptest::prelude::*;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+fn manifest() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn fixture(name: &str) -> PathBuf {
+    manifest().join("tests/fixtures/carmen").join(name)
+}
+
+fn shared(sub: &str) -> Option<PathBuf> {
+    let p = manifest().join("../shared/data").join(sub);
+    if p.exists() {
+        Some(p)
+    } else {
+        println!(
+            "skipping: {} is absent (real data lives in ../shared/data)",
+            p.display()
+        );
+        None
+    }
+}
+
+fn gzip(bytes: &[u8]) -> Vec<u8> {
+    let mut e = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    e.write_all(bytes).unwrap();
+    e.finish().unwrap()
+}
+
+fn lasers(recs: &[LogRecord]) -> Vec<&LaserRecord> {
+    recs.iter()
+        .filter_map(|r| match r {
+            LogRecord::Laser(l) => Some(l),
+            _ => None,
+        })
+        .collect()
+}
+
+// ---- reader on real logs ----------------------------------------------------------------------
+
+#[test]
+fn reads_the_three_real_logs() {
+    let Some(dir) = shared("carmen") else { return };
+    for (file, scans, beams) in [
+        ("intel-corrected.log.gz", 910, 180),
+        ("freiburg-079-corrected.log.gz", 4791, 360),
+        ("csail-corrected.log.gz", 406, 361),
+    ] {
+        let r = read_log(&dir.join(file), ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+        let l = lasers(&r.records);
+        assert_eq!(l.len(), scans, "{file}");
+        assert!(l.iter().all(|s| s.ranges_m.len() == beams), "{file}");
+        assert!(
+            l.iter().all(|s| s.fov_rad == std::f64::consts::PI),
+            "{file}"
+        );
+        assert_eq!(r.skipped_lines, 0);
+        assert!(
+            r.unknown_lines >= scans,
+            "NEFF lines are skipped as unknown"
+        );
+        let run = log_to_run(&r, file, TruthSource::Corrected, noise_free).unwrap();
+        let frames: Vec<_> = run.frames().collect();
+        assert_eq!(frames.len(), scans);
+        assert!(frames.windows(2).all(|w| w[1].time_s >= w[0].time_s));
+        // Noise-free derived odometry reproduces the corrected path.
+        let last = frames.last().unwrap();
+        assert!(last.odom.0.distance(&last.truth.0) < 1e-6, "{file}");
+        assert_eq!(last.scan.layout.count, beams);
+        // "No return" readings (~81.9 m) are not hits.
+        let misses = frames
+            .iter()
+            .flat_map(|f| (0..f.scan.ranges_m.len()).map(move |i| (f, i)))
+            .filter(|(f, i)| f.scan.ranges_m[*i] > 81.0)
+            .all(|(f, i)| !f.scan.is_hit(i));
+        assert!(misses, "{file}");
+    }
+}
+
+// ---- fixtures ---------------------------------------------------------------------------------
+
+#[test]
+fn mixed_fixture_reads_plain_and_gzip_alike() {
+    let path = fixture("mixed.log");
+    let plain = read_log(&path, ReadOptions::default()).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let gz = read_log_from(&gzip(&bytes)[..], "mixed.log.gz", ReadOptions::default()).unwrap();
+    assert_eq!(plain, gz);
+    assert_eq!(lasers(&plain.records).len(), 3);
+    assert_eq!(plain.unknown_lines, 2, "NEFF and SYNC");
+    assert_eq!(plain.robotlaser_max_range_m, Some(30.0));
+    let run = log_to_run(&plain, "mixed.log", TruthSource::TruePos, noise_free).unwrap();
+    let f: Vec<_> = run.frames().collect();
+    assert_eq!(f.len(), 3);
+    assert_eq!(f[0].truth.0, Pose2::new(0.01, 0.02, 0.001));
+    assert_eq!(f[2].truth.0, Pose2::new(0.21, 0.03, 0.012));
+    assert_eq!(
+        f[0].scan.layout.max_range_m, 50.0,
+        "PARAM robot_front_laser_max"
+    );
+    assert!(!f[0].scan.is_hit(3));
+    assert_eq!(f[2].scan.layout.start_angle_rad, -1.5);
+    assert!((f[2].scan.layout.fov_rad() - 3.0).abs() < 1e-12);
+}
+
+#[test]
+fn corrupted_line_gives_a_located_error_and_lenient_counts() {
+    let path = fixture("malformed.log");
+    let e = read_log(&path, ReadOptions::default()).unwrap_err();
+    let msg = e.to_string();
+    assert!(
+        matches!(
+            e,
+            CarmenError::Malformed {
+                line: 4,
+                col: 16,
+                ..
+            }
+        ),
+        "{msg}"
+    );
+    assert!(
+        msg.contains("malformed.log:4:16: FLASER field 3 (range) is `2.0x0`"),
+        "{msg}"
+    );
+    let r = read_log(&path, ReadOptions { lenient: true }).unwrap();
+    assert_eq!(r.skipped_lines, 2);
+    assert_eq!(lasers(&r.records).len(), 2);
+    assert!(r.first_skipped.unwrap().contains("malformed.log:4:16"));
+}
+
+#[test]
+fn truncated_gzip_gives_a_located_error() {
+    let mut text = String::new();
+    for i in 0..2000 {
+        text.push_str(&format!("ODOM {i} 0 0 0 0 0 {i}.5 host {i}.5\n"));
+    }
+    let gz = gzip(text.as_bytes());
+    for cut in [gz.len() / 2, gz.len() - 4, 12] {
+        let e = read_log_from(&gz[..cut], "cut.log.gz", ReadOptions { lenient: true }).unwrap_err();
+        let msg = e.to_string();
+        assert!(matches!(e, CarmenError::Decompress { .. }), "{msg}");
+        assert!(
+            msg.starts_with("cut.log.gz: the gzip stream is truncated or corrupt after line"),
+            "{msg}"
+        );
+    }
+    // On a real file, the line reached is named.
+    if let Some(dir) = shared("carmen") {
+        let bytes = std::fs::read(dir.join("intel-corrected.log.gz")).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        let p = tmp.path().join("intel-cut.log.gz");
+        std::fs::write(&p, &bytes[..bytes.len() / 3]).unwrap();
+        match read_log(&p, ReadOptions::default()).unwrap_err() {
+            CarmenError::Decompress { path, line, .. } => {
+                assert!(path.ends_with("intel-cut.log.gz"));
+                assert!(line > 1000, "{line}");
+            }
+            e => panic!("{e}"),
+        }
+    }
+}
+
+#[test]
+fn corrupted_gzip_never_panics() {
+    let bytes = std::fs::read(fixture("mixed.log")).unwrap();
+    let gz = gzip(&bytes);
+    for i in 10..gz.len() {
+        let mut bad = gz.clone();
+        bad[i] ^= 0x5a;
+        let _ = read_log_from(&bad[..], "bad.log.gz", ReadOptions::default());
+        let _ = read_log_from(&bad[..], "bad.log.gz", ReadOptions { lenient: true });
+    }
+}
+
+#[test]
+fn missing_file_names_it() {
+    let e = read_log(Path::new("/nonexistent/x.log"), ReadOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().starts_with("/nonexistent/x.log: cannot read"),
+        "{e}"
+    );
+}
+
+// ---- round trip -------------------------------------------------------------------------------
+
+fn round6(v: f64) -> f64 {
+    (v * 1e6).round() / 1e6
+}
+
+#[test]
+fn write_record_round_trips_to_print_precision() {
+    let p = |x: f64, y: f64, t: f64| Pose2::new(x, y, t);
+    let recs = vec![
+        LogRecord::Param {
+            name: "robot_front_laser_max".into(),
+            value: "32.767".into(),
+        },
+        LogRecord::Laser(LaserRecord {
+            start_angle_rad: -std::f64::consts::FRAC_PI_2,
+            fov_rad: std::f64::consts::PI,
+            ranges_m: vec![1.234, 32.767, 0.5, 7.0],
+            pose: p(1.5, -2.25, 0.125),
+            odom: p(1.4, -2.2, 0.12),
+            ipc_timestamp: 12.5,
+            host: "sim".into(),
+            logger_timestamp: 12.5,
+        }),
+        LogRecord::Odom(OdomRecord {
+            pose: p(1.0, 2.0, -3.0),
+            tv_m_s: 0.4,
+            rv_rad_s: -0.1,
+            accel_m_s2: 0.3,
+            ipc_timestamp: 13.0,
+            host: "sim".into(),
+            logger_timestamp: 13.25,
+        }),
+        LogRecord::TruePos(TruePosRecord {
+            truth: p(0.1, 0.2, 0.3),
+            odom: p(0.4, 0.5, 0.6),
+            ipc_timestamp: 14.0,
+            host: "sim".into(),
+            logger_timestamp: 14.0,
+        }),
+    ];
+    let mut out = String::new();
+    for r in &recs {
+        write_record(&mut out, r);
+    }
+    let back = parse_log_str(&out, "rt.log", ReadOptions::default()).unwrap();
+    assert_eq!(back.records, recs);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn random_records_round_trip(
+        ranges in prop::collection::vec(0.0f64..80.0, 1..400),
+        x in -1e4f64..1e4, y in -1e4f64..1e4, t in -3.1f64..3.1, stamp in 0.0f64..2e9,
+    ) {
+        let ranges: Vec<f64> = ranges.iter().map(|r| (r * 1e3).round() / 1e3).collect();
+        let pose = Pose2::new(round6(x), round6(y), round6(t));
+        let rec = LogRecord::Laser(LaserRecord {
+            start_angle_rad: -std::f64::consts::FRAC_PI_2,
+            fov_rad: std::f64::consts::PI,
+            ranges_m: ranges,
+            pose,
+            odom: pose,
+            ipc_timestamp: round6(stamp),
+            host: "h".into(),
+            logger_timestamp: round6(stamp),
+        });
+        let mut out = String::new();
+        write_record(&mut out, &rec);
+        let back = parse_log_str(&out, "p", ReadOptions::default()).unwrap();
+        let LogRecord::Laser(a) = &back.records[0] else { panic!() };
+        let LogRecord::Laser(b) = &rec else { panic!() };
+        prop_assert_eq!(a.ranges_m.len(), b.ranges_m.len());
+        for (u, v) in a.ranges_m.iter().zip(&b.ranges_m) {
+            prop_assert!((u - v).abs() < 1e-9);
+        }
+        prop_assert!((a.pose.x - b.pose.x).abs() < 1e-6 && (a.pose.theta - b.pose.theta).abs() < 1e-6);
+        prop_assert!((a.ipc_timestamp - b.ipc_timestamp).abs() < 1e-5);
+    }
+}
+
+// ---- never a panic ----------------------------------------------------------------------------
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    #[test]
+    fn arbitrary_text_never_panics(s in "\\PC*", lenient in any::<bool>()) {
+        let _ = parse_log_str(&s, "fuzz", ReadOptions { lenient });
+    }
+
+    #[test]
+    fn arbitrary_bytes_never_panic(b in prop::collection::vec(any::<u8>(), 0..600)) {
+        let _ = read_log_from(&b[..], "fuzz", ReadOptions::default());
+        let mut gz = vec![0x1f, 0x8b];
+        gz.extend_from_slice(&b);
+        let _ = read_log_from(&gz[..], "fuzz.gz", ReadOptions { lenient: true });
+    }
+
+    #[test]
+    fn mutated_valid_logs_never_panic(
+        edits in prop::collection::vec((any::<prop::sample::Index>(), 0u8..4, "[ 0-9a-zA-Z.\\-#\n]{0,3}"), 1..8),
+        lenient in any::<bool>(),
+    ) {
+        let mut s = std::fs::read_to_string(fixture("mixed.log")).unwrap();
+        for (at, op, text) in edits {
+            if s.is_empty() { break; }
+            let mut i = at.index(s.len());
+            while !s.is_char_boundary(i) { i -= 1; }
+            match op {
+                0 => s.insert_str(i, &text),
+                1 => { let j = (i + text.len() + 1).min(s.len()); let mut j2 = j; while !s.is_char_boundary(j2) { j2 -= 1; } s.replace_range(i..j2, ""); }
+                2 => { s.truncate(i); }
+                _ => { let j = (i + 1).min(s.len()); let mut j2 = j; while !s.is_char_boundary(j2) { j2 -= 1; } s.replace_range(i..j2, &text); }
+            }
+        }
+        let _ = parse_log_str(&s, "mut", ReadOptions { lenient });
+    }
+
+    #[test]
+    fn truncated_gzip_prefixes_never_panic(cut in 0usize..10_000) {
+        let bytes = std::fs::read(fixture("mixed.log")).unwrap();
+        let gz = gzip(&bytes);
+        let cut = cut % (gz.len() + 1);
+        let r = read_log_from(&gz[..cut], "cut.gz", ReadOptions::default());
+        if cut < gz.len() && cut >= 2 {
+            prop_assert!(r.is_err(), "a prefix of {cut} of {} bytes read as complete", gz.len());
+        }
+    }
+}
+
+// ---- MobileSim import -------------------------------------------------------------------------
+
+/// Exact segment–segment distance, written independently of the importer's.
+fn seg_dist(p: &Segment, q: &Segment) -> f64 {
+    let orient = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp(&(c - a));
+    let (d1, d2) = (orient(q.a, q.b, p.a), orient(q.a, q.b, p.b));
+    let (d3, d4) = (orient(p.a, p.b, q.a), orient(p.a, p.b, q.b));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return 0.0;
+    }
+    [
+        p.distance_to_point(q.a),
+        p.distance_to_point(q.b),
+        q.distance_to_point(p.a),
+        q.distance_to_point(p.b),
+    ]
+    .into_iter()
+    .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn mobilesim_maps_import_to_valid_worlds() {
+    let Some(dir) = shared("mobilesim") else {
+        return;
+    };
+    for file in ["office.map", "corridors.map"] {
+        let src = std::fs::read_to_string(dir.join(file)).unwrap();
+        let spec = import_mobilesim(&src, file).unwrap_or_else(|e| panic!("{e}"));
+        let toml_text = world_to_toml(&spec, file).unwrap();
+        assert!(toml_text.starts_with("# Imported by"));
+        assert!(toml_text.contains("Doors cannot be inferred"));
+        // Round trip through the world file parser.
+        let back: placewords::spec::world::WorldSpec = toml::from_str(&toml_text).unwrap();
+        assert_eq!(back, spec);
+        let world = placewords::spec::world::parse_world(&toml_text, file)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let walls = world.wall_segments();
+        let half = world
+            .walls
+            .iter()
+            .map(|w| w.thickness_m)
+            .fold(0.0, f64::max)
+            / 2.0;
+        assert!(walls.len() <= 100_000);
+        let (lo, hi) = world.bounds();
+        assert!((hi - lo).norm() <= 10_000.0);
+        let clear = |s: &Segment| {
+            walls
+                .iter()
+                .map(|w| seg_dist(w, s))
+                .fold(f64::INFINITY, f64::min)
+                - half
+        };
+        let home = world.home.position();
+        assert!(
+            clear(&Segment::new(home, home)) >= 0.25,
+            "{file}: home too close"
+        );
+        assert_eq!(world.routes.len(), 1);
+        let route = &world.routes[0];
+        assert!(route.waypoints.len() >= 3, "{file}");
+        for w in &route.waypoints {
+            assert!(
+                clear(&Segment::new(*w, *w)) >= 0.30,
+                "{file}: waypoint {w:?}"
+            );
+        }
+        for leg in route.legs() {
+            assert!(leg.length() > 0.0);
+            assert!(clear(&leg) >= 0.25, "{file}: leg {leg:?}");
+        }
+        assert!(
+            route.length_m() > 20.0,
+            "{file}: a real loop, {} m",
+            route.length_m()
+        );
+        println!(
+            "{file}: {} walls, route of {} waypoints, {:.1} m",
+            world.walls.len(),
+            route.waypoints.len(),
+            route.length_m()
+        );
+    }
+}
