@@ -31,6 +31,12 @@ use std::collections::{HashMap, VecDeque};
 /// Thickness given to imported walls, metres.
 pub const WALL_THICKNESS_M: f64 = 0.05;
 
+/// Most wall segments a world may hold (the world checks' limit).
+pub const MAX_SEGMENTS: usize = 100_000;
+
+/// Largest extent of a world, corner to corner, metres (the world checks' limit).
+pub const MAX_EXTENT_M: f64 = 10_000.0;
+
 /// Settings of the route generator.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImportOptions {
@@ -342,6 +348,21 @@ pub fn leg_clearance(walls: &[Segment], thickness_m: f64, leg: &Segment) -> f64 
         - thickness_m / 2.0
 }
 
+/// Whether a leg keeps at least `clearance_m` from every wall surface; walls whose bounding box
+/// is farther than that from the leg's are not measured.
+fn leg_clear(walls: &[Segment], thickness_m: f64, leg: &Segment, clearance_m: f64) -> bool {
+    let r = clearance_m + thickness_m / 2.0;
+    let (lo, hi) = (leg.a.inf(&leg.b), leg.a.sup(&leg.b));
+    walls.iter().all(|w| {
+        let (a, b) = (w.a.inf(&w.b), w.a.sup(&w.b));
+        b.x < lo.x - r
+            || a.x > hi.x + r
+            || b.y < lo.y - r
+            || a.y > hi.y + r
+            || segment_distance(w, leg) - thickness_m / 2.0 >= clearance_m
+    })
+}
+
 /// Imports a MobileSim map as a world with walls, the home pose and a generated route.
 pub fn import_mobilesim(src: &str, name: &str) -> Result<WorldSpec, MapError> {
     import_mobilesim_with(src, name, &ImportOptions::default())
@@ -365,6 +386,28 @@ pub fn import_mobilesim_with(
                 .into(),
         ));
     };
+    // The world checks' limits, reported here with the map's own numbers.
+    if map.segments.len() > MAX_SEGMENTS {
+        return Err(no_route(format!(
+            "the map has {} wall segments, more than a world may hold ({MAX_SEGMENTS}); \
+             split the map or merge collinear segments",
+            map.segments.len()
+        )));
+    }
+    let (mut lo, mut hi) = (Vec2::new(hx, hy), Vec2::new(hx, hy));
+    for s in &map.segments {
+        for p in [s.a, s.b] {
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+    }
+    if (hi - lo).norm() > MAX_EXTENT_M {
+        return Err(no_route(format!(
+            "the map (with its home) spans {:.0} m corner to corner, more than a world may ({MAX_EXTENT_M} m); \
+             check the units (the format is in millimetres) or remove stray far-away lines",
+            (hi - lo).norm()
+        )));
+    }
     let chains = chain_segments(&map.segments);
     if chains.is_empty() {
         return Err(no_route(
@@ -465,23 +508,45 @@ pub fn generate_route(
     }
     lo -= Vec2::new(1.0, 1.0);
     hi += Vec2::new(1.0, 1.0);
-    let nx = ((hi.x - lo.x) / res).ceil() as usize;
-    let ny = ((hi.y - lo.y) / res).ceil() as usize;
-    if nx.saturating_mul(ny) > 25_000_000 {
+    // 5 cm cells, coarsened (up to 10 cm) for large maps so the raster stays under 16 M cells.
+    let area = (hi.x - lo.x) * (hi.y - lo.y);
+    let res = res.max((area / 16.0e6).sqrt());
+    if res.is_nan() || res > 0.1 + 1e-12 {
         return Err(format!(
-            "the map spans {:.0} × {:.0} m, too large to rasterise at {res} m for route generation; {hand}",
+            "the map spans {:.0} × {:.0} m, too large to rasterise for route generation; {hand}",
             hi.x - lo.x,
             hi.y - lo.y
         ));
     }
+    let nx = ((hi.x - lo.x) / res).ceil() as usize;
+    let ny = ((hi.y - lo.y) / res).ceil() as usize;
     let center = |i: usize, j: usize| {
         Vec2::new(lo.x + (i as f64 + 0.5) * res, lo.y + (j as f64 + 0.5) * res)
     };
     let idx = |i: usize, j: usize| j * nx + i;
-    let mut free = vec![false; nx * ny];
-    for j in 0..ny {
-        for i in 0..nx {
-            free[idx(i, j)] = point_clearance(walls, thickness_m, center(i, j)) >= need;
+    // Blocked: cell centres within `need` of a wall surface. Each segment only visits the cells
+    // of its own bounding box grown by that distance (exact distances, no full scan per cell).
+    let mut free = vec![true; nx * ny];
+    let reach = need + thickness_m / 2.0;
+    let cell_of =
+        |v: f64, o: f64, n: usize| (((v - o) / res - 0.5).floor().max(0.0) as usize).min(n - 1);
+    for w in walls {
+        let (a, b) = (w.a.inf(&w.b), w.a.sup(&w.b));
+        let (i0, i1) = (
+            cell_of(a.x - reach, lo.x, nx),
+            cell_of(b.x + reach, lo.x, nx) + 1,
+        );
+        let (j0, j1) = (
+            cell_of(a.y - reach, lo.y, ny),
+            cell_of(b.y + reach, lo.y, ny) + 1,
+        );
+        for j in j0..=j1.min(ny - 1) {
+            for i in i0..=i1.min(nx - 1) {
+                let k = idx(i, j);
+                if free[k] && w.distance_to_point(center(i, j)) - thickness_m / 2.0 < need {
+                    free[k] = false;
+                }
+            }
         }
     }
     // The free cell nearest the home that the home can see (no wall between them), so a home
@@ -501,9 +566,7 @@ pub fn generate_route(
     cand.sort_by(|a, b| a.0.total_cmp(&b.0));
     let start = cand
         .iter()
-        .find(|(_, (i, j))| {
-            leg_clearance(walls, thickness_m, &Segment::new(home, center(*i, *j))) > 0.0
-        })
+        .find(|(_, (i, j))| leg_clear(walls, 0.0, &Segment::new(home, center(*i, *j)), 1e-9))
         .map(|c| c.1);
     let Some(start) = start else {
         return Err(format!(
@@ -635,7 +698,12 @@ pub fn generate_route(
         }
     }
     let leg_ok = |a: Vec2, b: Vec2| {
-        leg_clearance(walls, thickness_m, &Segment::new(a, b)) >= opts.leg_clearance_m
+        leg_clear(
+            walls,
+            thickness_m,
+            &Segment::new(a, b),
+            opts.leg_clearance_m,
+        )
     };
     let route = if let Some((_, cyc)) = best_cycle {
         let mut pts: Vec<Vec2> = cyc.iter().map(|&k| pt(k)).collect();
@@ -838,6 +906,13 @@ mod tests {
         let src = "2D-Map\nCairn: RobotHome 300 300 0\nLINES\n0 0 600 0\n600 0 600 600\n600 600 0 600\n0 600 0 0\n";
         let e = import_mobilesim(src, "t.map").unwrap_err();
         assert!(e.to_string().contains("[[routes]]"), "{e}");
+    }
+
+    #[test]
+    fn too_large_maps_are_refused() {
+        let src = "2D-Map\nCairn: RobotHome 0 0 0\nLINES\n0 0 20000000 0\n";
+        let e = import_mobilesim(src, "big.map").unwrap_err();
+        assert!(e.to_string().contains("millimetres"), "{e}");
     }
 
     #[test]

@@ -23,7 +23,7 @@
 //! (the logged pose is already the laser's). Maximum range, see [`max_range_m`].
 
 use crate::geom::{OdomPose, Pose2, TruePose};
-use crate::io::carmen::{LaserRecord, LogReadout, LogRecord, TruePosRecord};
+use crate::io::carmen::{LaserRecord, LogReadout, LogRecord, ReadOptions, TruePosRecord, read_log};
 use crate::scan::{BeamLayout, Scan};
 use crate::sim::{Frame, LapLog, RunLog};
 
@@ -44,8 +44,11 @@ pub enum TruthSource {
 }
 
 /// Why a log could not be turned into a run.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Debug, thiserror::Error)]
 pub enum RealLogError {
+    /// The log itself could not be read.
+    #[error(transparent)]
+    Read(#[from] crate::io::carmen::CarmenError),
     #[error(
         "{0}: the log holds no laser messages (FLASER, RLASER or ROBOTLASER1); check that it is a CARMEN laser log"
     )]
@@ -93,6 +96,20 @@ pub fn max_range_m(readout: &LogReadout) -> f64 {
         Some(v) if v.is_finite() && v > 0.0 => v,
         _ => DEFAULT_MAX_RANGE_M,
     }
+}
+
+/// Reads a log file (plain or gzip) and turns it into one run: [`read_log`] then [`log_to_run`].
+/// Also returns the readout's counts (records are dropped to save memory).
+pub fn load_run(
+    path: &std::path::Path,
+    opts: ReadOptions,
+    truth: TruthSource,
+    perturb: impl FnMut(Pose2) -> Pose2,
+) -> Result<(RunLog, LogReadout), RealLogError> {
+    let mut readout = read_log(path, opts)?;
+    let run = log_to_run(&readout, &path.display().to_string(), truth, perturb)?;
+    readout.records = Vec::new();
+    Ok((run, readout))
 }
 
 /// Turns a read log into one run; see the module documentation for every convention.
@@ -268,9 +285,11 @@ mod tests {
             ReadOptions::default(),
         )
         .unwrap();
-        assert_eq!(
-            log_to_run(&no_tp, "u", TruthSource::TruePos, noise_free).unwrap_err(),
-            RealLogError::NoTruePos("u".into())
-        );
+        let e = log_to_run(&no_tp, "u", TruthSource::TruePos, noise_free).unwrap_err();
+        assert!(matches!(e, RealLogError::NoTruePos(_)), "{e}");
+        let gap = "FLASER 1 1 0 0 0 0 0 0 5 h 5\nTRUEPOS 0 0 0 0 0 0 9 h 9\n";
+        let gap = parse_log_str(gap, "g", ReadOptions::default()).unwrap();
+        let e = log_to_run(&gap, "g", TruthSource::TruePos, noise_free).unwrap_err();
+        assert!(e.to_string().contains("nearest 4.000 s away"), "{e}");
     }
 }

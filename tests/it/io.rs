@@ -74,6 +74,15 @@ fn reads_the_three_real_logs() {
         let frames: Vec<_> = run.frames().collect();
         assert_eq!(frames.len(), scans);
         assert!(frames.windows(2).all(|w| w[1].time_s >= w[0].time_s));
+        let (run2, counts) = placewords::io::real_log::load_run(
+            &dir.join(file),
+            ReadOptions::default(),
+            TruthSource::Corrected,
+            noise_free,
+        )
+        .unwrap();
+        assert_eq!(run2, run);
+        assert_eq!(counts.skipped_lines, 0);
         // Noise-free derived odometry reproduces the corrected path.
         let last = frames.last().unwrap();
         assert!(last.odom.0.distance(&last.truth.0) < 1e-6, "{file}");
@@ -408,5 +417,41 @@ fn mobilesim_maps_import_to_valid_worlds() {
             route.waypoints.len(),
             route.length_m()
         );
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn mobilesim_import_never_panics_on_text(s in "\\PC*") {
+        let _ = import_mobilesim(&s, "fuzz.map");
+        let _ = import_mobilesim(&format!("2D-Map\nLINES\n{s}"), "fuzz.map");
+    }
+
+    #[test]
+    fn mobilesim_import_never_panics_on_random_maps(
+        segs in prop::collection::vec((-9000i32..9000, -9000i32..9000, -9000i32..9000, -9000i32..9000), 0..25),
+        home in (-9000i32..9000, -9000i32..9000),
+    ) {
+        let mut s = format!("2D-Map\nCairn: RobotHome {} {} 45 \"\" ICON \"\"\nLINES\n", home.0, home.1);
+        s.push_str("-10000 -10000 10000 -10000\n10000 -10000 10000 10000\n10000 10000 -10000 10000\n-10000 10000 -10000 -10000\n");
+        for (a, b, c, d) in segs {
+            s.push_str(&format!("{a} {b} {c} {d}\n"));
+        }
+        if let Ok(spec) = import_mobilesim(&s, "rand.map") {
+            // Whatever it generates passes the clearance rules.
+            let world = placewords::world::World::from_spec(&spec);
+            let walls = world.wall_segments();
+            let clear = |x: &Segment| walls.iter().map(|w| seg_dist(w, x)).fold(f64::INFINITY, f64::min) - 0.025;
+            let route = &world.routes[0];
+            prop_assert!(route.waypoints.len() >= 3);
+            for w in &route.waypoints {
+                prop_assert!(clear(&Segment::new(*w, *w)) >= 0.30);
+            }
+            for leg in route.legs() {
+                prop_assert!(clear(&leg) >= 0.25);
+            }
+        }
     }
 }
