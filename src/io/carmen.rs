@@ -122,6 +122,10 @@ fn fmt_stamp(ipc: f64, host: &str, logger: f64) -> String {
 use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 
+/// Longest line the reader accepts, bytes (a 100 000-beam laser line is well under 2 MiB); a
+/// longer one means the input is not a text log, and reading it whole could exhaust memory.
+pub const MAX_LINE_BYTES: u64 = 16 << 20;
+
 /// How strictly to read a log.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct ReadOptions {
@@ -221,8 +225,19 @@ fn read_lines<R: BufRead>(
     let mut bytes = Vec::new();
     loop {
         bytes.clear();
-        match r.read_until(b'\n', &mut bytes) {
+        match (&mut r).take(MAX_LINE_BYTES).read_until(b'\n', &mut bytes) {
             Ok(0) => break,
+            Ok(n) if n as u64 == MAX_LINE_BYTES && bytes.last() != Some(&b'\n') => {
+                return Err(CarmenError::Malformed {
+                    path: name.to_string(),
+                    line: line_no + 1,
+                    col: 1,
+                    message: format!(
+                        "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
+                        MAX_LINE_BYTES >> 20
+                    ),
+                });
+            }
             Ok(_) => {}
             Err(source) => {
                 return Err(if gz {

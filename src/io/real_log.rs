@@ -15,8 +15,11 @@
 //! (`ipc_timestamp`) to each laser line, at most [`TRUEPOS_MAX_GAP_S`] away.
 //!
 //! **Time.** `time_s` is the laser line's `ipc_timestamp` minus the first one, forced
-//! non-decreasing (some logs, e.g. csail, print stamps with six significant digits only, so
-//! many frames share one stamp).
+//! non-decreasing. When the stamps are unusable — more than 10 % of consecutive laser lines
+//! share or reverse their stamp, as in csail, whose stamps are printed with six significant
+//! digits (`1.13486e+09`) — time is derived instead from the distance travelled along the
+//! corrected path at [`NOMINAL_SPEED_M_S`] (the P3-DX cruise speed), and
+//! [`RunLog`]'s frames say so only through this rule (check [`stamps_usable`]).
 //!
 //! **Beam layout.** FLASER/RLASER: n beams over 180°, right to left (CARMEN convention, whatever
 //! n); ROBOTLASER1: its own start angle and field of view. The sensor mount is the identity
@@ -30,6 +33,18 @@ use crate::sim::{Frame, LapLog, RunLog};
 /// Used when the log names no laser maximum range, metres. SICK LMS scanners in CARMEN logs
 /// report "no return" as ~81.9 m, so readings at or beyond 80 m are treated as no return.
 pub const DEFAULT_MAX_RANGE_M: f64 = 80.0;
+
+/// Speed used to derive time from travelled distance when a log's stamps are unusable, m/s.
+pub const NOMINAL_SPEED_M_S: f64 = 0.4;
+
+/// Whether laser stamps can serve as time: at most 10 % of consecutive pairs fail to increase.
+pub fn stamps_usable(lasers: &[&LaserRecord]) -> bool {
+    let bad = lasers
+        .windows(2)
+        .filter(|w| w[1].ipc_timestamp <= w[0].ipc_timestamp)
+        .count();
+    bad * 10 <= lasers.len().saturating_sub(1)
+}
 
 /// The farthest a TRUEPOS message may be in time from a laser line to serve as its truth, seconds.
 pub const TRUEPOS_MAX_GAP_S: f64 = 1.0;
@@ -166,6 +181,8 @@ pub fn corrected_to_run(
         tp.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
     let t0 = lasers[0].ipc_timestamp;
+    let use_stamps = stamps_usable(lasers);
+    let mut travelled = 0.0f64;
     let mut frames = Vec::with_capacity(lasers.len());
     let mut odom = lasers[0].pose;
     let mut last_time = 0.0f64;
@@ -174,7 +191,15 @@ pub fn corrected_to_run(
             let inc = lasers[k - 1].pose.between(&l.pose);
             odom = odom.compose(&perturb(inc));
         }
-        let time_s = (l.ipc_timestamp - t0).max(last_time);
+        if k > 0 {
+            travelled += lasers[k - 1].pose.distance(&l.pose);
+        }
+        let raw = if use_stamps {
+            l.ipc_timestamp - t0
+        } else {
+            travelled / NOMINAL_SPEED_M_S
+        };
+        let time_s = raw.max(last_time);
         last_time = time_s;
         let true_pose = match truth {
             TruthSource::Corrected => l.pose,
@@ -240,7 +265,7 @@ mod tests {
         TRUEPOS 0.01 0 0 0 0 0 100.05 h 100.05\n\
         FLASER 3 1 2 3 1 0 0.5 1 0 0.5 100.2 h 100.2\n\
         TRUEPOS 1 0.01 0.5 0 0 0 100.25 h 100.25\n\
-        FLASER 3 1 2 3 2 1 1.0 2 1 1.0 100.1 h 100.1\n";
+        FLASER 3 1 2 3 2 1 1.0 2 1 1.0 100.3 h 100.3\n";
 
     #[test]
     fn noise_free_odometry_equals_corrected_pose() {
@@ -257,8 +282,20 @@ mod tests {
         }
         assert!(!f[0].scan.is_hit(2));
         assert!((f[1].time_s - 0.2).abs() < 1e-9);
-        assert!((f[2].time_s - 0.2).abs() < 1e-9, "time never goes back");
+        assert!((f[2].time_s - 0.3).abs() < 1e-9);
         assert_eq!(run.laps[0].door_config, "unknown");
+    }
+
+    #[test]
+    fn unusable_stamps_give_time_from_distance() {
+        let src = "FLASER 1 1 0 0 0 0 0 0 5 h 5\nFLASER 1 1 2 0 0 2 0 0 5 h 5\nFLASER 1 1 2 0.4 0 2 0.4 0 5 h 5\n";
+        let r = parse_log_str(src, "c", ReadOptions::default()).unwrap();
+        let run = log_to_run(&r, "c", TruthSource::Corrected, noise_free).unwrap();
+        let t: Vec<f64> = run.frames().map(|f| f.time_s).collect();
+        assert!(
+            (t[1] - 5.0).abs() < 1e-9 && (t[2] - 6.0).abs() < 1e-9,
+            "{t:?}"
+        );
     }
 
     #[test]

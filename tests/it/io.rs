@@ -455,3 +455,16 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn endless_line_is_refused_not_swallowed() {
+    let mut text = b"ODOM 0 0 0 0 0 0 1 h 1\n".to_vec();
+    text.extend(std::iter::repeat_n(b'7', 20 << 20));
+    let gz = gzip(&text);
+    let e = read_log_from(&gz[..], "bomb.log.gz", ReadOptions { lenient: true }).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("bomb.log.gz:2:1: line longer than 16 MiB"),
+        "{e}"
+    );
+}
