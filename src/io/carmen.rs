@@ -146,6 +146,8 @@ pub struct LogReadout {
     pub unknown_lines: usize,
     /// The `max_range` field of the first ROBOTLASER1 message, metres, if any.
     pub robotlaser_max_range_m: Option<f64>,
+    /// Indices into `records` of the lasers read from RLASER (rear scanner) lines.
+    pub rear_laser_indices: Vec<usize>,
 }
 
 /// Why a log could not be read.
@@ -440,7 +442,13 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
             let odom = f.pose(5 + n, "odometry")?;
             let (ipc, host, logger) = f.stamp(8 + n)?;
             LogRecord::Laser(LaserRecord {
-                start_angle_rad: -std::f64::consts::FRAC_PI_2,
+                // FLASER: 180° right to left, whatever the beam count. RLASER: the rear scanner
+                // faces backwards, so its beams start on the robot's left (+90°).
+                start_angle_rad: if first.s == "RLASER" {
+                    std::f64::consts::FRAC_PI_2
+                } else {
+                    -std::f64::consts::FRAC_PI_2
+                },
                 fov_rad: std::f64::consts::PI,
                 ranges_m: ranges,
                 pose,
@@ -492,8 +500,8 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
                 f.num(k + 1 + i, "remission")?;
             }
             let k = k + 1 + m;
-            let _laser_pose = f.pose(k, "laser pose")?;
-            let robot = f.pose(k + 3, "robot pose")?;
+            let laser_pose = f.pose(k, "laser pose")?;
+            let _robot = f.pose(k + 3, "robot pose")?;
             for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
                 .iter()
                 .enumerate()
@@ -508,8 +516,10 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
                 start_angle_rad: start,
                 fov_rad: fov,
                 ranges_m: ranges,
-                pose: robot,
-                odom: robot,
+                // The ranges are measured from the laser, so its pose is the scan's pose (as a
+                // FLASER line's pose is); the robot pose is only checked.
+                pose: laser_pose,
+                odom: laser_pose,
                 ipc_timestamp: ipc,
                 host,
                 logger_timestamp: logger,
@@ -568,6 +578,9 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
             return Ok(());
         }
     };
+    if first.s == "RLASER" {
+        out.rear_laser_indices.push(out.records.len());
+    }
     out.records.push(rec);
     Ok(())
 }
@@ -582,7 +595,7 @@ mod tests {
         NEFF 10\n\
         ODOM 1 2 0.5 0.1 0.2 0 11.0 h 11.0\n\
         TRUEPOS 1 2 3 4 5 6 12.0 h 12.0\n\
-        ROBOTLASER1 0 -1.5 3.0 0.5 30 0.01 0 3 1 2 3 0 0 0 0 1 2 0.3 0.1 0.2 0 0 0 13.0 h 13.0\n";
+        ROBOTLASER1 0 -1.5 3.0 0.5 30 0.01 0 3 1 2 3 0 1.1 2 0.3 1 2 0.3 0.1 0.2 0 0 0 13.0 h 13.0\n";
 
     #[test]
     fn reads_every_kind() {
@@ -614,7 +627,7 @@ mod tests {
         };
         assert_eq!(rl.start_angle_rad, -1.5);
         assert_eq!(rl.fov_rad, 3.0);
-        assert_eq!(rl.pose, Pose2::new(1.0, 2.0, 0.3));
+        assert_eq!(rl.pose, Pose2::new(1.1, 2.0, 0.3), "the laser pose");
         assert_eq!(r.robotlaser_max_range_m, Some(30.0));
     }
 

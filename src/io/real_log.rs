@@ -21,8 +21,12 @@
 //! corrected path at [`NOMINAL_SPEED_M_S`] (the P3-DX cruise speed), and
 //! [`RunLog`]'s frames say so only through this rule (check [`stamps_usable`]).
 //!
-//! **Beam layout.** FLASER/RLASER: n beams over 180°, right to left (CARMEN convention, whatever
-//! n); ROBOTLASER1: its own start angle and field of view. The sensor mount is the identity
+//! **Lasers used.** FLASER and ROBOTLASER1 lines; RLASER (rear scanner) lines only when the log
+//! has no other laser.
+//!
+//! **Beam layout.** FLASER: n beams over 180°, right to left (CARMEN convention, whatever n);
+//! RLASER: the same, facing backwards (beam 0 at +90°); ROBOTLASER1: its own start angle and
+//! field of view. The sensor mount is the identity
 //! (the logged pose is already the laser's). Maximum range, see [`max_range_m`].
 
 use crate::geom::{OdomPose, Pose2, TruePose};
@@ -135,13 +139,24 @@ pub fn log_to_run(
     truth: TruthSource,
     perturb: impl FnMut(Pose2) -> Pose2,
 ) -> Result<RunLog, RealLogError> {
-    let lasers: Vec<&LaserRecord> = readout
+    // Front lasers only, unless the log has nothing but rear ones: interleaving two scanners
+    // would make every other frame look backwards.
+    let rear: std::collections::HashSet<usize> =
+        readout.rear_laser_indices.iter().copied().collect();
+    let all: Vec<(usize, &LaserRecord)> = readout
         .records
         .iter()
-        .filter_map(|r| match r {
-            LogRecord::Laser(l) => Some(l),
+        .enumerate()
+        .filter_map(|(i, r)| match r {
+            LogRecord::Laser(l) => Some((i, l)),
             _ => None,
         })
+        .collect();
+    let any_front = all.iter().any(|(i, _)| !rear.contains(i));
+    let lasers: Vec<&LaserRecord> = all
+        .into_iter()
+        .filter(|(i, _)| !any_front || !rear.contains(i))
+        .map(|(_, l)| l)
         .collect();
     let truepos: Vec<&TruePosRecord> = readout
         .records

@@ -109,18 +109,28 @@ fn mixed_fixture_reads_plain_and_gzip_alike() {
     assert_eq!(lasers(&plain.records).len(), 3);
     assert_eq!(plain.unknown_lines, 2, "NEFF and SYNC");
     assert_eq!(plain.robotlaser_max_range_m, Some(30.0));
+    let LogRecord::Laser(rear) = &plain.records[plain.rear_laser_indices[0]] else {
+        panic!("RLASER index")
+    };
+    assert_eq!(
+        rear.start_angle_rad,
+        std::f64::consts::FRAC_PI_2,
+        "the rear laser faces backwards"
+    );
+    // The run uses the front lasers only (FLASER and ROBOTLASER1), truth from TRUEPOS by time.
     let run = log_to_run(&plain, "mixed.log", TruthSource::TruePos, noise_free).unwrap();
     let f: Vec<_> = run.frames().collect();
-    assert_eq!(f.len(), 3);
+    assert_eq!(f.len(), 2);
     assert_eq!(f[0].truth.0, Pose2::new(0.01, 0.02, 0.001));
-    assert_eq!(f[2].truth.0, Pose2::new(0.21, 0.03, 0.012));
+    assert_eq!(f[1].truth.0, Pose2::new(0.21, 0.03, 0.012));
     assert_eq!(
         f[0].scan.layout.max_range_m, 50.0,
         "PARAM robot_front_laser_max"
     );
     assert!(!f[0].scan.is_hit(3));
-    assert_eq!(f[2].scan.layout.start_angle_rad, -1.5);
-    assert!((f[2].scan.layout.fov_rad() - 3.0).abs() < 1e-12);
+    assert_eq!(f[1].scan.layout.start_angle_rad, -1.5);
+    assert!((f[1].scan.layout.fov_rad() - 3.0).abs() < 1e-12);
+    assert_eq!(f[1].scan.layout.count, 3);
 }
 
 #[test]
