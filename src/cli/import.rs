@@ -21,6 +21,23 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("{name}: cannot read; check the path"))?;
     let spec = match mobilesim::import_mobilesim(&src, &name) {
         Ok(s) => s,
+        Err(mobilesim::MapError::NoRoute {
+            path,
+            message,
+            partial: Some(partial),
+        }) => {
+            // Walls and home are fine: write them, so only the route is left to add by hand.
+            let text =
+                mobilesim::world_to_toml(&partial, &name).context("cannot serialise the world")?;
+            placewords::io::atomic::write_atomic(&args.out, text.as_bytes())
+                .with_context(|| format!("{}: cannot write", args.out.display()))?;
+            eprintln!("{path}: {message}");
+            eprintln!(
+                "{}: written with walls and home but no route; add the [[routes]] block there",
+                args.out.display()
+            );
+            return Ok(ExitCode::from(2));
+        }
         Err(e) => {
             eprintln!("{e}");
             return Ok(ExitCode::from(2));

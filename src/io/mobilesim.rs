@@ -76,8 +76,15 @@ pub enum MapError {
         message: String,
     },
     /// The map parsed but no drivable route could be generated.
+    ///
+    /// `partial` holds the world without a route when walls and home were imported; a caller
+    /// may write it so the user only has to add the `[[routes]]` block.
     #[error("{path}: {message}")]
-    NoRoute { path: String, message: String },
+    NoRoute {
+        path: String,
+        message: String,
+        partial: Option<Box<WorldSpec>>,
+    },
 }
 
 /// A parsed MobileSim map, in metres and degrees.
@@ -378,6 +385,7 @@ pub fn import_mobilesim_with(
     let no_route = |message: String| MapError::NoRoute {
         path: name.to_string(),
         message,
+        partial: None,
     };
     let Some((hx, hy, hdeg)) = map.home else {
         return Err(no_route(
@@ -421,21 +429,20 @@ pub fn import_mobilesim_with(
         .filter(|s| s.length() > 0.0)
         .collect();
     let home = Vec2::new(hx, hy);
-    let route = generate_route(&walls, WALL_THICKNESS_M, home, opts).map_err(no_route)?;
     let stem = std::path::Path::new(name)
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "imported".into());
     let r3 = |v: f64| (v * 1000.0).round() / 1000.0;
-    Ok(WorldSpec {
+    let file_name = std::path::Path::new(name)
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut spec = WorldSpec {
         format_version: 1,
         name: stem,
         description: Some(format!(
-            "imported from the MobileSim map {}; no doors (a line map cannot show them); route generated from the free-space skeleton",
-            std::path::Path::new(name)
-                .file_name()
-                .map(|f| f.to_string_lossy())
-                .unwrap_or_default()
+            "imported from the MobileSim map {file_name}; no doors (a line map cannot show them)"
         )),
         robot_home: HomeSpec {
             x_m: r3(hx),
@@ -453,12 +460,26 @@ pub fn import_mobilesim_with(
             })
             .collect(),
         doors: Vec::new(),
-        routes: vec![RouteSpec {
-            id: "loop".into(),
-            waypoints_m: route.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
-        }],
+        routes: Vec::new(),
         areas: Vec::new(),
-    })
+    };
+    match generate_route(&walls, WALL_THICKNESS_M, home, opts) {
+        Ok(route) => {
+            if let Some(d) = spec.description.as_mut() {
+                d.push_str("; route generated from the free-space skeleton");
+            }
+            spec.routes.push(RouteSpec {
+                id: "loop".into(),
+                waypoints_m: route.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
+            });
+            Ok(spec)
+        }
+        Err(message) => Err(MapError::NoRoute {
+            path: name.to_string(),
+            message,
+            partial: Some(Box::new(spec)),
+        }),
+    }
 }
 
 /// The world file text for an imported world, with a header naming the source.
@@ -473,17 +494,27 @@ pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser
                 "{key} = [\n    [{}],\n]\n",
                 rest[..rest.len() - 2].replace("], [", "],\n    [")
             ),
+            // Empty arrays would clash with the [[doors]] / [[routes]] blocks a user adds.
+            _ if l.ends_with(" = []") => String::new(),
             _ => format!("{l}\n"),
         })
         .collect();
+    let route_note = if spec.routes.is_empty() {
+        "# NO ROUTE: none could be generated through the free space. Add a [[routes]] block by hand\n\
+         # (id = \"loop\", waypoints_m = [[x1, y1], [x2, y2], [x3, y3], ...]: at least 3 waypoints, each\n\
+         # >= 0.30 m from every wall, legs clear of walls by the 0.25 m robot radius), then run\n\
+         # `placewords world check` on this file.\n"
+    } else {
+        "# The route \"loop\" was generated from the skeleton of the free space (waypoints >= 0.30 m\n\
+         # from walls, legs a 0.25 m robot disc can drive); edit or replace it freely.\n"
+    };
     Ok(format!(
         "# Imported by `placewords world import` from the MobileSim map {source}.\n\
-         # Walls: the map's LINES (millimetres → metres), touching segments chained into polylines,\n\
+         # Walls: the map's LINES (millimetres -> metres), touching segments chained into polylines,\n\
          # {WALL_THICKNESS_M} m thick. Home: the RobotHome cairn.\n\
          # Doors cannot be inferred from a line map: add [[doors]] blocks by hand (id, hinge_m,\n\
          # width_m, closed_heading_deg, open_heading_deg) where the real building has them.\n\
-         # The route \"loop\" was generated from the skeleton of the free space (waypoints >= 0.30 m\n\
-         # from walls, legs a 0.25 m robot disc can drive); edit or replace it freely.\n\n{body}"
+         {route_note}\n{body}"
     ))
 }
 

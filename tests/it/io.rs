@@ -478,3 +478,28 @@ fn endless_line_is_refused_not_swallowed() {
         "{e}"
     );
 }
+
+#[test]
+fn a_world_without_a_route_is_still_written_and_a_route_can_be_added() {
+    let src = "2D-Map\nCairn: RobotHome 300 300 0\nLINES\n0 0 600 0\n600 0 600 600\n600 600 0 600\n0 600 0 0\n";
+    let e = import_mobilesim(src, "tiny.map").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("[[routes]]"), "{msg}");
+    let placewords::io::mobilesim::MapError::NoRoute {
+        partial: Some(spec),
+        ..
+    } = e
+    else {
+        panic!("{msg}")
+    };
+    let text = world_to_toml(&spec, "tiny.map").unwrap();
+    assert!(text.contains("NO ROUTE"));
+    assert!(!text.contains("= []"), "{text}");
+    let fixed = format!(
+        "{text}\n[[routes]]\nid = \"loop\"\nwaypoints_m = [[0.3, 0.3], [0.31, 0.3], [0.3, 0.31]]\n\n[[doors]]\nid = \"d\"\nhinge_m = [0.0, 0.1]\nwidth_m = 0.3\nclosed_heading_deg = 90\nopen_heading_deg = 0\n"
+    );
+    let back: placewords::spec::world::WorldSpec = toml::from_str(&fixed).unwrap();
+    assert_eq!(back.routes.len(), 1);
+    assert_eq!(back.doors.len(), 1);
+    assert_eq!(back.walls, spec.walls);
+}
