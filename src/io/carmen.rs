@@ -258,6 +258,15 @@ fn read_lines<R: BufRead>(
         }
         line_no += 1;
         let text = String::from_utf8_lossy(&bytes);
+        // A byte-order mark would turn the first message type into an unknown one.
+        let text = if line_no == 1 {
+            text.strip_prefix('\u{feff}')
+                .unwrap_or(&text)
+                .to_string()
+                .into()
+        } else {
+            text
+        };
         match parse_line(&text, &mut out) {
             Ok(()) => {}
             Err((col, message)) => {
@@ -629,6 +638,17 @@ mod tests {
         assert_eq!(rl.fov_rad, 3.0);
         assert_eq!(rl.pose, Pose2::new(1.1, 2.0, 0.3), "the laser pose");
         assert_eq!(r.robotlaser_max_range_m, Some(30.0));
+    }
+
+    #[test]
+    fn byte_order_mark_is_ignored() {
+        let r = parse_log_str(
+            "\u{feff}ODOM 1 2 0.5 0.1 0.2 0 11.0 h 11.0\n",
+            "b",
+            ReadOptions::default(),
+        )
+        .unwrap();
+        assert_eq!(r.records.len(), 1);
     }
 
     #[test]
