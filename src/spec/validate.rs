@@ -22,6 +22,9 @@ pub const WAYPOINT_MARGIN_M: f64 = 0.05;
 pub const DOOR_GAP_TOLERANCE_M: f64 = 0.05;
 /// Largest world extent, metres.
 pub const MAX_EXTENT_M: f64 = 10_000.0;
+/// Largest absolute coordinate, metres: keeps every number the geometry squares or converts
+/// far from overflow.
+pub const MAX_ABS_COORD_M: f64 = 1_000_000.0;
 /// Most wall segments, door panels and route legs a world may hold.
 pub const MAX_SEGMENTS: usize = 100_000;
 /// Half the width of a walking person, metres (scenario A's pedestrians are about 0.3 m across).
@@ -122,6 +125,15 @@ impl<'a> Diags<'a> {
 
 fn v(p: &[f64; 2]) -> Vec2 {
     Vec2::new(p[0], p[1])
+}
+
+/// A coordinate for a message: plain when ordinary, in exponent form when huge.
+fn fmt_coord(x: f64) -> String {
+    if x.abs() >= 1e7 {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
 }
 
 fn fmt_m(x: f64) -> String {
@@ -233,7 +245,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             d.at(
                 l.points_key,
                 format!(
-                    "wall '{}' has {n} point(s); a{} wall needs at least {need}, add points or remove the wall",
+                    "wall '{}' has {n} point(s) but a{} wall needs at least {need}; add points or remove the wall",
                     w.id,
                     if w.closed { " closed" } else { "" }
                 ),
@@ -319,7 +331,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             d.at(
                 l.waypoints_key,
                 format!(
-                    "route '{}' has {n} waypoint(s); a route is a closed loop and needs at least 3",
+                    "route '{}' has {n} waypoint(s) but a route is a closed loop of at least 3; add waypoints",
                     r.id
                 ),
             );
@@ -394,6 +406,21 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
     if pts.is_empty() {
         return true;
     }
+    if let Some((p, at)) = pts
+        .iter()
+        .find(|(p, _)| p[0].abs() > MAX_ABS_COORD_M || p[1].abs() > MAX_ABS_COORD_M)
+    {
+        d.at(
+            *at,
+            format!(
+                "the point [{}, {}] is more than {:.0} km from the origin; coordinates are metres: check this value or move the world near [0, 0]",
+                fmt_coord(p[0]),
+                fmt_coord(p[1]),
+                MAX_ABS_COORD_M / 1000.0
+            ),
+        );
+        return false;
+    }
     for axis in 0..2 {
         let mut vals: Vec<f64> = pts.iter().map(|(p, _)| p[axis]).collect();
         let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
@@ -417,8 +444,8 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
                     "the world is {:.0} m across in {} (limit {MAX_EXTENT_M:.0} m), because of the point [{}, {}]; coordinates are metres: check this value",
                     hi - lo,
                     if axis == 0 { "x" } else { "y" },
-                    p[0],
-                    p[1]
+                    fmt_coord(p[0]),
+                    fmt_coord(p[1])
                 ),
             );
             return false;

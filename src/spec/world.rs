@@ -11,28 +11,36 @@
 //! ```toml
 //! format_version = 1
 //! name = "tiny"
+//!
 //! [robot_home]
 //! x_m = 1.0
 //! y_m = 1.0
-//! heading_deg = 0.0
-//! [[walls]]
+//! heading_deg = 0.0            # degrees in files, radians in code
+//!
+//! [[walls]]                    # a polyline with a thickness (default 0.1 m)
 //! id = "outer"
-//! points_m = [[0.0, 0.0], [6.0, 0.0], [6.0, 4.0], [0.0, 4.0]]
+//! points_m = [[0.0, 0.0], [12.0, 0.0], [12.0, 6.0], [0.0, 6.0]]
 //! closed = true
-//! thickness_m = 0.1
+//!
+//! [[walls]]                    # a room with a 0.9 m gap from x = 5.0 to 5.9
+//! id = "room"
+//! points_m = [[5.0, 2.0], [2.0, 2.0], [2.0, 4.0], [10.0, 4.0], [10.0, 2.0], [5.9, 2.0]]
+//!
 //! [[doors]]
 //! id = "d-1"
-//! hinge_m = [2.0, 4.0]         # hinge point
-//! width_m = 0.9                # panel length
-//! closed_heading_deg = 0.0     # hinge -> tip when closed
-//! open_heading_deg = 90.0      # hinge -> tip when open (into the room)
-//! [[routes]]
+//! hinge_m = [5.0, 2.0]         # one end of the gap
+//! width_m = 0.9                # panel length, hinge to tip
+//! closed_heading_deg = 0.0     # hinge -> tip when closed: across the gap
+//! open_heading_deg = 90.0      # hinge -> tip when open: into the room
+//!
+//! [[routes]]                   # a closed loop; the last leg returns to the first waypoint
 //! id = "lap"
-//! waypoints_m = [[1.0, 1.0], [5.0, 1.0], [5.0, 3.0], [1.0, 3.0]]
+//! waypoints_m = [[1.0, 1.0], [11.0, 1.0], [11.0, 5.0], [1.0, 5.0]]
+//!
 //! [[areas]]                    # optional: where people may walk
 //! id = "south"
-//! min_m = [0.5, 0.5]
-//! max_m = [5.5, 1.5]
+//! min_m = [2.0, 0.5]
+//! max_m = [10.0, 1.5]
 //! ```
 
 use crate::spec::diag::Diagnostic;
