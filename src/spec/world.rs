@@ -648,6 +648,26 @@ fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<Worl
     let door_tables = table_array(top, "doors", d);
     let route_tables = table_array(top, "routes", d);
     let area_tables = table_array(top, "areas", d);
+    if let Some((kat, v)) = get(top, "walls")
+        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
+    {
+        d.at(
+            kat,
+            "`walls` is empty; add at least one `[[walls]]` section with `id` and `points_m`"
+                .into(),
+        );
+        ok = false;
+    }
+    if let Some((kat, v)) = get(top, "routes")
+        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
+    {
+        d.at(
+            kat,
+            "`routes` is empty; add a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)"
+                .into(),
+        );
+        ok = false;
+    }
     if get(top, "walls").is_none() {
         missing(
             top,
