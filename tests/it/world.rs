@@ -208,6 +208,8 @@ enum Mutation {
     DeleteLine(usize),
     DuplicateLine(usize),
     ReplaceLine(usize, String),
+    /// Replaces the i-th number of the file with another, often extreme, value.
+    ReplaceNumber(usize, String),
 }
 
 fn mutation() -> impl Strategy<Value = Mutation> {
@@ -224,6 +226,31 @@ fn mutation() -> impl Strategy<Value = Mutation> {
         any::<usize>().prop_map(Mutation::DeleteLine),
         any::<usize>().prop_map(Mutation::DuplicateLine),
         (any::<usize>(), "[ -~]{0,30}").prop_map(|(i, s)| Mutation::ReplaceLine(i, s)),
+        (
+            any::<usize>(),
+            prop_oneof![
+                prop::sample::select(vec![
+                    "0",
+                    "-0.0",
+                    "nan",
+                    "inf",
+                    "-inf",
+                    "1e300",
+                    "-1e9",
+                    "0.3",
+                    "3.0",
+                    "360",
+                    "99999999999999999999",
+                    "1e-300",
+                    "0x10",
+                    "0.25",
+                    "20000"
+                ])
+                .prop_map(str::to_string),
+                (-50.0f64..50.0).prop_map(|x| format!("{x:.2}")),
+            ]
+        )
+            .prop_map(|(i, s)| Mutation::ReplaceNumber(i, s)),
     ]
 }
 
@@ -261,6 +288,34 @@ fn apply(src: &str, m: &Mutation) -> String {
             lines[i] = s.clone();
             lines.join("\n")
         }
+        Mutation::ReplaceNumber(i, s) => {
+            // Numbers: maximal runs of digits, '.', '-' and 'e' that start with a digit or '-'.
+            let bytes = src.as_bytes();
+            let mut spans = Vec::new();
+            let mut k = 0;
+            while k < bytes.len() {
+                let b = bytes[k];
+                let starts = (b.is_ascii_digit() || b == b'-')
+                    && (k == 0 || matches!(bytes[k - 1], b' ' | b'[' | b','));
+                if starts {
+                    let start = k;
+                    k += 1;
+                    while k < bytes.len()
+                        && (bytes[k].is_ascii_digit() || matches!(bytes[k], b'.' | b'e' | b'-'))
+                    {
+                        k += 1;
+                    }
+                    spans.push((start, k));
+                } else {
+                    k += 1;
+                }
+            }
+            if spans.is_empty() {
+                return src.to_string();
+            }
+            let (a, b) = spans[i % spans.len()];
+            format!("{}{}{}", &src[..a], s, &src[b..])
+        }
     }
 }
 
@@ -276,8 +331,11 @@ proptest! {
     }
 
     #[test]
-    fn mutated_worlds_never_panic(muts in prop::collection::vec(mutation(), 1..4)) {
-        let base = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    fn mutated_worlds_never_panic(
+        muts in prop::collection::vec(mutation(), 1..4),
+        which in prop::sample::select(vec!["loop-small.toml", "two-loops.toml"]),
+    ) {
+        let base = std::fs::read_to_string(root().join("worlds").join(which)).unwrap();
         let mut src = base;
         for m in &muts {
             src = apply(&src, m);
@@ -483,5 +541,88 @@ fn the_documented_example_is_valid() {
     assert!(example.contains("[[doors]]"), "no example found");
     if let Err(e) = parse_world(&example, "doc-example.toml") {
         panic!("{e}");
+    }
+}
+
+/// Free space reachable from the robot's home on a 0.1 m raster with the doors in `states`, or
+/// `None` when it leaks out of the building (reaches the raster's border).
+fn reachable_cells(w: &World, states: &DoorStates) -> Option<usize> {
+    use placewords::geom::{Segment, Vec2};
+    const CELL: f64 = 0.1;
+    let (lo, hi) = w.bounds();
+    let lo = lo - Vec2::new(1.0, 1.0);
+    let hi = hi + Vec2::new(1.0, 1.0);
+    let nx = ((hi.x - lo.x) / CELL).ceil() as usize + 1;
+    let ny = ((hi.y - lo.y) / CELL).ceil() as usize + 1;
+    let mut blocked = vec![false; nx * ny];
+    let mut mark = |s: Segment| {
+        let steps = (s.length() / (CELL / 2.0)).ceil().max(1.0) as usize;
+        for k in 0..=steps {
+            let p = s.a + (s.b - s.a) * (k as f64 / steps as f64);
+            let (cx, cy) = (
+                ((p.x - lo.x) / CELL) as isize,
+                ((p.y - lo.y) / CELL) as isize,
+            );
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    let (x, y) = (cx + dx, cy + dy);
+                    if x >= 0 && y >= 0 && (x as usize) < nx && (y as usize) < ny {
+                        blocked[y as usize * nx + x as usize] = true;
+                    }
+                }
+            }
+        }
+    };
+    w.wall_segments().into_iter().for_each(&mut mark);
+    for (i, d) in w.doors.iter().enumerate() {
+        mark(d.panel(states.is_open(i)));
+    }
+    let start = (
+        ((w.home.x - lo.x) / CELL) as usize,
+        ((w.home.y - lo.y) / CELL) as usize,
+    );
+    let mut seen = vec![false; nx * ny];
+    let mut stack = vec![start];
+    seen[start.1 * nx + start.0] = true;
+    let mut count = 0;
+    while let Some((x, y)) = stack.pop() {
+        count += 1;
+        if x == 0 || y == 0 || x + 1 == nx || y + 1 == ny {
+            return None;
+        }
+        for (a, b) in [(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)] {
+            let i = b * nx + a;
+            if !seen[i] && !blocked[i] {
+                seen[i] = true;
+                stack.push((a, b));
+            }
+        }
+    }
+    Some(count)
+}
+
+/// Layout sanity of every shipped world: the building is closed with all doors closed and with
+/// all open, and opening any single door reveals a room (at least 3 m² more free space).
+#[test]
+fn shipped_worlds_are_closed_and_every_door_opens_onto_a_room() {
+    for f in toml_files(&root().join("worlds")) {
+        let w = load_world(&f).unwrap();
+        let name = f.display();
+        let closed = reachable_cells(&w, &DoorStates::all_closed(&w))
+            .unwrap_or_else(|| panic!("{name}: free space leaks out with all doors closed"));
+        reachable_cells(&w, &DoorStates::all_open(&w))
+            .unwrap_or_else(|| panic!("{name}: free space leaks out with all doors open"));
+        for (i, d) in w.doors.iter().enumerate() {
+            let mut s = DoorStates::all_closed(&w);
+            s.open[i] = true;
+            let open = reachable_cells(&w, &s)
+                .unwrap_or_else(|| panic!("{name}: door '{}' opens onto the outside", d.id));
+            let gained_m2 = (open as f64 - closed as f64) * 0.01;
+            assert!(
+                gained_m2 >= 3.0,
+                "{name}: opening door '{}' adds only {gained_m2:.1} m² of free space",
+                d.id
+            );
+        }
     }
 }
