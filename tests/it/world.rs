@@ -144,6 +144,15 @@ fn invalid_fixtures_give_their_messages() {
     );
 }
 
+/// The invalid fixtures are each one mistake away from `tests/fixtures/valid-base.toml`, which
+/// must itself be valid (so each fixture's message is about its own mistake).
+#[test]
+fn the_fixtures_base_is_valid() {
+    if let Err(e) = load_world(&root().join("tests/fixtures/valid-base.toml")) {
+        panic!("{e}");
+    }
+}
+
 #[test]
 fn a_file_with_several_mistakes_reports_them_all() {
     let src = std::fs::read_to_string(root().join(INVALID).join("many-problems.toml")).unwrap();
