@@ -1,1 +1,6 @@
 //! Output for people and machines: JSON reports, text and Markdown tables, SVG pictures.
+
+pub mod svg;
+pub mod world_render;
+
+pub use world_render::{LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg};

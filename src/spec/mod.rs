@@ -3,6 +3,8 @@
 
 pub mod diag;
 pub mod evaluation;
+pub mod suggest;
+pub mod validate;
 pub mod world;
 
 pub use diag::{Diagnostic, SpecError};

@@ -2,8 +2,53 @@
 //!
 //! These structs describe the file only; [`crate::world::World`] is the validated model built
 //! from them. Units are in every physical key; angles are degrees here and radians in the model.
+//!
+//! Parsing walks toml's spanned document ([`toml::de::DeTable`]) by hand rather than through
+//! serde, so that every problem of a file (unknown keys, missing keys, wrong types, bad
+//! numbers) is reported at once with the line and column of the offending value; the geometric
+//! checks then run in [`crate::spec::validate`].
+//!
+//! ```toml
+//! format_version = 1
+//! name = "tiny"
+//!
+//! [robot_home]
+//! x_m = 1.0
+//! y_m = 1.0
+//! heading_deg = 0.0            # degrees in files, radians in code
+//!
+//! [[walls]]                    # a polyline with a thickness (default 0.1 m)
+//! id = "outer"
+//! points_m = [[0.0, 0.0], [12.0, 0.0], [12.0, 6.0], [0.0, 6.0]]
+//! closed = true
+//!
+//! [[walls]]                    # a room with a 0.9 m gap from x = 5.0 to 5.9
+//! id = "room"
+//! points_m = [[5.0, 2.0], [2.0, 2.0], [2.0, 4.0], [10.0, 4.0], [10.0, 2.0], [5.9, 2.0]]
+//!
+//! [[doors]]
+//! id = "d-1"
+//! hinge_m = [5.0, 2.0]         # one end of the gap
+//! width_m = 0.9                # panel length, hinge to tip
+//! closed_heading_deg = 0.0     # hinge -> tip when closed: across the gap
+//! open_heading_deg = 90.0      # hinge -> tip when open: into the room
+//!
+//! [[routes]]                   # a closed loop; the last leg returns to the first waypoint
+//! id = "lap"
+//! waypoints_m = [[1.0, 1.0], [11.0, 1.0], [11.0, 5.0], [1.0, 5.0]]
+//!
+//! [[areas]]                    # optional: where people may walk
+//! id = "south"
+//! min_m = [2.0, 0.5]
+//! max_m = [10.0, 1.5]
+//! ```
 
+use crate::spec::diag::Diagnostic;
+use crate::spec::suggest;
+use crate::spec::validate::{self, Diags};
 use serde::{Deserialize, Serialize};
+use toml::Spanned;
+use toml::de::{DeTable, DeValue};
 
 /// A whole world file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -97,28 +142,976 @@ fn is_false(b: &bool) -> bool {
     !*b
 }
 
-/// Parses and validates a world file's text; `path` only names the file in messages.
-///
-/// Minimal version: syntax and unknown keys (first error only). The foundation issue extends
-/// this with every check of DESIGN.md §3 and all problems at once.
-pub fn parse_world(src: &str, path: &str) -> Result<crate::world::World, crate::spec::SpecError> {
-    use crate::spec::diag::{Diagnostic, line_col};
-    match toml::from_str::<WorldSpec>(src) {
-        Ok(spec) => Ok(crate::world::World::from_spec(&spec)),
-        Err(e) => {
-            let (line, col) = e.span().map(|s| line_col(src, s.start)).unwrap_or((1, 1));
-            Err(crate::spec::SpecError::Invalid(vec![Diagnostic {
-                path: path.to_string(),
-                line,
-                col,
-                message: e.message().trim().to_string(),
-            }]))
+/// Known keys per table, for unknown-key checks and "did you mean" hints.
+pub const TOP_KEYS: &[&str] = &[
+    "format_version",
+    "name",
+    "description",
+    "robot_home",
+    "walls",
+    "doors",
+    "routes",
+    "areas",
+];
+pub const HOME_KEYS: &[&str] = &["x_m", "y_m", "heading_deg"];
+pub const WALL_KEYS: &[&str] = &["id", "points_m", "closed", "thickness_m"];
+pub const DOOR_KEYS: &[&str] = &[
+    "id",
+    "hinge_m",
+    "width_m",
+    "closed_heading_deg",
+    "open_heading_deg",
+    "thickness_m",
+];
+pub const ROUTE_KEYS: &[&str] = &["id", "waypoints_m"];
+pub const AREA_KEYS: &[&str] = &["id", "min_m", "max_m"];
+
+/// Byte offsets of the values of a world file, so later checks can point at them.
+#[derive(Clone, Debug, Default)]
+pub struct WorldLoc {
+    pub home: HomeLoc,
+    pub walls: Vec<WallLoc>,
+    pub doors: Vec<DoorLoc>,
+    pub routes: Vec<RouteLoc>,
+    pub areas: Vec<AreaLoc>,
+    /// Where `walls` starts (for whole-file limits).
+    pub walls_key: usize,
+    /// Whether every entity read cleanly (no missing or mistyped value); geometric checks run
+    /// only then, so one mistake does not cascade into misleading ones.
+    pub all_read: bool,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct HomeLoc {
+    /// Whether the home pose read cleanly.
+    pub valid: bool,
+    pub table: usize,
+    pub x: usize,
+    pub y: usize,
+    pub heading: usize,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct WallLoc {
+    pub table: usize,
+    pub id: usize,
+    pub points_key: usize,
+    pub points: Vec<usize>,
+    pub thickness: usize,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct DoorLoc {
+    pub table: usize,
+    pub id: usize,
+    pub hinge: usize,
+    pub width: usize,
+    pub closed_heading: usize,
+    pub open_heading: usize,
+    pub thickness: usize,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct RouteLoc {
+    pub table: usize,
+    pub id: usize,
+    pub waypoints_key: usize,
+    pub waypoints: Vec<usize>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct AreaLoc {
+    pub table: usize,
+    pub id: usize,
+    pub min: usize,
+    pub max: usize,
+}
+
+/// Parses and validates a world file's text into its file structures; `path` only names the
+/// file in messages. Every problem is reported, in file order.
+pub fn parse_world_spec(src: &str, path: &str) -> Result<WorldSpec, crate::spec::SpecError> {
+    let mut d = Diags::new(src, path);
+    let spec = read_and_validate(src, &mut d);
+    match (spec, d.into_sorted()) {
+        (Some(spec), diags) if diags.is_empty() => Ok(spec),
+        (_, mut diags) => {
+            if diags.is_empty() {
+                // Defensive: a failed read always reports why; never return an empty error.
+                diags.push(Diagnostic {
+                    path: path.to_string(),
+                    line: 1,
+                    col: 1,
+                    message: "the file could not be read as a world; check it against worlds/loop-small.toml".into(),
+                });
+            }
+            Err(crate::spec::SpecError::Invalid(diags))
         }
     }
+}
+
+/// Parses and validates a world file's text; `path` only names the file in messages.
+pub fn parse_world(src: &str, path: &str) -> Result<crate::world::World, crate::spec::SpecError> {
+    parse_world_spec(src, path).map(|spec| crate::world::World::from_spec(&spec))
 }
 
 /// Reads and validates a world file.
 pub fn load_world(path: &std::path::Path) -> Result<crate::world::World, crate::spec::SpecError> {
     let src = std::fs::read_to_string(path).map_err(|e| crate::spec::SpecError::io(path, e))?;
     parse_world(&src, &path.display().to_string())
+}
+
+fn read_and_validate(src: &str, d: &mut Diags) -> Option<WorldSpec> {
+    let (doc, errors) = DeTable::parse_recoverable(src);
+    if !errors.is_empty() {
+        for e in &errors {
+            let at = e.span().map(|s| s.start).unwrap_or(0);
+            let msg = e
+                .message()
+                .lines()
+                .map(str::trim)
+                .filter(|l| !l.is_empty())
+                .collect::<Vec<_>>()
+                .join(" ");
+            let msg = lowercase_first(msg.trim_end_matches('.'));
+            d.at(
+                at,
+                format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
+            );
+        }
+        return None;
+    }
+    let mut loc = WorldLoc::default();
+    let spec = read_top(doc.get_ref(), d, &mut loc)?;
+    validate::validate(&spec, &loc, d);
+    Some(spec)
+}
+
+fn lowercase_first(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_lowercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+type Val<'i> = Spanned<DeValue<'i>>;
+
+/// Looks a key up in a table: (key start, value).
+fn get<'t, 'i>(t: &'t DeTable<'i>, key: &str) -> Option<(usize, &'t Val<'i>)> {
+    t.iter()
+        .find(|(k, _)| k.get_ref().as_ref() == key)
+        .map(|(k, v)| (k.span().start, v))
+}
+
+/// Reports keys of `t` that are not in `known`.
+fn unknown_keys(t: &DeTable<'_>, known: &[&str], ctx: &str, d: &mut Diags) {
+    for (k, _) in t.iter() {
+        let name = k.get_ref().as_ref();
+        if !known.contains(&name) {
+            let hint = suggest::hint(name, known.iter().copied(), "keys here");
+            d.at(
+                k.span().start,
+                format!("unknown key `{name}` in {ctx}; {hint}"),
+            );
+        }
+    }
+}
+
+/// Whether `t` holds an unknown key that looks like a misspelling of `key` (then the
+/// unknown-key message, with its "did you mean", already says what is wrong).
+fn misspelt(t: &DeTable<'_>, key: &str, known: &[&str]) -> bool {
+    t.iter().any(|(k, _)| {
+        let name = k.get_ref().as_ref();
+        !known.contains(&name) && suggest::closest(name, known.iter().copied()) == Some(key)
+    })
+}
+
+/// Reports a missing key unless a misspelling of it is already reported.
+fn missing(t: &DeTable<'_>, key: &str, known: &[&str], at: usize, msg: String, d: &mut Diags) {
+    if !misspelt(t, key, known) {
+        d.at(at, msg);
+    }
+}
+
+fn type_name(v: &DeValue<'_>) -> &'static str {
+    match v {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) => "an integer",
+        DeValue::Float(_) => "a number",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a date",
+        DeValue::Array(_) => "an array",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+fn parse_int(s: &str, radix: u32) -> Option<i64> {
+    i64::from_str_radix(s, radix)
+        .ok()
+        .or_else(|| i64::from_str_radix(&s.replace('_', ""), radix).ok())
+}
+
+/// A finite number (integers accepted); reports wrong types and non-finite values.
+fn number(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<f64> {
+    let at = v.span().start;
+    let x = match v.get_ref() {
+        DeValue::Integer(i) => parse_int(i.as_str(), i.radix()).map(|n| n as f64),
+        DeValue::Float(f) => {
+            let s = f.as_str();
+            s.parse::<f64>()
+                .ok()
+                .or_else(|| s.replace('_', "").parse::<f64>().ok())
+        }
+        other => {
+            d.at(
+                at,
+                format!(
+                    "`{key}` in {ctx} must be a number, found {}; write a plain number such as `{key} = 1.0`",
+                    type_name(other)
+                ),
+            );
+            return None;
+        }
+    };
+    match x {
+        Some(x) if x.is_finite() => Some(x),
+        Some(_) => {
+            d.at(
+                at,
+                format!("`{key}` in {ctx} is not a finite number; use an ordinary number, not nan or inf"),
+            );
+            None
+        }
+        None => {
+            d.at(
+                at,
+                format!("`{key}` in {ctx} is out of range; use an ordinary number"),
+            );
+            None
+        }
+    }
+}
+
+/// A point `[x, y]` in metres.
+fn point(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<[f64; 2]> {
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(
+            v.span().start,
+            format!(
+                "`{key}` in {ctx} must be a point [x, y] in metres, found {}; write e.g. `[1.0, 2.0]`",
+                type_name(v.get_ref())
+            ),
+        );
+        return None;
+    };
+    if a.len() != 2 {
+        d.at(
+            v.span().start,
+            format!(
+                "`{key}` in {ctx} must be a point of 2 numbers [x, y], found {} value(s); write e.g. `[1.0, 2.0]`",
+                a.len()
+            ),
+        );
+        return None;
+    }
+    let x = number(&a[0], key, ctx, d);
+    let y = number(&a[1], key, ctx, d);
+    Some([x?, y?])
+}
+
+/// A list of points; each point's start offset goes to `spans`.
+fn points(
+    v: &Val<'_>,
+    key: &str,
+    ctx: &str,
+    d: &mut Diags,
+    spans: &mut Vec<usize>,
+) -> Option<Vec<[f64; 2]>> {
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(
+            v.span().start,
+            format!(
+                "`{key}` in {ctx} must be a list of points, found {}; write e.g. `[[0.0, 0.0], [4.0, 0.0]]`",
+                type_name(v.get_ref())
+            ),
+        );
+        return None;
+    };
+    let mut out = Vec::with_capacity(a.len().min(validate::MAX_SEGMENTS + 1));
+    let mut ok = true;
+    for p in a.iter() {
+        spans.push(p.span().start);
+        match point(p, key, ctx, d) {
+            Some(p) => out.push(p),
+            None => ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+    ok.then_some(out)
+}
+
+fn string(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<String> {
+    match v.get_ref() {
+        DeValue::String(s) => Some(s.to_string()),
+        other => {
+            d.at(
+                v.span().start,
+                format!(
+                    "`{key}` in {ctx} must be a string, found {}; put it in quotes, e.g. `{key} = \"text\"`",
+                    type_name(other)
+                ),
+            );
+            None
+        }
+    }
+}
+
+fn boolean(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<bool> {
+    match v.get_ref() {
+        DeValue::Boolean(b) => Some(*b),
+        other => {
+            d.at(
+                v.span().start,
+                format!(
+                    "`{key}` in {ctx} must be true or false, found {}; write `{key} = true` or `{key} = false`",
+                    type_name(other)
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// An entity id: non-empty, letters, digits, `-`, `_`, `.` (ids appear in comma lists on the
+/// command line).
+fn id(
+    t: &DeTable<'_>,
+    known: &[&str],
+    at_table: usize,
+    ctx: &str,
+    d: &mut Diags,
+) -> (Option<String>, usize) {
+    let Some((_, v)) = get(t, "id") else {
+        missing(
+            t,
+            "id",
+            known,
+            at_table,
+            format!("missing key `id` in {ctx}; add a unique `id = \"...\"`"),
+            d,
+        );
+        return (None, at_table);
+    };
+    let at = v.span().start;
+    let Some(s) = string(v, "id", ctx, d) else {
+        return (None, at);
+    };
+    if s.is_empty()
+        || !s
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+    {
+        d.at(
+            at,
+            format!(
+                "id {s:?} in {ctx} is not a plain id; use letters, digits, `-`, `_` or `.` only (e.g. \"n-03\")"
+            ),
+        );
+        return (None, at);
+    }
+    (Some(s), at)
+}
+
+/// The array of tables under `key` (e.g. `[[doors]]`), or an error when it is something else.
+fn table_array<'t, 'i>(
+    top: &'t DeTable<'i>,
+    key: &str,
+    d: &mut Diags,
+) -> Vec<(usize, &'t DeTable<'i>)> {
+    let Some((kat, v)) = get(top, key) else {
+        return Vec::new();
+    };
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(
+            kat,
+            format!(
+                "`{key}` must be a list of tables, found {}; write each entry as a `[[{key}]]` section",
+                type_name(v.get_ref())
+            ),
+        );
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for e in a.iter() {
+        match e.get_ref() {
+            DeValue::Table(t) => out.push((e.span().start, t)),
+            other => d.at(
+                e.span().start,
+                format!(
+                    "each entry of `{key}` must be a table, found {}; write each entry as a `[[{key}]]` section",
+                    type_name(other)
+                ),
+            ),
+        }
+    }
+    out
+}
+
+fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<WorldSpec> {
+    unknown_keys(top, TOP_KEYS, "the world file", d);
+    let mut ok = true;
+
+    let format_version = match get(top, "format_version") {
+        None => {
+            missing(
+                top,
+                "format_version",
+                TOP_KEYS,
+                0,
+                "missing key `format_version`; add `format_version = 1` as the first line".into(),
+                d,
+            );
+            ok = false;
+            0
+        }
+        Some((_, v)) => match v.get_ref() {
+            DeValue::Integer(i) if parse_int(i.as_str(), i.radix()) == Some(1) => 1,
+            DeValue::Integer(i) => {
+                d.at(
+                    v.span().start,
+                    format!(
+                        "unsupported format_version {}; this placewords reads `format_version = 1`",
+                        i.as_str()
+                    ),
+                );
+                ok = false;
+                0
+            }
+            other => {
+                d.at(
+                    v.span().start,
+                    format!(
+                        "`format_version` must be the integer 1, found {}; write `format_version = 1`",
+                        type_name(other)
+                    ),
+                );
+                ok = false;
+                0
+            }
+        },
+    };
+
+    let name = match get(top, "name") {
+        None => {
+            missing(
+                top,
+                "name",
+                TOP_KEYS,
+                0,
+                "missing key `name`; add `name = \"my-floor\"` near the top".into(),
+                d,
+            );
+            None
+        }
+        Some((_, v)) => match string(v, "name", "the world file", d) {
+            Some(s) if s.trim().is_empty() => {
+                d.at(
+                    v.span().start,
+                    "`name` is empty; give the world a short name".into(),
+                );
+                None
+            }
+            other => other,
+        },
+    };
+    ok &= name.is_some();
+
+    let description = match get(top, "description") {
+        None => None,
+        Some((_, v)) => {
+            let s = string(v, "description", "the world file", d);
+            ok &= s.is_some();
+            s
+        }
+    };
+
+    let robot_home = read_home(top, d, &mut loc.home);
+    let robot_home_ok = robot_home.is_some();
+    ok &= robot_home_ok;
+
+    if let Some((kat, _)) = get(top, "walls") {
+        loc.walls_key = kat;
+    }
+    let wall_tables = table_array(top, "walls", d);
+    let door_tables = table_array(top, "doors", d);
+    let route_tables = table_array(top, "routes", d);
+    let area_tables = table_array(top, "areas", d);
+    if let Some((kat, v)) = get(top, "walls")
+        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
+    {
+        d.at(
+            kat,
+            "`walls` is empty; add at least one `[[walls]]` section with `id` and `points_m`"
+                .into(),
+        );
+        ok = false;
+    }
+    if let Some((kat, v)) = get(top, "routes")
+        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
+    {
+        d.at(
+            kat,
+            "`routes` is empty; add a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)"
+                .into(),
+        );
+        ok = false;
+    }
+    if get(top, "walls").is_none() {
+        missing(
+            top,
+            "walls",
+            TOP_KEYS,
+            0,
+            "the world has no walls; add at least one `[[walls]]` section with `id` and `points_m`"
+                .into(),
+            d,
+        );
+        ok = false;
+    }
+    if get(top, "routes").is_none() {
+        missing(
+            top,
+            "routes",
+            TOP_KEYS,
+            0,
+            "the world has no routes; add a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)"
+                .into(),
+            d,
+        );
+        ok = false;
+    }
+
+    let mut walls = Vec::new();
+    for (i, (at, t)) in wall_tables.into_iter().enumerate() {
+        let mut l = WallLoc {
+            table: at,
+            ..Default::default()
+        };
+        match read_wall(t, at, i, d, &mut l) {
+            Some(w) => {
+                walls.push(w);
+                loc.walls.push(l);
+            }
+            None => ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+    let mut doors = Vec::new();
+    for (i, (at, t)) in door_tables.into_iter().enumerate() {
+        let mut l = DoorLoc {
+            table: at,
+            ..Default::default()
+        };
+        match read_door(t, at, i, d, &mut l) {
+            Some(x) => {
+                doors.push(x);
+                loc.doors.push(l);
+            }
+            None => ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+    let mut routes = Vec::new();
+    for (i, (at, t)) in route_tables.into_iter().enumerate() {
+        let mut l = RouteLoc {
+            table: at,
+            ..Default::default()
+        };
+        match read_route(t, at, i, d, &mut l) {
+            Some(x) => {
+                routes.push(x);
+                loc.routes.push(l);
+            }
+            None => ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+    let mut areas = Vec::new();
+    for (i, (at, t)) in area_tables.into_iter().enumerate() {
+        let mut l = AreaLoc {
+            table: at,
+            ..Default::default()
+        };
+        match read_area(t, at, i, d, &mut l) {
+            Some(x) => {
+                areas.push(x);
+                loc.areas.push(l);
+            }
+            None => ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+
+    let spec = WorldSpec {
+        format_version,
+        name: name.unwrap_or_default(),
+        description,
+        robot_home: robot_home.unwrap_or(HomeSpec {
+            x_m: 0.0,
+            y_m: 0.0,
+            heading_deg: 0.0,
+        }),
+        walls,
+        doors,
+        routes,
+        areas,
+    };
+    loc.home.valid = robot_home_ok;
+    loc.all_read = ok;
+    Some(spec)
+}
+
+fn read_home(top: &DeTable<'_>, d: &mut Diags, l: &mut HomeLoc) -> Option<HomeSpec> {
+    let ctx = "[robot_home]";
+    let Some((kat, v)) = get(top, "robot_home") else {
+        missing(
+            top,
+            "robot_home",
+            TOP_KEYS,
+            0,
+            "missing table [robot_home]; add `[robot_home]` with `x_m`, `y_m` and `heading_deg`"
+                .into(),
+            d,
+        );
+        return None;
+    };
+    let DeValue::Table(t) = v.get_ref() else {
+        d.at(
+            kat,
+            format!(
+                "`robot_home` must be a table, found {}; write a `[robot_home]` section with `x_m`, `y_m`, `heading_deg`",
+                type_name(v.get_ref())
+            ),
+        );
+        return None;
+    };
+    l.table = v.span().start;
+    unknown_keys(t, HOME_KEYS, ctx, d);
+    let mut req = |key: &str, slot: &mut usize| -> Option<f64> {
+        match get(t, key) {
+            None => {
+                missing(
+                    t,
+                    key,
+                    HOME_KEYS,
+                    l.table,
+                    format!("missing key `{key}` in {ctx}; add `{key} = <metres>`"),
+                    d,
+                );
+                None
+            }
+            Some((_, v)) => {
+                *slot = v.span().start;
+                number(v, key, ctx, d)
+            }
+        }
+    };
+    let (mut xs, mut ys) = (l.table, l.table);
+    let x = req("x_m", &mut xs);
+    let y = req("y_m", &mut ys);
+    l.x = xs;
+    l.y = ys;
+    l.heading = l.table;
+    let heading = match get(t, "heading_deg") {
+        None => Some(0.0),
+        Some((_, v)) => {
+            l.heading = v.span().start;
+            number(v, "heading_deg", ctx, d)
+        }
+    };
+    Some(HomeSpec {
+        x_m: x?,
+        y_m: y?,
+        heading_deg: heading?,
+    })
+}
+
+fn ctx_of(kind: &str, id: &Option<String>, i: usize) -> String {
+    match id {
+        Some(id) => format!("{kind} '{id}'"),
+        None => format!("{kind} #{}", i + 1),
+    }
+}
+
+/// Reads a required number key of an entity; stores the value's offset in `slot`.
+#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
+fn req_number(
+    t: &DeTable<'_>,
+    known: &[&str],
+    key: &str,
+    ctx: &str,
+    at_table: usize,
+    what: &str,
+    d: &mut Diags,
+    slot: &mut usize,
+) -> Option<f64> {
+    match get(t, key) {
+        None => {
+            missing(
+                t,
+                key,
+                known,
+                at_table,
+                format!("missing key `{key}` in {ctx}; add `{key} = ...` ({what})"),
+                d,
+            );
+            *slot = at_table;
+            None
+        }
+        Some((_, v)) => {
+            *slot = v.span().start;
+            number(v, key, ctx, d)
+        }
+    }
+}
+
+fn opt_number(
+    t: &DeTable<'_>,
+    key: &str,
+    ctx: &str,
+    default: f64,
+    at_table: usize,
+    d: &mut Diags,
+    slot: &mut usize,
+) -> Option<f64> {
+    match get(t, key) {
+        None => {
+            *slot = at_table;
+            Some(default)
+        }
+        Some((_, v)) => {
+            *slot = v.span().start;
+            number(v, key, ctx, d)
+        }
+    }
+}
+
+fn req_point(
+    t: &DeTable<'_>,
+    known: &[&str],
+    key: &str,
+    ctx: &str,
+    at_table: usize,
+    d: &mut Diags,
+    slot: &mut usize,
+) -> Option<[f64; 2]> {
+    match get(t, key) {
+        None => {
+            missing(
+                t,
+                key,
+                known,
+                at_table,
+                format!("missing key `{key}` in {ctx}; add `{key} = [x, y]` (metres)"),
+                d,
+            );
+            *slot = at_table;
+            None
+        }
+        Some((_, v)) => {
+            *slot = v.span().start;
+            point(v, key, ctx, d)
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
+fn req_points(
+    t: &DeTable<'_>,
+    known: &[&str],
+    key: &str,
+    ctx: &str,
+    at_table: usize,
+    d: &mut Diags,
+    key_slot: &mut usize,
+    spans: &mut Vec<usize>,
+) -> Option<Vec<[f64; 2]>> {
+    match get(t, key) {
+        None => {
+            missing(
+                t,
+                key,
+                known,
+                at_table,
+                format!("missing key `{key}` in {ctx}; add `{key} = [[x, y], ...]` (metres)"),
+                d,
+            );
+            *key_slot = at_table;
+            None
+        }
+        Some((_, v)) => {
+            *key_slot = v.span().start;
+            points(v, key, ctx, d, spans)
+        }
+    }
+}
+
+fn read_wall(
+    t: &DeTable<'_>,
+    at: usize,
+    i: usize,
+    d: &mut Diags,
+    l: &mut WallLoc,
+) -> Option<WallSpec> {
+    let (id, id_at) = id(t, WALL_KEYS, at, &format!("wall #{}", i + 1), d);
+    l.id = id_at;
+    let ctx = ctx_of("wall", &id, i);
+    unknown_keys(t, WALL_KEYS, &ctx, d);
+    let pts = req_points(
+        t,
+        WALL_KEYS,
+        "points_m",
+        &ctx,
+        at,
+        d,
+        &mut l.points_key,
+        &mut l.points,
+    );
+    let closed = match get(t, "closed") {
+        None => Some(false),
+        Some((_, v)) => boolean(v, "closed", &ctx, d),
+    };
+    let thickness = opt_number(
+        t,
+        "thickness_m",
+        &ctx,
+        default_wall_thickness_m(),
+        at,
+        d,
+        &mut l.thickness,
+    );
+    Some(WallSpec {
+        id: id?,
+        points_m: pts?,
+        closed: closed?,
+        thickness_m: thickness?,
+    })
+}
+
+fn read_door(
+    t: &DeTable<'_>,
+    at: usize,
+    i: usize,
+    d: &mut Diags,
+    l: &mut DoorLoc,
+) -> Option<DoorSpec> {
+    let (id, id_at) = id(t, DOOR_KEYS, at, &format!("door #{}", i + 1), d);
+    l.id = id_at;
+    let ctx = ctx_of("door", &id, i);
+    unknown_keys(t, DOOR_KEYS, &ctx, d);
+    let hinge = req_point(t, DOOR_KEYS, "hinge_m", &ctx, at, d, &mut l.hinge);
+    let width = req_number(
+        t,
+        DOOR_KEYS,
+        "width_m",
+        &ctx,
+        at,
+        "panel length, metres",
+        d,
+        &mut l.width,
+    );
+    let closed = req_number(
+        t,
+        DOOR_KEYS,
+        "closed_heading_deg",
+        &ctx,
+        at,
+        "direction hinge to tip when closed, degrees",
+        d,
+        &mut l.closed_heading,
+    );
+    let open = req_number(
+        t,
+        DOOR_KEYS,
+        "open_heading_deg",
+        &ctx,
+        at,
+        "direction hinge to tip when open, degrees",
+        d,
+        &mut l.open_heading,
+    );
+    let thickness = opt_number(
+        t,
+        "thickness_m",
+        &ctx,
+        default_door_thickness_m(),
+        at,
+        d,
+        &mut l.thickness,
+    );
+    Some(DoorSpec {
+        id: id?,
+        hinge_m: hinge?,
+        width_m: width?,
+        closed_heading_deg: closed?,
+        open_heading_deg: open?,
+        thickness_m: thickness?,
+    })
+}
+
+fn read_route(
+    t: &DeTable<'_>,
+    at: usize,
+    i: usize,
+    d: &mut Diags,
+    l: &mut RouteLoc,
+) -> Option<RouteSpec> {
+    let (id, id_at) = id(t, ROUTE_KEYS, at, &format!("route #{}", i + 1), d);
+    l.id = id_at;
+    let ctx = ctx_of("route", &id, i);
+    unknown_keys(t, ROUTE_KEYS, &ctx, d);
+    let wps = req_points(
+        t,
+        ROUTE_KEYS,
+        "waypoints_m",
+        &ctx,
+        at,
+        d,
+        &mut l.waypoints_key,
+        &mut l.waypoints,
+    );
+    Some(RouteSpec {
+        id: id?,
+        waypoints_m: wps?,
+    })
+}
+
+fn read_area(
+    t: &DeTable<'_>,
+    at: usize,
+    i: usize,
+    d: &mut Diags,
+    l: &mut AreaLoc,
+) -> Option<AreaSpec> {
+    let (id, id_at) = id(t, AREA_KEYS, at, &format!("area #{}", i + 1), d);
+    l.id = id_at;
+    let ctx = ctx_of("area", &id, i);
+    unknown_keys(t, AREA_KEYS, &ctx, d);
+    let min = req_point(t, AREA_KEYS, "min_m", &ctx, at, d, &mut l.min);
+    let max = req_point(t, AREA_KEYS, "max_m", &ctx, at, d, &mut l.max);
+    Some(AreaSpec {
+        id: id?,
+        min_m: min?,
+        max_m: max?,
+    })
 }

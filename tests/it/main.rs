@@ -1,2 +1,4 @@
 //! One integration-test binary (keeps link time down on 2 cores); one module per area.
+
 mod io;
+mod world;

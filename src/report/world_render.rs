@@ -1,0 +1,592 @@
+//! Pictures of a world as SVG: walls, doors (closed solid; open swung, with the swing arc), door
+//! ids, routes with direction arrows, the home pose, walking areas, a scale bar, a title and a
+//! legend; plus overlays other commands add (trajectories, matched pairs).
+//!
+//! Every wall segment is one `<line class="wall">` and every door one element with
+//! `class="door ..."` and `id="door-<id>"`, so tests and scripts can find them.
+
+use crate::geom::{Segment, Vec2};
+use crate::report::svg::{Svg, escape, num};
+use crate::world::{DoorStates, World};
+
+/// A polyline drawn over the world, e.g. a trajectory.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathOverlay {
+    /// Legend text; empty for no legend entry.
+    pub label: String,
+    /// Any SVG colour, e.g. `#d62728`.
+    pub color: String,
+    pub points: Vec<Vec2>,
+    pub dashed: bool,
+}
+
+/// A single segment drawn over the world, e.g. a matched pair of positions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegmentOverlay {
+    pub color: String,
+    pub a: Vec2,
+    pub b: Vec2,
+}
+
+/// An extra legend line (for overlays that carry no label themselves).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegendEntry {
+    pub label: String,
+    pub color: String,
+    pub dashed: bool,
+}
+
+/// What to draw and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// Door states; doors missing from it are closed. Default: all closed.
+    pub doors: DoorStates,
+    /// Title; default: the world's name.
+    pub title: Option<String>,
+    /// Draw the world's routes with direction arrows. Default true.
+    pub show_routes: bool,
+    /// Draw walking areas. Default true.
+    pub show_areas: bool,
+    /// Write door ids beside the doors. Default true.
+    pub show_door_labels: bool,
+    /// Trajectories and other polylines, drawn above the world.
+    pub paths: Vec<PathOverlay>,
+    /// Single segments (matched pairs), drawn above the paths.
+    pub segments: Vec<SegmentOverlay>,
+    /// Extra legend entries.
+    pub legend: Vec<LegendEntry>,
+    /// Pixels per metre; default: fit the world into about 1500 pixels.
+    pub px_per_m: Option<f64>,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            doors: DoorStates::default(),
+            title: None,
+            show_routes: true,
+            show_areas: true,
+            show_door_labels: true,
+            paths: Vec::new(),
+            segments: Vec::new(),
+            legend: Vec::new(),
+            px_per_m: None,
+        }
+    }
+}
+
+const WALL_COLOR: &str = "#222222";
+const DOOR_CLOSED_COLOR: &str = "#a0522d";
+const DOOR_OPEN_COLOR: &str = "#e67e22";
+const ROUTE_COLORS: [&str; 4] = ["#1f77b4", "#2ca02c", "#9467bd", "#17becf"];
+const HOME_COLOR: &str = "#d62728";
+const AREA_FILL: &str = "#f6e7a6";
+const LABEL_COLOR: &str = "#7a3b12";
+
+struct Frame {
+    min: Vec2,
+    max: Vec2,
+    s: f64,
+    left: f64,
+    top: f64,
+}
+
+impl Frame {
+    fn p(&self, v: Vec2) -> (f64, f64) {
+        (
+            self.left + (v.x - self.min.x) * self.s,
+            self.top + (self.max.y - v.y) * self.s,
+        )
+    }
+}
+
+fn nice_length(target_m: f64) -> f64 {
+    let mut best = 1.0;
+    for c in [
+        0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0,
+    ] {
+        if c <= target_m {
+            best = c;
+        }
+    }
+    best
+}
+
+/// Renders `world` as an SVG document.
+pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
+    // Extent of everything drawn.
+    let (mut lo, mut hi) = world.bounds();
+    let mut add = |p: Vec2| {
+        if p.x.is_finite() && p.y.is_finite() {
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+    };
+    if world.walls.is_empty() && world.doors.is_empty() {
+        add(world.home.position());
+    }
+    for r in &world.routes {
+        r.waypoints.iter().for_each(|p| add(*p));
+    }
+    for a in &world.areas {
+        add(a.min);
+        add(a.max);
+    }
+    add(world.home.position());
+    for p in &opts.paths {
+        p.points.iter().for_each(|q| add(*q));
+    }
+    for s in &opts.segments {
+        add(s.a);
+        add(s.b);
+    }
+    let margin_m = 1.0;
+    lo -= Vec2::new(margin_m, margin_m);
+    hi += Vec2::new(margin_m, margin_m);
+    let (w_m, h_m) = ((hi.x - lo.x).max(1.0), (hi.y - lo.y).max(1.0));
+    let s = opts
+        .px_per_m
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or_else(|| (1500.0 / w_m.max(h_m * 1.2)).clamp(2.0, 120.0));
+    let pad = 20.0;
+    let title_h = 56.0;
+    let legend_h = 70.0;
+    let map_w = w_m * s;
+    let map_h = h_m * s;
+    let width = (map_w + 2.0 * pad).max(760.0);
+    let height = title_h + map_h + legend_h + pad;
+    let f = Frame {
+        min: lo,
+        max: hi,
+        s,
+        left: pad + (width - 2.0 * pad - map_w) / 2.0,
+        top: title_h,
+    };
+
+    let mut svg = Svg::new(width, height);
+    let font = (0.55 * s).clamp(9.0, 16.0);
+
+    // Title and subtitle.
+    let title = opts.title.clone().unwrap_or_else(|| world.name.clone());
+    svg.text(
+        (pad, 28.0),
+        &title,
+        r##"font-size="22" font-weight="bold" fill="#111""##,
+    );
+    let n_open = (0..world.doors.len())
+        .filter(|i| opts.doors.is_open(*i))
+        .count();
+    let sub = format!(
+        "{} - {:.0} m x {:.0} m, {} doors ({} open), {} route(s)",
+        world.name,
+        w_m - 2.0 * margin_m,
+        h_m - 2.0 * margin_m,
+        world.doors.len(),
+        n_open,
+        world.routes.len()
+    );
+    svg.text((pad, 47.0), &sub, r##"font-size="13" fill="#555""##);
+
+    // Walking areas.
+    if opts.show_areas && !world.areas.is_empty() {
+        svg.open_group(r#"id="areas""#);
+        for a in &world.areas {
+            let p0 = f.p(Vec2::new(a.min.x, a.max.y));
+            svg.rect(
+                p0.0,
+                p0.1,
+                (a.max.x - a.min.x) * s,
+                (a.max.y - a.min.y) * s,
+                &format!(
+                    r#"class="area" id="area-{}" fill="{AREA_FILL}" fill-opacity="0.7""#,
+                    escape(&a.id)
+                ),
+            );
+        }
+        svg.close_group();
+    }
+
+    // Walls: one line per segment.
+    svg.open_group(&format!(
+        r#"id="walls" stroke="{WALL_COLOR}" stroke-linecap="square""#
+    ));
+    for w in &world.walls {
+        let sw = (w.thickness_m * s).max(2.0);
+        for (k, seg) in w.segments().iter().enumerate() {
+            svg.line(
+                f.p(seg.a),
+                f.p(seg.b),
+                &format!(
+                    r#"class="wall" id="wall-{}-{}" stroke-width="{}""#,
+                    escape(&w.id),
+                    k,
+                    num(sw)
+                ),
+            );
+        }
+    }
+    svg.close_group();
+
+    // Doors: one element each.
+    svg.open_group(r#"id="doors" stroke-linecap="butt""#);
+    for (i, d) in world.doors.iter().enumerate() {
+        let sw = (d.thickness_m * s * 1.5).max(3.0);
+        let closed = d.panel(false);
+        if opts.doors.is_open(i) {
+            let open = d.panel(true);
+            let sweep = crate::geom::wrap_angle(d.open_heading_rad - d.closed_heading_rad);
+            // SVG's y axis points down, so a counter-clockwise turn in the world is clockwise on
+            // screen: sweep-flag 0 for positive world angles.
+            let flag = if sweep > 0.0 { 0 } else { 1 };
+            let r = d.width_m * s;
+            let (a, b) = (f.p(closed.b), f.p(open.b));
+            svg.raw(&format!(
+                r#"<g class="door open" id="door-{id}"><path d="M {ax} {ay} A {r} {r} 0 0 {flag} {bx} {by}" fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3"/><line x1="{hx}" y1="{hy}" x2="{bx}" y2="{by}" stroke="{DOOR_OPEN_COLOR}" stroke-width="{sw}"/></g>"#,
+                id = escape(&d.id),
+                ax = num(a.0),
+                ay = num(a.1),
+                bx = num(b.0),
+                by = num(b.1),
+                r = num(r),
+                hx = num(f.p(d.hinge).0),
+                hy = num(f.p(d.hinge).1),
+                sw = num(sw),
+            ));
+        } else {
+            svg.line(
+                f.p(closed.a),
+                f.p(closed.b),
+                &format!(
+                    r#"class="door closed" id="door-{}" stroke="{DOOR_CLOSED_COLOR}" stroke-width="{}""#,
+                    escape(&d.id),
+                    num(sw)
+                ),
+            );
+        }
+    }
+    svg.close_group();
+
+    // Door ids, inside the room the door opens into.
+    if opts.show_door_labels && !world.doors.is_empty() {
+        svg.open_group(&format!(
+            r#"id="door-labels" font-size="{}" fill="{LABEL_COLOR}" text-anchor="middle""#,
+            num(font)
+        ));
+        for d in &world.doors {
+            let c = d.panel(false);
+            let mid = (c.a + c.b) / 2.0;
+            let into = Vec2::new(d.open_heading_rad.cos(), d.open_heading_rad.sin());
+            // Clear of the open panel and its arc: past the panel's length, plus half the
+            // label's extent in the direction it is pushed.
+            let half_w_m = 0.3 * font * d.id.chars().count() as f64 / s;
+            let half_h_m = 0.5 * font / s;
+            let at =
+                mid + into * (d.width_m + 0.25 + into.x.abs() * half_w_m + into.y.abs() * half_h_m);
+            let p = f.p(at);
+            svg.text((p.0, p.1 + font * 0.35), &d.id, r#"class="door-label""#);
+        }
+        svg.close_group();
+    }
+
+    // Routes with direction arrows.
+    if opts.show_routes {
+        svg.open_group(r#"id="routes""#);
+        for (ri, r) in world.routes.iter().enumerate() {
+            if r.waypoints.len() < 2 {
+                continue;
+            }
+            let color = ROUTE_COLORS[ri % ROUTE_COLORS.len()];
+            // Later routes are shifted a few pixels to the left of travel so that routes
+            // sharing a corridor stay visible side by side.
+            let shifted = offset_loop(&r.waypoints, ri as f64 * 6.0 / s);
+            let pts: Vec<(f64, f64)> = shifted.iter().map(|p| f.p(*p)).collect();
+            let dash = if ri == 0 {
+                ""
+            } else {
+                r#" stroke-dasharray="10 5""#
+            };
+            svg.polyline(
+                &pts,
+                true,
+                &format!(
+                    r#"class="route" id="route-{}" fill="none" stroke="{color}" stroke-width="2" stroke-opacity="0.8"{dash}"#,
+                    escape(&r.id)
+                ),
+            );
+            let n = shifted.len();
+            for k in 0..n {
+                arrows(
+                    &mut svg,
+                    &f,
+                    Segment::new(shifted[k], shifted[(k + 1) % n]),
+                    color,
+                );
+            }
+        }
+        svg.close_group();
+    }
+
+    // Overlays.
+    if !opts.paths.is_empty() {
+        svg.open_group(r#"id="paths" fill="none""#);
+        for p in &opts.paths {
+            let pts: Vec<(f64, f64)> = p.points.iter().map(|q| f.p(*q)).collect();
+            let dash = if p.dashed {
+                r#" stroke-dasharray="6 4""#
+            } else {
+                ""
+            };
+            svg.polyline(
+                &pts,
+                false,
+                &format!(
+                    r#"class="path" stroke="{}" stroke-width="1.5"{dash}"#,
+                    escape(&p.color)
+                ),
+            );
+        }
+        svg.close_group();
+    }
+    if !opts.segments.is_empty() {
+        svg.open_group(r#"id="segments" stroke-width="1" stroke-opacity="0.7""#);
+        for sg in &opts.segments {
+            svg.line(
+                f.p(sg.a),
+                f.p(sg.b),
+                &format!(r#"class="pair" stroke="{}""#, escape(&sg.color)),
+            );
+        }
+        svg.close_group();
+    }
+
+    // Home pose.
+    {
+        let h = world.home;
+        let c = f.p(h.position());
+        let r = (0.25 * s).max(5.0);
+        let tip = f.p(h.position() + Vec2::new(h.theta.cos(), h.theta.sin()) * (0.25 + 0.6));
+        svg.open_group(r#"id="home" class="home""#);
+        svg.circle(
+            c,
+            r,
+            &format!(
+                r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#
+            ),
+        );
+        svg.line(
+            c,
+            tip,
+            &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
+        );
+        svg.close_group();
+    }
+
+    // Scale bar, bottom left.
+    let y0 = title_h + map_h + 22.0;
+    let bar_m = nice_length(180.0 / s);
+    let x0 = pad;
+    svg.open_group(r#"id="scale-bar""#);
+    svg.line(
+        (x0, y0),
+        (x0 + bar_m * s, y0),
+        r##"stroke="#111" stroke-width="3""##,
+    );
+    svg.line(
+        (x0, y0 - 5.0),
+        (x0, y0 + 5.0),
+        r##"stroke="#111" stroke-width="2""##,
+    );
+    svg.line(
+        (x0 + bar_m * s, y0 - 5.0),
+        (x0 + bar_m * s, y0 + 5.0),
+        r##"stroke="#111" stroke-width="2""##,
+    );
+    let label = if bar_m >= 1.0 {
+        format!("{bar_m:.0} m")
+    } else {
+        format!("{bar_m} m")
+    };
+    svg.text(
+        (x0 + bar_m * s / 2.0, y0 + 20.0),
+        &label,
+        r##"font-size="13" text-anchor="middle" fill="#111""##,
+    );
+    svg.close_group();
+
+    // Legend, after the scale bar.
+    legend(
+        &mut svg,
+        world,
+        opts,
+        x0 + bar_m * s + 40.0,
+        y0,
+        width - pad,
+    );
+    svg.finish()
+}
+
+/// A closed loop moved `d` metres to the left of travel (mitred at the corners).
+fn offset_loop(pts: &[Vec2], d: f64) -> Vec<Vec2> {
+    let n = pts.len();
+    if d == 0.0 || n < 2 {
+        return pts.to_vec();
+    }
+    let left = |a: Vec2, b: Vec2| -> Vec2 {
+        let t = b - a;
+        let l = t.norm();
+        if l == 0.0 {
+            Vec2::zeros()
+        } else {
+            Vec2::new(-t.y, t.x) / l
+        }
+    };
+    (0..n)
+        .map(|i| {
+            let n_in = left(pts[(i + n - 1) % n], pts[i]);
+            let n_out = left(pts[i], pts[(i + 1) % n]);
+            let m = n_in + n_out;
+            let c = m.norm_squared();
+            if c < 1e-9 {
+                pts[i] + n_out * d
+            } else {
+                // Mitre: the offset along the bisector that keeps distance d from both legs.
+                pts[i] + m * (2.0 * d / c)
+            }
+        })
+        .collect()
+}
+
+/// Arrowheads along a leg: one every 8 m, at least one at the middle.
+fn arrows(svg: &mut Svg, f: &Frame, leg: Segment, color: &str) {
+    let len = leg.length();
+    if len <= 0.0 {
+        return;
+    }
+    let dir = (leg.b - leg.a) / len;
+    let n = ((len / 8.0).floor() as usize).clamp(1, 1000);
+    let size_px = 9.0;
+    for k in 0..n {
+        let t = (k as f64 + 0.5) / n as f64 * len;
+        let c = f.p(leg.a + dir * t);
+        // Screen direction (y flipped).
+        let (dx, dy) = (dir.x, -dir.y);
+        let (nx, ny) = (-dy, dx);
+        let tip = (c.0 + dx * size_px, c.1 + dy * size_px);
+        let l = (
+            c.0 - dx * size_px * 0.6 + nx * size_px * 0.6,
+            c.1 - dy * size_px * 0.6 + ny * size_px * 0.6,
+        );
+        let r = (
+            c.0 - dx * size_px * 0.6 - nx * size_px * 0.6,
+            c.1 - dy * size_px * 0.6 - ny * size_px * 0.6,
+        );
+        svg.polyline(
+            &[tip, l, r],
+            true,
+            &format!(r#"class="arrow" fill="{color}" stroke="none""#),
+        );
+    }
+}
+
+fn legend(svg: &mut Svg, world: &World, opts: &RenderOptions, x_start: f64, y: f64, x_end: f64) {
+    enum Sym {
+        Line(String, f64, bool),
+        Arc,
+        Home,
+        Area,
+    }
+    let mut entries: Vec<(Sym, String)> = vec![
+        (Sym::Line(WALL_COLOR.into(), 4.0, false), "wall".into()),
+        (
+            Sym::Line(DOOR_CLOSED_COLOR.into(), 4.0, false),
+            "door, closed".into(),
+        ),
+        (Sym::Arc, "door, open (swing arc)".into()),
+    ];
+    if opts.show_routes {
+        for (ri, r) in world.routes.iter().enumerate() {
+            entries.push((
+                Sym::Line(ROUTE_COLORS[ri % ROUTE_COLORS.len()].into(), 2.0, ri > 0),
+                format!("route '{}' ({:.0} m)", r.id, r.length_m()),
+            ));
+        }
+    }
+    entries.push((Sym::Home, "robot home".into()));
+    if opts.show_areas && !world.areas.is_empty() {
+        entries.push((Sym::Area, "walking area".into()));
+    }
+    for p in &opts.paths {
+        if !p.label.is_empty() {
+            entries.push((Sym::Line(p.color.clone(), 2.0, p.dashed), p.label.clone()));
+        }
+    }
+    for l in &opts.legend {
+        entries.push((Sym::Line(l.color.clone(), 2.0, l.dashed), l.label.clone()));
+    }
+    svg.open_group(r##"id="legend" font-size="13" fill="#111""##);
+    let (mut x, mut y) = (x_start, y);
+    for (sym, label) in entries {
+        let w = 34.0 + 7.2 * label.chars().count() as f64 + 18.0;
+        if x + w > x_end && x > x_start {
+            x = x_start;
+            y += 22.0;
+        }
+        match sym {
+            Sym::Line(c, sw, dashed) => {
+                let dash = if dashed {
+                    r#" stroke-dasharray="6 4""#
+                } else {
+                    ""
+                };
+                svg.line(
+                    (x, y),
+                    (x + 26.0, y),
+                    &format!(r#"stroke="{}" stroke-width="{sw}"{dash}"#, escape(&c)),
+                );
+            }
+            Sym::Arc => {
+                svg.path(
+                    &format!(
+                        "M {} {} A 20 20 0 0 0 {} {}",
+                        num(x + 20.0),
+                        num(y + 6.0),
+                        num(x),
+                        num(y - 14.0)
+                    ),
+                    &format!(
+                        r#"fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3""#
+                    ),
+                );
+                svg.line(
+                    (x, y + 6.0),
+                    (x, y - 14.0),
+                    &format!(r#"stroke="{DOOR_OPEN_COLOR}" stroke-width="4""#),
+                );
+            }
+            Sym::Home => {
+                svg.circle(
+                    (x + 8.0, y),
+                    6.0,
+                    &format!(r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#),
+                );
+                svg.line(
+                    (x + 8.0, y),
+                    (x + 22.0, y),
+                    &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
+                );
+            }
+            Sym::Area => {
+                svg.rect(
+                    x,
+                    y - 6.0,
+                    26.0,
+                    12.0,
+                    &format!(r#"fill="{AREA_FILL}" fill-opacity="0.7""#),
+                );
+            }
+        }
+        svg.text((x + 34.0, y + 4.5), &label, "");
+        x += w;
+    }
+    svg.close_group();
+}
