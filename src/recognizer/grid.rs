@@ -12,7 +12,10 @@
 //! walked away fades after a few scans.
 //!
 //! Beams are traced with an integer DDA (one cell per step along the beam's dominant axis, the
-//! other coordinate in 16.16 fixed point) from the sensor cell, and only up to the grid radius.
+//! other coordinate in 16.16 fixed point), only up to the grid radius. Near the sensor, where
+//! neighbouring beams cross the same cells, beams are thinned (see [`LocalGrid::integrate`]):
+//! the cells there are still crossed by the sparser beams, and about a quarter of the cell
+//! visits are saved.
 
 use super::density::{CellState, DensityKernel, RayDeltas, Visited, cell_state};
 use crate::geom::{OdomPose, Pose2};
@@ -183,6 +186,9 @@ impl LocalGrid {
     /// Integrates one scan taken at `odom` (the robot pose; the sensor sits at the layout's
     /// mount). A return within the grid radius marks its cell occupied and the cells before it
     /// free; a no-return beam, or a return beyond the radius, marks free space up to the radius.
+    /// Beam i is traced from the distance where beams 2^(t+1) steps apart (t = trailing zeros of
+    /// i) are half a cell apart: every 16th beam from the sensor, the odd ones from 0.72 m for
+    /// 1° beams and 5 cm cells.
     pub fn integrate(&mut self, odom: &OdomPose, scan: &Scan) {
         let robot = odom.0;
         let (rcx, rcy) = self.cell_of(robot.x, robot.y);
@@ -196,6 +202,7 @@ impl LocalGrid {
             return;
         }
         let n = scan.layout.count.min(scan.ranges_m.len());
+        let step = scan.layout.step_rad.abs();
         // Beam directions by rotation, not a sin_cos per beam (drift over 1000 beams ~1e-13).
         let (mut s, mut c) = (sensor.theta + scan.layout.start_angle_rad).sin_cos();
         let (ds, dc) = scan.layout.step_rad.sin_cos();
@@ -211,9 +218,41 @@ impl LocalGrid {
             } else {
                 (r.min(reach), false)
             };
+            // Near the sensor neighbouring beams pass through the same cells: beam i starts
+            // where beams 2^(t+1) steps apart (t: trailing zeros of i) get more than half a
+            // cell apart, so the cells there are still crossed by the sparser beams.
+            let t = if i == 0 {
+                31
+            } else {
+                i.trailing_zeros().min(31)
+            };
+            let start = if t >= 4 || step <= 0.0 {
+                0.0
+            } else {
+                0.5 * self.cell_m / (step * (1u32 << (t + 1)) as f64)
+            };
             let (ex, ey) = self.cell_of(sensor.x + bc * len, sensor.y + bs * len);
-            self.trace(sx, sy, ex, ey, hit);
+            if start >= len {
+                if hit {
+                    self.mark(ex, ey, true);
+                }
+                continue;
+            }
+            let (bx, by) = if start > 0.0 {
+                self.cell_of(sensor.x + bc * start, sensor.y + bs * start)
+            } else {
+                (sx, sy)
+            };
+            self.trace(bx, by, ex, ey, hit);
         }
+    }
+
+    /// Updates one cell: a beam ended in it (`hit`) or passed it.
+    #[inline]
+    fn mark(&mut self, x: i32, y: i32, hit: bool) {
+        let i = self.index(x, y);
+        let v = (self.cells[i] & 15) as usize;
+        self.cells[i] = if hit { HIT_NEXT[v] } else { FREE_NEXT[v] };
     }
 
     /// Marks the cells from (x0, y0) to (x1, y1) free, the last one occupied when `hit`.
@@ -222,7 +261,8 @@ impl LocalGrid {
         let (dx, dy) = ((x1 - x0) as i64, (y1 - y0) as i64);
         let n = dx.abs().max(dy.abs());
         if n > 0 {
-            let (ix, iy) = ((dx << 16) / n, (dy << 16) / n);
+            let inv = 65536.0 / n as f64;
+            let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
             let mut xf = ((x0 as i64) << 16) + 0x8000;
             let mut yf = ((y0 as i64) << 16) + 0x8000;
             let (shift, mask) = (self.shift, self.mask);
@@ -234,9 +274,7 @@ impl LocalGrid {
                 yf += iy;
             }
         }
-        let i = self.index(x1, y1);
-        let v = (self.cells[i] & 15) as usize;
-        self.cells[i] = if hit { HIT_NEXT[v] } else { FREE_NEXT[v] };
+        self.mark(x1, y1, hit);
     }
 
     /// Free cells the kernel reaches from global cell (cx, cy); `deltas` must be

@@ -36,9 +36,10 @@ struct Entry {
     past: WordId,
     /// Longest chain per level configuration (0 when a word's level is outside it).
     len: [u16; MAX_LEVELS],
-    /// Per configuration, 4 bits: predecessor slot of the current word (2 bits) and of the past
-    /// word (2 bits) of the best chain.
-    back: u16,
+    /// Per configuration, 2 bits: predecessor slot of the current word on the best chain.
+    back_slot: u8,
+    /// Per configuration: index of the best chain's previous pair in that predecessor's memo.
+    back_idx: [u32; MAX_LEVELS],
     /// Bit k: reported in configuration k.
     reported: u8,
 }
@@ -91,10 +92,18 @@ impl WordMatcher {
         })
     }
 
-    /// Adds one observation; returns the matches that became known with it.
+    /// Adds one observation; returns the matches that became known with it. An observation
+    /// whose `run` is later than the current run starts the new run first (as
+    /// [`start_run`](Self::start_run)), so a stored observation stream can be replayed without
+    /// calling it.
     pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
+        let mut out = Vec::new();
+        while obs.run > self.words.run() {
+            out.extend(self.start_run());
+        }
         let closed = self.words.push(obs);
-        self.match_words(&closed)
+        out.extend(self.match_words(&closed));
+        out
     }
 
     /// Closes the current run (its last word is matched) and starts a new one.
@@ -187,11 +196,12 @@ impl WordMatcher {
             }
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
-            let mut back = 0u16;
+            let mut back_slot = 0u8;
+            let mut back_idx = [0u32; MAX_LEVELS];
             for l in len.iter_mut().take(levels).skip(top) {
                 *l = 1;
             }
-            for (pj, &pp) in pw.pred_ids().iter().enumerate() {
+            for &pp in pw.pred_ids() {
                 for (ci, &cp) in c_preds.iter().enumerate() {
                     let (s, idx) = self.lookup[ci][pp as usize];
                     if s != stamp {
@@ -207,8 +217,9 @@ impl WordMatcher {
                     {
                         if el > 0 && el >= *l {
                             *l = el.saturating_add(1);
-                            let shift = 4 * k;
-                            back = (back & !(0xF << shift)) | ((((ci << 2) | pj) as u16) << shift);
+                            let shift = 2 * k;
+                            back_slot = (back_slot & !(3 << shift)) | ((ci as u8) << shift);
+                            back_idx[k] = idx;
                         }
                     }
                 }
@@ -216,17 +227,12 @@ impl WordMatcher {
             entries.push(Entry {
                 past: p,
                 len,
-                back,
+                back_slot,
+                back_idx,
                 reported: 0,
             });
         }
         self.memo.push(entries);
-    }
-
-    fn find(&self, c: WordId, p: WordId) -> Option<usize> {
-        self.memo[c as usize]
-            .binary_search_by_key(&p, |e| e.past)
-            .ok()
     }
 
     /// The pair before (c, p) on the best chain of configuration k.
@@ -234,12 +240,9 @@ impl WordMatcher {
         if entry.len[k] <= 1 {
             return None;
         }
-        let b = (entry.back >> (4 * k)) & 0xF;
-        let (ci, pj) = ((b >> 2) as usize, (b & 3) as usize);
-        let cp = *self.word(c).pred_ids().get(ci)?;
-        let pp = *self.word(entry.past).pred_ids().get(pj)?;
-        let idx = self.find(cp, pp)?;
-        Some((cp, idx))
+        let slot = ((entry.back_slot >> (2 * k)) & 3) as usize;
+        let cp = *self.word(c).pred_ids().get(slot)?;
+        Some((cp, entry.back_idx[k] as usize))
     }
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
@@ -301,30 +304,28 @@ impl WordMatcher {
     /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
     fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
         let obs = self.words.observations();
+        let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
-        let n = cw.size.min(pw.size);
+        let n = cw.size.min(pw.size) as i64;
         let (s2, s1) = (cw.first_obs as i64, pw.first_obs as i64);
-        let run = pw.run;
-        let valid = |j: i64| j >= 0 && (j as usize) < obs.len() && obs[j as usize].run == run;
+        let run = self.words.run_range(pw.run);
+        let (lo, hi) = (run.start as i64, run.end as i64);
+        // For shift d, the i with s1 + i + d inside the past word's run.
+        let overlap = |d: i64| (lo - s1 - d).max(0)..(hi - s1 - d).min(n);
         let dmax = self.params.max_offset as i64;
         // Shifts whose whole window exists come first (Eq. 2 sums over all n observations);
         // near a run's ends, the shifts with the largest overlap.
-        let mut best: Option<(usize, f64, i64)> = None;
+        let mut best: Option<(i64, f64, i64)> = None;
         for m in 0..=2 * dmax {
             let d = if m % 2 == 1 { (m + 1) / 2 } else { -(m / 2) };
-            let mut sum = 0.0;
-            let mut count = 0usize;
-            for i in 0..n as i64 {
-                let j = s1 + i + d;
-                if valid(j) {
-                    let diff = obs[j as usize].psi - obs[(s2 + i) as usize].psi;
-                    sum += diff * diff;
-                    count += 1;
-                }
-            }
-            if count == 0 {
+            let r = overlap(d);
+            let count = r.end - r.start;
+            if count <= 0 {
                 continue;
             }
+            let past = &psi[(s1 + d + r.start) as usize..(s1 + d + r.end) as usize];
+            let cur = &psi[(s2 + r.start) as usize..(s2 + r.end) as usize];
+            let sum = squared_error(past, cur);
             let cost = sum / count as f64;
             let better = match best {
                 None => true,
@@ -335,12 +336,8 @@ impl WordMatcher {
             }
         }
         let Some((_, _, d)) = best else { return };
-        for i in 0..n as i64 {
-            let j = s1 + i + d;
-            if !valid(j) {
-                continue;
-            }
-            let (q, pst) = (&obs[(s2 + i) as usize], &obs[j as usize]);
+        for i in overlap(d) {
+            let (q, pst) = (&obs[(s2 + i) as usize], &obs[(s1 + i + d) as usize]);
             if q.travel_m - pst.travel_m + 1e-9 < self.params.min_gap_m {
                 continue;
             }
@@ -352,4 +349,19 @@ impl WordMatcher {
             });
         }
     }
+}
+
+/// Σ (a − b)², four lanes at a time.
+fn squared_error(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            let d = x[l] - y[l];
+            acc[l] += d * d;
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
+    acc[0] + acc[1] + acc[2] + acc[3] + tail
 }

@@ -179,30 +179,63 @@ pub fn corridor_with_branch(
     ]
 }
 
+/// What interrupts the outer wall of a [`LoopFloor`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Feature {
+    /// A 0.9 m door into a 4 m × 4 m room; open or closed per lap.
+    Door,
+    /// A 2 m wide dead-end side corridor, 6 m deep (a bifurcation).
+    Branch,
+    /// The wall juts 0.6 m into the corridor for 6 m (a cabinet row, a pillar block).
+    Narrowing,
+}
+
 /// A rectangular loop floor: a corridor `corridor_m` wide around a block, centreline
-/// `length_m` × `width_m`, with `rooms` side rooms (4 m × 4 m) behind doors in the outer wall.
-/// `open[i]` says whether door i is open (a closed door is a wall segment in the gap).
+/// `length_m` × `width_m`, with features along the outer wall at given travel positions
+/// (measured along the centreline from the start corner, counter-clockwise).
+#[derive(Clone, Debug, PartialEq)]
 pub struct LoopFloor {
     pub length_m: f64,
     pub width_m: f64,
     pub corridor_m: f64,
-    /// Door centres as travel along the centreline from the start corner, metres.
-    pub doors_at_m: Vec<f64>,
-    pub door_width_m: f64,
+    pub features: Vec<(f64, Feature)>,
 }
 
 impl LoopFloor {
-    /// The 200 m lap used by the benchmarks: 58 m × 42 m centreline, 2 m corridor, 10 doors.
+    /// The 200 m lap used by the benchmarks: 58 m × 42 m centreline, 2 m corridor, 8 doors,
+    /// 3 branches, 4 narrowings.
     pub fn institute() -> Self {
+        use Feature::*;
         LoopFloor {
             length_m: 58.0,
             width_m: 42.0,
             corridor_m: 2.0,
-            doors_at_m: vec![
-                12.0, 30.0, 47.0, 70.0, 85.0, 110.0, 128.0, 150.0, 168.0, 185.0,
+            features: vec![
+                (10.0, Door),
+                (20.0, Narrowing),
+                (33.0, Branch),
+                (45.0, Door),
+                (66.0, Door),
+                (78.0, Narrowing),
+                (90.0, Door),
+                (110.0, Branch),
+                (122.0, Door),
+                (134.0, Door),
+                (146.0, Narrowing),
+                (168.0, Door),
+                (180.0, Branch),
+                (191.0, Door),
+                (196.0, Narrowing),
             ],
-            door_width_m: 0.9,
         }
+    }
+
+    /// Number of doors (the length of the `open` slices).
+    pub fn door_count(&self) -> usize {
+        self.features
+            .iter()
+            .filter(|f| f.1 == Feature::Door)
+            .count()
     }
 
     pub fn lap_length_m(&self) -> f64 {
@@ -227,7 +260,7 @@ impl LoopFloor {
         }
     }
 
-    /// Wall segments with the given doors open.
+    /// Wall segments with the given doors open (`open[i]` for the i-th door along the lap).
     pub fn walls(&self, open: &[bool]) -> Vec<Segment> {
         let h = self.corridor_m / 2.0;
         let (l, w) = (self.length_m, self.width_m);
@@ -238,44 +271,62 @@ impl LoopFloor {
             seg(l - h, w - h, h, w - h),
             seg(h, w - h, h, h),
         ];
-        // Outer wall, side by side, with door gaps; rooms behind the doors.
-        let corners = [
+        let mut door = 0usize;
+        let mut features: Vec<(f64, Feature, bool)> = Vec::new();
+        for &(at, f) in &self.features {
+            let is_open = f == Feature::Door && open.get(door).copied().unwrap_or(false);
+            if f == Feature::Door {
+                door += 1;
+            }
+            features.push((at, f, is_open));
+        }
+        // Outer wall, side by side, interrupted by the features.
+        let sides = [
             (Vec2::new(-h, -h), Vec2::new(l + h, -h), 0.0, l),
             (Vec2::new(l + h, -h), Vec2::new(l + h, w + h), l, w),
             (Vec2::new(l + h, w + h), Vec2::new(-h, w + h), l + w, l),
             (Vec2::new(-h, w + h), Vec2::new(-h, -h), 2.0 * l + w, w),
         ];
-        for (a, b, s0, len) in corners {
+        for (a, b, s0, len) in sides {
             let dir = (b - a) / (b - a).norm();
-            let out = Vec2::new(dir.y, -dir.x); // outward (to the right of travel)
-            let total = (b - a).norm();
-            let mut cuts: Vec<(f64, bool)> = self
-                .doors_at_m
-                .iter()
-                .enumerate()
-                .filter(|(_, d)| **d > s0 && **d < s0 + len)
-                .map(|(i, d)| (*d - s0 + h, open.get(i).copied().unwrap_or(false)))
-                .collect();
-            cuts.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let out = Vec2::new(dir.y, -dir.x); // away from the corridor
+            let at = |t: f64, o: f64| a + dir * t + out * o;
             let mut from = 0.0;
-            for (c, is_open) in cuts {
-                let g0 = c - self.door_width_m / 2.0;
-                let g1 = c + self.door_width_m / 2.0;
-                walls.push(Segment::new(a + dir * from, a + dir * g0));
-                let (p0, p1) = (a + dir * g0, a + dir * g1);
-                if !is_open {
-                    walls.push(Segment::new(p0, p1));
+            for &(pos, f, is_open) in features.iter().filter(|f| f.0 > s0 && f.0 < s0 + len) {
+                let c = pos - s0 + h;
+                let mut push = |p: Vec2, q: Vec2| {
+                    if (q - p).norm() > 1e-9 {
+                        walls.push(Segment::new(p, q));
+                    }
+                };
+                match f {
+                    Feature::Door | Feature::Branch => {
+                        let (gap, half, depth) = if f == Feature::Door {
+                            (0.45, 2.0, 4.0)
+                        } else {
+                            (1.0, 1.0, 6.0)
+                        };
+                        push(at(from, 0.0), at(c - gap, 0.0));
+                        if f == Feature::Door && !is_open {
+                            push(at(c - gap, 0.0), at(c + gap, 0.0));
+                        }
+                        push(at(c - half, 0.0), at(c - gap, 0.0));
+                        push(at(c + gap, 0.0), at(c + half, 0.0));
+                        push(at(c - half, 0.0), at(c - half, depth));
+                        push(at(c + half, 0.0), at(c + half, depth));
+                        push(at(c - half, depth), at(c + half, depth));
+                        from = c + gap;
+                    }
+                    Feature::Narrowing => {
+                        push(at(from, 0.0), at(c - 3.0, 0.0));
+                        push(at(c - 3.0, 0.0), at(c - 3.0, -0.6));
+                        push(at(c - 3.0, -0.6), at(c + 3.0, -0.6));
+                        push(at(c + 3.0, -0.6), at(c + 3.0, 0.0));
+                        from = c + 3.0;
+                    }
                 }
-                // A 4 m × 4 m room centred on the door.
-                let (r0, r1) = (a + dir * (c - 2.0), a + dir * (c + 2.0));
-                walls.push(Segment::new(r0, p0));
-                walls.push(Segment::new(p1, r1));
-                walls.push(Segment::new(r0, r0 + out * 4.0));
-                walls.push(Segment::new(r1, r1 + out * 4.0));
-                walls.push(Segment::new(r0 + out * 4.0, r1 + out * 4.0));
-                from = g1;
             }
-            walls.push(Segment::new(a + dir * from, a + dir * total));
+            walls.push(Segment::new(at(from, 0.0), b));
         }
         walls
     }

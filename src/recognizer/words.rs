@@ -96,6 +96,10 @@ pub struct WordLevels {
     min_word_size: usize,
     levels: usize,
     observations: Vec<Observation>,
+    /// Ψ of each observation, contiguous for the alignment.
+    psi: Vec<f64>,
+    /// Index of the first observation of each run.
+    run_starts: Vec<usize>,
     obs_class: Vec<u8>,
     words: Vec<Word>,
     by_level: [Vec<WordId>; MAX_LEVELS],
@@ -117,6 +121,8 @@ impl WordLevels {
             min_word_size: min_word_size.max(1),
             levels: levels.clamp(1, MAX_LEVELS),
             observations: Vec::new(),
+            psi: Vec::new(),
+            run_starts: vec![0],
             obs_class: Vec::new(),
             words: Vec::new(),
             by_level: Default::default(),
@@ -138,6 +144,7 @@ impl WordLevels {
         let i = self.observations.len();
         let q = self.class_of(obs.psi);
         self.observations.push(*obs);
+        self.psi.push(obs.psi);
         self.obs_class.push(q);
         let Some(mut open) = self.open else {
             self.open = Some(Run {
@@ -205,6 +212,7 @@ impl WordLevels {
     pub fn start_run(&mut self) -> Vec<WordId> {
         let closed = self.finish_run();
         self.run += 1;
+        self.run_starts.push(self.observations.len());
         self.run_first_l0 = self.by_level[0].len();
         self.next_preds.clear();
         closed
@@ -279,6 +287,26 @@ impl WordLevels {
         &self.observations
     }
 
+    /// Ψ of each observation.
+    pub fn psi(&self) -> &[f64] {
+        &self.psi
+    }
+
+    /// Observation indices of run `run` (so far).
+    pub fn run_range(&self, run: usize) -> std::ops::Range<usize> {
+        let lo = self
+            .run_starts
+            .get(run)
+            .copied()
+            .unwrap_or(self.observations.len());
+        let hi = self
+            .run_starts
+            .get(run + 1)
+            .copied()
+            .unwrap_or(self.observations.len());
+        lo..hi
+    }
+
     /// Density class of each observation.
     pub fn observation_classes(&self) -> &[u8] {
         &self.obs_class
@@ -318,6 +346,11 @@ impl WordLevels {
                     .collect()
             })
             .unwrap_or_default()
+    }
+
+    /// Index of the current run (0 for the first).
+    pub fn run(&self) -> usize {
+        self.run
     }
 
     /// Number of word levels built (1..=4).

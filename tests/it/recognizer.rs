@@ -381,6 +381,7 @@ fn runs_break_predecessor_chains() {
     }
     m.finish_run();
     let first_of_run = m.words().level(0).nth(n0).unwrap();
+    assert_eq!(m.words().run(), 1);
     assert_eq!(first_of_run.run, 1);
     assert!(m.words().predecessors(first_of_run.word_ref()).is_empty());
     for w in m.words().all_words() {
@@ -388,6 +389,31 @@ fn runs_break_predecessor_chains() {
             assert_eq!(m.words().word(p).run, w.run);
         }
     }
+}
+
+/// Replaying a stored observation stream splits runs by `Observation::run` by itself, and gives
+/// the same words and matches as explicit `start_run` calls.
+#[test]
+fn replay_splits_runs_by_observation_run() {
+    let cfg = RecognizerConfig::default();
+    let lap = random_stretches(5, 30);
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&lap, 0.1, 1, first.last());
+    let mut explicit = WordMatcher::new(&cfg).unwrap();
+    let mut a = Vec::new();
+    for o in &first {
+        a.extend(explicit.push_observation(o));
+    }
+    a.extend(explicit.start_run());
+    for o in &second {
+        a.extend(explicit.push_observation(o));
+    }
+    a.extend(explicit.finish_run());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (replayed, b) = run_matcher(&cfg, &all);
+    assert!(!a.is_empty());
+    assert_eq!(a, b);
+    assert_eq!(explicit.words().all_words(), replayed.words().all_words());
 }
 
 /// Fine alignment finds the shift that puts the same density profile together.
@@ -415,6 +441,52 @@ fn alignment_recovers_a_shift() {
     assert!(!matches.is_empty());
     for p in matches.iter().flat_map(|m| &m.pairs) {
         assert_eq!(p.query - n, p.past);
+    }
+}
+
+/// One scan into open space marks its field of view free up to 2.5 m but for isolated cells
+/// between 8-connected beam lines beyond 1.4 m, where 1° beams are more than half a cell apart
+/// (under 5 %; the next scans fill them), and nothing behind the sensor.
+#[test]
+fn one_scan_covers_its_field_of_view() {
+    for layout in [
+        synth::lms200(),
+        BeamLayout::centered(361, std::f64::consts::PI, 30.0, Pose2::IDENTITY),
+    ] {
+        let mut g = placewords::recognizer::LocalGrid::new(0.05, 3.0);
+        let pose = Pose2::new(1.02, -0.37, 0.3);
+        let scan = synth::scan_of(&[], pose, &layout, 0.0);
+        g.integrate(&OdomPose(pose), &scan);
+        let sensor = pose.compose(&layout.mount);
+        let (cx, cy) = g.cell_of(sensor.x, sensor.y);
+        let (mut holes, mut cells) = (0, 0);
+        for dy in -60..=60 {
+            for dx in -60..=60 {
+                let (x, y) = (cx + dx, cy + dy);
+                let (px, py) = (
+                    (x as f64 + 0.5) * 0.05 - sensor.x,
+                    (y as f64 + 0.5) * 0.05 - sensor.y,
+                );
+                let d = px.hypot(py);
+                let bearing = placewords::geom::wrap_angle(py.atan2(px) - sensor.theta);
+                if d > 0.1 && d < 2.5 && bearing.abs() < 1.5 {
+                    cells += 1;
+                    if g.state(x, y) != CellState::Free {
+                        holes += 1;
+                    }
+                }
+                let ahead = px * sensor.theta.cos() + py * sensor.theta.sin();
+                if ahead < -0.1 {
+                    assert_eq!(g.state(x, y), CellState::Unknown, "behind the sensor");
+                }
+            }
+        }
+        eprintln!("{} beams: {holes} of {cells} cells unseen", layout.count);
+        assert!(
+            holes * 20 <= cells,
+            "{} beams: {holes} of {cells} cells unseen",
+            layout.count
+        );
     }
 }
 
@@ -501,7 +573,7 @@ fn front_end_corridor_and_bifurcation_with_any_layout() {
 #[test]
 fn whole_recognizer_recognizes_a_second_lap() {
     let floor = synth::LoopFloor::institute();
-    let inputs = floor.lap_inputs(&[false; 10], &synth::lms200());
+    let inputs = floor.lap_inputs(&vec![false; floor.door_count()], &synth::lms200());
     let mut rec = Recognizer::new(RecognizerConfig::default()).unwrap();
     let mut matches = Vec::new();
     for _ in 0..2 {
