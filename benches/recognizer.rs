@@ -1,0 +1,190 @@
+//! Recognizer costs: grid update per scan, density per observation, word building per lap,
+//! matching per lap (1, 2, 3 level configurations × 1, 10, 40 laps of history), and the whole
+//! recognizer per lap. Inputs are synthetic (see `recognizer::synth`); setup is outside the
+//! timed part. Figures and the machine are in BENCHMARKS.md.
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use placewords::geom::OdomPose;
+use placewords::recognizer::synth::{self, LoopFloor, SplitMix};
+use placewords::recognizer::{
+    DensityFrontEnd, DensityKernel, LocalGrid, Observation, Recognizer, RecognizerConfig,
+    WordLevels, WordMatcher,
+};
+use placewords::scan::Scan;
+use std::hint::black_box;
+use std::time::Duration;
+
+const FLOOR_SEED: u64 = 42;
+
+/// One lap of (odometry, scan) on the 200 m loop floor, doors drawn from `seed`.
+fn lap_inputs(seed: u64) -> Vec<(OdomPose, Scan)> {
+    let floor = LoopFloor::institute();
+    let mut r = SplitMix::new(seed);
+    let open: Vec<bool> = (0..floor.door_count()).map(|_| r.unit() < 0.3).collect();
+    floor.lap_inputs(&open, &synth::lms200())
+}
+
+/// `n` consecutive procedural observation laps (~2000 observations each) after `after`.
+fn observation_laps(
+    n: usize,
+    first_seed: u64,
+    after: Option<Observation>,
+) -> Vec<Vec<Observation>> {
+    let mut last = after;
+    (0..n)
+        .map(|i| {
+            let lap = synth::procedural_lap(FLOOR_SEED, first_seed + i as u64, last.as_ref());
+            last = lap.last().copied();
+            lap
+        })
+        .collect()
+}
+
+fn front_end(c: &mut Criterion) {
+    let cfg = RecognizerConfig::default();
+    let inputs = lap_inputs(1);
+    let mut g = c.benchmark_group("front_end");
+    g.measurement_time(Duration::from_secs(3));
+
+    let mut grid = LocalGrid::new(cfg.grid_cell_m, cfg.grid_radius_m);
+    let mut i = 0usize;
+    g.bench_function("grid_update_per_scan_181_beams", |b| {
+        b.iter(|| {
+            let (o, s) = &inputs[i % inputs.len()];
+            grid.integrate(o, s);
+            i += 1;
+        })
+    });
+
+    // A grid as the robot has it in the middle of the lap.
+    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.ray_step_deg);
+    let mut grid = LocalGrid::new(cfg.grid_cell_m, cfg.grid_radius_m);
+    let deltas = kernel.deltas(grid.side());
+    let mid = inputs.len() / 3;
+    for (o, s) in &inputs[mid - 100..mid] {
+        grid.integrate(o, s);
+    }
+    let at = inputs[mid - 1].0.0;
+    g.bench_function("density_per_observation_2.5m_1deg", |b| {
+        b.iter(|| black_box(grid.psi_at(&kernel, &deltas, at.x, at.y)))
+    });
+
+    g.sample_size(10);
+    g.bench_function("front_end_per_lap_5000_scans", |b| {
+        b.iter_batched(
+            || DensityFrontEnd::new(&cfg).unwrap(),
+            |mut fe| {
+                let mut n = 0;
+                for (o, s) in &inputs {
+                    n += fe.push(*o, s).is_some() as usize;
+                }
+                n
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+fn word_building(c: &mut Criterion) {
+    let lap = observation_laps(1, 1, None).remove(0);
+    let mut g = c.benchmark_group("back_end");
+    g.bench_function("word_building_per_lap_3_levels", |b| {
+        b.iter_batched(
+            || WordLevels::new(8, 5, 3),
+            |mut w| {
+                for o in &lap {
+                    black_box(w.push(o));
+                }
+                w
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+fn matching(c: &mut Criterion) {
+    let mut g = c.benchmark_group("matching_per_lap");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(4));
+    let history_max = 40;
+    let laps = observation_laps(history_max + 1, 1, None);
+    for levels in 1..=3 {
+        let cfg = RecognizerConfig {
+            levels,
+            ..Default::default()
+        };
+        for history in [1usize, 10, 40] {
+            let mut m = WordMatcher::new(&cfg).unwrap();
+            for lap in &laps[..history] {
+                for o in lap {
+                    m.push_observation(o);
+                }
+            }
+            // The timed lap continues the last history lap.
+            let next = observation_laps(1, 1000, laps[history - 1].last().copied()).remove(0);
+            g.bench_function(format!("{levels}_levels/{history}_laps_history"), |b| {
+                b.iter_batched(
+                    || m.clone(),
+                    |mut m| {
+                        let mut pairs = 0;
+                        for o in &next {
+                            for mt in m.push_observation(o) {
+                                pairs += mt.pairs.len();
+                            }
+                        }
+                        (m, pairs)
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
+        }
+    }
+    g.finish();
+}
+
+fn whole_recognizer(c: &mut Criterion) {
+    let mut g = c.benchmark_group("recognizer_per_lap");
+    g.sample_size(10);
+    g.measurement_time(Duration::from_secs(5));
+    let cfg = RecognizerConfig::default();
+    let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
+    let mut rec = Recognizer::new(cfg).unwrap();
+    let mut done = 0usize;
+    for history in [1usize, 40] {
+        while done < history {
+            for (o, s) in &laps[done % laps.len()] {
+                rec.push(*o, s);
+            }
+            done += 1;
+        }
+        // Lap inputs restart at the same odometry: the loop is closed in odometry too.
+        let next = &laps[history % laps.len()];
+        g.bench_function(format!("3_levels/{history}_laps_history"), |b| {
+            b.iter_batched(
+                || rec.clone(),
+                |mut r| {
+                    let mut pairs = 0;
+                    for (o, s) in next {
+                        for mt in r.push(*o, s) {
+                            pairs += mt.pairs.len();
+                        }
+                    }
+                    (r, pairs)
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    front_end,
+    word_building,
+    matching,
+    whole_recognizer
+);
+criterion_main!(benches);

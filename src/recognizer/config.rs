@@ -1,0 +1,265 @@
+//! The recognizer's settings: one struct, readable from a scenario's `[recognizer]` table.
+//! Every field has a default (DESIGN.md §5) and a unit.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Settings of the whole recognizer (front end and back end). Missing keys take their default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RecognizerConfig {
+    /// Odometric travel between two observations, metres. Default 0.10.
+    pub observation_spacing_m: f64,
+    /// Side of a local grid cell, metres. Default 0.05.
+    pub grid_cell_m: f64,
+    /// Radius of the local grid around the robot, metres; cells farther away are forgotten.
+    /// Default 3.0.
+    pub grid_radius_m: f64,
+    /// Radius of the density kernel, metres (at most `grid_radius_m`). Default 2.5.
+    pub kernel_radius_m: f64,
+    /// Angle between two density rays, degrees. Default 1.0.
+    pub ray_step_deg: f64,
+    /// Number of uniform density classes over [0, 1]: class = min(floor(classes·Ψ), classes − 1).
+    /// Default 8.
+    pub classes: usize,
+    /// Minimum word size t_o, observations: a shorter run of another class is absorbed by the word
+    /// it interrupts. Default 5.
+    pub min_word_size: usize,
+    /// Size syllables match when |S₁ − S₂| ≤ ratio · max(S₁, S₂). Default 0.25.
+    pub size_tolerance_ratio: f64,
+    /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
+    pub angle_tolerance_deg: f64,
+    /// Number of level configurations searched: 1 = level 0 only, 2 = levels 0-1, 3 = levels 0-2,
+    /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3.
+    pub levels: usize,
+    /// Minimum n-gram size (words) per level configuration: index k applies to configuration
+    /// k + 1. Needs at least `levels` entries. Default [6, 9, 12, 15].
+    pub min_ngram: Vec<usize>,
+    /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
+    pub max_alignment_offset: usize,
+    /// A past word must end at least this much odometric travel before the current n-gram
+    /// begins, metres. Default 20.0.
+    pub min_gap_m: f64,
+}
+
+impl Default for RecognizerConfig {
+    fn default() -> Self {
+        RecognizerConfig {
+            observation_spacing_m: 0.10,
+            grid_cell_m: 0.05,
+            grid_radius_m: 3.0,
+            kernel_radius_m: 2.5,
+            ray_step_deg: 1.0,
+            classes: 8,
+            min_word_size: 5,
+            size_tolerance_ratio: 0.25,
+            angle_tolerance_deg: 30.0,
+            levels: 3,
+            min_ngram: vec![6, 9, 12, 15],
+            max_alignment_offset: 10,
+            min_gap_m: 20.0,
+        }
+    }
+}
+
+/// One invalid setting: the field's name and what is wrong with it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ConfigProblem {
+    pub field: &'static str,
+    /// `what is wrong; what to try`, lowercase.
+    pub problem: String,
+}
+
+impl fmt::Display for ConfigProblem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.field, self.problem)
+    }
+}
+
+/// Largest local grid the recognizer accepts, cells from the centre to the edge.
+pub const MAX_GRID_HALF_CELLS: f64 = 1000.0;
+
+impl RecognizerConfig {
+    /// Every problem of the settings, in field order; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut out = Vec::new();
+        let mut bad =
+            |field: &'static str, problem: String| out.push(ConfigProblem { field, problem });
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.observation_spacing_m) {
+            bad(
+                "observation_spacing_m",
+                format!(
+                    "must be a positive distance, got {}; the default is 0.10",
+                    self.observation_spacing_m
+                ),
+            );
+        }
+        if !positive(self.grid_cell_m) {
+            bad(
+                "grid_cell_m",
+                format!(
+                    "must be a positive size, got {}; the default is 0.05",
+                    self.grid_cell_m
+                ),
+            );
+        }
+        if !positive(self.grid_radius_m) {
+            bad(
+                "grid_radius_m",
+                format!(
+                    "must be a positive radius, got {}; the default is 3.0",
+                    self.grid_radius_m
+                ),
+            );
+        } else if positive(self.grid_cell_m)
+            && self.grid_radius_m / self.grid_cell_m > MAX_GRID_HALF_CELLS
+        {
+            bad(
+                "grid_radius_m",
+                format!(
+                    "{} m is more than {} cells of {} m; use a smaller radius or larger cells",
+                    self.grid_radius_m, MAX_GRID_HALF_CELLS, self.grid_cell_m
+                ),
+            );
+        }
+        if !positive(self.kernel_radius_m) {
+            bad(
+                "kernel_radius_m",
+                format!(
+                    "must be a positive radius, got {}; the default is 2.5",
+                    self.kernel_radius_m
+                ),
+            );
+        } else if self.kernel_radius_m > self.grid_radius_m {
+            bad(
+                "kernel_radius_m",
+                format!(
+                    "{} m is larger than grid_radius_m ({} m); the kernel must fit in the local grid",
+                    self.kernel_radius_m, self.grid_radius_m
+                ),
+            );
+        }
+        if !(positive(self.ray_step_deg) && self.ray_step_deg <= 360.0) {
+            bad(
+                "ray_step_deg",
+                format!(
+                    "must be in (0, 360], got {}; the default is 1.0",
+                    self.ray_step_deg
+                ),
+            );
+        }
+        if self.classes == 0 || self.classes > 255 {
+            bad(
+                "classes",
+                format!(
+                    "must be between 1 and 255, got {}; the default is 8",
+                    self.classes
+                ),
+            );
+        }
+        if self.min_word_size == 0 {
+            bad(
+                "min_word_size",
+                "must be at least 1 observation; the default is 5".to_string(),
+            );
+        }
+        if !(self.size_tolerance_ratio.is_finite()
+            && (0.0..1.0).contains(&self.size_tolerance_ratio))
+        {
+            bad(
+                "size_tolerance_ratio",
+                format!(
+                    "must be in [0, 1), got {}; the default is 0.25",
+                    self.size_tolerance_ratio
+                ),
+            );
+        }
+        if !(self.angle_tolerance_deg.is_finite()
+            && (0.0..=180.0).contains(&self.angle_tolerance_deg))
+        {
+            bad(
+                "angle_tolerance_deg",
+                format!(
+                    "must be in [0, 180], got {}; the default is 30",
+                    self.angle_tolerance_deg
+                ),
+            );
+        }
+        if !(1..=4).contains(&self.levels) {
+            bad(
+                "levels",
+                format!(
+                    "must be 1, 2, 3 or 4, got {}; the default is 3",
+                    self.levels
+                ),
+            );
+        }
+        if self.min_ngram.len() < self.levels.min(4) {
+            bad(
+                "min_ngram",
+                format!(
+                    "has {} entries but levels = {} needs one per level configuration; e.g. [6, 9, 12, 15]",
+                    self.min_ngram.len(),
+                    self.levels
+                ),
+            );
+        } else if self
+            .min_ngram
+            .iter()
+            .take(self.levels)
+            .any(|&n| n == 0 || n > 10_000)
+        {
+            bad(
+                "min_ngram",
+                "every size must be between 1 and 10000 words".to_string(),
+            );
+        }
+        if !(self.min_gap_m.is_finite() && self.min_gap_m >= 0.0) {
+            bad(
+                "min_gap_m",
+                format!(
+                    "must be a distance of at least 0, got {}; the default is 20",
+                    self.min_gap_m
+                ),
+            );
+        }
+        out
+    }
+
+    /// `Ok` when the settings are usable, else every problem.
+    pub fn validate(&self) -> Result<(), RecognizerError> {
+        let problems = self.problems();
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(RecognizerError::InvalidConfig(problems))
+        }
+    }
+
+    /// Density class of Ψ: min(floor(classes·Ψ), classes − 1).
+    pub fn class_of(&self, psi: f64) -> u8 {
+        let c = (psi * self.classes as f64).floor();
+        (c.max(0.0) as usize).min(self.classes - 1) as u8
+    }
+
+    /// Kernel radius in grid cells (rounded).
+    pub fn kernel_radius_cells(&self) -> usize {
+        (self.kernel_radius_m / self.grid_cell_m).round() as usize
+    }
+}
+
+/// Why a recognizer could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum RecognizerError {
+    #[error("invalid recognizer settings: {}", join(.0))]
+    InvalidConfig(Vec<ConfigProblem>),
+}
+
+fn join(problems: &[ConfigProblem]) -> String {
+    problems
+        .iter()
+        .map(|p| p.to_string())
+        .collect::<Vec<_>>()
+        .join("; ")
+}

@@ -1,0 +1,358 @@
+//! Free-space density Ψ of a cell (paper Eq. 1, as the authors' code computes it).
+//!
+//! From the cell, a ray is cast every `ray_step`; each ray starts at the cell's integer
+//! coordinates and advances one cell per step along its dominant axis (the other coordinate moves
+//! by tan of the angle and is floored), for floor(max(|cos|, |sin|)·W) + 1 steps, W being the
+//! kernel radius in cells. A free cell counts once (the first time any ray reaches it), an
+//! unknown cell is skipped but does not stop the ray, an occupied cell stops it. The count is
+//! divided by the same count on an all-free window, so Ψ ∈ [0, 1].
+//!
+//! The ray cell offsets are computed once per kernel and turned into index steps for the array
+//! they read; counting "once" uses a stamp array instead of clearing marks between queries.
+
+/// What a grid knows about a cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CellState {
+    Unknown,
+    Free,
+    Occupied,
+}
+
+/// Cell values shared by every grid the kernel reads: 0 unknown, 1..=7 free, 8..=15 occupied
+/// (the local grid keeps a small evidence counter in that range).
+pub const CELL_UNKNOWN: u8 = 0;
+/// Smallest value of an occupied cell.
+pub const CELL_OCCUPIED_FROM: u8 = 8;
+
+/// The state a cell value encodes.
+#[inline(always)]
+pub fn cell_state(v: u8) -> CellState {
+    if v == CELL_UNKNOWN {
+        CellState::Unknown
+    } else if v >= CELL_OCCUPIED_FROM {
+        CellState::Occupied
+    } else {
+        CellState::Free
+    }
+}
+
+/// A value encoding `state`.
+pub fn cell_value(state: CellState) -> u8 {
+    match state {
+        CellState::Unknown => CELL_UNKNOWN,
+        CellState::Free => 1,
+        CellState::Occupied => 15,
+    }
+}
+
+/// "Seen by this query" marks without clearing: a cell is marked when its stamp equals the
+/// current one (one byte per cell, so marks and cells stay in the L1 cache).
+#[derive(Clone, Debug, Default)]
+pub struct Visited {
+    stamps: Vec<u8>,
+    current: u8,
+}
+
+impl Visited {
+    /// Starts a new query over keys `0..len`.
+    fn begin(&mut self, len: usize) {
+        if self.stamps.len() < len {
+            self.stamps.resize(len, 0);
+        }
+        self.current = self.current.wrapping_add(1);
+        if self.current == 0 {
+            self.stamps.fill(0);
+            self.current = 1;
+        }
+    }
+}
+
+/// Precomputed rays of a density kernel.
+#[derive(Clone, Debug)]
+pub struct DensityKernel {
+    radius_cells: usize,
+    /// Cell offsets of every ray, one ray after the other.
+    offsets: Vec<(i16, i16)>,
+    /// Ray `r` is `offsets[ray_starts[r]..ray_starts[r + 1]]`.
+    ray_starts: Vec<usize>,
+    /// Free cells an all-free window yields (the normaliser).
+    full_count: u32,
+}
+
+/// A kernel's rays as index steps in a row-major cell array of some row stride.
+#[derive(Clone, Debug, Default)]
+pub struct RayDeltas {
+    stride: isize,
+    deltas: Vec<isize>,
+    ray_starts: Vec<usize>,
+}
+
+impl DensityKernel {
+    /// A kernel of `radius_cells` with a ray every `ray_step_deg` degrees, starting at 0°.
+    pub fn new(radius_cells: usize, ray_step_deg: f64) -> Self {
+        let step = ray_step_deg.clamp(1e-3, 360.0);
+        let n_rays = ((360.0 / step) - 1e-9).ceil().max(1.0) as usize;
+        let w = radius_cells as f64;
+        let mut offsets = Vec::new();
+        let mut ray_starts = Vec::with_capacity(n_rays + 1);
+        for i in 0..n_rays {
+            ray_starts.push(offsets.len());
+            let a = (i as f64 * step).to_radians();
+            let (s, c) = a.sin_cos();
+            let dmax = c.abs().max(s.abs());
+            let (dx, dy) = (c / dmax, s / dmax);
+            let steps = (dmax * w + 1e-9).floor() as i64;
+            for k in 0..=steps {
+                let kf = k as f64;
+                // The authors accumulate in f32 from an integer start: a drift of a few 1e-7
+                // cells never crosses a cell border there, so absorb it here too.
+                let ox = (kf * dx + 1e-6).floor() as i16;
+                let oy = (kf * dy + 1e-6).floor() as i16;
+                offsets.push((ox, oy));
+            }
+        }
+        ray_starts.push(offsets.len());
+        let mut kernel = DensityKernel {
+            radius_cells,
+            offsets,
+            ray_starts,
+            full_count: 1,
+        };
+        let mut free = DenseGrid::new(1, 1, CellState::Free);
+        free.set_pad(radius_cells + 1, CellState::Free);
+        let deltas = kernel.deltas(free.stride());
+        let base = free.base(0, 0);
+        kernel.full_count = kernel
+            .count_free_at(
+                &deltas,
+                &free.cells,
+                base,
+                usize::MAX,
+                &mut Visited::default(),
+            )
+            .max(1);
+        kernel
+    }
+
+    pub fn radius_cells(&self) -> usize {
+        self.radius_cells
+    }
+
+    /// Number of rays.
+    pub fn ray_count(&self) -> usize {
+        self.ray_starts.len() - 1
+    }
+
+    /// Free cells counted on an all-free window.
+    pub fn full_count(&self) -> u32 {
+        self.full_count
+    }
+
+    /// Cell offsets (x, y) of ray `r`, from the centre outward.
+    pub fn ray(&self, r: usize) -> &[(i16, i16)] {
+        &self.offsets[self.ray_starts[r]..self.ray_starts[r + 1]]
+    }
+
+    /// The rays as index steps in a row-major array whose rows are `stride` cells apart.
+    pub fn deltas(&self, stride: usize) -> RayDeltas {
+        let stride = stride as isize;
+        RayDeltas {
+            stride,
+            deltas: self
+                .offsets
+                .iter()
+                .map(|&(ox, oy)| oy as isize * stride + ox as isize)
+                .collect(),
+            ray_starts: self.ray_starts.clone(),
+        }
+    }
+
+    /// Free cells reached from the cell at index `base` of a row-major array of cell values
+    /// (see [`CELL_UNKNOWN`], [`CELL_OCCUPIED_FROM`]); indices are `(base + delta) & mask`
+    /// (`usize::MAX` for a plain array, side² − 1 for a power-of-two torus). The numerator of Ψ;
+    /// every grid the recognizer or the oracle test uses goes through here.
+    pub fn count_free_at(
+        &self,
+        deltas: &RayDeltas,
+        cells: &[u8],
+        base: usize,
+        mask: usize,
+        visited: &mut Visited,
+    ) -> u32 {
+        visited.begin(cells.len());
+        let stamp = visited.current;
+        let stamps = &mut visited.stamps[..cells.len()];
+        let mut count = 0u32;
+        for r in 0..deltas.ray_starts.len() - 1 {
+            for &d in &deltas.deltas[deltas.ray_starts[r]..deltas.ray_starts[r + 1]] {
+                let i = (base as isize).wrapping_add(d) as usize & mask;
+                let v = cells[i];
+                if v >= CELL_OCCUPIED_FROM {
+                    break;
+                }
+                if v != CELL_UNKNOWN && stamps[i] != stamp {
+                    stamps[i] = stamp;
+                    count += 1;
+                }
+            }
+        }
+        count
+    }
+
+    /// Ψ from a free-cell count, in [0, 1].
+    pub fn psi_of_count(&self, count: u32) -> f64 {
+        (count as f64 / self.full_count as f64).min(1.0)
+    }
+}
+
+impl RayDeltas {
+    /// Row stride the deltas were made for.
+    pub fn stride(&self) -> usize {
+        self.stride as usize
+    }
+}
+
+/// A fixed rectangular grid of cell states, x to the right and y up, cell (0, 0) at the bottom
+/// left. Cells outside it are unknown (queries copy it with a margin of unknown cells as wide as
+/// the kernel, so rays never leave the array).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DenseGrid {
+    pub width: usize,
+    pub height: usize,
+    pad: usize,
+    /// Row-major from y = −pad upward, `width + 2·pad` per row.
+    cells: Vec<u8>,
+}
+
+impl DenseGrid {
+    pub fn new(width: usize, height: usize, fill: CellState) -> Self {
+        DenseGrid {
+            width,
+            height,
+            pad: 0,
+            cells: vec![cell_value(fill); width * height],
+        }
+    }
+
+    fn stride(&self) -> usize {
+        self.width + 2 * self.pad
+    }
+
+    /// Grows the margin to `pad` cells (filled with `fill`).
+    fn set_pad(&mut self, pad: usize, fill: CellState) {
+        if pad == self.pad {
+            return;
+        }
+        let stride = self.width + 2 * pad;
+        let mut cells = vec![cell_value(fill); stride * (self.height + 2 * pad)];
+        for y in 0..self.height {
+            for x in 0..self.width {
+                cells[(y + pad) * stride + x + pad] = self.cells[self.index(x, y)];
+            }
+        }
+        self.cells = cells;
+        self.pad = pad;
+    }
+
+    fn index(&self, x: usize, y: usize) -> usize {
+        (y + self.pad) * self.stride() + x + self.pad
+    }
+
+    fn base(&self, x: usize, y: usize) -> usize {
+        self.index(x, y)
+    }
+
+    pub fn get(&self, x: i32, y: i32) -> CellState {
+        if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 {
+            return CellState::Unknown;
+        }
+        cell_state(self.cells[self.index(x as usize, y as usize)])
+    }
+
+    pub fn set(&mut self, x: usize, y: usize, state: CellState) {
+        let i = self.index(x, y);
+        self.cells[i] = cell_value(state);
+    }
+
+    /// Ψ of every free cell (`None` elsewhere), row-major from y = 0.
+    pub fn density_map(&self, kernel: &DensityKernel) -> Vec<Option<f64>> {
+        let mut padded = self.clone();
+        padded.set_pad(kernel.radius_cells() + 1, CellState::Unknown);
+        let deltas = kernel.deltas(padded.stride());
+        let mut visited = Visited::default();
+        let mut out = Vec::with_capacity(self.width * self.height);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let base = padded.base(x, y);
+                out.push(match cell_state(padded.cells[base]) {
+                    CellState::Free => {
+                        let n = kernel.count_free_at(
+                            &deltas,
+                            &padded.cells,
+                            base,
+                            usize::MAX,
+                            &mut visited,
+                        );
+                        Some(kernel.psi_of_count(n))
+                    }
+                    _ => None,
+                });
+            }
+        }
+        out
+    }
+
+    /// Ψ of cell (x, y).
+    pub fn psi(&self, kernel: &DensityKernel, x: usize, y: usize) -> f64 {
+        let mut padded = self.clone();
+        padded.set_pad(kernel.radius_cells() + 1, CellState::Unknown);
+        let deltas = kernel.deltas(padded.stride());
+        let base = padded.base(x, y);
+        let n = kernel.count_free_at(
+            &deltas,
+            &padded.cells,
+            base,
+            usize::MAX,
+            &mut Visited::default(),
+        );
+        kernel.psi_of_count(n)
+    }
+}
+
+/// Ψ of cell (x, y) of `grid` with a kernel of `radius_cells` and a ray every `ray_step_deg`
+/// degrees (builds the kernel; reuse a [`DensityKernel`] and [`DenseGrid::density_map`] for
+/// many queries).
+pub fn density(
+    grid: &DenseGrid,
+    x: usize,
+    y: usize,
+    radius_cells: usize,
+    ray_step_deg: f64,
+) -> f64 {
+    grid.psi(&DensityKernel::new(radius_cells, ray_step_deg), x, y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_free_gives_one_and_walls_lower_it() {
+        let k = DensityKernel::new(10, 1.0);
+        let mut g = DenseGrid::new(41, 41, CellState::Free);
+        assert!((g.psi(&k, 20, 20) - 1.0).abs() < 1e-12);
+        for x in 0..41 {
+            g.set(x, 23, CellState::Occupied);
+            g.set(x, 17, CellState::Occupied);
+        }
+        let psi = g.psi(&k, 20, 20);
+        assert!(psi > 0.05 && psi < 0.5, "corridor psi {psi}");
+    }
+
+    #[test]
+    fn unknown_cells_do_not_count_nor_stop() {
+        let k = DensityKernel::new(10, 1.0);
+        let g = DenseGrid::new(41, 41, CellState::Unknown);
+        assert_eq!(g.psi(&k, 20, 20), 0.0);
+    }
+}

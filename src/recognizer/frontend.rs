@@ -1,0 +1,109 @@
+//! Front end: odometry poses and scans → the stream of density observations.
+//!
+//! Every scan is integrated into the local grid; each time the odometric travel passes the next
+//! multiple of `observation_spacing_m` (counted from the start of the run), Ψ is computed at the
+//! robot's cell and an [`Observation`] is made. At most one observation per scan: when a scan
+//! comes after a long jump, the multiples it skipped are dropped.
+
+use super::config::{RecognizerConfig, RecognizerError};
+use super::density::{DensityKernel, RayDeltas};
+use super::grid::LocalGrid;
+use super::types::Observation;
+use crate::geom::OdomPose;
+use crate::scan::Scan;
+
+/// Local grid + density: makes observations from odometry and scans.
+#[derive(Clone, Debug)]
+pub struct DensityFrontEnd {
+    spacing_m: f64,
+    grid: LocalGrid,
+    kernel: DensityKernel,
+    deltas: RayDeltas,
+    last_odom: Option<OdomPose>,
+    travel_m: f64,
+    next_obs_travel_m: f64,
+    run: usize,
+    inputs: usize,
+    next_id: usize,
+}
+
+impl DensityFrontEnd {
+    pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
+        config.validate()?;
+        let grid = LocalGrid::new(config.grid_cell_m, config.grid_radius_m);
+        let kernel = DensityKernel::new(config.kernel_radius_cells(), config.ray_step_deg);
+        Ok(DensityFrontEnd {
+            spacing_m: config.observation_spacing_m,
+            deltas: kernel.deltas(grid.side()),
+            grid,
+            kernel,
+            last_odom: None,
+            travel_m: 0.0,
+            next_obs_travel_m: config.observation_spacing_m,
+            run: 0,
+            inputs: 0,
+            next_id: 0,
+        })
+    }
+
+    /// Integrates one scan taken at `odom`; returns the observation it made, if any.
+    pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Option<Observation> {
+        let input_index = self.inputs;
+        self.inputs += 1;
+        if let Some(last) = self.last_odom {
+            let step = last.0.distance(&odom.0);
+            if step.is_finite() {
+                self.travel_m += step;
+            }
+        }
+        self.last_odom = Some(odom);
+        self.grid.integrate(&odom, scan);
+        if self.travel_m + 1e-9 < self.next_obs_travel_m {
+            return None;
+        }
+        while self.next_obs_travel_m <= self.travel_m + 1e-9 {
+            self.next_obs_travel_m += self.spacing_m;
+        }
+        let psi = self
+            .grid
+            .psi_at(&self.kernel, &self.deltas, odom.0.x, odom.0.y);
+        let obs = Observation {
+            id: self.next_id,
+            run: self.run,
+            input_index,
+            odom_pose: odom,
+            travel_m: self.travel_m,
+            psi,
+        };
+        self.next_id += 1;
+        Some(obs)
+    }
+
+    /// Starts a new run: the grid is cleared and the jump to the new start is not travel.
+    pub fn start_run(&mut self) {
+        self.run += 1;
+        self.grid.clear();
+        self.last_odom = None;
+        self.next_obs_travel_m = self.travel_m + self.spacing_m;
+    }
+
+    /// The local grid (for plots and tests).
+    pub fn grid(&self) -> &LocalGrid {
+        &self.grid
+    }
+
+    /// The density kernel in use.
+    pub fn kernel(&self) -> &DensityKernel {
+        &self.kernel
+    }
+
+    /// Odometric travel so far, metres.
+    pub fn travel_m(&self) -> f64 {
+        self.travel_m
+    }
+
+    /// Index of the current run (0 for the first).
+    pub fn run(&self) -> usize {
+        self.run
+    }
+}

@@ -1,0 +1,300 @@
+//! The local occupancy grid around the robot, in the odometry frame.
+//!
+//! A square window of 2ⁿ × 2ⁿ cells stored as a torus: global cell (x, y) lives at index
+//! (y·2ⁿ + x) mod 4ⁿ, which is one-to-one inside any 2ⁿ × 2ⁿ window and lets the density kernel
+//! read it with constant index steps. When the robot moves to another cell the window scrolls
+//! with it: the cells that leave it are cleared, so everything farther than about
+//! `grid_radius_m` from the robot is forgotten.
+//!
+//! Each cell holds a small counter: 0 unknown, 1..=7 free, 8..=15 occupied. A beam passing a cell
+//! lowers it by one (a first pass makes it 4, free); a beam ending in it raises it by three (a
+//! first hit makes it 11, occupied). A wall cell grazed by a few beams stays a wall, a person who
+//! walked away fades after a few scans.
+//!
+//! Beams are traced with an integer DDA (one cell per step along the beam's dominant axis, the
+//! other coordinate in 16.16 fixed point), only up to the grid radius. Near the sensor, where
+//! neighbouring beams cross the same cells, beams are thinned (see [`LocalGrid::integrate`]):
+//! the cells there are still crossed by the sparser beams, and about a quarter of the cell
+//! visits are saved.
+
+use super::density::{CellState, DensityKernel, RayDeltas, Visited, cell_state};
+use crate::geom::{OdomPose, Pose2};
+use crate::scan::Scan;
+
+const fn free_next() -> [u8; 16] {
+    let mut t = [0u8; 16];
+    let mut v = 0;
+    while v < 16 {
+        t[v] = if v == 0 {
+            4
+        } else if v > 1 {
+            v as u8 - 1
+        } else {
+            1
+        };
+        v += 1;
+    }
+    t
+}
+
+const fn hit_next() -> [u8; 16] {
+    let mut t = [0u8; 16];
+    let mut v = 0;
+    while v < 16 {
+        t[v] = if v == 0 {
+            11
+        } else if v + 3 > 15 {
+            15
+        } else {
+            v as u8 + 3
+        };
+        v += 1;
+    }
+    t
+}
+
+/// Counter after a beam passes the cell.
+const FREE_NEXT: [u8; 16] = free_next();
+/// Counter after a beam ends in the cell.
+const HIT_NEXT: [u8; 16] = hit_next();
+
+/// floor(v) as i32 without a libm call (v well inside the i32 range).
+#[inline(always)]
+fn floor_i32(v: f64) -> i32 {
+    let t = v as i32;
+    if (t as f64) > v { t - 1 } else { t }
+}
+
+/// The rolling local grid.
+#[derive(Clone, Debug)]
+pub struct LocalGrid {
+    cell_m: f64,
+    radius_m: f64,
+    /// log2 of the side.
+    shift: u32,
+    /// side² − 1.
+    mask: usize,
+    cells: Vec<u8>,
+    /// Global cell coordinates of the window's lowest corner.
+    origin: (i32, i32),
+    half: i32,
+    has_origin: bool,
+    visited: Visited,
+}
+
+impl LocalGrid {
+    /// A grid of `cell_m` cells keeping everything within `radius_m` of the robot.
+    pub fn new(cell_m: f64, radius_m: f64) -> Self {
+        let half = (radius_m / cell_m).ceil() as i32 + 2;
+        let side = ((2 * half + 1) as u32).next_power_of_two() as usize;
+        LocalGrid {
+            cell_m,
+            radius_m,
+            shift: side.trailing_zeros(),
+            mask: side * side - 1,
+            cells: vec![0; side * side],
+            origin: (0, 0),
+            half: side as i32 / 2,
+            has_origin: false,
+            visited: Visited::default(),
+        }
+    }
+
+    /// Side of the window, cells.
+    pub fn side(&self) -> usize {
+        1 << self.shift
+    }
+
+    /// Forgets everything.
+    pub fn clear(&mut self) {
+        self.cells.fill(0);
+        self.has_origin = false;
+    }
+
+    /// Global cell of a point of the odometry frame.
+    #[inline]
+    pub fn cell_of(&self, x: f64, y: f64) -> (i32, i32) {
+        (floor_i32(x / self.cell_m), floor_i32(y / self.cell_m))
+    }
+
+    #[inline(always)]
+    fn index(&self, x: i32, y: i32) -> usize {
+        (((y as i64) << self.shift) + x as i64) as usize & self.mask
+    }
+
+    fn inside(&self, x: i32, y: i32) -> bool {
+        let side = self.side() as i32;
+        self.has_origin
+            && x >= self.origin.0
+            && y >= self.origin.1
+            && x < self.origin.0 + side
+            && y < self.origin.1 + side
+    }
+
+    /// State of global cell (x, y) (unknown outside the window).
+    pub fn state(&self, x: i32, y: i32) -> CellState {
+        if !self.inside(x, y) {
+            return CellState::Unknown;
+        }
+        cell_state(self.cells[self.index(x, y)])
+    }
+
+    /// Scrolls the window so that it is centred on global cell (cx, cy), clearing what leaves it.
+    pub fn recenter(&mut self, cx: i32, cy: i32) {
+        let side = self.side() as i32;
+        let new_origin = (cx - self.half, cy - self.half);
+        if !self.has_origin {
+            self.origin = new_origin;
+            self.has_origin = true;
+            return;
+        }
+        let (ox, oy) = self.origin;
+        let (nx, ny) = new_origin;
+        if (nx, ny) == (ox, oy) {
+            return;
+        }
+        if (nx - ox).abs() >= side || (ny - oy).abs() >= side {
+            self.cells.fill(0);
+            self.origin = new_origin;
+            return;
+        }
+        let leaving_cols = if nx > ox {
+            ox..nx
+        } else {
+            nx + side..ox + side
+        };
+        for x in leaving_cols {
+            for y in oy..oy + side {
+                let i = self.index(x, y);
+                self.cells[i] = 0;
+            }
+        }
+        let leaving_rows = if ny > oy {
+            oy..ny
+        } else {
+            ny + side..oy + side
+        };
+        for y in leaving_rows {
+            for x in ox..ox + side {
+                let i = self.index(x, y);
+                self.cells[i] = 0;
+            }
+        }
+        self.origin = new_origin;
+    }
+
+    /// Integrates one scan taken at `odom` (the robot pose; the sensor sits at the layout's
+    /// mount). A return within the grid radius marks its cell occupied and the cells before it
+    /// free; a no-return beam, or a return beyond the radius, marks free space up to the radius.
+    /// Beam i is traced from the distance where beams 2^(t+1) steps apart (t = trailing zeros of
+    /// i) are half a cell apart: every 16th beam from the sensor, the odd ones from 0.72 m for
+    /// 1° beams and 5 cm cells.
+    pub fn integrate(&mut self, odom: &OdomPose, scan: &Scan) {
+        let robot = odom.0;
+        let (rcx, rcy) = self.cell_of(robot.x, robot.y);
+        self.recenter(rcx, rcy);
+        let mount = &scan.layout.mount;
+        let sensor: Pose2 = robot.compose(mount);
+        // Keep every traced cell within the radius of the robot, hence inside the window.
+        let reach = (self.radius_m - mount.x.hypot(mount.y)).max(0.0);
+        let (sx, sy) = self.cell_of(sensor.x, sensor.y);
+        if !self.inside(sx, sy) {
+            return;
+        }
+        let n = scan.layout.count.min(scan.ranges_m.len());
+        let step = scan.layout.step_rad.abs();
+        // Beam directions by rotation, not a sin_cos per beam (drift over 1000 beams ~1e-13).
+        let (mut s, mut c) = (sensor.theta + scan.layout.start_angle_rad).sin_cos();
+        let (ds, dc) = scan.layout.step_rad.sin_cos();
+        for i in 0..n {
+            let r = scan.ranges_m[i];
+            let (bs, bc) = (s, c);
+            (s, c) = (s * dc + c * ds, c * dc - s * ds);
+            if r.is_nan() || r <= 0.0 {
+                continue;
+            }
+            let (len, hit) = if scan.is_hit(i) && r <= reach {
+                (r, true)
+            } else {
+                (r.min(reach), false)
+            };
+            // Near the sensor neighbouring beams pass through the same cells: beam i starts
+            // where beams 2^(t+1) steps apart (t: trailing zeros of i) get more than half a
+            // cell apart, so the cells there are still crossed by the sparser beams.
+            let t = if i == 0 {
+                31
+            } else {
+                i.trailing_zeros().min(31)
+            };
+            let start = if t >= 4 || step <= 0.0 {
+                0.0
+            } else {
+                0.5 * self.cell_m / (step * (1u32 << (t + 1)) as f64)
+            };
+            let (ex, ey) = self.cell_of(sensor.x + bc * len, sensor.y + bs * len);
+            if start >= len {
+                if hit {
+                    self.mark(ex, ey, true);
+                }
+                continue;
+            }
+            let (bx, by) = if start > 0.0 {
+                self.cell_of(sensor.x + bc * start, sensor.y + bs * start)
+            } else {
+                (sx, sy)
+            };
+            self.trace(bx, by, ex, ey, hit);
+        }
+    }
+
+    /// Updates one cell: a beam ended in it (`hit`) or passed it.
+    #[inline]
+    fn mark(&mut self, x: i32, y: i32, hit: bool) {
+        let i = self.index(x, y);
+        let v = (self.cells[i] & 15) as usize;
+        self.cells[i] = if hit { HIT_NEXT[v] } else { FREE_NEXT[v] };
+    }
+
+    /// Marks the cells from (x0, y0) to (x1, y1) free, the last one occupied when `hit`.
+    #[inline]
+    fn trace(&mut self, x0: i32, y0: i32, x1: i32, y1: i32, hit: bool) {
+        let (dx, dy) = ((x1 - x0) as i64, (y1 - y0) as i64);
+        let n = dx.abs().max(dy.abs());
+        if n > 0 {
+            let inv = 65536.0 / n as f64;
+            let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
+            let mut xf = ((x0 as i64) << 16) + 0x8000;
+            let mut yf = ((y0 as i64) << 16) + 0x8000;
+            let (shift, mask) = (self.shift, self.mask);
+            let cells = &mut self.cells[..];
+            for _ in 0..n {
+                let i = (((yf >> 16) << shift) + (xf >> 16)) as usize & mask;
+                cells[i] = FREE_NEXT[(cells[i] & 15) as usize];
+                xf += ix;
+                yf += iy;
+            }
+        }
+        self.mark(x1, y1, hit);
+    }
+
+    /// Free cells the kernel reaches from global cell (cx, cy); `deltas` must be
+    /// `kernel.deltas(self.side())`.
+    pub fn count_free(
+        &mut self,
+        kernel: &DensityKernel,
+        deltas: &RayDeltas,
+        cx: i32,
+        cy: i32,
+    ) -> u32 {
+        debug_assert_eq!(deltas.stride(), self.side());
+        let base = self.index(cx, cy);
+        kernel.count_free_at(deltas, &self.cells, base, self.mask, &mut self.visited)
+    }
+
+    /// Ψ at the cell holding the odometry position (x, y).
+    pub fn psi_at(&mut self, kernel: &DensityKernel, deltas: &RayDeltas, x: f64, y: f64) -> f64 {
+        let (cx, cy) = self.cell_of(x, y);
+        let n = self.count_free(kernel, deltas, cx, cy);
+        kernel.psi_of_count(n)
+    }
+}

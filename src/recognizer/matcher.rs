@@ -1,0 +1,367 @@
+//! Back end: observations → words of every level → n-gram matches → fine alignment.
+//!
+//! **Matching** (paper §III). Level configuration k (k = 1..`levels`) uses words of levels
+//! 0..k−1. Two words match when D is equal, |S₁ − S₂| ≤ ratio·max(S₁, S₂) and A differs by at
+//! most the angle tolerance. An n-gram match is a chain of word pairs (c₁, p₁) … (cₙ, pₙ) where
+//! each cᵢ is a predecessor of cᵢ₊₁ and each pᵢ of pᵢ₊₁ (so current and past n-grams are paths in
+//! the predecessor lists, mixing levels freely).
+//!
+//! When a word c closes, its candidates are the words of its class (a per-class occurrence list)
+//! that end at least `min_gap_m` of travel before c begins and match it. For each candidate p the
+//! longest chain ending at (c, p) is 1 + the best memoised chain of a pair (c', p') with c' a
+//! predecessor of c and p' one of p, computed for every level configuration at once; the memo
+//! holds one entry per matching pair, so the work per word is candidates × predecessors², and
+//! nothing sweeps the trajectory.
+//!
+//! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
+//! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
+//! least `min_gap_m` after p ends. Each word pair is reported at most once per configuration: the
+//! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
+//! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
+//! length). The result of an L-level run is the union of the matches with `levels` ≤ L.
+//!
+//! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
+//! d ∈ [−Δmax, Δmax] minimising the mean squared Ψ difference between current observation
+//! s₂ + i and past observation s₁ + i + d, i < min(S₁, S₂). Shifts whose whole window lies in
+//! the past word's run are preferred (near a run's start or end, those with the largest overlap);
+//! ties go to the smallest |d|. The aligned pairs whose travel differs by
+//! less than `min_gap_m` are dropped.
+
+use super::config::{RecognizerConfig, RecognizerError};
+use super::types::{AlignedPair, Match, Observation};
+use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
+
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    past: WordId,
+    /// Longest chain per level configuration (0 when a word's level is outside it).
+    len: [u16; MAX_LEVELS],
+    /// Per configuration, 2 bits: predecessor slot of the current word on the best chain.
+    back_slot: u8,
+    /// Per configuration: index of the best chain's previous pair in that predecessor's memo.
+    back_idx: [u32; MAX_LEVELS],
+    /// Bit k: reported in configuration k.
+    reported: u8,
+}
+
+#[derive(Clone, Debug)]
+struct Params {
+    levels: usize,
+    min_ngram: [usize; MAX_LEVELS],
+    size_ratio: f64,
+    angle_tol_deg: f64,
+    min_gap_m: f64,
+    max_offset: usize,
+}
+
+/// Words, multi-level words, matching and alignment over a stream of observations.
+#[derive(Clone, Debug)]
+pub struct WordMatcher {
+    params: Params,
+    words: WordLevels,
+    /// Per class, the words of that class in creation order (so by end travel).
+    occurrences: Vec<Vec<WordId>>,
+    /// Per word, an entry per matching past word, sorted by past word.
+    memo: Vec<Vec<Entry>>,
+    /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
+    lookup: [Vec<(u32, u32)>; MAX_LEVELS],
+    stamp: u32,
+}
+
+impl WordMatcher {
+    pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
+        config.validate()?;
+        let mut min_ngram = [usize::MAX; MAX_LEVELS];
+        for (k, m) in min_ngram.iter_mut().enumerate().take(config.levels) {
+            *m = config.min_ngram[k];
+        }
+        Ok(WordMatcher {
+            params: Params {
+                levels: config.levels,
+                min_ngram,
+                size_ratio: config.size_tolerance_ratio,
+                angle_tol_deg: config.angle_tolerance_deg,
+                min_gap_m: config.min_gap_m,
+                max_offset: config.max_alignment_offset,
+            },
+            words: WordLevels::new(config.classes, config.min_word_size, config.levels),
+            occurrences: vec![Vec::new(); config.classes],
+            memo: Vec::new(),
+            lookup: Default::default(),
+            stamp: 0,
+        })
+    }
+
+    /// Adds one observation; returns the matches that became known with it. An observation
+    /// whose `run` is later than the current run starts the new run first (as
+    /// [`start_run`](Self::start_run)), so a stored observation stream can be replayed without
+    /// calling it.
+    pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
+        let mut out = Vec::new();
+        while obs.run > self.words.run() {
+            out.extend(self.start_run());
+        }
+        let closed = self.words.push(obs);
+        out.extend(self.match_words(&closed));
+        out
+    }
+
+    /// Closes the current run (its last word is matched) and starts a new one.
+    pub fn start_run(&mut self) -> Vec<Match> {
+        let closed = self.words.start_run();
+        self.match_words(&closed)
+    }
+
+    /// Closes the current run's open word and matches it, without starting a new run (call at
+    /// the end of the input).
+    pub fn finish_run(&mut self) -> Vec<Match> {
+        let closed = self.words.finish_run();
+        self.match_words(&closed)
+    }
+
+    pub fn words(&self) -> &WordLevels {
+        &self.words
+    }
+
+    pub fn observations(&self) -> &[Observation] {
+        self.words.observations()
+    }
+
+    /// Matching word pairs held in the memo (a measure of its size).
+    pub fn memo_entries(&self) -> usize {
+        self.memo.iter().map(Vec::len).sum()
+    }
+
+    fn word(&self, id: WordId) -> &Word {
+        self.words.word(id)
+    }
+
+    fn syllables_match(&self, a: &Word, b: &Word) -> bool {
+        let (sa, sb) = (a.size as f64, b.size as f64);
+        if (sa - sb).abs() > self.params.size_ratio * sa.max(sb) + 1e-9 {
+            return false;
+        }
+        let mut d = (a.angle_deg - b.angle_deg).abs() % 360.0;
+        if d > 180.0 {
+            d = 360.0 - d;
+        }
+        d <= self.params.angle_tol_deg + 1e-9
+    }
+
+    fn match_words(&mut self, closed: &[WordId]) -> Vec<Match> {
+        let mut out = Vec::new();
+        for &c in closed {
+            self.memoise(c);
+            self.report(c, &mut out);
+            let class = self.word(c).class as usize;
+            self.occurrences[class].push(c);
+        }
+        out
+    }
+
+    /// Fills the memo of word `c`: one entry per matching past word.
+    fn memoise(&mut self, c: WordId) {
+        let n_words = self.words.all_words().len();
+        debug_assert_eq!(self.memo.len(), c as usize);
+        let cw = self.word(c).clone();
+        let limit = cw.start_travel_m - self.params.min_gap_m;
+        let occ = &self.occurrences[cw.class as usize];
+        let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
+
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            for l in &mut self.lookup {
+                l.fill((0, 0));
+            }
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let c_preds = cw.pred_ids();
+        for (slot, &cp) in c_preds.iter().enumerate() {
+            let table = &mut self.lookup[slot];
+            if table.len() < n_words {
+                table.resize(n_words, (0, 0));
+            }
+            for (idx, e) in self.memo[cp as usize].iter().enumerate() {
+                table[e.past as usize] = (stamp, idx as u32);
+            }
+        }
+
+        let levels = self.params.levels;
+        let mut entries = Vec::new();
+        for &p in &occ[..end] {
+            let pw = self.word(p);
+            if !self.syllables_match(&cw, pw) {
+                continue;
+            }
+            let top = cw.level.max(pw.level);
+            let mut len = [0u16; MAX_LEVELS];
+            let mut back_slot = 0u8;
+            let mut back_idx = [0u32; MAX_LEVELS];
+            for l in len.iter_mut().take(levels).skip(top) {
+                *l = 1;
+            }
+            for &pp in pw.pred_ids() {
+                for (ci, &cp) in c_preds.iter().enumerate() {
+                    let (s, idx) = self.lookup[ci][pp as usize];
+                    if s != stamp {
+                        continue;
+                    }
+                    let e = &self.memo[cp as usize][idx as usize];
+                    for (k, (l, &el)) in len
+                        .iter_mut()
+                        .zip(&e.len)
+                        .enumerate()
+                        .take(levels)
+                        .skip(top)
+                    {
+                        if el > 0 && el >= *l {
+                            *l = el.saturating_add(1);
+                            let shift = 2 * k;
+                            back_slot = (back_slot & !(3 << shift)) | ((ci as u8) << shift);
+                            back_idx[k] = idx;
+                        }
+                    }
+                }
+            }
+            entries.push(Entry {
+                past: p,
+                len,
+                back_slot,
+                back_idx,
+                reported: 0,
+            });
+        }
+        self.memo.push(entries);
+    }
+
+    /// The pair before (c, p) on the best chain of configuration k.
+    fn step_back(&self, c: WordId, entry: &Entry, k: usize) -> Option<(WordId, usize)> {
+        if entry.len[k] <= 1 {
+            return None;
+        }
+        let slot = ((entry.back_slot >> (2 * k)) & 3) as usize;
+        let cp = *self.word(c).pred_ids().get(slot)?;
+        Some((cp, entry.back_idx[k] as usize))
+    }
+
+    fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+        for k in 0..self.params.levels {
+            let tau = self.params.min_ngram[k];
+            for idx in 0..self.memo[c as usize].len() {
+                let e = self.memo[c as usize][idx];
+                if (e.len[k] as usize) < tau {
+                    continue;
+                }
+                // Walk the τ-gram ending here: check the gap, collect unreported pairs.
+                let past_end = self.word(e.past).end_travel_m;
+                let mut chain = vec![(c, idx)];
+                let mut fresh = 1usize;
+                let mut all_fresh = true;
+                let (mut wc, mut we) = (c, e);
+                while chain.len() < tau {
+                    let Some((pc, pidx)) = self.step_back(wc, &we, k) else {
+                        break;
+                    };
+                    let pe = self.memo[pc as usize][pidx];
+                    chain.push((pc, pidx));
+                    if all_fresh && pe.reported & (1 << k) == 0 {
+                        fresh += 1;
+                    } else {
+                        all_fresh = false;
+                    }
+                    wc = pc;
+                    we = pe;
+                }
+                if chain.len() < tau {
+                    continue;
+                }
+                let first_current = self.word(chain[tau - 1].0);
+                if first_current.start_travel_m + 1e-9 < past_end + self.params.min_gap_m {
+                    continue;
+                }
+                chain.truncate(fresh);
+                chain.reverse();
+                let mut word_pairs = Vec::with_capacity(chain.len());
+                let mut pairs = Vec::new();
+                for &(wc, widx) in &chain {
+                    let entry = &mut self.memo[wc as usize][widx];
+                    entry.reported |= 1 << k;
+                    let past = entry.past;
+                    word_pairs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
+                    self.align(wc, past, &mut pairs);
+                }
+                out.push(Match {
+                    levels: k + 1,
+                    ngram_len: e.len[k] as usize,
+                    word_pairs,
+                    pairs,
+                });
+            }
+        }
+    }
+
+    /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
+    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
+        let obs = self.words.observations();
+        let psi = self.words.psi();
+        let (cw, pw) = (self.word(c), self.word(p));
+        let n = cw.size.min(pw.size) as i64;
+        let (s2, s1) = (cw.first_obs as i64, pw.first_obs as i64);
+        let run = self.words.run_range(pw.run);
+        let (lo, hi) = (run.start as i64, run.end as i64);
+        // For shift d, the i with s1 + i + d inside the past word's run.
+        let overlap = |d: i64| (lo - s1 - d).max(0)..(hi - s1 - d).min(n);
+        let dmax = self.params.max_offset as i64;
+        // Shifts whose whole window exists come first (Eq. 2 sums over all n observations);
+        // near a run's ends, the shifts with the largest overlap.
+        let mut best: Option<(i64, f64, i64)> = None;
+        for m in 0..=2 * dmax {
+            let d = if m % 2 == 1 { (m + 1) / 2 } else { -(m / 2) };
+            let r = overlap(d);
+            let count = r.end - r.start;
+            if count <= 0 {
+                continue;
+            }
+            let past = &psi[(s1 + d + r.start) as usize..(s1 + d + r.end) as usize];
+            let cur = &psi[(s2 + r.start) as usize..(s2 + r.end) as usize];
+            let sum = squared_error(past, cur);
+            let cost = sum / count as f64;
+            let better = match best {
+                None => true,
+                Some((bc, bcost, _)) => count > bc || (count == bc && cost < bcost - 1e-15),
+            };
+            if better {
+                best = Some((count, cost, d));
+            }
+        }
+        let Some((_, _, d)) = best else { return };
+        for i in overlap(d) {
+            let (q, pst) = (&obs[(s2 + i) as usize], &obs[(s1 + i + d) as usize]);
+            if q.travel_m - pst.travel_m + 1e-9 < self.params.min_gap_m {
+                continue;
+            }
+            out.push(AlignedPair {
+                query: q.id,
+                past: pst.id,
+                query_odom: q.odom_pose,
+                past_odom: pst.odom_pose,
+            });
+        }
+    }
+}
+
+/// Σ (a − b)², four lanes at a time.
+fn squared_error(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            let d = x[l] - y[l];
+            acc[l] += d * d;
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
+    acc[0] + acc[1] + acc[2] + acc[3] + tail
+}

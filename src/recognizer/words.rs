@@ -1,0 +1,360 @@
+//! Words (paper Algorithm 1) and multi-level words (Algorithm 2), built online.
+//!
+//! Observations are quantized into density classes. A level-0 word is a run of observations of
+//! one class; a run of another class shorter than `min_word_size` (t_o) is absorbed by the word
+//! it interrupts, so a word closes only once the new class has lasted t_o observations (the first
+//! word of a run, if shorter than t_o, is absorbed by the second). A word's syllables: D its
+//! class, S its observation count, A = angle(median→last) − angle(first→median) in degrees,
+//! wrapped to (−180, 180].
+//!
+//! When level-0 word w_j closes, for each level l ≥ 1 with w_{j−l−1}.D = w_j.D a level-l word
+//! is built from the observations of w_{j−l−1} … w_j (same run only): its class is that of
+//! w_{j−l−1}, its predecessors are those of w_{j−l−1}, and it becomes a predecessor of w_{j+1},
+//! whose predecessors are w_j and every upper-level word ending at w_j (at most one per level).
+//! This is Algorithm 2 with the upper-level words built as soon as their last word closes, not
+//! when the next one does: the words and predecessor lists are the same, they are only known one
+//! word earlier.
+
+use super::types::{Observation, WordRef};
+use crate::geom::wrap_angle;
+
+/// Arena index of a word (across levels).
+pub type WordId = u32;
+
+/// Highest number of word levels (L = 0..3).
+pub const MAX_LEVELS: usize = 4;
+
+/// One word of some level.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Word {
+    pub level: usize,
+    /// Position in its level's list.
+    pub index: usize,
+    /// D: density class.
+    pub class: u8,
+    /// S: observation count.
+    pub size: usize,
+    /// A: heading change, degrees in (−180, 180].
+    pub angle_deg: f64,
+    /// Index (in the back end's observation list) of the first observation; a word's observations
+    /// are consecutive.
+    pub first_obs: usize,
+    pub run: usize,
+    /// Level-0 indices of the first and last level-0 word it spans.
+    pub l0_first: usize,
+    pub l0_last: usize,
+    /// Odometric travel at its first and last observation, metres.
+    pub start_travel_m: f64,
+    pub end_travel_m: f64,
+    preds: [WordId; MAX_LEVELS],
+    n_preds: u8,
+}
+
+impl Word {
+    /// Observation indices of the word.
+    pub fn obs_range(&self) -> std::ops::Range<usize> {
+        self.first_obs..self.first_obs + self.size
+    }
+
+    /// Arena ids of its predecessors (at most one per level).
+    pub fn pred_ids(&self) -> &[WordId] {
+        &self.preds[..self.n_preds as usize]
+    }
+
+    pub fn word_ref(&self) -> WordRef {
+        WordRef {
+            level: self.level,
+            index: self.index,
+        }
+    }
+}
+
+/// A = angle(median→last) − angle(first→median), degrees, wrapped to (−180, 180].
+pub fn word_angle_deg(obs: &[Observation]) -> f64 {
+    if obs.is_empty() {
+        return 0.0;
+    }
+    let first = obs[0].odom_pose.0;
+    let med = obs[(obs.len() - 1) / 2].odom_pose.0;
+    let last = obs[obs.len() - 1].odom_pose.0;
+    let a2 = (last.y - med.y).atan2(last.x - med.x);
+    let a1 = (med.y - first.y).atan2(med.x - first.x);
+    wrap_angle(a2 - a1).to_degrees()
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    class: u8,
+    start: usize,
+    len: usize,
+}
+
+/// The online word builder: observations in, words of every level out.
+#[derive(Clone, Debug)]
+pub struct WordLevels {
+    classes: usize,
+    min_word_size: usize,
+    levels: usize,
+    observations: Vec<Observation>,
+    /// Ψ of each observation, contiguous for the alignment.
+    psi: Vec<f64>,
+    /// Index of the first observation of each run.
+    run_starts: Vec<usize>,
+    obs_class: Vec<u8>,
+    words: Vec<Word>,
+    by_level: [Vec<WordId>; MAX_LEVELS],
+    open: Option<Run>,
+    pending: Option<Run>,
+    run: usize,
+    /// Level-0 index of the first word of the current run.
+    run_first_l0: usize,
+    /// Predecessors of the next level-0 word: the last level-0 word and upper words ending at it.
+    next_preds: Vec<WordId>,
+}
+
+impl WordLevels {
+    /// A builder with `classes` uniform classes, minimum word size t_o and words up to level
+    /// `levels − 1` (1..=4).
+    pub fn new(classes: usize, min_word_size: usize, levels: usize) -> Self {
+        WordLevels {
+            classes: classes.clamp(1, 255),
+            min_word_size: min_word_size.max(1),
+            levels: levels.clamp(1, MAX_LEVELS),
+            observations: Vec::new(),
+            psi: Vec::new(),
+            run_starts: vec![0],
+            obs_class: Vec::new(),
+            words: Vec::new(),
+            by_level: Default::default(),
+            open: None,
+            pending: None,
+            run: 0,
+            run_first_l0: 0,
+            next_preds: Vec::new(),
+        }
+    }
+
+    pub fn class_of(&self, psi: f64) -> u8 {
+        let c = (psi * self.classes as f64).floor();
+        (c.max(0.0) as usize).min(self.classes - 1) as u8
+    }
+
+    /// Adds one observation; returns the ids of the words it closed (level 0 first).
+    pub fn push(&mut self, obs: &Observation) -> Vec<WordId> {
+        let i = self.observations.len();
+        let q = self.class_of(obs.psi);
+        self.observations.push(*obs);
+        self.psi.push(obs.psi);
+        self.obs_class.push(q);
+        let Some(mut open) = self.open else {
+            self.open = Some(Run {
+                class: q,
+                start: i,
+                len: 1,
+            });
+            return Vec::new();
+        };
+        let mut closed = Vec::new();
+        if q == open.class {
+            if let Some(p) = self.pending.take() {
+                open.len += p.len;
+            }
+            open.len += 1;
+        } else {
+            let mut pending = match self.pending.take() {
+                Some(mut p) if p.class == q => {
+                    p.len += 1;
+                    p
+                }
+                Some(p) => {
+                    open.len += p.len;
+                    Run {
+                        class: q,
+                        start: i,
+                        len: 1,
+                    }
+                }
+                None => Run {
+                    class: q,
+                    start: i,
+                    len: 1,
+                },
+            };
+            if pending.len >= self.min_word_size {
+                if open.len < self.min_word_size {
+                    // The short first word of a run joins the word that follows it.
+                    pending.start = open.start;
+                    pending.len += open.len;
+                } else {
+                    closed = self.close_word(open);
+                }
+                open = pending;
+            } else {
+                self.pending = Some(pending);
+            }
+        }
+        self.open = Some(open);
+        closed
+    }
+
+    /// Closes the open word of the run (however short); returns the words it closed.
+    pub fn finish_run(&mut self) -> Vec<WordId> {
+        let Some(mut open) = self.open.take() else {
+            return Vec::new();
+        };
+        if let Some(p) = self.pending.take() {
+            open.len += p.len;
+        }
+        self.close_word(open)
+    }
+
+    /// Closes the current run and starts a new one: no word will have a predecessor across.
+    pub fn start_run(&mut self) -> Vec<WordId> {
+        let closed = self.finish_run();
+        self.run += 1;
+        self.run_starts.push(self.observations.len());
+        self.run_first_l0 = self.by_level[0].len();
+        self.next_preds.clear();
+        closed
+    }
+
+    fn make_word(
+        &self,
+        level: usize,
+        class: u8,
+        start: usize,
+        len: usize,
+        l0: (usize, usize),
+    ) -> Word {
+        let obs = &self.observations[start..start + len];
+        Word {
+            level,
+            index: self.by_level[level].len(),
+            class,
+            size: len,
+            angle_deg: word_angle_deg(obs),
+            first_obs: start,
+            run: self.run,
+            l0_first: l0.0,
+            l0_last: l0.1,
+            start_travel_m: obs[0].travel_m,
+            end_travel_m: obs[len - 1].travel_m,
+            preds: [0; MAX_LEVELS],
+            n_preds: 0,
+        }
+    }
+
+    fn add(&mut self, mut word: Word, preds: &[WordId]) -> WordId {
+        for &p in preds.iter().take(MAX_LEVELS) {
+            word.preds[word.n_preds as usize] = p;
+            word.n_preds += 1;
+        }
+        let id = self.words.len() as WordId;
+        self.by_level[word.level].push(id);
+        self.words.push(word);
+        id
+    }
+
+    fn close_word(&mut self, run: Run) -> Vec<WordId> {
+        let j = self.by_level[0].len();
+        let w = self.make_word(0, run.class, run.start, run.len, (j, j));
+        let preds = std::mem::take(&mut self.next_preds);
+        let id = self.add(w, &preds);
+        let mut closed = vec![id];
+        let mut next_preds = vec![id];
+        for l in 1..self.levels {
+            if j < self.run_first_l0 + l + 1 {
+                break;
+            }
+            let first_id = self.by_level[0][j - l - 1];
+            let first = &self.words[first_id as usize];
+            if first.class != run.class {
+                continue;
+            }
+            let start = first.first_obs;
+            let len = run.start + run.len - start;
+            let first_preds: Vec<WordId> = first.pred_ids().to_vec();
+            let w = self.make_word(l, first.class, start, len, (j - l - 1, j));
+            let uid = self.add(w, &first_preds);
+            closed.push(uid);
+            next_preds.push(uid);
+        }
+        self.next_preds = next_preds;
+        closed
+    }
+
+    pub fn observations(&self) -> &[Observation] {
+        &self.observations
+    }
+
+    /// Ψ of each observation.
+    pub fn psi(&self) -> &[f64] {
+        &self.psi
+    }
+
+    /// Observation indices of run `run` (so far).
+    pub fn run_range(&self, run: usize) -> std::ops::Range<usize> {
+        let lo = self
+            .run_starts
+            .get(run)
+            .copied()
+            .unwrap_or(self.observations.len());
+        let hi = self
+            .run_starts
+            .get(run + 1)
+            .copied()
+            .unwrap_or(self.observations.len());
+        lo..hi
+    }
+
+    /// Density class of each observation.
+    pub fn observation_classes(&self) -> &[u8] {
+        &self.obs_class
+    }
+
+    /// Every word, in creation order (arena ids).
+    pub fn all_words(&self) -> &[Word] {
+        &self.words
+    }
+
+    pub fn word(&self, id: WordId) -> &Word {
+        &self.words[id as usize]
+    }
+
+    /// Words of `level`, in order (empty for levels not built).
+    pub fn level(&self, level: usize) -> impl Iterator<Item = &Word> + '_ {
+        self.by_level
+            .get(level)
+            .into_iter()
+            .flatten()
+            .map(move |&id| &self.words[id as usize])
+    }
+
+    /// The word a [`WordRef`] names.
+    pub fn get(&self, r: WordRef) -> Option<&Word> {
+        let id = *self.by_level.get(r.level)?.get(r.index)?;
+        Some(&self.words[id as usize])
+    }
+
+    /// Predecessors of a word, as references.
+    pub fn predecessors(&self, r: WordRef) -> Vec<WordRef> {
+        self.get(r)
+            .map(|w| {
+                w.pred_ids()
+                    .iter()
+                    .map(|&p| self.words[p as usize].word_ref())
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+
+    /// Index of the current run (0 for the first).
+    pub fn run(&self) -> usize {
+        self.run
+    }
+
+    /// Number of word levels built (1..=4).
+    pub fn levels(&self) -> usize {
+        self.levels
+    }
+}

@@ -1,0 +1,715 @@
+//! The recognizer: density against the authors' oracle, words (Fig. 2), multi-level words
+//! (Fig. 4), matching, alignment, and property tests.
+
+use placewords::geom::{OdomPose, Pose2};
+use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
+use placewords::recognizer::{
+    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Match, Observation, Recognizer,
+    RecognizerConfig, WordLevels, WordMatcher, WordRef,
+};
+use placewords::scan::BeamLayout;
+use proptest::prelude::*;
+use std::path::Path;
+
+fn tokens(path: &Path) -> Option<Vec<String>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    Some(text.split_whitespace().map(str::to_string).collect())
+}
+
+/// Our Ψ on the authors' Robot@Home map equals theirs (30-cell kernel, 1° rays).
+#[test]
+fn density_matches_authors_oracle() {
+    let dir = Path::new("../shared/data/fsd/alma-s1");
+    let (Some(map), Some(dens)) = (
+        tokens(&dir.join("fullhouse1.txt")),
+        tokens(&dir.join("densities_W30_A1.000000.txt")),
+    ) else {
+        eprintln!("skipping density_matches_authors_oracle: ../shared/data/fsd/alma-s1 is absent");
+        return;
+    };
+    let (w, h): (usize, usize) = (map[3].parse().unwrap(), map[4].parse().unwrap());
+    assert_eq!(map.len(), 5 + w * h, "map token count");
+    let mut grid = DenseGrid::new(w, h, CellState::Unknown);
+    for r in 0..h {
+        for x in 0..w {
+            let state = match map[5 + r * w + x].as_str() {
+                "0" => CellState::Free,
+                "1" => CellState::Occupied,
+                _ => CellState::Unknown,
+            };
+            grid.set(x, h - 1 - r, state); // rows listed from the top down
+        }
+    }
+    assert_eq!(
+        (
+            dens[0].parse::<usize>().unwrap(),
+            dens[1].parse::<usize>().unwrap()
+        ),
+        (w, h)
+    );
+    let theirs: Vec<f64> = dens[5..].iter().map(|t| t.parse().unwrap()).collect();
+    assert_eq!(theirs.len(), w * h);
+
+    let kernel = DensityKernel::new(30, 1.0);
+    let ours = grid.density_map(&kernel);
+    let mut errors = Vec::new();
+    for (i, (o, t)) in ours.iter().zip(&theirs).enumerate() {
+        match o {
+            Some(psi) => {
+                assert!(*t >= 0.0, "cell {i} free here but not in the oracle");
+                errors.push((psi - t).abs());
+            }
+            None => assert!(*t < 0.0, "cell {i} not free here but {t} in the oracle"),
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let mean = errors.iter().sum::<f64>() / errors.len() as f64;
+    let p99 = errors[(errors.len() as f64 * 0.99) as usize];
+    eprintln!(
+        "oracle: {} free cells, mean abs error {mean:.5}, p99 {p99:.5}, max {:.5}",
+        errors.len(),
+        errors[errors.len() - 1]
+    );
+    assert!(mean <= 0.005, "mean abs error {mean}");
+    assert!(p99 <= 0.03, "p99 abs error {p99}");
+}
+
+fn config(f: impl FnOnce(&mut RecognizerConfig)) -> RecognizerConfig {
+    let mut c = RecognizerConfig::default();
+    f(&mut c);
+    c.validate().expect("test config is valid");
+    c
+}
+
+/// Feeds observations (closing the run at the end) and collects every match.
+fn run_matcher(cfg: &RecognizerConfig, obs: &[Observation]) -> (WordMatcher, Vec<Match>) {
+    let mut m = WordMatcher::new(cfg).unwrap();
+    let mut out = Vec::new();
+    for o in obs {
+        out.extend(m.push_observation(o));
+    }
+    out.extend(m.finish_run());
+    (m, out)
+}
+
+fn summary(words: &WordLevels, level: usize) -> Vec<(u8, usize)> {
+    words.level(level).map(|w| (w.class, w.size)).collect()
+}
+
+fn wr(level: usize, index: usize) -> WordRef {
+    WordRef { level, index }
+}
+
+#[test]
+fn config_defaults_parse_and_validate() {
+    let c: RecognizerConfig = toml::from_str("").unwrap();
+    assert_eq!(c, RecognizerConfig::default());
+    assert_eq!(c.min_ngram, vec![6, 9, 12, 15]);
+    assert!(c.validate().is_ok());
+    let c: RecognizerConfig = toml::from_str("levels = 2\nmin_ngram = [4, 8]").unwrap();
+    assert!(c.validate().is_ok());
+    assert!(
+        toml::from_str::<RecognizerConfig>("level = 2").is_err(),
+        "unknown keys are refused"
+    );
+    let bad = RecognizerConfig {
+        levels: 5,
+        kernel_radius_m: 4.0,
+        min_ngram: vec![6],
+        ..Default::default()
+    };
+    let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
+    assert_eq!(fields, vec!["kernel_radius_m", "levels", "min_ngram"]);
+    assert!(Recognizer::new(bad).is_err());
+}
+
+/// Paper Fig. 2: corridors, a corner and a bifurcation in three classes; the right turn gives
+/// a word with A = -90°.
+#[test]
+fn fig2_words_from_a_synthetic_path() {
+    let cfg = config(|c| c.classes = 3);
+    let (corridor, corner, bifurcation) = (class_psi(0, 3), class_psi(1, 3), class_psi(2, 3));
+    let obs = synth::observations(
+        &[
+            Stretch::new(corridor, 30, 0.0),
+            Stretch::new(corner, 18, -90.0),
+            Stretch::new(corridor, 25, 0.0),
+            Stretch::new(bifurcation, 12, 0.0),
+            Stretch::new(corridor, 20, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &obs);
+    let words: Vec<_> = m.words().level(0).collect();
+    let got: Vec<(u8, usize)> = words.iter().map(|w| (w.class, w.size)).collect();
+    assert_eq!(got, vec![(0, 30), (1, 18), (0, 25), (2, 12), (0, 20)]);
+    assert!(
+        (words[1].angle_deg + 90.0).abs() < 1e-6,
+        "right turn: A = {}",
+        words[1].angle_deg
+    );
+    for i in [0, 2, 3, 4] {
+        assert!(
+            words[i].angle_deg.abs() < 1e-6,
+            "straight word {i}: A = {}",
+            words[i].angle_deg
+        );
+    }
+    // Fig. 2(c)'s n-grams are paths through the predecessor lists.
+    assert_eq!(m.words().predecessors(wr(0, 3)), vec![wr(0, 2), wr(1, 0)]);
+}
+
+/// Paper Fig. 4(b): words of sizes 9, 3 and 7 whose first and last share a class give one
+/// level-1 word of that class holding all 19 observations (Algorithm 2 concatenates).
+#[test]
+fn fig4_level1_word_holds_all_observations() {
+    let cfg = config(|c| c.min_word_size = 3);
+    let (g, b) = (class_psi(5, 8), class_psi(2, 8));
+    let obs = synth::observations(
+        &[
+            Stretch::new(g, 9, 0.0),
+            Stretch::new(b, 3, 0.0),
+            Stretch::new(g, 7, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &obs);
+    assert_eq!(summary(m.words(), 0), vec![(5, 9), (2, 3), (5, 7)]);
+    assert_eq!(summary(m.words(), 1), vec![(5, 19)]);
+    let w = m.words().level(1).next().unwrap();
+    assert_eq!(w.obs_range(), 0..19);
+}
+
+/// Fig. 4(c): every word three extra levels give, with the predecessor lists of Algorithm 2.
+#[test]
+fn fig4_full_multilevel_set_and_predecessors() {
+    let cfg = config(|c| {
+        c.min_word_size = 3;
+        c.levels = 4;
+    });
+    let (g, b) = (class_psi(5, 8), class_psi(2, 8));
+    let obs = synth::observations(
+        &[
+            Stretch::new(g, 9, 0.0),
+            Stretch::new(b, 3, 0.0),
+            Stretch::new(g, 7, 0.0),
+            Stretch::new(b, 5, 0.0),
+            Stretch::new(g, 6, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &obs);
+    let w = m.words();
+    assert_eq!(summary(w, 0), vec![(5, 9), (2, 3), (5, 7), (2, 5), (5, 6)]);
+    assert_eq!(summary(w, 1), vec![(5, 19), (2, 15), (5, 18)]);
+    assert_eq!(summary(w, 2), vec![]);
+    assert_eq!(summary(w, 3), vec![(5, 30)]);
+    let p = |l, i| w.predecessors(wr(l, i));
+    assert_eq!(p(0, 0), vec![]);
+    assert_eq!(p(0, 1), vec![wr(0, 0)]);
+    assert_eq!(p(0, 2), vec![wr(0, 1)]);
+    assert_eq!(p(0, 3), vec![wr(0, 2), wr(1, 0)]);
+    assert_eq!(p(0, 4), vec![wr(0, 3), wr(1, 1)]);
+    assert_eq!(p(1, 0), vec![]); // copied from w⁰₀
+    assert_eq!(p(1, 1), vec![wr(0, 0)]); // from w⁰₁
+    assert_eq!(p(1, 2), vec![wr(0, 1)]); // from w⁰₂
+    assert_eq!(p(3, 0), vec![]);
+
+    // Level 2 needs w_{j-3}.D = w_j.D: G B R G B G gives G(9+3+4+7) and B(3+4+7+5).
+    let r = class_psi(7, 8);
+    let obs = synth::observations(
+        &[
+            Stretch::new(g, 9, 0.0),
+            Stretch::new(b, 3, 0.0),
+            Stretch::new(r, 4, 0.0),
+            Stretch::new(g, 7, 0.0),
+            Stretch::new(b, 5, 0.0),
+            Stretch::new(g, 6, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &obs);
+    assert_eq!(summary(m.words(), 1), vec![(5, 18)]);
+    assert_eq!(summary(m.words(), 2), vec![(5, 23), (2, 19)]);
+    assert_eq!(summary(m.words(), 3), vec![]);
+    assert_eq!(m.words().predecessors(wr(2, 1)), vec![wr(0, 0)]);
+    assert_eq!(m.words().predecessors(wr(0, 5)), vec![wr(0, 4), wr(2, 1)]);
+}
+
+/// Fig. 3: an open door in the middle of a corridor splits it in three words; level 1 holds the
+/// "corrected" long word, which matches the corridor seen with the door closed.
+#[test]
+fn door_bump_yields_the_corrected_long_word() {
+    let cfg = config(|c| c.levels = 2);
+    let (corr, door, hall) = (class_psi(2, 8), class_psi(4, 8), class_psi(6, 8));
+    let open = synth::observations(
+        &[
+            Stretch::new(corr, 30, 0.0),
+            Stretch::new(door, 8, 0.0),
+            Stretch::new(corr, 30, 0.0),
+            Stretch::new(hall, 10, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &open);
+    assert_eq!(
+        summary(m.words(), 0),
+        vec![(2, 30), (4, 8), (2, 30), (6, 10)]
+    );
+    assert_eq!(summary(m.words(), 1), vec![(2, 68)]);
+
+    // A blip shorter than t_o = 5 is absorbed by the corridor word.
+    let blip = synth::observations(
+        &[
+            Stretch::new(corr, 30, 0.0),
+            Stretch::new(door, 3, 0.0),
+            Stretch::new(corr, 30, 0.0),
+            Stretch::new(hall, 10, 0.0),
+        ],
+        0.1,
+        0,
+        None,
+    );
+    let (m, _) = run_matcher(&cfg, &blip);
+    assert_eq!(summary(m.words(), 0), vec![(2, 63), (6, 10)]);
+}
+
+/// A lap of random words, its repetition, and a shuffled repetition.
+fn random_stretches(seed: u64, n: usize) -> Vec<Stretch> {
+    let mut r = SplitMix::new(seed);
+    let mut out: Vec<Stretch> = Vec::new();
+    while out.len() < n {
+        let class = r.int(0, 7);
+        if out.last().is_some_and(|s| s.psi == class_psi(class, 8)) {
+            continue;
+        }
+        let turn = [0.0, 0.0, 90.0, -90.0][r.int(0, 3)];
+        out.push(Stretch::new(class_psi(class, 8), r.int(8, 30), turn));
+    }
+    out
+}
+
+fn with_noise(mut obs: Vec<Observation>, seed: u64) -> Vec<Observation> {
+    let mut r = SplitMix::new(seed);
+    for o in &mut obs {
+        o.psi += r.range(-0.04, 0.04);
+    }
+    obs
+}
+
+#[test]
+fn repeated_sequence_matches_and_shuffled_does_not() {
+    let cfg = RecognizerConfig::default();
+    let lap = random_stretches(7, 40);
+    let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
+    let lap_len = first.len();
+    let second = with_noise(synth::observations(&lap, 0.1, 0, first.last()), 2);
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (_, matches) = run_matcher(&cfg, &all);
+    let one_level: Vec<&Match> = matches.iter().filter(|m| m.levels == 1).collect();
+    assert!(!one_level.is_empty(), "the repeated lap is recognized");
+    let pairs: Vec<_> = one_level.iter().flat_map(|m| &m.pairs).collect();
+    assert!(
+        pairs.len() > lap_len / 2,
+        "most of lap 2 is paired: {} pairs",
+        pairs.len()
+    );
+    for p in &pairs {
+        assert_eq!(
+            p.query - lap_len,
+            p.past,
+            "aligned pairs put the same place together"
+        );
+    }
+    // Reported once per configuration: no word pair twice within a level configuration
+    // (observation pairs may repeat when words of two levels cover the same observations).
+    for k in 1..=3 {
+        let mut seen: Vec<(WordRef, WordRef)> = matches
+            .iter()
+            .filter(|m| m.levels == k)
+            .flat_map(|m| m.word_pairs.iter().copied())
+            .collect();
+        let n = seen.len();
+        seen.sort_by_key(|(c, p)| (c.level, c.index, p.level, p.index));
+        seen.dedup();
+        assert_eq!(seen.len(), n, "configuration {k} repeats word pairs");
+    }
+    for m in &matches {
+        assert!(m.ngram_len >= cfg.min_ngram[m.levels - 1]);
+        assert!(!m.word_pairs.is_empty());
+    }
+
+    let mut shuffled = lap.clone();
+    let mut r = SplitMix::new(99);
+    for i in (1..shuffled.len()).rev() {
+        shuffled.swap(i, r.int(0, i));
+    }
+    let second = with_noise(synth::observations(&shuffled, 0.1, 0, first.last()), 2);
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (_, matches) = run_matcher(&cfg, &all);
+    assert!(
+        matches.is_empty(),
+        "a shuffled lap must not match: {:?}",
+        matches.first().map(|m| &m.word_pairs)
+    );
+}
+
+#[test]
+fn runs_break_predecessor_chains() {
+    let cfg = RecognizerConfig::default();
+    let lap = random_stretches(3, 20);
+    let mut m = WordMatcher::new(&cfg).unwrap();
+    let first = synth::observations(&lap, 0.1, 0, None);
+    for o in &first {
+        m.push_observation(o);
+    }
+    m.start_run();
+    let n0 = m.words().level(0).count();
+    let second = synth::observations(&lap, 0.1, 1, first.last());
+    for o in &second {
+        m.push_observation(o);
+    }
+    m.finish_run();
+    let first_of_run = m.words().level(0).nth(n0).unwrap();
+    assert_eq!(m.words().run(), 1);
+    assert_eq!(first_of_run.run, 1);
+    assert!(m.words().predecessors(first_of_run.word_ref()).is_empty());
+    for w in m.words().all_words() {
+        for &p in w.pred_ids() {
+            assert_eq!(m.words().word(p).run, w.run);
+        }
+    }
+}
+
+/// Replaying a stored observation stream splits runs by `Observation::run` by itself, and gives
+/// the same words and matches as explicit `start_run` calls.
+#[test]
+fn replay_splits_runs_by_observation_run() {
+    let cfg = RecognizerConfig::default();
+    let lap = random_stretches(5, 30);
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&lap, 0.1, 1, first.last());
+    let mut explicit = WordMatcher::new(&cfg).unwrap();
+    let mut a = Vec::new();
+    for o in &first {
+        a.extend(explicit.push_observation(o));
+    }
+    a.extend(explicit.start_run());
+    for o in &second {
+        a.extend(explicit.push_observation(o));
+    }
+    a.extend(explicit.finish_run());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (replayed, b) = run_matcher(&cfg, &all);
+    assert!(!a.is_empty());
+    assert_eq!(a, b);
+    assert_eq!(explicit.words().all_words(), replayed.words().all_words());
+}
+
+/// Fine alignment finds the shift that puts the same density profile together.
+#[test]
+fn alignment_recovers_a_shift() {
+    let cfg = config(|c| {
+        c.levels = 1;
+        c.min_ngram = vec![3];
+        c.min_gap_m = 5.0;
+    });
+    // A corridor whose Ψ has a distinctive ramp, seen twice; the second time its words start
+    // 3 observations later relative to the ramp.
+    let stretches = random_stretches(11, 12);
+    let mut first = synth::observations(&stretches, 0.1, 0, None);
+    for (i, o) in first.iter_mut().enumerate() {
+        o.psi += 0.05 * ((i as f64) * 0.7).sin();
+    }
+    let n = first.len();
+    let mut second = synth::observations(&stretches, 0.1, 0, first.last());
+    for (i, o) in second.iter_mut().enumerate() {
+        o.psi += 0.05 * ((i as f64) * 0.7).sin();
+    }
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (_, matches) = run_matcher(&cfg, &all);
+    assert!(!matches.is_empty());
+    for p in matches.iter().flat_map(|m| &m.pairs) {
+        assert_eq!(p.query - n, p.past);
+    }
+}
+
+/// One scan into open space marks its field of view free up to 2.5 m but for isolated cells
+/// between 8-connected beam lines beyond 1.4 m, where 1° beams are more than half a cell apart
+/// (under 5 %; the next scans fill them), and nothing behind the sensor.
+#[test]
+fn one_scan_covers_its_field_of_view() {
+    for layout in [
+        synth::lms200(),
+        BeamLayout::centered(361, std::f64::consts::PI, 30.0, Pose2::IDENTITY),
+    ] {
+        let mut g = placewords::recognizer::LocalGrid::new(0.05, 3.0);
+        let pose = Pose2::new(1.02, -0.37, 0.3);
+        let scan = synth::scan_of(&[], pose, &layout, 0.0);
+        g.integrate(&OdomPose(pose), &scan);
+        let sensor = pose.compose(&layout.mount);
+        let (cx, cy) = g.cell_of(sensor.x, sensor.y);
+        let (mut holes, mut cells) = (0, 0);
+        for dy in -60..=60 {
+            for dx in -60..=60 {
+                let (x, y) = (cx + dx, cy + dy);
+                let (px, py) = (
+                    (x as f64 + 0.5) * 0.05 - sensor.x,
+                    (y as f64 + 0.5) * 0.05 - sensor.y,
+                );
+                let d = px.hypot(py);
+                let bearing = placewords::geom::wrap_angle(py.atan2(px) - sensor.theta);
+                if d > 0.1 && d < 2.5 && bearing.abs() < 1.5 {
+                    cells += 1;
+                    if g.state(x, y) != CellState::Free {
+                        holes += 1;
+                    }
+                }
+                let ahead = px * sensor.theta.cos() + py * sensor.theta.sin();
+                if ahead < -0.1 {
+                    assert_eq!(g.state(x, y), CellState::Unknown, "behind the sensor");
+                }
+            }
+        }
+        eprintln!("{} beams: {holes} of {cells} cells unseen", layout.count);
+        assert!(
+            holes * 20 <= cells,
+            "{} beams: {holes} of {cells} cells unseen",
+            layout.count
+        );
+    }
+}
+
+fn corridor_inputs(layout: &BeamLayout) -> Vec<(OdomPose, placewords::scan::Scan)> {
+    let walls = synth::corridor_with_branch(30.0, 2.0, 15.0, 3.0);
+    (0..700)
+        .map(|i| {
+            let pose = Pose2::new(0.5 + i as f64 * 0.04, 0.0, 0.0);
+            (
+                OdomPose(pose),
+                synth::scan_of(&walls, pose, layout, i as f64 * 0.1),
+            )
+        })
+        .collect()
+}
+
+fn front_end_psi(layout: &BeamLayout) -> Vec<Observation> {
+    let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+    corridor_inputs(layout)
+        .iter()
+        .filter_map(|(o, s)| fe.push(*o, s))
+        .collect()
+}
+
+/// The front end on analytic corridor scans: an observation every 0.10 m, low Ψ in the
+/// corridor, higher at the bifurcation, whatever the beam layout.
+#[test]
+fn front_end_corridor_and_bifurcation_with_any_layout() {
+    let mount = Pose2::new(0.021, 0.0, 0.0);
+    let pi = std::f64::consts::PI;
+    let layouts = [
+        BeamLayout::centered(181, pi, 32.767, mount),
+        BeamLayout::centered(180, pi * 179.0 / 180.0, 8.191, mount),
+        BeamLayout::centered(361, pi, 32.767, mount),
+        BeamLayout::centered(360, pi * 359.5 / 360.0, 32.767, mount),
+        BeamLayout::centered(271, 1.5 * pi, 20.0, Pose2::new(0.1, 0.0, 0.0)),
+    ];
+    let reference = front_end_psi(&layouts[0]);
+    let travel = 699.0 * 0.04;
+    assert!(
+        (reference.len() as f64 - travel / 0.1).abs() <= 1.0,
+        "{} observations",
+        reference.len()
+    );
+    for w in reference.windows(2) {
+        assert!((w[1].travel_m - w[0].travel_m - 0.1).abs() < 0.041);
+    }
+    let at = |obs: &[Observation], x: f64| {
+        obs.iter()
+            .min_by(|a, b| {
+                (a.odom_pose.0.x - x)
+                    .abs()
+                    .total_cmp(&(b.odom_pose.0.x - x).abs())
+            })
+            .unwrap()
+            .psi
+    };
+    let corridor = at(&reference, 8.0);
+    let branch = at(&reference, 15.0);
+    assert!(
+        corridor > 0.3 && corridor < 0.6,
+        "2 m corridor Ψ {corridor} (the strip covers 0.49 of the disc)"
+    );
+    assert!(
+        branch > corridor + 0.1,
+        "bifurcation Ψ {branch} vs corridor {corridor}"
+    );
+    for layout in &layouts[1..] {
+        let obs = front_end_psi(layout);
+        assert_eq!(obs.len(), reference.len());
+        for x in [6.0, 8.0, 15.0, 22.0] {
+            let (a, b) = (at(&obs, x), at(&reference, x));
+            assert!(
+                (a - b).abs() < 0.06,
+                "{} beams at x = {x}: Ψ {a} vs {b}",
+                layout.count
+            );
+        }
+    }
+}
+
+/// Two laps of a loop floor through the whole recognizer: lap 2 is recognized, and every
+/// aligned pair is within 1 m (odometry is exact here, so it is the truth).
+#[test]
+fn whole_recognizer_recognizes_a_second_lap() {
+    let floor = synth::LoopFloor::institute();
+    let inputs = floor.lap_inputs(&vec![false; floor.door_count()], &synth::lms200());
+    let mut rec = Recognizer::new(RecognizerConfig::default()).unwrap();
+    let mut matches = Vec::new();
+    for _ in 0..2 {
+        for (o, s) in &inputs {
+            matches.extend(rec.push(*o, s));
+        }
+    }
+    matches.extend(rec.finish());
+    let obs = rec.observations();
+    let lap_obs = obs.len() / 2;
+    let pairs: Vec<_> = matches.iter().flat_map(|m| &m.pairs).collect();
+    let correct = pairs
+        .iter()
+        .filter(|p| p.query_odom.0.distance(&p.past_odom.0) <= 1.0)
+        .count();
+    let queries: std::collections::BTreeSet<usize> = pairs.iter().map(|p| p.query).collect();
+    eprintln!(
+        "loop floor: {} observations, {} words, {} matches, {} pairs, {} correct, {} query observations",
+        obs.len(),
+        rec.words().level(0).count(),
+        matches.len(),
+        pairs.len(),
+        correct,
+        queries.len()
+    );
+    assert!(correct as f64 >= 0.9 * pairs.len() as f64, "precision");
+    assert!(queries.len() as f64 >= 0.3 * lap_obs as f64, "recall");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Level-0 words partition the observations; every level-l word spans exactly l + 2
+    /// consecutive level-0 words, with the class of both ends.
+    #[test]
+    fn words_partition_and_levels_span(
+        sizes in prop::collection::vec((0usize..8, 1usize..12), 1..40),
+        t_o in 1usize..7,
+    ) {
+        let stretches: Vec<Stretch> = sizes.iter().map(|&(c, n)| Stretch::new(class_psi(c, 8), n, 0.0)).collect();
+        let obs = synth::observations(&stretches, 0.1, 0, None);
+        let mut w = WordLevels::new(8, t_o, 4);
+        for o in &obs { w.push(o); }
+        w.finish_run();
+        let l0: Vec<_> = w.level(0).collect();
+        let mut next = 0;
+        for word in &l0 {
+            prop_assert_eq!(word.first_obs, next);
+            prop_assert!(word.size >= 1);
+            next += word.size;
+        }
+        prop_assert_eq!(next, obs.len());
+        for l in 1..4 {
+            for word in w.level(l) {
+                prop_assert_eq!(word.l0_last - word.l0_first, l + 1);
+                let (a, b) = (l0[word.l0_first], l0[word.l0_last]);
+                prop_assert_eq!(word.first_obs, a.first_obs);
+                prop_assert_eq!(word.size, b.first_obs + b.size - a.first_obs);
+                prop_assert_eq!(word.class, a.class);
+                prop_assert_eq!(a.class, b.class);
+                prop_assert!(w.predecessors(word.word_ref()) == w.predecessors(a.word_ref()));
+            }
+        }
+        for word in w.all_words() {
+            let preds = word.pred_ids();
+            let mut levels: Vec<usize> = preds.iter().map(|&p| w.word(p).level).collect();
+            levels.dedup();
+            prop_assert_eq!(levels.len(), preds.len(), "one predecessor per level");
+            for &p in preds {
+                prop_assert_eq!(w.word(p).l0_last + 1, word.l0_first);
+            }
+        }
+    }
+
+    /// Ψ is in [0, 1] on any grid.
+    #[test]
+    fn psi_in_unit_interval(
+        cells in prop::collection::vec(0u8..3, 31 * 31),
+        radius in 1usize..20,
+        step in 0.3f64..45.0,
+        x in 0usize..31,
+        y in 0usize..31,
+    ) {
+        let mut g = DenseGrid::new(31, 31, CellState::Unknown);
+        for (i, c) in cells.iter().enumerate() {
+            g.set(i % 31, i / 31, [CellState::Unknown, CellState::Free, CellState::Occupied][*c as usize]);
+        }
+        let k = DensityKernel::new(radius, step);
+        let psi = g.psi(&k, x, y);
+        prop_assert!((0.0..=1.0).contains(&psi), "psi {}", psi);
+    }
+
+    /// The front end's Ψ is in [0, 1] with random scans.
+    #[test]
+    fn front_end_psi_in_unit_interval(seed in 0u64..1000) {
+        let mut r = SplitMix::new(seed);
+        let layout = synth::lms200();
+        let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+        let mut pose = Pose2::IDENTITY;
+        for i in 0..60 {
+            pose = pose.compose(&Pose2::new(r.range(0.0, 0.1), 0.0, r.range(-0.2, 0.2)));
+            let ranges_m = (0..layout.count).map(|_| r.range(0.0, 40.0)).collect();
+            let scan = placewords::scan::Scan { layout: layout.clone(), ranges_m, time_s: i as f64 };
+            if let Some(o) = fe.push(OdomPose(pose), &scan) {
+                prop_assert!((0.0..=1.0).contains(&o.psi));
+            }
+        }
+    }
+
+    /// Matching never pairs observations closer than min_gap_m in travel, and a past word always
+    /// ends min_gap_m before the current n-gram begins.
+    #[test]
+    fn matches_respect_min_gap(
+        seed in 0u64..10_000,
+        gap in 1.0f64..8.0,
+    ) {
+        let cfg = config(|c| {
+            c.min_word_size = 2;
+            c.min_ngram = vec![2, 3, 4];
+            c.min_gap_m = gap;
+        });
+        let mut r = SplitMix::new(seed);
+        let stretches: Vec<Stretch> = (0..60)
+            .map(|_| Stretch::new(class_psi(r.int(0, 2) * 3, 8), r.int(2, 8), 0.0))
+            .collect();
+        let obs = synth::observations(&stretches, 0.1, 0, None);
+        let (m, matches) = run_matcher(&cfg, &obs);
+        let travel = |id: usize| obs[id].travel_m;
+        for mt in &matches {
+            for p in &mt.pairs {
+                prop_assert!(travel(p.query) - travel(p.past) >= gap - 1e-9);
+            }
+            for (c, p) in &mt.word_pairs {
+                let (c, p) = (m.words().get(*c).unwrap(), m.words().get(*p).unwrap());
+                prop_assert!(c.start_travel_m - p.end_travel_m >= gap - 1e-9);
+            }
+        }
+    }
+}
