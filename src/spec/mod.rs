@@ -3,6 +3,7 @@
 
 pub mod diag;
 pub mod evaluation;
+pub mod scenario;
 pub mod world;
 
 pub use diag::{Diagnostic, SpecError};

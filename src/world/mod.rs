@@ -1,6 +1,9 @@
 //! The validated world model: walls, doors and their states, routes, home, walking areas, and the
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
+pub mod physics;
+pub mod raycast;
+
 use crate::geom::{Pose2, Segment, Vec2};
 use crate::spec::world::WorldSpec;
 

@@ -1,1 +1,2 @@
 //! One integration-test binary (keeps link time down on 2 cores); one module per area.
+mod sim;
