@@ -41,10 +41,17 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         b
     };
     let tick = || bar.inc(1);
+    let started = std::time::Instant::now();
     let logs_ = placewords::sim::simulate(&scn, args.laps, &tick)?;
+    let simulated_s = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
     let files = logs::write_logs(&scn, &logs_, args.laps, &args.out)?;
     if !args.quiet {
+        eprintln!(
+            "simulated {total} laps in {simulated_s:.2} s; wrote {} files in {:.2} s",
+            files.len(),
+            started.elapsed().as_secs_f64() - simulated_s
+        );
         for f in &files {
             eprintln!("wrote {}", f.display());
         }

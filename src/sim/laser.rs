@@ -88,6 +88,8 @@ pub struct Laser {
     layout: BeamLayout,
     beams: Beams,
     angle_errors_rad: Vec<f64>,
+    /// cos and sin of each beam's nominal angle.
+    nominal_dirs: Vec<(f64, f64)>,
 }
 
 impl Laser {
@@ -115,11 +117,18 @@ impl Laser {
             layout.count,
             &angle_errors_rad,
         );
+        let nominal_dirs = (0..layout.count)
+            .map(|i| {
+                let (s, c) = layout.beam_angle_rad(i).sin_cos();
+                (c, s)
+            })
+            .collect();
         Laser {
             config,
             layout,
             beams,
             angle_errors_rad,
+            nominal_dirs,
         }
     }
 
@@ -129,6 +138,18 @@ impl Laser {
 
     pub fn angle_errors_rad(&self) -> &[f64] {
         &self.angle_errors_rad
+    }
+
+    /// Hit points of `ranges` in the robot frame, along the nominal beam directions (beams at
+    /// maximum range are left out).
+    pub fn hits_in_robot<'r>(&'r self, ranges: &'r [f64]) -> impl Iterator<Item = Vec2> + 'r {
+        let max = self.config.max_range_m;
+        let mount = self.layout.mount;
+        ranges
+            .iter()
+            .zip(&self.nominal_dirs)
+            .filter(move |(r, _)| **r < max)
+            .map(move |(r, (c, s))| Vec2::new(mount.x + r * c, mount.y + r * s))
     }
 
     /// Where the sensor is for a robot at `robot_pose`.

@@ -160,10 +160,13 @@ pub fn write_logs(
     let ctx = |p: &Path, e: std::io::Error| {
         std::io::Error::new(e.kind(), format!("{}: cannot write: {e}", p.display()))
     };
+    use rayon::prelude::*;
     let mut written = Vec::new();
-    for r in runs {
+    // Formatting dominates; format the runs in parallel, write them one by one.
+    let texts: Vec<String> = runs.par_iter().map(|r| carmen_log(scn, r)).collect();
+    for (r, text) in runs.iter().zip(texts) {
         let p = dir.join(log_file_name(r.run));
-        write_atomic(&p, carmen_log(scn, r).as_bytes()).map_err(|e| ctx(&p, e))?;
+        write_atomic(&p, text.as_bytes()).map_err(|e| ctx(&p, e))?;
         written.push(p);
     }
     let p = dir.join("manifest.json");

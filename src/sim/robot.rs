@@ -256,7 +256,7 @@ mod tests {
         let p = integrate(Pose2::IDENTITY, 1.0, 0.0, 2.0);
         assert!((p.x - 2.0).abs() < 1e-12 && p.y.abs() < 1e-12);
         let mut q = Pose2::IDENTITY;
-        for _ in 0..100 {
+        for _ in 0..50 {
             q = integrate(q, 1.0, std::f64::consts::PI, 0.02);
         }
         // Half a circle of radius 1/π.

@@ -8,7 +8,7 @@
 //! `1 / laser.rate_hz` seconds a scan is taken and a frame recorded. A lap ends when progress
 //! reaches a whole route length. Door states change only between laps.
 
-use crate::geom::{OdomPose, Pose2, TruePose, Vec2};
+use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
@@ -258,19 +258,8 @@ impl<'a> RunSim<'a> {
         self.laser
             .exact_ranges(&self.caster, self.truth, &self.discs, &mut self.ranges);
         // The controller sees obstacles through the (noise-free) scan.
+        self.free_ahead_m = free_ahead(&self.scn.robot, self.laser.hits_in_robot(&self.ranges));
         let layout = self.laser.layout();
-        let mount = layout.mount;
-        let max = self.laser.config.max_range_m;
-        let hits = self
-            .ranges
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| **r < max)
-            .map(|(i, r)| {
-                let a = layout.beam_angle_rad(i);
-                Vec2::new(mount.x + r * a.cos(), mount.y + r * a.sin())
-            });
-        self.free_ahead_m = free_ahead(&self.scn.robot, hits);
         let mut ranges = self.ranges.clone();
         self.laser.add_noise(&mut ranges, &mut self.laser_rng);
         Frame {

@@ -76,12 +76,23 @@ impl Beams {
         if self.step_rad <= 0.0 {
             return Some((0, n - 1));
         }
-        let f0 = ((lo - self.start_rad) / self.step_rad - self.margin_beams).ceil();
-        let f1 = ((hi - self.start_rad) / self.step_rad + self.margin_beams).floor();
-        if f1 < 0.0 || f0 > (n - 1) as f64 || f0 > f1 {
+        let x0 = (lo - self.start_rad) / self.step_rad - self.margin_beams;
+        let x1 = (hi - self.start_rad) / self.step_rad + self.margin_beams;
+        let last = (n - 1) as f64;
+        if x1 < 0.0 || x0 > last || x0 > x1 {
             return None;
         }
-        Some((f0.max(0.0) as usize, (f1 as usize).min(n - 1)))
+        // ceil and floor by truncation (both are within [0, n-1] after clamping; avoids libm).
+        let x0 = x0.max(0.0);
+        let mut i0 = x0 as usize;
+        if (i0 as f64) < x0 {
+            i0 += 1;
+        }
+        let i1 = (x1.min(last) as usize).min(n - 1);
+        if i0 > i1 {
+            return None;
+        }
+        Some((i0, i1))
     }
 }
 
@@ -90,25 +101,77 @@ impl Beams {
 pub struct SweepCaster {
     /// (ax, ay, bx, by).
     segs: Vec<[f64; 4]>,
+    /// Per segment: +1 visible only from its left (looking from a to b), -1 only from its right,
+    /// 0 from both. A face of a solid is only seen from outside the solid.
+    faces: Vec<i8>,
 }
+
+/// Whether `p` is inside the rectangle of half-width `half` around `s` (not its round caps).
+fn inside_slab(s: &Segment, half: f64, p: Vec2) -> bool {
+    let d = s.b - s.a;
+    let len2 = d.norm_squared();
+    if len2 == 0.0 {
+        return false;
+    }
+    let t = (p - s.a).dot(&d) / len2;
+    if !(0.0..=1.0).contains(&t) {
+        return false;
+    }
+    let cross = (d.x * (p.y - s.a.y) - d.y * (p.x - s.a.x)).abs() / len2.sqrt();
+    cross < half
+}
+
+/// Segments whose bounding box comes this close to the sensor are swept first, metres.
+const NEAR_M: f64 = 3.0;
 
 /// Maximum error of [`fast_atan2`], radians (1e-5 in practice; 1e-4 leaves room).
 const ATAN2_TOL_RAD: f64 = 1e-4;
 
 impl SweepCaster {
+    /// Segments seen from both sides.
     pub fn new(segments: &[Segment]) -> Self {
-        SweepCaster {
-            segs: segments
-                .iter()
-                .filter(|s| s.length() > 0.0)
-                .map(|s| [s.a.x, s.a.y, s.b.x, s.b.y])
-                .collect(),
-        }
+        let segs: Vec<[f64; 4]> = segments
+            .iter()
+            .filter(|s| s.length() > 0.0)
+            .map(|s| [s.a.x, s.a.y, s.b.x, s.b.y])
+            .collect();
+        let faces = vec![0; segs.len()];
+        SweepCaster { segs, faces }
     }
 
-    /// The world's walls and doors with the doors in `doors`.
+    /// The world's walls and doors with the doors in `doors` (their outline, from
+    /// [`World::obstacle_outline`]). Each outline segment that is a face of a thick wall or door
+    /// (solid on one side, free on the other, tested 1 mm either side of its midpoint) is culled
+    /// when the sensor is on its solid side: a ray from outside a solid meets a front face first,
+    /// so the ranges are unchanged and about half the segments are skipped.
     pub fn for_world(world: &World, doors: &DoorStates) -> Self {
-        Self::new(&world.obstacle_outline(doors))
+        let mut c = Self::new(&world.obstacle_outline(doors));
+        let mut solids: Vec<(Segment, f64)> = Vec::new();
+        for w in &world.walls {
+            for s in w.segments() {
+                solids.push((s, w.thickness_m / 2.0));
+            }
+        }
+        for (i, d) in world.doors.iter().enumerate() {
+            solids.push((d.panel(doors.is_open(i)), d.thickness_m / 2.0));
+        }
+        let inside = |p: Vec2| {
+            solids
+                .iter()
+                .any(|(s, h)| *h > 0.0 && inside_slab(s, *h, p))
+        };
+        for (k, g) in c.segs.iter().enumerate() {
+            let (a, b) = (Vec2::new(g[0], g[1]), Vec2::new(g[2], g[3]));
+            let d = b - a;
+            let n = Vec2::new(-d.y, d.x) / d.norm() * 1e-3;
+            let m = (a + b) / 2.0;
+            c.faces[k] = match (inside(m + n), inside(m - n)) {
+                (false, true) => 1,
+                (true, false) => -1,
+                _ => 0,
+            };
+        }
+        c
     }
 
     pub fn segment_count(&self) -> usize {
@@ -147,28 +210,25 @@ impl SweepCaster {
         }
         let (ox, oy) = (origin.x, origin.y);
         let r = max_range_m;
-        for seg in &self.segs {
+        // Near segments first, so that far ones can skip beams that already hit something
+        // closer than the segment's nearest point (a lower bound from its bounding box).
+        let mut process = |k: usize, dmin: f64| {
+            let seg = &self.segs[k];
+            let face = self.faces[k];
             let (px, py, qx, qy) = (seg[0] - ox, seg[1] - oy, seg[2] - ox, seg[3] - oy);
-            // Outside the square of the maximum range.
-            if (px > r && qx > r)
-                || (px < -r && qx < -r)
-                || (py > r && qy > r)
-                || (py < -r && qy < -r)
-            {
-                continue;
-            }
             // Into the sensor frame.
             let (pxs, pys) = (hc * px + hs * py, -hs * px + hc * py);
             let (qxs, qys) = (hc * qx + hs * qy, -hs * qx + hc * qy);
             if beams.front_only && pxs < 0.0 && qxs < 0.0 {
-                continue;
+                return;
             }
             let ex = qx - px;
             let ey = qy - py;
             let pe = px * ey - py * ex;
-            if pe == 0.0 {
-                // The segment's line passes through the sensor: seen edge-on, no area to hit.
-                continue;
+            // pe > 0: the sensor is on the segment's left.
+            if pe == 0.0 || (face > 0 && pe < 0.0) || (face < 0 && pe > 0.0) {
+                // Edge-on (the line passes through the sensor), or a face seen from inside.
+                return;
             }
             let ap = fast_atan2(pys, pxs);
             let aq = fast_atan2(qys, qxs);
@@ -182,6 +242,9 @@ impl SweepCaster {
             let hi = lo + span.abs() + 2.0 * ATAN2_TOL_RAD;
             let mut hit = |i0: usize, i1: usize| {
                 for i in i0..=i1 {
+                    if out[i] <= dmin {
+                        continue;
+                    }
                     let (bx, by) = (dx[i], dy[i]);
                     let denom = bx * ey - by * ex;
                     if denom == 0.0 {
@@ -214,6 +277,34 @@ impl SweepCaster {
             {
                 hit(i0, i1);
             }
+        };
+        let near2 = NEAR_M * NEAR_M;
+        let r2 = r * r;
+        let mut far: Vec<(u32, f64)> = Vec::with_capacity(self.segs.len());
+        for (k, seg) in self.segs.iter().enumerate() {
+            let (px, py, qx, qy) = (seg[0] - ox, seg[1] - oy, seg[2] - ox, seg[3] - oy);
+            let bx = if px * qx <= 0.0 {
+                0.0
+            } else {
+                px.abs().min(qx.abs())
+            };
+            let by = if py * qy <= 0.0 {
+                0.0
+            } else {
+                py.abs().min(qy.abs())
+            };
+            let d2 = bx * bx + by * by;
+            if d2 >= r2 {
+                continue; // wholly beyond the maximum range
+            }
+            if d2 <= near2 {
+                process(k, 0.0);
+            } else {
+                far.push((k as u32, d2));
+            }
+        }
+        for (k, d2) in far {
+            process(k as usize, d2.sqrt());
         }
         for d in discs {
             let (cx, cy) = (d.centre.x - ox, d.centre.y - oy);

@@ -231,6 +231,50 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(100))]
+    /// Culling the faces seen from inside a solid changes no range for a sensor in free space.
+    #[test]
+    fn face_culling_changes_no_range(x in 0.3f64..19.7, y in 0.3f64..7.7, th in -4.0f64..4.0, doors in 0usize..4) {
+        let world = loop_small();
+        let st = DoorStates { open: vec![doors & 1 == 1, doors & 2 == 2] };
+        let outline = world.obstacle_outline(&st);
+        let sensor = Vec2::new(x, y);
+        prop_assume!(outline.iter().all(|s| s.distance_to_point(sensor) > 0.1));
+        let laser = exact_laser(LaserPreset::Lms200);
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        let pose = Pose2::new(x - 0.021 * th.cos(), y - 0.021 * th.sin(), th);
+        laser.exact_ranges(&SweepCaster::for_world(&world, &st), pose, &[], &mut a);
+        laser.exact_ranges(&SweepCaster::new(&outline), pose, &[], &mut b);
+        prop_assert_eq!(&a, &b);
+        // And both agree with a brute-force cast of every beam against every segment.
+        let s = laser.sensor_pose(pose);
+        for (i, got) in a.iter().enumerate() {
+            let ang = s.theta + laser.layout().beam_angle_rad(i);
+            let want = brute_force_range(s.position(), Vec2::new(ang.cos(), ang.sin()), &outline, 32.767);
+            prop_assert!((got - want).abs() < 1e-9, "beam {}: sweep {} vs brute force {}", i, got, want);
+        }
+    }
+}
+
+fn brute_force_range(o: Vec2, d: Vec2, segs: &[Segment], max: f64) -> f64 {
+    let mut best = max;
+    for s in segs {
+        let e = s.b - s.a;
+        let p = s.a - o;
+        let denom = d.x * e.y - d.y * e.x;
+        if denom == 0.0 {
+            continue;
+        }
+        let t = (p.x * e.y - p.y * e.x) / denom;
+        let u = (p.x * d.y - p.y * d.x) / denom;
+        if t > 0.0 && (0.0..=1.0).contains(&u) && t < best {
+            best = t;
+        }
+    }
+    best
+}
+
 const TINY_LOOP: &str = r#"
 format_version = 1
 name = "tiny"
