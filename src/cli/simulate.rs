@@ -1,6 +1,8 @@
-//! `placewords simulate SCENARIO -o DIR`.
+//! `placewords simulate SCENARIO [--laps N] -o DIR [--quiet]`: one CARMEN log per run and a JSON
+//! manifest, all written atomically.
 
 use clap::Args;
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -8,11 +10,51 @@ use std::process::ExitCode;
 pub struct SimulateArgs {
     /// Scenario file (TOML).
     pub scenario: PathBuf,
+    /// Laps per run, replacing the scenario's counts.
+    #[arg(long)]
+    pub laps: Option<usize>,
     /// Output folder for the logs and manifest.
     #[arg(short, long)]
     pub out: PathBuf,
+    /// No progress bar.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
-pub fn run(_args: SimulateArgs) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("simulate is being built (issue 3)")
+pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
+    use placewords::sim::logs;
+    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let total: usize = scn
+        .runs
+        .iter()
+        .map(|r| args.laps.unwrap_or(r.laps) as u64 as usize)
+        .sum();
+    let bar = if args.quiet || !std::io::stderr().is_terminal() {
+        indicatif::ProgressBar::hidden()
+    } else {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} laps {elapsed}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_message(format!("simulating {}", scn.name));
+        b
+    };
+    let tick = || bar.inc(1);
+    let started = std::time::Instant::now();
+    let logs_ = placewords::sim::simulate(&scn, args.laps, &tick)?;
+    let simulated_s = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let files = logs::write_logs(&scn, &logs_, args.laps, &args.out)?;
+    if !args.quiet {
+        eprintln!(
+            "simulated {total} laps in {simulated_s:.2} s; wrote {} files in {:.2} s",
+            files.len(),
+            started.elapsed().as_secs_f64() - simulated_s
+        );
+        for f in &files {
+            eprintln!("wrote {}", f.display());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -4,6 +4,16 @@
 //! What a simulation produces ([`RunLog`]) is also what real logs are turned into, so the
 //! recognizer and evaluation see one shape of data.
 
+pub mod laser;
+pub mod logs;
+pub mod odometry;
+pub mod pedestrians;
+pub mod rng;
+pub mod robot;
+pub mod runner;
+
+pub use runner::{SimError, simulate};
+
 use crate::geom::{OdomPose, TruePose};
 use crate::scan::Scan;
 

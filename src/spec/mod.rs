@@ -3,6 +3,7 @@
 
 pub mod diag;
 pub mod evaluation;
+pub mod scenario;
 pub mod suggest;
 pub mod validate;
 pub mod world;

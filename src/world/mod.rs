@@ -3,6 +3,8 @@
 
 pub mod geometry;
 pub mod info;
+pub mod physics;
+pub mod raycast;
 
 use crate::geom::{Pose2, Segment, Vec2};
 use crate::spec::world::WorldSpec;

@@ -2,4 +2,5 @@
 
 mod io;
 mod recognizer;
+mod sim;
 mod world;

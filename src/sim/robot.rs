@@ -1,0 +1,283 @@
+//! The Pioneer 3-DX: differential-drive kinematics, route tracking on the true trajectory, and a
+//! pure-pursuit controller that keeps to cruise speed within the acceleration limits, slows for
+//! obstacles ahead and waits for them to clear.
+
+use crate::geom::{Pose2, Segment, Vec2, wrap_angle};
+use crate::world::Route;
+
+/// Robot and controller parameters (P3-DX defaults from ARIA/MobileSim).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotConfig {
+    /// Body radius, metres. Default 0.25.
+    pub radius_m: f64,
+    /// Distance between the wheels, metres. Default 0.357.
+    pub axle_track_m: f64,
+    /// Speed along the route, m/s. Default 0.4.
+    pub cruise_speed_m_s: f64,
+    /// Speed limit, m/s. Default 1.0.
+    pub max_speed_m_s: f64,
+    /// Turn rate limit, rad/s. Default 100°/s.
+    pub max_turn_rate_rad_s: f64,
+    /// Linear acceleration and deceleration limit, m/s². Default 0.3.
+    pub accel_m_s2: f64,
+    /// Angular acceleration limit, rad/s². Default 100°/s².
+    pub turn_accel_rad_s2: f64,
+    /// Pure-pursuit look-ahead along the route, metres. Default 0.8.
+    pub lookahead_m: f64,
+    /// The robot stops when an obstacle is this close ahead of its front, metres. Default 0.6.
+    pub stop_distance_m: f64,
+    /// It starts slowing when an obstacle is this close ahead of its front, metres. Default 1.2.
+    pub slow_distance_m: f64,
+    /// A run fails when the robot makes no progress for this long, seconds. Default 30.
+    pub blocked_timeout_s: f64,
+    /// Simulation time step, seconds. Default 0.05.
+    pub step_s: f64,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        RobotConfig {
+            radius_m: 0.25,
+            axle_track_m: 0.357,
+            cruise_speed_m_s: 0.4,
+            max_speed_m_s: 1.0,
+            max_turn_rate_rad_s: 100f64.to_radians(),
+            accel_m_s2: 0.3,
+            turn_accel_rad_s2: 100f64.to_radians(),
+            lookahead_m: 0.8,
+            stop_distance_m: 0.6,
+            slow_distance_m: 1.2,
+            blocked_timeout_s: 30.0,
+            step_s: 0.05,
+        }
+    }
+}
+
+/// Exact motion of a differential drive at constant (v, ω) for `dt` seconds.
+pub fn integrate(pose: Pose2, v: f64, w: f64, dt: f64) -> Pose2 {
+    let th = pose.theta;
+    let (dx, dy) = if w.abs() < 1e-9 {
+        (v * dt * th.cos(), v * dt * th.sin())
+    } else {
+        let r = v / w;
+        let th1 = th + w * dt;
+        (r * (th1.sin() - th.sin()), -r * (th1.cos() - th.cos()))
+    };
+    Pose2::new(pose.x + dx, pose.y + dy, wrap_angle(th + w * dt))
+}
+
+/// Wheel speeds (left, right) for body speeds (v, ω), m/s.
+pub fn wheel_speeds(v: f64, w: f64, axle_track_m: f64) -> (f64, f64) {
+    (v - w * axle_track_m / 2.0, v + w * axle_track_m / 2.0)
+}
+
+/// Progress along a closed route, measured by projecting the true position onto the route
+/// polyline near the previous projection, unwrapped so that it grows by the route length every
+/// lap.
+#[derive(Clone, Debug)]
+pub struct RouteTracker {
+    legs: Vec<Segment>,
+    /// Arc length at the start of each leg, from waypoint 0.
+    starts: Vec<f64>,
+    length_m: f64,
+    /// Arc length (from waypoint 0) where the run started.
+    origin_m: f64,
+    /// Unwrapped progress since the start, metres.
+    progress_m: f64,
+}
+
+impl RouteTracker {
+    pub fn new(route: &Route, start_waypoint: usize) -> Self {
+        let legs = route.legs();
+        let mut starts = Vec::with_capacity(legs.len());
+        let mut acc = 0.0;
+        for l in &legs {
+            starts.push(acc);
+            acc += l.length();
+        }
+        let origin_m = starts.get(start_waypoint).copied().unwrap_or(0.0);
+        RouteTracker {
+            legs,
+            starts,
+            length_m: acc,
+            origin_m,
+            progress_m: 0.0,
+        }
+    }
+
+    pub fn length_m(&self) -> f64 {
+        self.length_m
+    }
+
+    /// Unwrapped progress since the start, metres.
+    pub fn progress_m(&self) -> f64 {
+        self.progress_m
+    }
+
+    fn wrap(&self, s: f64) -> f64 {
+        s.rem_euclid(self.length_m)
+    }
+
+    /// The point at arc length `s` (any real, taken modulo the loop) and the leg's direction.
+    pub fn point_at(&self, s: f64) -> (Vec2, Vec2) {
+        let s = self.wrap(s);
+        let i = match self.starts.partition_point(|&x| x <= s) {
+            0 => 0,
+            k => k - 1,
+        };
+        let leg = self.legs[i];
+        let len = leg.length().max(1e-12);
+        let dir = (leg.b - leg.a) / len;
+        (leg.a + dir * (s - self.starts[i]).min(len), dir)
+    }
+
+    /// The pose at the start (the start waypoint, facing along its leg).
+    pub fn start_pose(&self) -> Pose2 {
+        let (p, d) = self.point_at(self.origin_m);
+        Pose2::new(p.x, p.y, d.y.atan2(d.x))
+    }
+
+    /// Arc length (absolute, unwrapped) of the current progress.
+    pub fn arc_m(&self) -> f64 {
+        self.origin_m + self.progress_m
+    }
+
+    /// Updates progress from a new true position; only projections within a few metres of the
+    /// previous one are considered, so parallel corridors never make it jump.
+    pub fn update(&mut self, p: Vec2) -> f64 {
+        let window = 3.0;
+        let prev = self.wrap(self.arc_m());
+        let mut best: Option<(f64, f64)> = None; // (distance, delta)
+        for (i, leg) in self.legs.iter().enumerate() {
+            let d = leg.b - leg.a;
+            let len2 = d.norm_squared();
+            let t = if len2 > 0.0 {
+                ((p - leg.a).dot(&d) / len2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let s = self.starts[i] + t * len2.sqrt();
+            let mut delta = s - prev;
+            let half = self.length_m / 2.0;
+            if delta > half {
+                delta -= self.length_m;
+            } else if delta < -half {
+                delta += self.length_m;
+            }
+            if delta.abs() > window {
+                continue;
+            }
+            let dist = (p - (leg.a + d * t)).norm();
+            if best.is_none_or(|(bd, _)| dist < bd) {
+                best = Some((dist, delta));
+            }
+        }
+        if let Some((_, delta)) = best {
+            self.progress_m += delta;
+        }
+        self.progress_m
+    }
+}
+
+/// The controller's state: current commanded speeds.
+#[derive(Clone, Debug, Default)]
+pub struct Controller {
+    pub v_m_s: f64,
+    pub w_rad_s: f64,
+}
+
+impl Controller {
+    /// New speeds for the next step. `free_ahead_m` is the clear distance in front of the
+    /// robot's body along its heading (from its last scan).
+    pub fn command(
+        &mut self,
+        cfg: &RobotConfig,
+        pose: Pose2,
+        tracker: &RouteTracker,
+        free_ahead_m: f64,
+    ) -> (f64, f64) {
+        let dt = cfg.step_s;
+        let (target, _) = tracker.point_at(tracker.arc_m() + cfg.lookahead_m);
+        let to = target - pose.position();
+        let alpha = wrap_angle(to.y.atan2(to.x) - pose.theta);
+        // Speed: cruise, less when the route bends away, and less near obstacles.
+        let cruise = cfg.cruise_speed_m_s.min(cfg.max_speed_m_s);
+        let heading_factor = if alpha.abs() > 60f64.to_radians() {
+            0.0
+        } else {
+            alpha.cos().max(0.0)
+        };
+        let span = (cfg.slow_distance_m - cfg.stop_distance_m).max(1e-6);
+        let obstacle_factor = ((free_ahead_m - cfg.stop_distance_m) / span).clamp(0.0, 1.0);
+        let v_goal = cruise * heading_factor * obstacle_factor;
+        let dv = cfg.accel_m_s2 * dt;
+        let v = v_goal.clamp(self.v_m_s - dv, self.v_m_s + dv);
+        // Turn: pure pursuit curvature at (at least) a nominal speed so the robot can line up
+        // when it is slow or stopped.
+        let ld = to.norm().max(1e-3);
+        let w_goal = (2.0 * v.max(0.15) * alpha.sin() / ld)
+            .clamp(-cfg.max_turn_rate_rad_s, cfg.max_turn_rate_rad_s);
+        let dw = cfg.turn_accel_rad_s2 * dt;
+        let w = w_goal.clamp(self.w_rad_s - dw, self.w_rad_s + dw);
+        self.v_m_s = v;
+        self.w_rad_s = w;
+        (v, w)
+    }
+}
+
+/// Clear distance ahead of the robot's front from a scan's hit points, given in the robot frame:
+/// the nearest hit within a band as wide as the body (plus 5 cm each side) ahead of it.
+pub fn free_ahead(cfg: &RobotConfig, hits_in_robot: impl Iterator<Item = Vec2>) -> f64 {
+    let half = cfg.radius_m + 0.05;
+    hits_in_robot
+        .filter(|h| h.x > 0.0 && h.y.abs() < half)
+        .map(|h| h.x - cfg.radius_m)
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> Route {
+        Route {
+            id: "r".into(),
+            waypoints: vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(10.0, 0.0),
+                Vec2::new(10.0, 4.0),
+                Vec2::new(0.0, 4.0),
+            ],
+        }
+    }
+
+    #[test]
+    fn integrate_goes_straight_and_turns_in_a_circle() {
+        let p = integrate(Pose2::IDENTITY, 1.0, 0.0, 2.0);
+        assert!((p.x - 2.0).abs() < 1e-12 && p.y.abs() < 1e-12);
+        let mut q = Pose2::IDENTITY;
+        for _ in 0..50 {
+            q = integrate(q, 1.0, std::f64::consts::PI, 0.02);
+        }
+        // Half a circle of radius 1/π.
+        assert!(q.x.abs() < 1e-9 && (q.y - 2.0 / std::f64::consts::PI).abs() < 1e-9);
+    }
+
+    #[test]
+    fn tracker_unwraps_laps_and_starts_at_the_start_waypoint() {
+        let r = square();
+        let mut t = RouteTracker::new(&r, 1);
+        assert_eq!(t.length_m(), 28.0);
+        let s = t.start_pose();
+        assert!(
+            (s.x - 10.0).abs() < 1e-12 && (s.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-12
+        );
+        let mut s = 0.0;
+        while s < 2.0 * 28.0 {
+            s += 0.5;
+            let (p, _) = t.point_at(t.arc_m() + 0.5);
+            t.update(p);
+        }
+        assert!((t.progress_m() - 56.0).abs() < 1e-9);
+    }
+}
