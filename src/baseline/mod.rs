@@ -1,5 +1,5 @@
 //! Baselines the recognizer is compared with (ICP).
 
-// pub mod icp;
+pub mod icp;
 
-// pub use icp::{IcpConfig, IcpRecognizer};
+pub use icp::{IcpConfig, IcpRecognizer};

@@ -1,4 +1,5 @@
 //! One integration-test binary (keeps link time down on 2 cores); one module per area.
 
+mod eval;
 mod io;
 mod world;
