@@ -7,7 +7,7 @@
 //! error, is the CLI's business).
 
 use crate::report::json::{Report, Scores};
-use crate::spec::evaluation::{Expectation, ExpectSpec};
+use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
 /// Which bound of an expectation.
@@ -37,7 +37,11 @@ impl Outcome {
     /// The testcase name: `levels=3 precision >= 0.90`.
     pub fn name(&self) -> String {
         let (what, op) = self.what_op();
-        format!("{} {what} {op} {}", self.subject, fmt_limit(self.bound, self.limit))
+        format!(
+            "{} {what} {op} {}",
+            self.subject,
+            fmt_limit(self.bound, self.limit)
+        )
     }
 
     fn what_op(&self) -> (&'static str, &'static str) {
@@ -140,7 +144,11 @@ fn push_bounds(
 
 /// 0 when every outcome passed, 1 when any missed.
 pub fn exit_code(outcomes: &[Outcome]) -> i32 {
-    if outcomes.iter().all(|o| o.passed) { 0 } else { 1 }
+    if outcomes.iter().all(|o| o.passed) {
+        0
+    } else {
+        1
+    }
 }
 
 #[cfg(test)]
@@ -203,7 +211,11 @@ mod tests {
         };
         let o = check(&rep, &spec);
         assert!(o.iter().all(|o| !o.passed));
-        assert!(o[0].line().ends_with("not in the report"), "{}", o[0].line());
+        assert!(
+            o[0].line().ends_with("not in the report"),
+            "{}",
+            o[0].line()
+        );
         assert_eq!(exit_code(&o), 1);
     }
 

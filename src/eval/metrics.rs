@@ -246,7 +246,11 @@ impl<'a> Scorer<'a> {
         breakdown: bool,
         revisits: &[bool],
     ) -> (Metrics, Vec<DoorConfigMetrics>) {
-        assert_eq!(revisits.len(), self.obs.len(), "revisits of other observations");
+        assert_eq!(
+            revisits.len(),
+            self.obs.len(),
+            "revisits of other observations"
+        );
         let n_cfg = self.configs.len();
         let mut total = Counts::default();
         let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
@@ -260,7 +264,8 @@ impl<'a> Scorer<'a> {
             let (mut n, mut ok) = (0usize, 0usize);
             let mut match_cfg = None;
             for p in &m.pairs {
-                let (Some(&qi), Some(&pi)) = (self.index_of.get(&p.query), self.index_of.get(&p.past))
+                let (Some(&qi), Some(&pi)) =
+                    (self.index_of.get(&p.query), self.index_of.get(&p.past))
                 else {
                     if seen.insert((p.query, p.past)) {
                         total.unresolved += 1;
@@ -406,7 +411,11 @@ pub(crate) mod tests {
             });
             for k in 0..per_lap {
                 let a = k as f64 / per_lap as f64 * 2.0 * std::f64::consts::PI;
-                let pose = Pose2::new(radius * a.cos(), radius * a.sin(), a + std::f64::consts::FRAC_PI_2);
+                let pose = Pose2::new(
+                    radius * a.cos(),
+                    radius * a.sin(),
+                    a + std::f64::consts::FRAC_PI_2,
+                );
                 let i = obs.len();
                 gt.frames.push(FrameTruth {
                     pose: TruePose(pose),
@@ -532,7 +541,11 @@ pub(crate) mod tests {
         let (obs, gt) = circle(2, 40.0);
         // Match 1: 2 correct, 1 wrong → correct match. Match 2 repeats a pair and adds a wrong
         // one: 1 of 2 correct → not more than half → wrong match.
-        let m1 = one_match(vec![pair(&obs, 400, 0), pair(&obs, 401, 1), pair(&obs, 402, 200)]);
+        let m1 = one_match(vec![
+            pair(&obs, 400, 0),
+            pair(&obs, 401, 1),
+            pair(&obs, 402, 200),
+        ]);
         let m2 = one_match(vec![pair(&obs, 400, 0), pair(&obs, 403, 200)]);
         let m = score(&obs, &[m1, m2], &gt, &EvaluationSpec::default(), 1.0);
         assert_eq!((m.pairs, m.correct_pairs), (4, 2));
@@ -562,7 +575,11 @@ pub(crate) mod tests {
         assert_eq!(e.sensitivity[0].precision, 0.0);
         assert_eq!(e.sensitivity[1].precision, 1.0);
         assert!(e.sensitivity[1].recall > 0.9, "{:?}", e.sensitivity[1]);
-        let names: Vec<_> = e.door_configs.iter().map(|d| d.door_config.as_str()).collect();
+        let names: Vec<_> = e
+            .door_configs
+            .iter()
+            .map(|d| d.door_config.as_str())
+            .collect();
         assert_eq!(names, ["closed", "open"]);
         assert_eq!(e.door_configs[0].laps, 2);
         assert_eq!(e.door_configs[1].metrics.pairs, 385);
@@ -577,7 +594,13 @@ pub(crate) mod tests {
         let (obs, gt) = circle(2, 40.0);
         let mut p = pair(&obs, 400, 0);
         p.query = 99_999;
-        let m = score(&obs, &[one_match(vec![p])], &gt, &EvaluationSpec::default(), 1.0);
+        let m = score(
+            &obs,
+            &[one_match(vec![p])],
+            &gt,
+            &EvaluationSpec::default(),
+            1.0,
+        );
         assert_eq!((m.pairs, m.unresolved_pairs), (0, 1));
     }
 }

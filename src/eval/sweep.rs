@@ -313,7 +313,10 @@ mod tests {
         let one = run(1);
         let two = run(2);
         assert_eq!(one, two);
-        assert_eq!(one.iter().map(|r| r.point.clone()).collect::<Vec<_>>(), grid);
+        assert_eq!(
+            one.iter().map(|r| r.point.clone()).collect::<Vec<_>>(),
+            grid
+        );
         assert_eq!(one[0].metrics.precision, 1.0);
         assert_eq!(one[9].metrics.precision, 1.0);
     }

@@ -147,7 +147,12 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         let br = c
             .best_recall_at_precision
             .as_ref()
-            .map(|p| format!("R {:.3} at P≥{PRECISION_FLOOR} (τ={})", p.recall, p.threshold))
+            .map(|p| {
+                format!(
+                    "R {:.3} at P≥{PRECISION_FLOOR} (τ={})",
+                    p.recall, p.threshold
+                )
+            })
             .unwrap_or_else(|| format!("no point at P≥{PRECISION_FLOOR}"));
         let _ = writeln!(
             s,

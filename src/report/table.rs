@@ -60,11 +60,7 @@ pub fn text_table(report: &Report) -> String {
     let _ = writeln!(
         out,
         "scenario {}  seed {}  laps {}  revisits {}  simulation {:.2} s/lap",
-        report.scenario,
-        report.seed,
-        report.laps,
-        report.revisits,
-        report.simulate_seconds_per_lap
+        report.scenario, report.seed, report.laps, report.revisits, report.simulate_seconds_per_lap
     );
     let _ = writeln!(
         out,
@@ -192,7 +188,7 @@ pub fn markdown_table_i(reports: &[Report]) -> String {
     out
 }
 
-/// Thresholds per level row of Table I, as a Markdown note ("1: [6]; 2: [9, 6]; ...") taken
+/// Thresholds per level row of Table I, as a Markdown note (`1 level: [6]; 2 levels: [6, 9]`) taken
 /// from the first report that has each row.
 pub fn thresholds_note(reports: &[Report]) -> String {
     let mut seen: Vec<(usize, Vec<usize>)> = Vec::new();
@@ -223,8 +219,14 @@ mod tests {
         let md = markdown_table_i(&[a, b]);
         let lines: Vec<&str> = md.lines().collect();
         assert_eq!(lines.len(), 6, "{md}");
-        assert_eq!(lines[0], "| levels | A P – R | A s/lap | B P – R | B s/lap |");
-        assert_eq!(lines[2], "| 1 | 0.935 – 0.103 | 0.50 | 0.931 – 0.106 | 0.50 |");
+        assert_eq!(
+            lines[0],
+            "| levels | A P – R | A s/lap | B P – R | B s/lap |"
+        );
+        assert_eq!(
+            lines[2],
+            "| 1 | 0.935 – 0.103 | 0.50 | 0.931 – 0.106 | 0.50 |"
+        );
         assert!(lines[5].starts_with("| ICP | 0.050 – 0.040 | 9.00 |"));
     }
 

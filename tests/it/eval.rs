@@ -36,9 +36,21 @@ fn world() -> Vec<Segment> {
         (0.0, 8.0),
         (0.0, 0.0),
     ]));
-    s.extend(poly(&[(2.0, 2.0), (18.0, 2.0), (18.0, 6.0), (2.0, 6.0), (2.0, 2.0)]));
+    s.extend(poly(&[
+        (2.0, 2.0),
+        (18.0, 2.0),
+        (18.0, 6.0),
+        (2.0, 6.0),
+        (2.0, 2.0),
+    ]));
     // Pillars.
-    for (x, y) in [(10.0, 0.3), (15.0, 7.7), (19.7, 4.0), (3.0, 7.7), (0.3, 3.0)] {
+    for (x, y) in [
+        (10.0, 0.3),
+        (15.0, 7.7),
+        (19.7, 4.0),
+        (3.0, 7.7),
+        (0.3, 3.0),
+    ] {
         s.extend(poly(&[
             (x - 0.15, y - 0.15),
             (x + 0.15, y - 0.15),
@@ -72,7 +84,12 @@ fn ray(walls: &[Segment], o: Vec2, d: Vec2, max: f64) -> f64 {
 /// seen from another frame (so nothing can use world coordinates by accident).
 fn runs(runs: usize, laps: usize) -> Vec<RunLog> {
     let walls = world();
-    let layout = BeamLayout::centered(181, std::f64::consts::PI, 32.767, Pose2::new(0.021, 0.0, 0.0));
+    let layout = BeamLayout::centered(
+        181,
+        std::f64::consts::PI,
+        32.767,
+        Pose2::new(0.021, 0.0, 0.0),
+    );
     let route = [(1.0, 1.0), (19.0, 1.0), (19.0, 7.0), (1.0, 7.0), (1.0, 1.0)];
     let odom_from_world = Pose2::new(5.0, -3.0, 0.4);
     let mut out = Vec::new();
@@ -92,7 +109,12 @@ fn runs(runs: usize, laps: usize) -> Vec<RunLog> {
                     let ranges_m = (0..layout.count)
                         .map(|i| {
                             let ang = sensor.theta + layout.beam_angle_rad(i);
-                            ray(&walls, sensor.position(), Vec2::new(ang.cos(), ang.sin()), 32.767)
+                            ray(
+                                &walls,
+                                sensor.position(),
+                                Vec2::new(ang.cos(), ang.sin()),
+                                32.767,
+                            )
                         })
                         .collect();
                     frames.push(Frame {
@@ -110,7 +132,12 @@ fn runs(runs: usize, laps: usize) -> Vec<RunLog> {
             }
             laps_out.push(LapLog {
                 lap,
-                door_config: if lap % 2 == 0 { "all-closed" } else { "one-open" }.into(),
+                door_config: if lap % 2 == 0 {
+                    "all-closed"
+                } else {
+                    "one-open"
+                }
+                .into(),
                 open_doors: vec![],
                 frames,
             });
@@ -207,7 +234,11 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
         &runs,
     );
     let eb = evaluate(&best, &spec);
-    eprintln!("icp only_best: {} matches, {:?}", best.matches.len(), eb.main);
+    eprintln!(
+        "icp only_best: {} matches, {:?}",
+        best.matches.len(),
+        eb.main
+    );
     assert!(best.matches.len() <= r.matches.len());
     let e = evaluate(&r, &spec);
     eprintln!(
@@ -267,7 +298,10 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
         error: None,
         seconds: r.seconds,
     }]);
-    assert!(xml.contains("<failure message=\"FAIL loop levels=1 precision"), "{xml}");
+    assert!(
+        xml.contains("<failure message=\"FAIL loop levels=1 precision"),
+        "{xml}"
+    );
 }
 
 #[test]
