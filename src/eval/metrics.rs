@@ -114,6 +114,51 @@ pub fn score(
         .0
 }
 
+/// One deduplicated observation pair with its true positions, for pictures of what matched.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScoredPair {
+    pub query: ObsId,
+    pub past: ObsId,
+    pub query_truth: crate::geom::TruePose,
+    pub past_truth: crate::geom::TruePose,
+    /// Whether the true positions are within the radius.
+    pub correct: bool,
+}
+
+/// Every distinct `(query, past)` pair of `rec`'s matches (first occurrence order) with its true
+/// poses and whether it is correct at `radius_m`. Pairs without truth are left out.
+pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
+    let index_of: HashMap<ObsId, usize> = rec
+        .observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    let truth_of = |id: ObsId| {
+        index_of
+            .get(&id)
+            .and_then(|&i| rec.truth.frame(rec.observations[i].input_index))
+            .map(|f| f.pose)
+    };
+    let mut seen = HashSet::new();
+    let mut out = Vec::new();
+    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
+        if !seen.insert((p.query, p.past)) {
+            continue;
+        }
+        if let (Some(q), Some(pa)) = (truth_of(p.query), truth_of(p.past)) {
+            out.push(ScoredPair {
+                query: p.query,
+                past: p.past,
+                query_truth: q,
+                past_truth: pa,
+                correct: q.0.distance(&pa.0) <= radius_m,
+            });
+        }
+    }
+    out
+}
+
 /// Truth-side facts about one observation.
 #[derive(Clone, Copy, Debug)]
 struct ObsTruth {
@@ -587,6 +632,36 @@ pub(crate) mod tests {
             e.door_configs[0].metrics.revisits + e.door_configs[1].metrics.revisits,
             e.main.revisits
         );
+    }
+
+    #[test]
+    fn revisit_search_is_fast_on_forty_long_laps() {
+        // 40 laps × 2000 observations = 80 000, the size of scenario B.
+        let (obs, gt) = circle(40, 200.0);
+        let t = std::time::Instant::now();
+        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 3.0);
+        assert_eq!(m.revisits, 39 * 2000 + 30);
+        assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
+    }
+
+    #[test]
+    fn scored_pairs_deduplicate_and_classify() {
+        let (obs, gt) = circle(2, 40.0);
+        let matches = vec![
+            one_match(vec![pair(&obs, 400, 0), pair(&obs, 401, 200)]),
+            one_match(vec![pair(&obs, 400, 0)]),
+        ];
+        let rec = Recognition {
+            name: "t".into(),
+            observations: obs,
+            matches,
+            seconds: 0.0,
+            laps: 2,
+            truth: gt,
+        };
+        let p = scored_pairs(&rec, 1.0);
+        assert_eq!(p.len(), 2);
+        assert!(p[0].correct && !p[1].correct);
     }
 
     #[test]

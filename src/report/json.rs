@@ -135,6 +135,29 @@ impl Report {
             .unwrap_or(0);
     }
 
+    /// Scores `rec` (a recognizer run with `levels` levels and `thresholds`) and adds it.
+    pub fn add_level(
+        &mut self,
+        levels: usize,
+        thresholds: &[usize],
+        rec: &Recognition,
+    ) -> &LevelReport {
+        let scores = Scores::of(rec, &self.evaluation);
+        self.levels.push(LevelReport {
+            levels,
+            thresholds: thresholds.to_vec(),
+            scores,
+        });
+        self.levels.last().expect("just pushed")
+    }
+
+    /// Scores `rec` (an ICP baseline run) and sets it as the report's ICP result.
+    pub fn set_icp(&mut self, rec: &Recognition) {
+        self.icp = Some(IcpReport {
+            scores: Scores::of(rec, &self.evaluation),
+        });
+    }
+
     /// The result of the configuration with `levels` levels.
     pub fn level(&self, levels: usize) -> Option<&LevelReport> {
         self.levels.iter().find(|l| l.levels == levels)

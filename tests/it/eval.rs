@@ -6,7 +6,7 @@ use placewords::eval::gate::{check, exit_code};
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
 use placewords::recognizer::{AlignedPair, Match, Observation};
-use placewords::report::json::{IcpReport, LevelReport, Report, Scores};
+use placewords::report::json::Report;
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
 use placewords::sim::{Frame, LapLog, RunLog};
@@ -258,15 +258,11 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
     assert!(e.main.recall > 0.5, "{:?}", e.main);
 
     let mut report = Report::new("loop", 1, r.laps, spec.clone());
-    report.levels.push(LevelReport {
-        levels: 1,
-        thresholds: vec![6],
-        scores: Scores::of(&r, &spec),
-    });
-    report.icp = Some(IcpReport {
-        scores: Scores::of(&r, &spec),
-    });
+    report.add_level(1, &[6], &r);
+    report.set_icp(&r);
     report.finish();
+    assert_eq!(report.revisits, e.main.revisits);
+    assert_eq!(report.icp.as_ref().unwrap().scores.pairs, e.main.pairs);
     let pass = ExpectSpec {
         levels: vec![LevelExpectation {
             levels: 1,
