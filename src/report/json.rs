@@ -186,6 +186,25 @@ pub struct SweepReport {
 }
 
 impl SweepReport {
+    /// A sweep report of `results` (in grid order) with its PR curves.
+    pub fn new(
+        scenario: &str,
+        seed: u64,
+        laps: usize,
+        evaluation: EvaluationSpec,
+        results: Vec<SweepResult>,
+    ) -> Self {
+        let curves = crate::eval::sweep::pr_curves(&results);
+        SweepReport {
+            scenario: scenario.to_string(),
+            seed,
+            laps,
+            evaluation,
+            results,
+            curves,
+        }
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a sweep report always serializes")
     }

@@ -119,17 +119,18 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         for p in c.points.iter().filter(|p| p.pairs > 0) {
             let _ = writeln!(
                 s,
-                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{} τ={}: P {:.3} R {:.3}</title></circle>"#,
+                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{} τ{}={}: P {:.3} R {:.3}</title></circle>"#,
                 sx(p.recall),
                 sy(p.precision),
                 escape(&c.label),
+                c.fixed_thresholds.len(),
                 p.threshold,
                 p.precision,
                 p.recall
             );
         }
         // Legend entry.
-        let ly = TOP + 10.0 + 34.0 * i as f64;
+        let ly = TOP + 10.0 + 46.0 * i as f64;
         let lx = W - RIGHT + 16.0;
         let _ = writeln!(
             s,
@@ -139,10 +140,11 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
             ly + 4.0,
             escape(&c.label)
         );
+        let v = c.fixed_thresholds.len();
         let f1 = c
             .max_f1
             .as_ref()
-            .map(|p| format!("max F1 {:.3} (τ={})", p.f1, p.threshold))
+            .map(|p| format!("max F1 {:.3} (τ{v}={})", p.f1, p.threshold))
             .unwrap_or_else(|| "max F1 –".into());
         let br = c
             .best_recall_at_precision
@@ -156,10 +158,12 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
             .unwrap_or_else(|| format!("no point at P≥{PRECISION_FLOOR}"));
         let _ = writeln!(
             s,
-            r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{} · {}</text>"##,
+            r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text><text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text>"##,
             lx + 30.0,
             ly + 17.0,
             escape(&f1),
+            lx + 30.0,
+            ly + 30.0,
             escape(&br)
         );
     }
@@ -224,6 +228,9 @@ mod tests {
         assert_eq!(lines[0].attribute("stroke-dasharray"), Some("2 3"));
         assert_eq!(lines[1].attribute("stroke-dasharray"), None);
         assert!(svg.contains("max F1"));
+        if let Ok(path) = std::env::var("PLACEWORDS_PLOT_SAMPLE") {
+            std::fs::write(path, &svg).unwrap();
+        }
         assert!(svg.contains("B &lt;sweep&gt;"));
     }
 }

@@ -207,6 +207,30 @@ pub fn thresholds_note(reports: &[Report]) -> String {
     format!("Minimum n-gram sizes per level: {}.", parts.join("; "))
 }
 
+/// One line per PR curve: its max-F1 point and its best recall at precision ≥ 0.9.
+pub fn curves_table(curves: &[crate::eval::sweep::PrCurve]) -> String {
+    let floor = crate::eval::sweep::PRECISION_FLOOR;
+    let body: Vec<Vec<String>> = curves
+        .iter()
+        .map(|c| {
+            let (f1, f1_at) = match &c.max_f1 {
+                Some(p) => (
+                    format!("{:.3}", p.f1),
+                    format!("τ={} P {:.3} R {:.3}", p.threshold, p.precision, p.recall),
+                ),
+                None => ("-".into(), "-".into()),
+            };
+            let best = match &c.best_recall_at_precision {
+                Some(p) => format!("{:.3} (τ={}, P {:.3})", p.recall, p.threshold, p.precision),
+                None => "-".into(),
+            };
+            vec![c.label.clone(), f1, f1_at, best]
+        })
+        .collect();
+    let best_header = format!("best R at P≥{floor}");
+    render(&["curve", "max F1", "at", &best_header], &body)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,6 +252,26 @@ mod tests {
             "| 1 | 0.935 – 0.103 | 0.50 | 0.931 – 0.106 | 0.50 |"
         );
         assert!(lines[5].starts_with("| ICP | 0.050 – 0.040 | 9.00 |"));
+    }
+
+    #[test]
+    fn curves_table_has_a_line_per_curve() {
+        use crate::eval::metrics::Metrics;
+        use crate::eval::sweep::{GridPoint, SweepResult, pr_curves};
+        let r = |l: usize, th: &[usize], p: f64, rc: f64| SweepResult {
+            point: GridPoint::new(l, th),
+            metrics: Metrics {
+                precision: p,
+                recall: rc,
+                pairs: 1,
+                ..Metrics::default()
+            },
+            recognize_seconds_per_lap: 0.0,
+        };
+        let c = pr_curves(&[r(1, &[5], 0.95, 0.1), r(2, &[6, 3], 0.5, 0.5)]);
+        let t = curves_table(&c);
+        assert_eq!(t.lines().count(), 4, "{t}");
+        assert!(t.contains("0.100 (τ=5, P 0.950)"), "{t}");
     }
 
     #[test]
