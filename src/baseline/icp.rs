@@ -64,7 +64,8 @@ pub struct IcpConfig {
     /// are expressed in the robot's own frame, so two passes in the same direction differ by
     /// a few degrees only.
     pub initial_rotations_deg: Vec<f64>,
-    /// Stop when a step moves less than this (and turns less than this in mrad). Default 1e-4.
+    /// Stop when a step's translation (m) plus rotation (rad) is below this. Default 1e-3
+    /// (about 1 mm or 1 mrad).
     pub convergence: f64,
     /// From this iteration on, give up when fewer than `early_reject_fraction` of the points
     /// have a correspondence or the trimmed mean residual exceeds `early_reject_residual_m`.
@@ -107,7 +108,7 @@ impl Default for IcpConfig {
             max_correspondence_m: 0.5,
             trim_ratio: 0.8,
             initial_rotations_deg: Vec::new(),
-            convergence: 1e-4,
+            convergence: 1e-3,
             early_reject_iteration: 6,
             early_reject_fraction: 0.5,
             early_reject_residual_m: 0.15,
@@ -325,7 +326,7 @@ fn align_from(source: &Cloud, target: &Cloud, start: Rigid, cfg: &IcpConfig) -> 
                 .map(|&(_, i, j)| (source.points[i], target.points[j])),
         );
         let next = fit(&pairs);
-        let step = (next.t - tf.t).norm() + (next.theta - tf.theta).abs() * 1e-3;
+        let step = (next.t - tf.t).norm() + crate::geom::wrap_angle(next.theta - tf.theta).abs();
         tf = next;
         if step < cfg.convergence {
             break;

@@ -315,3 +315,23 @@ fn icp_is_deterministic_whatever_the_threads() {
     };
     assert_eq!(go(1), go(2));
 }
+
+/// How the ICP baseline's cost grows with laps (every new region meets every past one):
+/// `cargo test --release --test it icp_cost -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn icp_cost_over_twenty_laps() {
+    let runs = runs(1, 20);
+    let mut icp = IcpRecognizer::new(IcpConfig::default());
+    let r = recognize_runs(&mut icp, &runs);
+    let e = evaluate(&r, &EvaluationSpec::default());
+    eprintln!(
+        "icp over {} laps: {:.3} s/lap, {} regions, {} matches, P {:.3} R {:.3}",
+        r.laps,
+        r.seconds_per_lap(),
+        icp.region_count(),
+        r.matches.len(),
+        e.main.precision,
+        e.main.recall
+    );
+}
