@@ -171,7 +171,7 @@ struct ObsTruth {
 }
 
 /// Observations joined with their truth, reusable across radii.
-pub struct Scorer<'a> {
+pub struct Scorer {
     /// Observation id → position in `obs`.
     index_of: HashMap<ObsId, usize>,
     /// Per observation (creation order); `None` when its input frame has no truth.
@@ -180,15 +180,10 @@ pub struct Scorer<'a> {
     config_laps: Vec<usize>,
     min_gap_m: f64,
     heading_tol_rad: f64,
-    _truth: &'a GroundTruth,
 }
 
-impl<'a> Scorer<'a> {
-    pub fn new(
-        observations: &[Observation],
-        truth: &'a GroundTruth,
-        spec: &EvaluationSpec,
-    ) -> Self {
+impl Scorer {
+    pub fn new(observations: &[Observation], truth: &GroundTruth, spec: &EvaluationSpec) -> Self {
         let configs = truth.door_configs();
         let config_index: HashMap<&str, usize> = configs
             .iter()
@@ -228,7 +223,6 @@ impl<'a> Scorer<'a> {
             config_laps,
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
-            _truth: truth,
         }
     }
 
