@@ -277,6 +277,9 @@ mod tests {
     #[test]
     fn text_table_lists_every_recognizer() {
         let t = text_table(&sample("B", [0.9; 3], [0.2; 3]));
+        if std::env::var_os("PLACEWORDS_SHOW_TABLE").is_some() {
+            eprintln!("{t}");
+        }
         for needle in ["1 [6]", "2 [6, 9]", "3 [6, 9, 12]", "ICP", "revisits 5000"] {
             assert!(t.contains(needle), "{needle} missing in\n{t}");
         }
