@@ -83,14 +83,20 @@ fn ray(walls: &[Segment], o: Vec2, d: Vec2, max: f64) -> f64 {
 /// `laps` laps around the loop, counter-clockwise, a frame each 4 cm; odometry is the truth
 /// seen from another frame (so nothing can use world coordinates by accident).
 fn runs(runs: usize, laps: usize) -> Vec<RunLog> {
-    let walls = world();
+    let route = [(1.0, 1.0), (19.0, 1.0), (19.0, 7.0), (1.0, 7.0)];
+    let route: Vec<Vec2> = route.iter().map(|p| Vec2::new(p.0, p.1)).collect();
+    drive(&world(), &route, 0.04, runs, laps)
+}
+
+/// Drives the closed loop `route` among `walls`, a frame each `step_m`. Beams only see walls
+/// within 4 m (farther ones report no return), which is all ICP uses.
+fn drive(walls: &[Segment], route: &[Vec2], step_m: f64, runs: usize, laps: usize) -> Vec<RunLog> {
     let layout = BeamLayout::centered(
         181,
         std::f64::consts::PI,
         32.767,
         Pose2::new(0.021, 0.0, 0.0),
     );
-    let route = [(1.0, 1.0), (19.0, 1.0), (19.0, 7.0), (1.0, 7.0), (1.0, 1.0)];
     let odom_from_world = Pose2::new(5.0, -3.0, 0.4);
     let mut out = Vec::new();
     for r in 0..runs {
@@ -98,23 +104,25 @@ fn runs(runs: usize, laps: usize) -> Vec<RunLog> {
         let mut time_s = 0.0;
         for lap in 0..laps {
             let mut frames = Vec::new();
-            for w in route.windows(2) {
-                let (a, b) = (Vec2::new(w[0].0, w[0].1), Vec2::new(w[1].0, w[1].1));
+            for i in 0..route.len() {
+                let (a, b) = (route[i], route[(i + 1) % route.len()]);
                 let heading = (b - a).y.atan2((b - a).x);
-                let n = ((b - a).norm() / 0.04).round() as usize;
+                let n = ((b - a).norm() / step_m).round() as usize;
                 for k in 0..n {
                     let p = a + (b - a) * (k as f64 / n as f64);
                     let truth = Pose2::new(p.x, p.y, heading);
                     let sensor = truth.compose(&layout.mount);
+                    let near: Vec<Segment> = walls
+                        .iter()
+                        .filter(|w| w.distance_to_point(sensor.position()) < 4.0)
+                        .copied()
+                        .collect();
                     let ranges_m = (0..layout.count)
                         .map(|i| {
                             let ang = sensor.theta + layout.beam_angle_rad(i);
-                            ray(
-                                &walls,
-                                sensor.position(),
-                                Vec2::new(ang.cos(), ang.sin()),
-                                32.767,
-                            )
+                            let d = Vec2::new(ang.cos(), ang.sin());
+                            let r = ray(&near, sensor.position(), d, 32.767);
+                            if r > 4.0 { 32.767 } else { r }
                         })
                         .collect();
                     frames.push(Frame {
@@ -226,20 +234,21 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
     let mut icp = IcpRecognizer::new(IcpConfig::default());
     let r = recognize_runs(&mut icp, &runs);
     let spec = EvaluationSpec::default();
-    let best = recognize_runs(
+    let all = recognize_runs(
         &mut IcpRecognizer::new(IcpConfig {
-            only_best: true,
+            only_best: false,
             ..IcpConfig::default()
         }),
         &runs,
     );
-    let eb = evaluate(&best, &spec);
+    let ea = evaluate(&all, &spec);
     eprintln!(
-        "icp only_best: {} matches, {:?}",
-        best.matches.len(),
-        eb.main
+        "icp, every accepted region: {} matches, {:?}",
+        all.matches.len(),
+        ea.main
     );
-    assert!(best.matches.len() <= r.matches.len());
+    assert!(r.matches.len() <= icp.region_count());
+    assert!(all.matches.len() >= r.matches.len());
     let e = evaluate(&r, &spec);
     eprintln!(
         "icp: {} observations, {} regions, {} matches, {:?}",
@@ -252,10 +261,11 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
     let per_lap = r.observations.len() as f64 / 3.0;
     assert!((470.0..=490.0).contains(&per_lap), "{per_lap}");
     assert!(e.main.pairs > 0);
-    // ICP accepts every corridor stretch that looks like another: recall is high, precision
-    // low (as in the paper's Table I).
-    assert!(e.main.precision > 0.05, "{:?}", e.main);
+    // ICP accepts every corridor stretch that looks like another; the best of them is right
+    // most of the time on this small loop with pillars.
+    assert!(e.main.precision > 0.5, "{:?}", e.main);
     assert!(e.main.recall > 0.5, "{:?}", e.main);
+    assert!(ea.main.precision < e.main.precision, "{:?}", ea.main);
 
     let mut report = Report::new("loop", 1, r.laps, spec.clone());
     report.add_level(1, &[6], &r);
@@ -266,12 +276,12 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
     let pass = ExpectSpec {
         levels: vec![LevelExpectation {
             levels: 1,
-            min_precision: Some(0.05),
+            min_precision: Some(0.5),
             min_recall: Some(0.5),
             max_seconds_per_lap: None,
         }],
         icp: Some(Expectation {
-            min_precision: Some(0.05),
+            min_precision: Some(0.5),
             ..Expectation::default()
         }),
     };
@@ -329,6 +339,41 @@ fn icp_cost_over_twenty_laps() {
         "icp over {} laps: {:.3} s/lap, {} regions, {} matches, P {:.3} R {:.3}",
         r.laps,
         r.seconds_per_lap(),
+        icp.region_count(),
+        r.matches.len(),
+        e.main.precision,
+        e.main.recall
+    );
+}
+
+/// The ICP baseline on `worlds/institute-floor.toml` (all doors closed, no noise): its cost
+/// per lap for a few laps, to extrapolate to scenario B:
+/// `cargo test --release --test it icp_cost_on_institute -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn icp_cost_on_institute_floor() {
+    let world =
+        placewords::spec::world::load_world(std::path::Path::new("worlds/institute-floor.toml"))
+            .expect("the shipped world loads");
+    let walls = world.obstacle_outline(&placewords::world::DoorStates::all_closed(&world));
+    let route = world.route("lap").expect("route lap").waypoints.clone();
+    let laps = 6;
+    let runs = drive(&walls, &route, 0.1, 1, laps);
+    let mut icp = IcpRecognizer::new(IcpConfig::default());
+    let mut per_lap = Vec::new();
+    let r = placewords::eval::recognize_runs_with_progress(&mut icp, &runs, &mut |_| {
+        per_lap.push(std::time::Instant::now())
+    });
+    let e = evaluate(&r, &EvaluationSpec::default());
+    let lap_s: Vec<String> = per_lap
+        .windows(2)
+        .map(|w| format!("{:.2}", (w[1] - w[0]).as_secs_f64()))
+        .collect();
+    eprintln!(
+        "icp on institute-floor, {laps} laps: {:.3} s/lap on average, lap times {:?}, {:?}, {} regions, {} matches, P {:.3} R {:.3}",
+        r.seconds_per_lap(),
+        lap_s,
+        icp.stats(),
         icp.region_count(),
         r.matches.len(),
         e.main.precision,
