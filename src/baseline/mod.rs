@@ -1,1 +1,5 @@
 //! Baselines the recognizer is compared with (ICP).
+
+pub mod icp;
+
+pub use icp::{IcpConfig, IcpRecognizer};

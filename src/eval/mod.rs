@@ -1,1 +1,176 @@
 //! Evaluation: ground truth pairs, precision and recall, sweeps and the paper's Table I.
+//!
+//! The flow is: [`recognize_runs`] feeds the frames of simulated (or logged) runs to a
+//! [`PlaceRecognizer`] in order, keeping the ground truth of every frame to itself
+//! ([`GroundTruth`]); [`metrics::evaluate`] turns the recognizer's matches into observation pairs
+//! and scores them (DESIGN.md §6); [`sweep`] repeats this over a grid of thresholds;
+//! [`gate`] compares a report with a scenario's `[expect]` block.
+
+pub mod gate;
+pub mod metrics;
+pub mod sweep;
+
+use crate::geom::{OdomPose, TruePose};
+use crate::recognizer::{Match, Observation};
+use crate::scan::Scan;
+use crate::sim::RunLog;
+use std::time::Instant;
+
+pub use metrics::{Metrics, evaluate};
+
+/// Anything that recognizes places from odometry and scans alone: the paper's recognizer, the
+/// ICP baseline, or a test double. It never sees ground truth.
+pub trait PlaceRecognizer {
+    /// Marks the start of a new run (no matching link crosses a run boundary). Called before
+    /// the first frame of every run, the first one included.
+    fn start_run(&mut self);
+    /// Feeds one odometry pose and its scan; returns the matches found because of it.
+    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match>;
+    /// Every observation made so far, in the order made (`observations()[i].id == i` is not
+    /// required; ids are looked up).
+    fn observations(&self) -> &[Observation];
+    /// A short name for reports and progress bars ("levels=2 [6, 9]", "icp").
+    fn name(&self) -> String;
+}
+
+/// What the evaluation knows about one lap.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LapInfo {
+    /// 0-based run index within the scenario.
+    pub run: usize,
+    /// 0-based lap within the run.
+    pub lap: usize,
+    /// Name of the door configuration during the lap.
+    pub door_config: String,
+    /// Ids of the doors open during the lap.
+    pub open_doors: Vec<String>,
+}
+
+/// Ground truth of one input frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameTruth {
+    pub pose: TruePose,
+    /// Index into [`GroundTruth::laps`].
+    pub lap_slot: usize,
+}
+
+/// Ground truth of every frame fed to a recognizer, indexed by the global input index
+/// (`Observation::input_index`). Built beside the recognizer; never handed to it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GroundTruth {
+    pub frames: Vec<FrameTruth>,
+    pub laps: Vec<LapInfo>,
+}
+
+impl GroundTruth {
+    /// The truth of the frames of `runs`, in the order [`recognize_runs`] feeds them.
+    pub fn from_runs(runs: &[RunLog]) -> Self {
+        let mut gt = GroundTruth::default();
+        for run in runs {
+            for lap in &run.laps {
+                let slot = gt.laps.len();
+                gt.laps.push(LapInfo {
+                    run: run.run,
+                    lap: lap.lap,
+                    door_config: lap.door_config.clone(),
+                    open_doors: lap.open_doors.clone(),
+                });
+                gt.frames.extend(lap.frames.iter().map(|f| FrameTruth {
+                    pose: f.truth,
+                    lap_slot: slot,
+                }));
+            }
+        }
+        gt
+    }
+
+    /// Truth of input frame `input_index`, if it exists.
+    pub fn frame(&self, input_index: usize) -> Option<&FrameTruth> {
+        self.frames.get(input_index)
+    }
+
+    /// The lap of input frame `input_index`.
+    pub fn lap_of(&self, input_index: usize) -> Option<&LapInfo> {
+        self.frame(input_index).map(|f| &self.laps[f.lap_slot])
+    }
+
+    /// Names of the door configurations in order of first appearance.
+    pub fn door_configs(&self) -> Vec<String> {
+        let mut names: Vec<String> = Vec::new();
+        for l in &self.laps {
+            if !names.contains(&l.door_config) {
+                names.push(l.door_config.clone());
+            }
+        }
+        names
+    }
+}
+
+/// The outcome of feeding runs to a recognizer.
+#[derive(Clone, Debug)]
+pub struct Recognition {
+    /// The recognizer's name.
+    pub name: String,
+    /// Every observation, as the recognizer reported them at the end.
+    pub observations: Vec<Observation>,
+    /// Every match, in the order found.
+    pub matches: Vec<Match>,
+    /// Wall-clock seconds spent inside `start_run` and `push` (truth bookkeeping excluded).
+    pub seconds: f64,
+    /// Number of laps fed.
+    pub laps: usize,
+    /// Truth of every frame fed, by input index.
+    pub truth: GroundTruth,
+}
+
+impl Recognition {
+    /// Recognition seconds per lap (0 when no lap was fed).
+    pub fn seconds_per_lap(&self) -> f64 {
+        if self.laps == 0 {
+            0.0
+        } else {
+            self.seconds / self.laps as f64
+        }
+    }
+}
+
+/// Feeds every frame of `runs` to `rec` in order (calling `start_run` before each run), with
+/// input indices counted across runs, and times the recognizer.
+pub fn recognize_runs(rec: &mut dyn PlaceRecognizer, runs: &[RunLog]) -> Recognition {
+    recognize_runs_with_progress(rec, runs, &mut |_| {})
+}
+
+/// [`recognize_runs`] with a callback after every lap (argument: laps done so far), for
+/// progress bars.
+pub fn recognize_runs_with_progress(
+    rec: &mut dyn PlaceRecognizer,
+    runs: &[RunLog],
+    on_lap: &mut dyn FnMut(usize),
+) -> Recognition {
+    let truth = GroundTruth::from_runs(runs);
+    let mut matches = Vec::new();
+    let mut seconds = 0.0;
+    let mut laps = 0;
+    for run in runs {
+        let t = Instant::now();
+        rec.start_run();
+        seconds += t.elapsed().as_secs_f64();
+        for lap in &run.laps {
+            let t = Instant::now();
+            for frame in &lap.frames {
+                matches.extend(rec.push(frame.odom, &frame.scan));
+            }
+            seconds += t.elapsed().as_secs_f64();
+            laps += 1;
+            on_lap(laps);
+        }
+    }
+    Recognition {
+        name: rec.name(),
+        observations: rec.observations().to_vec(),
+        matches,
+        seconds,
+        laps,
+        truth,
+    }
+}

@@ -1,6 +1,10 @@
 //! Output for people and machines: JSON reports, text and Markdown tables, SVG pictures.
 
+pub mod json;
+pub mod junit;
+pub mod plot;
 pub mod svg;
+pub mod table;
 pub mod world_render;
 
 pub use world_render::{LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg};

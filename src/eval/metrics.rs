@@ -1,0 +1,675 @@
+//! Ground truth scoring of matches (DESIGN.md §6).
+//!
+//! Definitions, all at one radius `r` (`tp_radius_m`, or a sensitivity radius):
+//!
+//! - **Pairs.** Every match contributes its aligned observation pairs `(query, past)`. A pair
+//!   that occurs more than once (in one match or in several matches) counts once: pairs are
+//!   deduplicated on the ordered id pair `(query, past)`, the first occurrence wins. Pairs whose
+//!   ids the recognizer never reported as observations are not scored; they are counted in
+//!   [`Metrics::unresolved_pairs`] (always 0 for a well-behaved recognizer).
+//! - **Correct pair.** The true positions of the two observations (truth of the frames that made
+//!   them) are at most `r` apart.
+//! - **Precision** = correct pairs / pairs. With no pair at all, precision is reported as 0 and
+//!   [`Metrics::no_pairs`] is set, so reports stay free of NaN.
+//! - **Per-match precision** (`match_precision`): a match is correct when strictly more than half
+//!   of its own (deduplicated) pairs are correct; `match_precision` = correct matches / matches
+//!   with at least one scored pair. Matches without pairs are ignored.
+//! - **Revisit.** Observation `o` has a revisit when an observation made before it, with at least
+//!   `min_gap_m` less odometric travel, lies within `r` of it (true positions) with a true
+//!   heading within `heading_tolerance_deg` of `o`'s (same direction, as the paper counts).
+//!   The radius of the revisit test follows the scoring radius, so a sensitivity radius changes
+//!   both what is correct and what could have been found.
+//! - **Recall** = observations with a revisit that are the *query* side of at least one correct
+//!   pair / observations with a revisit. With no revisit recall is 0 (and `revisits` is 0).
+//!   [`Metrics::recall_either_side`] counts either side of a correct pair, for reference.
+//! - **Per door configuration**: pairs, matches and observations are attributed to the door
+//!   configuration of the lap of the query observation (for a match: of its first pair's query).
+//!
+//! Revisits are searched with a spatial hash of cell size `r`, in creation order, so the cost is
+//! about linear in the number of observations.
+
+use super::{GroundTruth, Recognition};
+use crate::recognizer::{Match, ObsId, Observation};
+use crate::spec::evaluation::EvaluationSpec;
+use serde::{Deserialize, Serialize};
+use std::collections::{HashMap, HashSet};
+
+/// Scores at one radius.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct Metrics {
+    /// Radius a pair must be within to be correct (and a revisit to count), metres.
+    pub radius_m: f64,
+    /// Distinct `(query, past)` observation pairs scored.
+    pub pairs: usize,
+    pub correct_pairs: usize,
+    /// correct_pairs / pairs; 0 when there is no pair (see `no_pairs`).
+    pub precision: f64,
+    /// Set when there was no pair to score: `precision` is then 0 by convention.
+    pub no_pairs: bool,
+    /// Matches with at least one scored pair.
+    pub matches: usize,
+    /// Matches with strictly more than half of their pairs correct.
+    pub correct_matches: usize,
+    /// correct_matches / matches; 0 when there is no match.
+    pub match_precision: f64,
+    /// Observations that have a revisit.
+    pub revisits: usize,
+    /// Observations with a revisit that are the query of at least one correct pair.
+    pub recalled: usize,
+    /// recalled / revisits; 0 when there is no revisit.
+    pub recall: f64,
+    /// Like `recall`, counting an observation on either side of a correct pair.
+    pub recall_either_side: f64,
+    /// Pairs naming an observation id the recognizer never reported (not scored).
+    pub unresolved_pairs: usize,
+}
+
+/// Scores of the observations and pairs attributed to one door configuration.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct DoorConfigMetrics {
+    pub door_config: String,
+    /// Laps driven in this configuration.
+    pub laps: usize,
+    pub metrics: Metrics,
+}
+
+/// Everything [`evaluate`] computes for one recognition.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct Evaluation {
+    /// At `tp_radius_m`.
+    pub main: Metrics,
+    /// At each of `sensitivity_radii_m`, in the spec's order.
+    pub sensitivity: Vec<Metrics>,
+    /// At `tp_radius_m`, per door configuration (order of first appearance in the runs).
+    pub door_configs: Vec<DoorConfigMetrics>,
+}
+
+/// Scores `rec` as DESIGN.md §6 says: at `tp_radius_m`, at every sensitivity radius, and per
+/// door configuration.
+pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
+    let scorer = Scorer::new(&rec.observations, &rec.truth, spec);
+    let (main, door_configs) = scorer.score(&rec.matches, spec.tp_radius_m, true);
+    let sensitivity = spec
+        .sensitivity_radii_m
+        .iter()
+        .map(|&r| scorer.score(&rec.matches, r, false).0)
+        .collect();
+    Evaluation {
+        main,
+        sensitivity,
+        door_configs,
+    }
+}
+
+/// Scores observations and matches at one radius against `truth` (no breakdown).
+pub fn score(
+    observations: &[Observation],
+    matches: &[Match],
+    truth: &GroundTruth,
+    spec: &EvaluationSpec,
+    radius_m: f64,
+) -> Metrics {
+    Scorer::new(observations, truth, spec)
+        .score(matches, radius_m, false)
+        .0
+}
+
+/// One deduplicated observation pair with its true positions, for pictures of what matched.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScoredPair {
+    pub query: ObsId,
+    pub past: ObsId,
+    pub query_truth: crate::geom::TruePose,
+    pub past_truth: crate::geom::TruePose,
+    /// Whether the true positions are within the radius.
+    pub correct: bool,
+}
+
+/// Every distinct `(query, past)` pair of `rec`'s matches (first occurrence order) with its true
+/// poses and whether it is correct at `radius_m`. Pairs without truth are left out.
+pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
+    let index_of: HashMap<ObsId, usize> = rec
+        .observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    let truth_of = |id: ObsId| {
+        index_of
+            .get(&id)
+            .and_then(|&i| rec.truth.frame(rec.observations[i].input_index))
+            .map(|f| f.pose)
+    };
+    let mut seen = HashSet::new();
+    let mut out = Vec::new();
+    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
+        if !seen.insert((p.query, p.past)) {
+            continue;
+        }
+        if let (Some(q), Some(pa)) = (truth_of(p.query), truth_of(p.past)) {
+            out.push(ScoredPair {
+                query: p.query,
+                past: p.past,
+                query_truth: q,
+                past_truth: pa,
+                correct: q.0.distance(&pa.0) <= radius_m,
+            });
+        }
+    }
+    out
+}
+
+/// Truth-side facts about one observation.
+#[derive(Clone, Copy, Debug)]
+struct ObsTruth {
+    x: f64,
+    y: f64,
+    theta: f64,
+    travel_m: f64,
+    /// Door configuration index.
+    config: usize,
+}
+
+/// Observations joined with their truth, reusable across radii.
+pub struct Scorer {
+    /// Observation id → position in `obs`.
+    index_of: HashMap<ObsId, usize>,
+    /// Per observation (creation order); `None` when its input frame has no truth.
+    obs: Vec<Option<ObsTruth>>,
+    configs: Vec<String>,
+    config_laps: Vec<usize>,
+    min_gap_m: f64,
+    heading_tol_rad: f64,
+}
+
+impl Scorer {
+    pub fn new(observations: &[Observation], truth: &GroundTruth, spec: &EvaluationSpec) -> Self {
+        let configs = truth.door_configs();
+        let config_index: HashMap<&str, usize> = configs
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.as_str(), i))
+            .collect();
+        let mut config_laps = vec![0; configs.len()];
+        for l in &truth.laps {
+            config_laps[config_index[l.door_config.as_str()]] += 1;
+        }
+        let lap_config: Vec<usize> = truth
+            .laps
+            .iter()
+            .map(|l| config_index[l.door_config.as_str()])
+            .collect();
+        let index_of = observations
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (o.id, i))
+            .collect();
+        let obs = observations
+            .iter()
+            .map(|o| {
+                truth.frame(o.input_index).map(|f| ObsTruth {
+                    x: f.pose.0.x,
+                    y: f.pose.0.y,
+                    theta: f.pose.0.theta,
+                    travel_m: o.travel_m,
+                    config: lap_config[f.lap_slot],
+                })
+            })
+            .collect();
+        Scorer {
+            index_of,
+            obs,
+            configs,
+            config_laps,
+            min_gap_m: spec.min_gap_m,
+            heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
+        }
+    }
+
+    /// Which observations have a revisit at radius `r`.
+    pub fn revisits(&self, r: f64) -> Vec<bool> {
+        let mut has = vec![false; self.obs.len()];
+        if r <= 0.0 || !r.is_finite() {
+            return has;
+        }
+        let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
+        let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+        let r2 = r * r;
+        for (i, o) in self.obs.iter().enumerate() {
+            let Some(o) = o else { continue };
+            let (cx, cy) = cell(o.x, o.y);
+            'search: for dx in -1..=1 {
+                for dy in -1..=1 {
+                    let Some(list) = grid.get(&(cx + dx, cy + dy)) else {
+                        continue;
+                    };
+                    // Oldest first: the earliest laps hit soonest, and the list is sorted by
+                    // creation, so once the travel gap fails it fails for the rest.
+                    for &j in list {
+                        let p = self.obs[j].expect("only observations with truth are inserted");
+                        if o.travel_m - p.travel_m < self.min_gap_m {
+                            break;
+                        }
+                        let d2 = (o.x - p.x).powi(2) + (o.y - p.y).powi(2);
+                        if d2 <= r2
+                            && crate::geom::wrap_angle(o.theta - p.theta).abs()
+                                <= self.heading_tol_rad
+                        {
+                            has[i] = true;
+                            break 'search;
+                        }
+                    }
+                }
+            }
+            grid.entry((cx, cy)).or_default().push(i);
+        }
+        has
+    }
+
+    /// Scores `matches` at radius `r`; with `breakdown`, also per door configuration.
+    pub fn score(
+        &self,
+        matches: &[Match],
+        r: f64,
+        breakdown: bool,
+    ) -> (Metrics, Vec<DoorConfigMetrics>) {
+        self.score_with_revisits(matches, r, breakdown, &self.revisits(r))
+    }
+
+    /// [`Scorer::score`] with the revisits at `r` already computed (see [`Scorer::revisits`]);
+    /// saves the revisit search when many match sets are scored on the same observations.
+    pub fn score_with_revisits(
+        &self,
+        matches: &[Match],
+        r: f64,
+        breakdown: bool,
+        revisits: &[bool],
+    ) -> (Metrics, Vec<DoorConfigMetrics>) {
+        assert_eq!(
+            revisits.len(),
+            self.obs.len(),
+            "revisits of other observations"
+        );
+        let n_cfg = self.configs.len();
+        let mut total = Counts::default();
+        let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
+        let mut recalled_query = vec![false; self.obs.len()];
+        let mut recalled_any = vec![false; self.obs.len()];
+        let mut seen: HashSet<(ObsId, ObsId)> = HashSet::new();
+        let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
+        let r2 = r * r;
+        for m in matches {
+            in_match.clear();
+            let (mut n, mut ok) = (0usize, 0usize);
+            let mut match_cfg = None;
+            for p in &m.pairs {
+                let (Some(&qi), Some(&pi)) =
+                    (self.index_of.get(&p.query), self.index_of.get(&p.past))
+                else {
+                    if seen.insert((p.query, p.past)) {
+                        total.unresolved += 1;
+                    }
+                    continue;
+                };
+                let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi]) else {
+                    if seen.insert((p.query, p.past)) {
+                        total.unresolved += 1;
+                    }
+                    continue;
+                };
+                let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2;
+                if in_match.insert((p.query, p.past)) {
+                    n += 1;
+                    ok += correct as usize;
+                    match_cfg.get_or_insert(q.config);
+                }
+                if seen.insert((p.query, p.past)) {
+                    total.pairs += 1;
+                    total.correct += correct as usize;
+                    if breakdown {
+                        per_cfg[q.config].pairs += 1;
+                        per_cfg[q.config].correct += correct as usize;
+                    }
+                    if correct {
+                        recalled_query[qi] = true;
+                        recalled_any[qi] = true;
+                        recalled_any[pi] = true;
+                    }
+                }
+            }
+            if n > 0 {
+                let good = 2 * ok > n;
+                total.matches += 1;
+                total.correct_matches += good as usize;
+                if let (true, Some(c)) = (breakdown, match_cfg) {
+                    per_cfg[c].matches += 1;
+                    per_cfg[c].correct_matches += good as usize;
+                }
+            }
+        }
+        for (i, o) in self.obs.iter().enumerate() {
+            let Some(o) = o else { continue };
+            if !revisits[i] {
+                continue;
+            }
+            total.revisits += 1;
+            total.recalled += recalled_query[i] as usize;
+            total.recalled_any += recalled_any[i] as usize;
+            if breakdown {
+                let c = &mut per_cfg[o.config];
+                c.revisits += 1;
+                c.recalled += recalled_query[i] as usize;
+                c.recalled_any += recalled_any[i] as usize;
+            }
+        }
+        let configs = per_cfg
+            .iter()
+            .enumerate()
+            .map(|(i, c)| DoorConfigMetrics {
+                door_config: self.configs[i].clone(),
+                laps: self.config_laps[i],
+                metrics: c.metrics(r),
+            })
+            .collect();
+        (total.metrics(r), configs)
+    }
+}
+
+#[derive(Clone, Debug, Default)]
+struct Counts {
+    pairs: usize,
+    correct: usize,
+    matches: usize,
+    correct_matches: usize,
+    revisits: usize,
+    recalled: usize,
+    recalled_any: usize,
+    unresolved: usize,
+}
+
+/// `num / den`, 0 when `den` is 0.
+pub fn ratio(num: usize, den: usize) -> f64 {
+    if den == 0 {
+        0.0
+    } else {
+        num as f64 / den as f64
+    }
+}
+
+impl Counts {
+    fn metrics(&self, r: f64) -> Metrics {
+        Metrics {
+            radius_m: r,
+            pairs: self.pairs,
+            correct_pairs: self.correct,
+            precision: ratio(self.correct, self.pairs),
+            no_pairs: self.pairs == 0,
+            matches: self.matches,
+            correct_matches: self.correct_matches,
+            match_precision: ratio(self.correct_matches, self.matches),
+            revisits: self.revisits,
+            recalled: self.recalled,
+            recall: ratio(self.recalled, self.revisits),
+            recall_either_side: ratio(self.recalled_any, self.revisits),
+            unresolved_pairs: self.unresolved,
+        }
+    }
+}
+
+/// F1 score of a precision and a recall (0 when both are 0).
+pub fn f1(precision: f64, recall: f64) -> f64 {
+    if precision + recall <= 0.0 {
+        0.0
+    } else {
+        2.0 * precision * recall / (precision + recall)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::eval::{FrameTruth, LapInfo};
+    use crate::geom::{OdomPose, Pose2, TruePose};
+    use crate::recognizer::AlignedPair;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// `laps` laps of a circle of perimeter `perimeter` m, one observation each 0.1 m; truth
+    /// equals odometry. Door configuration alternates "closed"/"open" per lap.
+    pub(crate) fn circle(laps: usize, perimeter: f64) -> (Vec<Observation>, GroundTruth) {
+        let per_lap = (perimeter / 0.1).round() as usize;
+        let radius = perimeter / (2.0 * std::f64::consts::PI);
+        let mut obs = Vec::new();
+        let mut gt = GroundTruth::default();
+        for lap in 0..laps {
+            gt.laps.push(LapInfo {
+                run: 0,
+                lap,
+                door_config: if lap % 2 == 0 { "closed" } else { "open" }.into(),
+                open_doors: vec![],
+            });
+            for k in 0..per_lap {
+                let a = k as f64 / per_lap as f64 * 2.0 * std::f64::consts::PI;
+                let pose = Pose2::new(
+                    radius * a.cos(),
+                    radius * a.sin(),
+                    a + std::f64::consts::FRAC_PI_2,
+                );
+                let i = obs.len();
+                gt.frames.push(FrameTruth {
+                    pose: TruePose(pose),
+                    lap_slot: lap,
+                });
+                obs.push(Observation {
+                    id: i,
+                    run: 0,
+                    input_index: i,
+                    odom_pose: OdomPose(pose),
+                    travel_m: i as f64 * 0.1,
+                    psi: 0.5,
+                });
+            }
+        }
+        (obs, gt)
+    }
+
+    fn pair(obs: &[Observation], q: usize, p: usize) -> AlignedPair {
+        AlignedPair {
+            query: q,
+            past: p,
+            query_odom: obs[q].odom_pose,
+            past_odom: obs[p].odom_pose,
+        }
+    }
+
+    fn one_match(pairs: Vec<AlignedPair>) -> Match {
+        Match {
+            levels: 1,
+            ngram_len: 1,
+            word_pairs: vec![],
+            pairs,
+        }
+    }
+
+    /// The oracle: for every observation, its nearest earlier neighbour that makes a revisit.
+    fn oracle(obs: &[Observation], gt: &GroundTruth, spec: &EvaluationSpec) -> Vec<AlignedPair> {
+        let pos = |i: usize| gt.frames[obs[i].input_index].pose.0;
+        let mut pairs = Vec::new();
+        for q in 0..obs.len() {
+            let best = (0..q)
+                .filter(|&p| obs[q].travel_m - obs[p].travel_m >= spec.min_gap_m)
+                .filter(|&p| {
+                    crate::geom::wrap_angle(pos(q).theta - pos(p).theta).abs()
+                        <= spec.heading_tolerance_deg.to_radians()
+                })
+                .map(|p| (pos(q).distance(&pos(p)), p))
+                .filter(|(d, _)| *d <= spec.tp_radius_m)
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((_, p)) = best {
+                pairs.push(pair(obs, q, p));
+            }
+        }
+        pairs
+    }
+
+    #[test]
+    fn perfect_recognizer_scores_one() {
+        let (obs, gt) = circle(3, 40.0);
+        let spec = EvaluationSpec::default();
+        let matches: Vec<Match> = oracle(&obs, &gt, &spec)
+            .chunks(20)
+            .map(|c| one_match(c.to_vec()))
+            .collect();
+        let m = score(&obs, &matches, &gt, &spec, 1.0);
+        // Two full laps after the first, plus the last metre of the first lap closing the loop.
+        assert_eq!(m.revisits, 810);
+        assert_eq!(m.pairs, 810);
+        assert_eq!(m.precision, 1.0);
+        assert_eq!(m.recall, 1.0);
+        assert_eq!(m.match_precision, 1.0);
+        assert!(!m.no_pairs);
+    }
+
+    #[test]
+    fn random_recognizer_scores_low() {
+        let (obs, gt) = circle(3, 40.0);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let matches: Vec<Match> = (400..obs.len())
+            .map(|q| {
+                let p = rng.random_range(0..q - 200);
+                one_match(vec![pair(&obs, q, p)])
+            })
+            .collect();
+        let m = score(&obs, &matches, &gt, &EvaluationSpec::default(), 1.0);
+        assert!(m.precision < 0.15, "{m:?}");
+        assert!(m.recall < 0.15, "{m:?}");
+        assert!(m.match_precision < 0.15, "{m:?}");
+    }
+
+    #[test]
+    fn no_matches_means_zero_precision_with_flag() {
+        let (obs, gt) = circle(3, 40.0);
+        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 1.0);
+        assert_eq!((m.pairs, m.precision, m.recall), (0, 0.0, 0.0));
+        assert!(m.no_pairs);
+        assert_eq!(m.revisits, 810);
+    }
+
+    #[test]
+    fn no_revisits_means_zero_recall() {
+        let (mut obs, gt) = circle(1, 40.0);
+        obs.truncate(300);
+        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 1.0);
+        assert_eq!((m.revisits, m.recall), (0, 0.0));
+    }
+
+    #[test]
+    fn opposite_direction_is_no_revisit() {
+        let (mut obs, mut gt) = circle(2, 40.0);
+        for f in &mut gt.frames[400..] {
+            f.pose.0.theta += std::f64::consts::PI;
+        }
+        obs.truncate(800);
+        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 1.0);
+        // Only the loop closures inside each lap (last metre near the lap's own start).
+        assert_eq!(m.revisits, 20);
+    }
+
+    #[test]
+    fn duplicate_pairs_count_once_and_majority_rule_for_matches() {
+        let (obs, gt) = circle(2, 40.0);
+        // Match 1: 2 correct, 1 wrong → correct match. Match 2 repeats a pair and adds a wrong
+        // one: 1 of 2 correct → not more than half → wrong match.
+        let m1 = one_match(vec![
+            pair(&obs, 400, 0),
+            pair(&obs, 401, 1),
+            pair(&obs, 402, 200),
+        ]);
+        let m2 = one_match(vec![pair(&obs, 400, 0), pair(&obs, 403, 200)]);
+        let m = score(&obs, &[m1, m2], &gt, &EvaluationSpec::default(), 1.0);
+        assert_eq!((m.pairs, m.correct_pairs), (4, 2));
+        assert_eq!((m.matches, m.correct_matches), (2, 1));
+        assert_eq!(m.recalled, 2);
+        assert!((m.precision - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sensitivity_and_door_breakdown() {
+        let (obs, gt) = circle(3, 40.0);
+        // Pairs off by 15 observations (1.5 m along the circle): wrong at 1 m, right at 2 m.
+        let matches = vec![one_match(
+            (415..obs.len()).map(|q| pair(&obs, q, q - 415)).collect(),
+        )];
+        let rec = Recognition {
+            name: "t".into(),
+            observations: obs,
+            matches,
+            seconds: 1.0,
+            laps: 3,
+            truth: gt,
+        };
+        let e = evaluate(&rec, &EvaluationSpec::default());
+        assert_eq!(e.main.precision, 0.0);
+        assert_eq!(e.sensitivity.len(), 3);
+        assert_eq!(e.sensitivity[0].precision, 0.0);
+        assert_eq!(e.sensitivity[1].precision, 1.0);
+        assert!(e.sensitivity[1].recall > 0.9, "{:?}", e.sensitivity[1]);
+        let names: Vec<_> = e
+            .door_configs
+            .iter()
+            .map(|d| d.door_config.as_str())
+            .collect();
+        assert_eq!(names, ["closed", "open"]);
+        assert_eq!(e.door_configs[0].laps, 2);
+        assert_eq!(e.door_configs[1].metrics.pairs, 385);
+        assert_eq!(
+            e.door_configs[0].metrics.revisits + e.door_configs[1].metrics.revisits,
+            e.main.revisits
+        );
+    }
+
+    #[test]
+    fn revisit_search_is_fast_on_forty_long_laps() {
+        // 40 laps × 2000 observations = 80 000, the size of scenario B.
+        let (obs, gt) = circle(40, 200.0);
+        let t = std::time::Instant::now();
+        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 3.0);
+        assert_eq!(m.revisits, 39 * 2000 + 30);
+        assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
+    }
+
+    #[test]
+    fn scored_pairs_deduplicate_and_classify() {
+        let (obs, gt) = circle(2, 40.0);
+        let matches = vec![
+            one_match(vec![pair(&obs, 400, 0), pair(&obs, 401, 200)]),
+            one_match(vec![pair(&obs, 400, 0)]),
+        ];
+        let rec = Recognition {
+            name: "t".into(),
+            observations: obs,
+            matches,
+            seconds: 0.0,
+            laps: 2,
+            truth: gt,
+        };
+        let p = scored_pairs(&rec, 1.0);
+        assert_eq!(p.len(), 2);
+        assert!(p[0].correct && !p[1].correct);
+    }
+
+    #[test]
+    fn unknown_ids_are_not_scored() {
+        let (obs, gt) = circle(2, 40.0);
+        let mut p = pair(&obs, 400, 0);
+        p.query = 99_999;
+        let m = score(
+            &obs,
+            &[one_match(vec![p])],
+            &gt,
+            &EvaluationSpec::default(),
+            1.0,
+        );
+        assert_eq!((m.pairs, m.unresolved_pairs), (0, 1));
+    }
+}
