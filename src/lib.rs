@@ -8,6 +8,7 @@
 
 pub mod baseline;
 pub mod eval;
+pub mod experiment;
 pub mod geom;
 pub mod io;
 pub mod recognizer;

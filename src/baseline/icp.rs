@@ -581,12 +581,13 @@ impl IcpRecognizer {
 }
 
 impl PlaceRecognizer for IcpRecognizer {
-    fn start_run(&mut self) {
+    fn start_run(&mut self) -> Vec<Match> {
         self.run = Some(self.run.map_or(0, |r| r + 1));
         self.cells.clear();
         self.last_pose = None;
         self.next_obs_travel_m = None;
         self.pending.clear();
+        Vec::new()
     }
 
     fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {

@@ -4,8 +4,14 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod check;
+pub mod common;
 pub mod import;
+pub mod recognize;
+pub mod run;
 pub mod simulate;
+pub mod sweep;
+pub mod table;
 pub mod world;
 
 /// Long-term place recognition with multi-level words of spatial densities, and the harness
@@ -24,11 +30,26 @@ pub enum Command {
     World(world::WorldCommand),
     /// Drive the simulated robot through a scenario and write CARMEN logs.
     Simulate(simulate::SimulateArgs),
+    /// Simulate a scenario, recognize places at 1, 2 and 3 levels, evaluate and report.
+    Run(run::RunArgs),
+    /// Run scenarios and compare them with their [expect] blocks (the CI gate).
+    Check(check::CheckArgs),
+    /// The paper's Table I for one or more scenarios, as Markdown and JSON.
+    Table(table::TableArgs),
+    /// The paper's Fig. 8: precision/recall over the n-gram thresholds.
+    Sweep(sweep::SweepArgs),
+    /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
+    Recognize(recognize::RecognizeArgs),
 }
 
 pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::World(c) => world::run(c),
         Command::Simulate(a) => simulate::run(a),
+        Command::Run(a) => run::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Table(a) => table::run(a),
+        Command::Sweep(a) => sweep::run(a),
+        Command::Recognize(a) => recognize::run(a),
     }
 }

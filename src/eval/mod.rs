@@ -22,10 +22,15 @@ pub use metrics::{Metrics, evaluate};
 /// ICP baseline, or a test double. It never sees ground truth.
 pub trait PlaceRecognizer {
     /// Marks the start of a new run (no matching link crosses a run boundary). Called before
-    /// the first frame of every run, the first one included.
-    fn start_run(&mut self);
+    /// the first frame of every run, the first one included. Returns the matches that closing
+    /// the previous run produced (its last word is only complete once the run ends).
+    fn start_run(&mut self) -> Vec<Match>;
     /// Feeds one odometry pose and its scan; returns the matches found because of it.
     fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match>;
+    /// Called after the last frame: returns the matches that closing the last run produced.
+    fn finish(&mut self) -> Vec<Match> {
+        Vec::new()
+    }
     /// Every observation made so far, in the order made (`observations()[i].id == i` is not
     /// required; ids are looked up).
     fn observations(&self) -> &[Observation];
@@ -153,7 +158,7 @@ pub fn recognize_runs_with_progress(
     let mut laps = 0;
     for run in runs {
         let t = Instant::now();
-        rec.start_run();
+        matches.extend(rec.start_run());
         seconds += t.elapsed().as_secs_f64();
         for lap in &run.laps {
             let t = Instant::now();
@@ -165,6 +170,9 @@ pub fn recognize_runs_with_progress(
             on_lap(laps);
         }
     }
+    let t = Instant::now();
+    matches.extend(rec.finish());
+    seconds += t.elapsed().as_secs_f64();
     Recognition {
         name: rec.name(),
         observations: rec.observations().to_vec(),

@@ -1,0 +1,179 @@
+//! `placewords recognize LOG`: the recognizer and evaluation on a real CARMEN log, with the same
+//! definitions and report schema as `run`.
+
+use super::common::{LevelsArg, write_file};
+use anyhow::bail;
+use clap::{Args, ValueEnum};
+use placewords::experiment::{self, ExperimentOptions, picture};
+use placewords::io::real_log::TruthSource;
+use placewords::recognizer::RecognizerConfig;
+use placewords::sim::odometry::{OdometryConfig, OdometryModel};
+use placewords::spec::evaluation::EvaluationSpec;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum TruthArg {
+    /// The corrected pose on each laser line.
+    Corrected,
+    /// TRUEPOS messages, matched to laser lines by time.
+    Truepos,
+}
+
+#[derive(Debug, Args)]
+pub struct RecognizeArgs {
+    /// CARMEN log, plain or gzip.
+    pub log: PathBuf,
+    /// Where the ground truth comes from.
+    #[arg(long, value_enum, default_value = "corrected")]
+    pub truth: TruthArg,
+    /// Odometry derived from the corrected increments: `none`, `proportional` (0.0075 m/m and
+    /// rad/rad), `proportional:T,R`, or `thrun:A1,A2,A3,A4`.
+    #[arg(long, value_name = "MODEL", default_value = "proportional")]
+    pub odometry_noise: String,
+    /// Seed of the odometry noise stream.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[command(flatten)]
+    pub levels: LevelsArg,
+    /// Also run the ICP baseline.
+    #[arg(long)]
+    pub icp: bool,
+    /// Skip malformed lines (and report how many) instead of stopping at the first.
+    #[arg(long)]
+    pub lenient: bool,
+    /// A pair is correct when its true positions are within this distance, metres.
+    #[arg(long, default_value_t = 1.0, value_name = "M")]
+    pub tp_radius_m: f64,
+    /// Minimum odometric travel between matched or revisiting observations, metres.
+    #[arg(long, default_value_t = 20.0, value_name = "M")]
+    pub min_gap_m: f64,
+    /// Write the JSON report here.
+    #[arg(long, value_name = "OUT.json")]
+    pub report: Option<PathBuf>,
+    /// Write pictures here: paths and matched pairs per level configuration.
+    #[arg(long, value_name = "DIR")]
+    pub svg: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// Parses `--odometry-noise`.
+pub fn noise_model(s: &str) -> anyhow::Result<Option<OdometryConfig>> {
+    let (name, params) = s.split_once(':').unwrap_or((s, ""));
+    let nums = || -> anyhow::Result<Vec<f64>> {
+        params
+            .split(',')
+            .map(|p| {
+                p.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v >= 0.0)
+                    .ok_or_else(|| {
+                        anyhow::anyhow!("--odometry-noise {s}: `{p}` is not a non-negative number")
+                    })
+            })
+            .collect()
+    };
+    let model = match (name, params.is_empty()) {
+        ("none", true) => return Ok(None),
+        ("proportional", true) => OdometryConfig::default().model,
+        ("proportional", false) => match nums()?[..] {
+            [t, r] => OdometryModel::Proportional {
+                translation_ratio: t,
+                rotation_ratio: r,
+            },
+            _ => bail!(
+                "--odometry-noise {s}: proportional takes two numbers, e.g. proportional:0.0075,0.0075"
+            ),
+        },
+        ("thrun", false) => match nums()?[..] {
+            [a, b, c, d] => OdometryModel::Thrun {
+                alpha: [a, b, c, d],
+            },
+            _ => bail!(
+                "--odometry-noise {s}: thrun takes four numbers, e.g. thrun:0.01,0.01,0.01,0.01"
+            ),
+        },
+        _ => bail!(
+            "--odometry-noise {s}: unknown model; use none, proportional, proportional:T,R or thrun:A1,A2,A3,A4"
+        ),
+    };
+    Ok(Some(OdometryConfig {
+        model,
+        ..OdometryConfig::default()
+    }))
+}
+
+pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
+    let noise = noise_model(&args.odometry_noise)?;
+    for (flag, v) in [
+        ("--tp-radius-m", args.tp_radius_m),
+        ("--min-gap-m", args.min_gap_m),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            bail!("{flag} {v}: must be a positive distance in metres");
+        }
+    }
+    let truth = match args.truth {
+        TruthArg::Corrected => TruthSource::Corrected,
+        TruthArg::Truepos => TruthSource::TruePos,
+    };
+    let (run, skipped) =
+        experiment::real::load_real_run(&args.log, args.lenient, truth, noise.as_ref(), args.seed)?;
+    if skipped > 0 {
+        eprintln!(
+            "{}: skipped {skipped} malformed line(s)",
+            args.log.display()
+        );
+    }
+    let name = args
+        .log
+        .file_name()
+        .map(|n| {
+            n.to_string_lossy()
+                .trim_end_matches(".gz")
+                .trim_end_matches(".log")
+                .to_string()
+        })
+        .unwrap_or_else(|| "log".into());
+    let evaluation = EvaluationSpec {
+        tp_radius_m: args.tp_radius_m,
+        min_gap_m: args.min_gap_m,
+        ..EvaluationSpec::default()
+    };
+    let base = RecognizerConfig {
+        min_gap_m: args.min_gap_m,
+        ..RecognizerConfig::default()
+    };
+    let opts = ExperimentOptions {
+        levels: args.levels.levels(),
+        icp: args.icp,
+        laps: None,
+        quiet: args.quiet,
+    };
+    let exp = experiment::evaluate_runs(&name, args.seed, vec![run], &base, &evaluation, &opts)?;
+    print!("{}", placewords::report::table::text_table(&exp.report));
+    if let Some(path) = &args.report {
+        write_file(path, exp.report.to_json().as_bytes())?;
+        eprintln!("report: {}", path.display());
+    }
+    if let Some(dir) = &args.svg {
+        let world = picture::empty_world(&exp.runs, &name);
+        write_file(
+            &dir.join("trajectory.svg"),
+            picture::trajectory_svg(&world, &exp.runs, &format!("{name}: paths")).as_bytes(),
+        )?;
+        for (levels, rec) in &exp.recognitions {
+            let title = format!("{name}: matched pairs, {levels} level(s)");
+            let svg = picture::matches_svg(&world, &exp.runs, rec, args.tp_radius_m, &title);
+            write_file(
+                &dir.join(format!("matches-levels{levels}.svg")),
+                svg.as_bytes(),
+            )?;
+        }
+        eprintln!("pictures: {}", dir.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,70 @@
+//! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report.
+
+use super::common::{LevelsArg, write_file};
+use clap::Args;
+use placewords::experiment::{self, ExperimentOptions, picture};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scenario file (TOML).
+    pub scenario: PathBuf,
+    #[command(flatten)]
+    pub levels: LevelsArg,
+    /// Also run the ICP baseline (slow: every region is aligned with every past region).
+    #[arg(long)]
+    pub icp: bool,
+    /// Replace every run's lap count (for a quick look).
+    #[arg(long, value_name = "N")]
+    pub laps: Option<usize>,
+    /// Write the JSON report here (schema in the README).
+    #[arg(long, value_name = "OUT.json")]
+    pub report: Option<PathBuf>,
+    /// Write pictures here: the true and odometry paths, and the matched pairs of each level
+    /// configuration (green correct, red wrong).
+    #[arg(long, value_name = "DIR")]
+    pub svg: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
+    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let opts = ExperimentOptions {
+        levels: args.levels.levels(),
+        icp: args.icp,
+        laps: args.laps,
+        quiet: args.quiet,
+    };
+    let exp = experiment::run_scenario(&scn, &opts)?;
+    print!("{}", placewords::report::table::text_table(&exp.report));
+    if let Some(path) = &args.report {
+        write_file(path, exp.report.to_json().as_bytes())?;
+        eprintln!("report: {}", path.display());
+    }
+    if let Some(dir) = &args.svg {
+        let radius = scn.evaluation.tp_radius_m;
+        write_file(
+            &dir.join("trajectory.svg"),
+            picture::trajectory_svg(&scn.world, &exp.runs, &format!("{}: paths", scn.name))
+                .as_bytes(),
+        )?;
+        for (levels, rec) in &exp.recognitions {
+            let title = format!("{}: matched pairs, {levels} level(s)", scn.name);
+            let svg = picture::matches_svg(&scn.world, &exp.runs, rec, radius, &title);
+            write_file(
+                &dir.join(format!("matches-levels{levels}.svg")),
+                svg.as_bytes(),
+            )?;
+        }
+        if let Some(rec) = &exp.icp {
+            let title = format!("{}: matched pairs, ICP", scn.name);
+            let svg = picture::matches_svg(&scn.world, &exp.runs, rec, radius, &title);
+            write_file(&dir.join("matches-icp.svg"), svg.as_bytes())?;
+        }
+        eprintln!("pictures: {}", dir.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}

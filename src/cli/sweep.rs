@@ -1,0 +1,51 @@
+//! `placewords sweep SCENARIO -o DIR`: the paper's Fig. 8. Simulates once, computes the
+//! observations once, then runs the back end at every threshold configuration in parallel;
+//! writes PR curves as SVG and JSON.
+
+use super::common::write_file;
+use clap::Args;
+use placewords::eval::sweep::fig8_grid;
+use placewords::experiment::{self, ExperimentOptions};
+use placewords::report::json::SweepReport;
+use placewords::report::plot::pr_curves_svg;
+use placewords::report::table::curves_table;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// Scenario file (TOML).
+    pub scenario: PathBuf,
+    /// Output folder for sweep.json and pr-curves.svg.
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Replace every run's lap count (for a quick look).
+    #[arg(long, value_name = "N")]
+    pub laps: Option<usize>,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
+    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let base = experiment::recognizer_config(&scn)?;
+    let opts = ExperimentOptions {
+        laps: args.laps,
+        quiet: args.quiet,
+        ..ExperimentOptions::default()
+    };
+    let (runs, _) = experiment::simulate(&scn, &opts)?;
+    let laps = runs.iter().map(|r| r.laps.len()).sum();
+    let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
+    let report = SweepReport::new(&scn.name, scn.seed, laps, scn.evaluation.clone(), results);
+    print!("{}", curves_table(&report.curves));
+    write_file(&args.out.join("sweep.json"), report.to_json().as_bytes())?;
+    let title = format!("{}: precision / recall (Fig. 8)", scn.name);
+    write_file(
+        &args.out.join("pr-curves.svg"),
+        pr_curves_svg(&report.curves, &title).as_bytes(),
+    )?;
+    eprintln!("sweep: {}", args.out.display());
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,66 @@
+//! `placewords table SCENARIO... -o DIR`: the paper's Table I (precision–recall at 1, 2 and 3
+//! levels and for ICP, with each one's time per lap, measured in the same run), as Markdown and
+//! JSON.
+
+use super::common::write_file;
+use clap::Args;
+use placewords::experiment::{self, ExperimentOptions};
+use placewords::report::json::TableReport;
+use placewords::report::table::{markdown_table_i, thresholds_note};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct TableArgs {
+    /// Scenario files (TOML), one column each.
+    #[arg(required = true)]
+    pub scenarios: Vec<PathBuf>,
+    /// Output folder for table.md, table.json and one report per scenario.
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Leave out the ICP baseline (it dominates the run time).
+    #[arg(long)]
+    pub no_icp: bool,
+    /// Replace every run's lap count (for a quick look).
+    #[arg(long, value_name = "N")]
+    pub laps: Option<usize>,
+    /// No progress bars.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
+    let opts = ExperimentOptions {
+        levels: vec![1, 2, 3],
+        icp: !args.no_icp,
+        laps: args.laps,
+        quiet: args.quiet,
+    };
+    // Load every scenario first, so a broken file is reported before minutes of simulation.
+    let scenarios = args
+        .scenarios
+        .iter()
+        .map(|p| placewords::spec::scenario::load_scenario(p))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut reports = Vec::new();
+    for scn in &scenarios {
+        eprintln!("scenario {}", scn.name);
+        let exp = experiment::run_scenario(scn, &opts)?;
+        write_file(
+            &args.out.join(format!("report-{}.json", scn.name)),
+            exp.report.to_json().as_bytes(),
+        )?;
+        reports.push(exp.report);
+    }
+    let md = format!(
+        "{}\n{}",
+        markdown_table_i(&reports),
+        thresholds_note(&reports)
+    );
+    print!("{md}");
+    write_file(&args.out.join("table.md"), md.as_bytes())?;
+    let json = serde_json::to_string_pretty(&TableReport { reports })?;
+    write_file(&args.out.join("table.json"), json.as_bytes())?;
+    eprintln!("table: {}", args.out.join("table.md").display());
+    Ok(ExitCode::SUCCESS)
+}

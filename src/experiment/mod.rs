@@ -1,0 +1,350 @@
+//! An experiment: runs of frames (simulated from a scenario, or read from a real log) fed to the
+//! recognizer at each requested level configuration and to the ICP baseline, scored against the
+//! truth, and gathered in one [`Report`]. The commands `run`, `check`, `table`, `sweep` and
+//! `recognize` are thin layers over this module.
+
+pub mod picture;
+pub mod real;
+
+use crate::baseline::icp::{IcpConfig, IcpRecognizer};
+use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
+use crate::eval::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs_with_progress};
+use crate::geom::OdomPose;
+use crate::recognizer::{
+    DensityFrontEnd, Match, Observation, Recognizer, RecognizerConfig, WordMatcher,
+};
+use crate::report::json::Report;
+use crate::scan::Scan;
+use crate::sim::{RunLog, SimError};
+use crate::spec::SpecError;
+use crate::spec::diag::{Diagnostic, line_col};
+use crate::spec::evaluation::EvaluationSpec;
+use crate::spec::scenario::Scenario;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Why an experiment could not be carried out.
+#[derive(Debug, thiserror::Error)]
+pub enum ExperimentError {
+    #[error(transparent)]
+    Spec(#[from] SpecError),
+    #[error("simulation failed: {0}")]
+    Sim(#[from] SimError),
+    #[error("{0}")]
+    Recognizer(String),
+}
+
+/// What to run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExperimentOptions {
+    /// Level configurations of the recognizer to run (1, 2, 3, 4). Default [1, 2, 3].
+    pub levels: Vec<usize>,
+    /// Also run the ICP baseline. Default false (it is slow: every region against every past one).
+    pub icp: bool,
+    /// Replace every run's lap count. Default: the scenario's.
+    pub laps: Option<usize>,
+    /// Hide progress bars. Default false (they hide themselves when stderr is not a terminal).
+    pub quiet: bool,
+}
+
+impl Default for ExperimentOptions {
+    fn default() -> Self {
+        ExperimentOptions {
+            levels: vec![1, 2, 3],
+            icp: false,
+            laps: None,
+            quiet: false,
+        }
+    }
+}
+
+/// Everything an experiment produced: the report, and the data behind it for pictures.
+pub struct Experiment {
+    pub report: Report,
+    pub runs: Vec<RunLog>,
+    /// One recognition per level configuration, in the order of `ExperimentOptions::levels`.
+    pub recognitions: Vec<(usize, Recognition)>,
+    pub icp: Option<Recognition>,
+}
+
+/// A progress bar on stderr, hidden under `quiet` or when stderr is not a terminal.
+pub fn progress_bar(len: u64, message: &str, quiet: bool) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{msg:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> "),
+    );
+    bar.set_message(message.to_string());
+    bar
+}
+
+/// The recognizer settings of a scenario: its `[recognizer]` table over the defaults, checked,
+/// with problems located in the scenario file.
+pub fn recognizer_config(scn: &Scenario) -> Result<RecognizerConfig, SpecError> {
+    let src = std::fs::read_to_string(&scn.path).unwrap_or_default();
+    let file = scn.path.display().to_string();
+    let locate = |key: Option<&str>| -> (usize, usize) {
+        let table = src.find("[recognizer]");
+        let at = match (table, key) {
+            (Some(t), Some(k)) => src[t..]
+                .find(&format!("\n{k}"))
+                .map(|i| t + i + 1)
+                .unwrap_or(t),
+            (Some(t), None) => t,
+            _ => 0,
+        };
+        line_col(&src, at)
+    };
+    let cfg: RecognizerConfig =
+        scn.recognizer
+            .clone()
+            .try_into()
+            .map_err(|e: toml::de::Error| {
+                let msg = e.message().trim().to_string();
+                let key = msg
+                    .split('`')
+                    .nth(1)
+                    .filter(|_| msg.starts_with("unknown field"));
+                let (line, col) = locate(key);
+                SpecError::Invalid(vec![Diagnostic {
+                    path: file.clone(),
+                    line,
+                    col,
+                    message: format!("[recognizer]: {msg}"),
+                }])
+            })?;
+    let problems = cfg.problems();
+    if problems.is_empty() {
+        return Ok(cfg);
+    }
+    Err(SpecError::Invalid(
+        problems
+            .into_iter()
+            .map(|p| {
+                let (line, col) = locate(Some(p.field));
+                Diagnostic {
+                    path: file.clone(),
+                    line,
+                    col,
+                    message: format!("[recognizer] {}: {}", p.field, p.problem),
+                }
+            })
+            .collect(),
+    ))
+}
+
+/// `base` with `levels` level configurations (thresholds unchanged).
+pub fn config_for_levels(base: &RecognizerConfig, levels: usize) -> RecognizerConfig {
+    RecognizerConfig {
+        levels,
+        ..base.clone()
+    }
+}
+
+/// The thresholds a level configuration uses (τ0 .. τ(levels-1)).
+pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
+    cfg.min_ngram.iter().copied().take(cfg.levels).collect()
+}
+
+/// The recognizer as evaluation sees it.
+impl PlaceRecognizer for Recognizer {
+    fn start_run(&mut self) -> Vec<Match> {
+        Recognizer::start_run(self)
+    }
+    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+        Recognizer::push(self, odom, scan)
+    }
+    fn finish(&mut self) -> Vec<Match> {
+        Recognizer::finish(self)
+    }
+    fn observations(&self) -> &[Observation] {
+        Recognizer::observations(self)
+    }
+    fn name(&self) -> String {
+        let c = self.config();
+        format!("levels={} {:?}", c.levels, thresholds(c))
+    }
+}
+
+/// Simulates a scenario with a progress bar; returns the runs and the wall-clock seconds.
+pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
+    let laps: usize = scn.runs.iter().map(|r| opts.laps.unwrap_or(r.laps)).sum();
+    let bar = progress_bar(laps as u64, "simulating", opts.quiet);
+    let t = Instant::now();
+    let runs = crate::sim::runner::simulate(scn, opts.laps, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    Ok((runs, t.elapsed().as_secs_f64()))
+}
+
+/// Simulates a scenario and evaluates it.
+pub fn run_scenario(
+    scn: &Scenario,
+    opts: &ExperimentOptions,
+) -> Result<Experiment, ExperimentError> {
+    let base = recognizer_config(scn)?;
+    let (runs, sim_s) = simulate(scn, opts)?;
+    let mut exp = evaluate_runs(&scn.name, scn.seed, runs, &base, &scn.evaluation, opts)?;
+    let laps = exp.report.laps.max(1);
+    exp.report.simulate_seconds_per_lap = sim_s / laps as f64;
+    Ok(exp)
+}
+
+/// Feeds `runs` to the recognizer at each requested level configuration (in parallel; each
+/// times itself) and, if asked, to ICP; scores them all.
+pub fn evaluate_runs(
+    name: &str,
+    seed: u64,
+    runs: Vec<RunLog>,
+    base: &RecognizerConfig,
+    evaluation: &EvaluationSpec,
+    opts: &ExperimentOptions,
+) -> Result<Experiment, ExperimentError> {
+    let laps: usize = runs.iter().map(|r| r.laps.len()).sum();
+    let mut configs = Vec::new();
+    for &levels in &opts.levels {
+        let cfg = config_for_levels(base, levels);
+        let problems = cfg.problems();
+        if !problems.is_empty() {
+            let text: Vec<String> = problems.iter().map(ToString::to_string).collect();
+            return Err(ExperimentError::Recognizer(format!(
+                "recognizer with {levels} levels: {}",
+                text.join("; ")
+            )));
+        }
+        configs.push(cfg);
+    }
+    let jobs = configs.len() + usize::from(opts.icp);
+    let bar = progress_bar((jobs * laps) as u64, "recognizing", opts.quiet);
+    // Each task is single-threaded and timed on its own; the tasks share the cores.
+    let mut results: Vec<(Option<usize>, Recognition)> = (0..jobs)
+        .into_par_iter()
+        .map(|j| {
+            let mut on_lap = |_: usize| bar.inc(1);
+            if j < configs.len() {
+                let cfg = &configs[j];
+                let mut rec = Recognizer::new(cfg.clone())
+                    .map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+                Ok((
+                    Some(cfg.levels),
+                    recognize_runs_with_progress(&mut rec, &runs, &mut on_lap),
+                ))
+            } else {
+                let mut icp = IcpRecognizer::new(IcpConfig {
+                    min_gap_m: evaluation.min_gap_m,
+                    ..IcpConfig::default()
+                });
+                Ok((
+                    None,
+                    recognize_runs_with_progress(&mut icp, &runs, &mut on_lap),
+                ))
+            }
+        })
+        .collect::<Result<_, ExperimentError>>()?;
+    bar.finish_and_clear();
+    let mut report = Report::new(name, seed, laps, evaluation.clone());
+    let icp = match results.last() {
+        Some((None, _)) => results.pop().map(|(_, r)| r),
+        _ => None,
+    };
+    if let Some(r) = &icp {
+        report.set_icp(r);
+    }
+    let mut recognitions = Vec::new();
+    for (levels, r) in results {
+        let levels = levels.unwrap_or(1);
+        report.add_level(levels, &thresholds(&configs[recognitions.len()]), &r);
+        recognitions.push((levels, r));
+    }
+    report.finish();
+    Ok(Experiment {
+        report,
+        runs,
+        recognitions,
+        icp,
+    })
+}
+
+/// The observations of `runs` under `cfg`'s front end, computed once (for sweeps), with the
+/// wall-clock seconds it took.
+pub fn observe(
+    runs: &[RunLog],
+    cfg: &RecognizerConfig,
+) -> Result<(Vec<Observation>, f64), ExperimentError> {
+    let mut front =
+        DensityFrontEnd::new(cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+    let t = Instant::now();
+    let mut out = Vec::new();
+    for (i, run) in runs.iter().enumerate() {
+        if i > 0 {
+            front.start_run();
+        }
+        for f in run.frames() {
+            out.extend(front.push(f.odom, &f.scan));
+        }
+    }
+    Ok((out, t.elapsed().as_secs_f64()))
+}
+
+/// The matches the back end finds in `observations` with the levels and thresholds of `point`.
+pub fn back_end_matches(
+    observations: &[Observation],
+    base: &RecognizerConfig,
+    point: &GridPoint,
+) -> Result<Vec<Match>, ExperimentError> {
+    let mut min_ngram = base.min_ngram.clone();
+    for (k, t) in point.thresholds.iter().enumerate() {
+        if k < min_ngram.len() {
+            min_ngram[k] = *t;
+        } else {
+            min_ngram.push(*t);
+        }
+    }
+    let cfg = RecognizerConfig {
+        levels: point.levels,
+        min_ngram,
+        ..base.clone()
+    };
+    let mut back =
+        WordMatcher::new(&cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+    let mut out = Vec::new();
+    for o in observations {
+        out.extend(back.push_observation(o));
+    }
+    out.extend(back.finish_run());
+    Ok(out)
+}
+
+/// The paper's Fig. 8 sweep: observations computed once, then every grid point's back end in
+/// parallel; results in grid order whatever the thread count.
+pub fn sweep(
+    runs: &[RunLog],
+    base: &RecognizerConfig,
+    evaluation: &EvaluationSpec,
+    grid: &[GridPoint],
+    quiet: bool,
+) -> Result<Vec<SweepResult>, ExperimentError> {
+    let (observations, _) = observe(runs, base)?;
+    let truth = GroundTruth::from_runs(runs);
+    // Check every grid point's settings before the parallel part, so errors are reported once.
+    for p in grid {
+        back_end_matches(&[], base, p)?;
+    }
+    let bar = progress_bar(grid.len() as u64, "sweeping", quiet);
+    let results = sweep_matches(
+        grid,
+        &observations,
+        &truth,
+        evaluation,
+        |p| back_end_matches(&observations, base, p).unwrap_or_default(),
+        &|| bar.inc(1),
+    );
+    bar.finish_and_clear();
+    Ok(results)
+}
