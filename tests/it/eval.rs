@@ -324,7 +324,13 @@ fn icp_is_deterministic_whatever_the_threads() {
                 recognize_runs(&mut icp, &runs).matches
             })
     };
-    assert_eq!(go(1), go(2));
+    let two = go(2);
+    assert_eq!(go(1), two);
+    let mut serial = IcpRecognizer::new(IcpConfig {
+        parallel: false,
+        ..IcpConfig::default()
+    });
+    assert_eq!(recognize_runs(&mut serial, &runs).matches, two);
 }
 
 /// How the ICP baseline's cost grows with laps (every new region meets every past one):
