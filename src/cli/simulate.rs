@@ -24,11 +24,7 @@ pub struct SimulateArgs {
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     use placewords::sim::logs;
     let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
-    let total: usize = scn
-        .runs
-        .iter()
-        .map(|r| args.laps.unwrap_or(r.laps) as u64 as usize)
-        .sum();
+    let total: usize = scn.runs.iter().map(|r| args.laps.unwrap_or(r.laps)).sum();
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {

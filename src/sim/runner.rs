@@ -185,10 +185,9 @@ impl<'a> RunSim<'a> {
     }
 
     fn update_discs(&mut self) {
-        let t = self.time_s - self.lap_start_s;
         self.discs.clear();
         self.discs
-            .extend(self.pedestrians.iter().map(|p| p.disc(t)));
+            .extend(self.pedestrians.iter().map(Pedestrian::disc));
     }
 
     pub fn truth(&self) -> Pose2 {
@@ -224,9 +223,11 @@ impl<'a> RunSim<'a> {
         let next = integrate(self.truth, v, w, dt);
         self.odometry.update(vl * dt, vr * dt, &mut self.odom_rng);
         self.time_s += dt;
-        let t = self.time_s - self.lap_start_s;
-        for (i, p) in self.pedestrians.iter().enumerate() {
-            self.physics.set_pedestrian_next(i, p.position(t));
+        // People keep a hand's width off the robot's body.
+        let keep_away = cfg.radius_m + self.scn.pedestrians.radius_m + 0.1;
+        for (i, p) in self.pedestrians.iter_mut().enumerate() {
+            p.advance(dt, next.position(), keep_away);
+            self.physics.set_pedestrian_next(i, p.position());
         }
         self.physics.set_robot_next(next);
         self.physics.step();
@@ -277,9 +278,6 @@ impl<'a> RunSim<'a> {
     /// Drives lap `lap` to its end.
     pub fn run_lap(&mut self, lap: usize) -> Result<LapLog, SimError> {
         self.begin_lap(lap);
-        if lap == 0 && self.time_s == 0.0 {
-            self.next_scan_s = 0.0;
-        }
         let goal = (lap + 1) as f64 * self.tracker.length_m();
         let mut frames = Vec::new();
         while self.tracker.progress_m() < goal {

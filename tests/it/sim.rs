@@ -209,6 +209,36 @@ paths_m = [[[3.0, 0.6], [17.0, 0.6]], [[19.4, 1.0], [19.4, 7.0]]]
     assert!(unexplained > 100, "only {unexplained} hits off the walls");
 }
 
+/// The controller keeps the robot's body off the walls all round the small loop, and a person
+/// walking on the route makes it stop and wait, then carry on.
+#[test]
+fn the_robot_keeps_off_walls_and_waits_for_people() {
+    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let base = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 5\n[[runs]]\nlaps = 2\ndoors = \"all-open\"\n";
+    let scn = scenario(&world, base).unwrap();
+    let mut sim = placewords::sim::runner::RunSim::new(&scn, 0);
+    for lap in 0..2 {
+        sim.run_lap(lap).unwrap();
+    }
+    assert_eq!(sim.contact_steps(), 0, "the robot touched a wall or door");
+
+    let scn = scenario(
+        &world,
+        &format!("{base}[pedestrians]\ncount = 1\npaths_m = [[[4.0, 1.0], [17.0, 1.0]]]\nspeed_min_m_s = 0.5\nspeed_max_m_s = 0.5\n"),
+    )
+    .unwrap();
+    let runs = simulate(&scn, Some(1), &|| {}).unwrap();
+    let frames: Vec<_> = runs[0].frames().collect();
+    let stopped = frames
+        .windows(2)
+        .filter(|w| w[0].time_s > 3.0 && w[0].truth.0.distance(&w[1].truth.0) < 1e-3)
+        .count();
+    assert!(
+        stopped >= 5,
+        "the robot never waited ({stopped} still frames)"
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
     /// Ranges are never NaN, never negative and never beyond the maximum range, wherever the
