@@ -832,7 +832,7 @@ fn find_key(src: &str, header: &str) -> Range<usize> {
     at..at
 }
 
-/// "; did you mean `x`?" for the closest name, or "; known <what>: a, b, c".
+/// "; did you mean `x`?" for the closest name, or "; known `what`: a, b, c".
 pub fn hint(name: &str, known: &[&str], what: &str) -> String {
     let best = known
         .iter()

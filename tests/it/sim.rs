@@ -584,3 +584,84 @@ fn simulate_command_writes_carmen_logs_and_a_manifest() {
     assert_eq!(manifest["runs"][0]["file"], "run-000.log");
     assert_eq!(manifest["runs"][0]["laps"][0]["door_config"], "all-closed");
 }
+
+/// Presets, overrides, the Thrun model, door plans and the pass-through blocks are read as
+/// written.
+#[test]
+fn scenario_settings_are_read_with_units_converted() {
+    use placewords::sim::odometry::OdometryModel;
+    use placewords::spec::scenario::DoorPlan;
+    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let scn = scenario(
+        &world,
+        r#"format_version = 1
+world = "w"
+route = "lap"
+seed = 3
+[door_configs]
+north = ["d-north"]
+[[runs]]
+laps = 3
+start_waypoint = 2
+doors_cycle = ["all-closed", "north", "all-open"]
+[[runs]]
+laps = 1
+doors_random = { open_probability = 0.25 }
+[laser]
+preset = "lms200-mm"
+angle_error_deg = 0.1
+[odometry]
+model = "thrun"
+alpha1 = 0.02
+alpha3 = 0.03
+wheel_radius_mismatch_ratio = 0.001
+[robot]
+cruise_speed_m_s = 0.5
+max_turn_rate_deg_s = 90
+[recognizer]
+levels = 3
+anything = { nested = true }
+[evaluation]
+tp_radius_m = 1.5
+[[expect.levels]]
+levels = 2
+min_precision = 0.9
+"#,
+    )
+    .unwrap();
+    assert_eq!(scn.laser.max_range_m, 8.191);
+    assert!((scn.laser.angle_error_rad - 0.1f64.to_radians()).abs() < 1e-15);
+    assert_eq!(
+        scn.odometry.model,
+        OdometryModel::Thrun {
+            alpha: [0.02, 0.01, 0.03, 0.01]
+        }
+    );
+    assert_eq!(scn.odometry.wheel_radius_mismatch_ratio, 0.001);
+    assert_eq!(scn.robot.cruise_speed_m_s, 0.5);
+    assert!((scn.robot.max_turn_rate_rad_s - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(scn.runs[0].start_waypoint, 2);
+    match &scn.runs[0].doors {
+        DoorPlan::Cycle(c) => {
+            let names: Vec<&str> = c.iter().map(|d| d.name.as_str()).collect();
+            assert_eq!(names, ["all-closed", "north", "all-open"]);
+            assert_eq!(c[1].states.open, [false, true]);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        scn.runs[1].doors,
+        DoorPlan::Random {
+            open_probability: 0.25
+        }
+    );
+    assert_eq!(scn.recognizer["levels"].as_integer(), Some(3));
+    assert_eq!(scn.evaluation.tp_radius_m, 1.5);
+    assert_eq!(scn.expect.levels[0].min_precision, Some(0.9));
+    // Door states per lap follow the plan.
+    let (name, st) = placewords::sim::runner::door_states(&scn, 0, 4);
+    assert_eq!(
+        (name.as_str(), st.open.as_slice()),
+        ("north", &[false, true][..])
+    );
+}
