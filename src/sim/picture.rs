@@ -51,7 +51,7 @@ pub fn run_svg(world: &World, run: &RunLog) -> String {
         .map(|d| {
             run.laps
                 .first()
-                .is_some_and(|l| l.open_doors.iter().any(|o| *o == d.id))
+                .is_some_and(|l| l.open_doors.contains(&d.id))
         })
         .collect();
     let states = DoorStates { open };
