@@ -7,6 +7,9 @@
 //! new poses and steps; the route tracker measures progress on the true trajectory. Every
 //! `1 / laser.rate_hz` seconds a scan is taken and a frame recorded. A lap ends when progress
 //! reaches a whole route length. Door states change only between laps.
+//!
+//! Each run starts at its start waypoint facing along the route, at rest, with the odometry at
+//! (0, 0, 0) as on a robot just switched on; odometry is continuous across the run's laps.
 
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::sim::laser::Laser;
