@@ -17,8 +17,51 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The small loop as these tests know it (a copy, so that edits to `worlds/` do not move the
+/// geometry the assertions rely on): 20 × 8 m, corridors 2 m wide, doors `d-south` (hinge
+/// (5, 2), closed along +x, opens to +y) and `d-north`, route `lap`.
+const LOOP_WORLD: &str = r#"format_version = 1
+name = "loop-small"
+
+[robot_home]
+x_m = 1.0
+y_m = 1.0
+heading_deg = 0.0
+
+[[walls]]
+id = "outer"
+points_m = [[0.0, 0.0], [20.0, 0.0], [20.0, 8.0], [0.0, 8.0]]
+closed = true
+
+[[walls]]
+id = "inner-south-east"
+points_m = [[5.9, 2.0], [18.0, 2.0], [18.0, 6.0], [12.9, 6.0]]
+
+[[walls]]
+id = "inner-north-west"
+points_m = [[12.0, 6.0], [2.0, 6.0], [2.0, 2.0], [5.0, 2.0]]
+
+[[doors]]
+id = "d-south"
+hinge_m = [5.0, 2.0]
+width_m = 0.9
+closed_heading_deg = 0.0
+open_heading_deg = 90.0
+
+[[doors]]
+id = "d-north"
+hinge_m = [12.9, 6.0]
+width_m = 0.9
+closed_heading_deg = 180.0
+open_heading_deg = 270.0
+
+[[routes]]
+id = "lap"
+waypoints_m = [[1.0, 1.0], [19.0, 1.0], [19.0, 7.0], [1.0, 7.0]]
+"#;
+
 fn loop_small() -> World {
-    placewords::spec::world::load_world(&root().join("worlds/loop-small.toml")).unwrap()
+    parse_world(LOOP_WORLD, "loop-small.toml").unwrap()
 }
 
 /// A scenario over an in-memory world.
@@ -166,7 +209,7 @@ fn pedestrians_show_up_in_scans() {
 #[test]
 fn pedestrians_show_up_in_simulated_scans() {
     let scn = scenario(
-        &std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap(),
+        LOOP_WORLD,
         r#"
 format_version = 1
 world = "w.toml"
@@ -213,7 +256,7 @@ paths_m = [[[3.0, 0.6], [17.0, 0.6]], [[19.4, 1.0], [19.4, 7.0]]]
 /// walking on the route makes it stop and wait, then carry on.
 #[test]
 fn the_robot_keeps_off_walls_and_waits_for_people() {
-    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let world = LOOP_WORLD.to_string();
     let base = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 5\n[[runs]]\nlaps = 2\ndoors = \"all-open\"\n";
     let scn = scenario(&world, base).unwrap();
     let mut sim = placewords::sim::runner::RunSim::new(&scn, 0);
@@ -457,7 +500,7 @@ fn a_blocked_robot_ends_the_run_with_an_error_naming_the_place() {
 /// Problems in a scenario are reported with their line and column, all at once.
 #[test]
 fn a_malformed_scenario_gives_located_errors() {
-    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let world = LOOP_WORLD.to_string();
     let src = r#"format_version = 1
 world = "w.toml"
 route = "lapp"
@@ -594,7 +637,7 @@ fn simulate_command_writes_carmen_logs_and_a_manifest() {
 fn scenario_settings_are_read_with_units_converted() {
     use placewords::sim::odometry::OdometryModel;
     use placewords::spec::scenario::DoorPlan;
-    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let world = LOOP_WORLD.to_string();
     let scn = scenario(
         &world,
         r#"format_version = 1
