@@ -19,16 +19,15 @@ pub struct SimulateArgs {
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Also draw each run (world, true path, odometry path) as `run-NNN.svg` in the output folder.
+    #[arg(long)]
+    pub svg: bool,
 }
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     use placewords::sim::logs;
     let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
-    let total: usize = scn
-        .runs
-        .iter()
-        .map(|r| args.laps.unwrap_or(r.laps) as u64 as usize)
-        .sum();
+    let total: usize = scn.runs.iter().map(|r| args.laps.unwrap_or(r.laps)).sum();
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -45,7 +44,16 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     let logs_ = placewords::sim::simulate(&scn, args.laps, &tick)?;
     let simulated_s = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let files = logs::write_logs(&scn, &logs_, args.laps, &args.out)?;
+    let mut files = logs::write_logs(&scn, &logs_, args.laps, &args.out)?;
+    if args.svg {
+        for r in &logs_ {
+            let p = args.out.join(format!("run-{:03}.svg", r.run));
+            let svg = placewords::sim::picture::run_svg(&scn.world, r);
+            placewords::io::atomic::write_atomic(&p, svg.as_bytes())
+                .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", p.display()))?;
+            files.push(p);
+        }
+    }
     if !args.quiet {
         eprintln!(
             "simulated {total} laps in {simulated_s:.2} s; wrote {} files in {:.2} s",

@@ -177,16 +177,22 @@ impl Laser {
         );
     }
 
-    /// Adds the range noise to exact ranges: hits get uniform ±`range_noise_m` and stay within
-    /// [0, max]; no-returns stay at the maximum range.
+    /// Adds the range noise to exact ranges: hits get uniform ±`range_noise_m`, are rounded to
+    /// whole millimetres (the LMS200 reports integer millimetres in both presets) and stay
+    /// within [0, max]; no-returns stay at the maximum range.
     pub fn add_noise(&self, ranges: &mut [f64], rng: &mut SimRng) {
         let max = self.config.max_range_m;
         let n = self.config.range_noise_m;
         for r in ranges.iter_mut() {
             if *r >= max || !r.is_finite() {
                 *r = max;
-            } else if n > 0.0 {
-                *r = (*r + rng.random_range(-n..=n)).clamp(0.0, max);
+            } else {
+                let noisy = if n > 0.0 {
+                    *r + rng.random_range(-n..=n)
+                } else {
+                    *r
+                };
+                *r = ((noisy * 1000.0).round() / 1000.0).clamp(0.0, max);
             }
         }
     }

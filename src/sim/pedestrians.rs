@@ -1,7 +1,7 @@
 //! People walking back and forth: each pedestrian walks a polyline (along the longer side of a
 //! world area, at a random offset across it, or an explicit path), turning round at its ends, at
-//! a constant speed drawn from the speed range. Their positions are a pure function of time, so
-//! the simulation stays deterministic and cheap.
+//! a constant speed drawn from the speed range. A person about to walk into the robot turns
+//! round instead (people step aside for robots; the robot, in turn, waits for people ahead).
 
 use crate::geom::Vec2;
 use crate::sim::rng::SimRng;
@@ -17,6 +17,10 @@ pub enum WalkSource {
     /// An explicit polyline, metres.
     Path(Vec<Vec2>),
 }
+
+/// An encounter with the robot ends when the person is this much farther than the keep-away
+/// distance from it, metres.
+pub const ENCOUNTER_END_M: f64 = 2.0;
 
 /// Pedestrian parameters. Default: none.
 #[derive(Clone, Debug, PartialEq)]
@@ -51,8 +55,16 @@ pub struct Pedestrian {
     /// Arc length at each vertex.
     cum: Vec<f64>,
     pub speed_m_s: f64,
-    /// Where along the out-and-back cycle the walk starts, metres.
-    phase_m: f64,
+    /// Where along the out-and-back cycle (length 2 × path length) the person is, metres.
+    cycle_m: f64,
+    /// +1 walking forward along the cycle, -1 after turning round for the robot.
+    sense: f64,
+    /// Already turned round for the robot during this encounter (the robot has not been more
+    /// than [`ENCOUNTER_END_M`] beyond the keep-away distance since); blocked again, the person
+    /// squeezes past instead of turning again (at a path's end both ways lead towards the robot).
+    turned: bool,
+    /// Squeezing past the robot: keeps walking until the robot is behind.
+    squeezing: bool,
     pub radius_m: f64,
 }
 
@@ -70,7 +82,10 @@ impl Pedestrian {
             path,
             cum,
             speed_m_s,
-            phase_m,
+            cycle_m: phase_m,
+            sense: 1.0,
+            turned: false,
+            squeezing: false,
             radius_m,
         }
     }
@@ -79,8 +94,7 @@ impl Pedestrian {
         self.cum.last().copied().unwrap_or(0.0)
     }
 
-    /// Centre `t` seconds after the lap started.
-    pub fn position(&self, t: f64) -> Vec2 {
+    fn at_cycle(&self, c: f64) -> Vec2 {
         let len = self.length_m();
         if self.path.is_empty() {
             return Vec2::zeros();
@@ -88,7 +102,7 @@ impl Pedestrian {
         if len <= 0.0 {
             return self.path[0];
         }
-        let c = (self.phase_m + self.speed_m_s * t).rem_euclid(2.0 * len);
+        let c = c.rem_euclid(2.0 * len);
         let s = if c > len { 2.0 * len - c } else { c };
         let i = match self.cum.partition_point(|&x| x <= s) {
             0 => 0,
@@ -103,9 +117,42 @@ impl Pedestrian {
         self.path[i] + (self.path[i + 1] - self.path[i]) * f.clamp(0.0, 1.0)
     }
 
-    pub fn disc(&self, t: f64) -> Disc {
+    /// Current centre.
+    pub fn position(&self) -> Vec2 {
+        self.at_cycle(self.cycle_m)
+    }
+
+    /// Walks for `dt` seconds. A step that would bring the person closer than `keep_away_m`
+    /// (centre to centre) to `robot`, and closer than now, is not taken: the person turns round
+    /// instead. If they are still heading for the robot right after turning (at the end of a
+    /// path), they squeeze past it.
+    pub fn advance(&mut self, dt: f64, robot: Vec2, keep_away_m: f64) {
+        let next = self.cycle_m + self.sense * self.speed_m_s * dt;
+        let (now_d, next_d) = (
+            (self.position() - robot).norm(),
+            (self.at_cycle(next) - robot).norm(),
+        );
+        let blocked = next_d < keep_away_m && next_d < now_d;
+        if now_d > keep_away_m + ENCOUNTER_END_M {
+            self.turned = false;
+        }
+        if blocked && !self.squeezing && !self.turned {
+            self.sense = -self.sense;
+            self.turned = true;
+        } else {
+            self.squeezing = blocked;
+            let len2 = 2.0 * self.length_m();
+            self.cycle_m = if len2 > 0.0 {
+                next.rem_euclid(len2)
+            } else {
+                0.0
+            };
+        }
+    }
+
+    pub fn disc(&self) -> Disc {
         Disc {
-            centre: self.position(t),
+            centre: self.position(),
             radius_m: self.radius_m,
         }
     }
@@ -162,7 +209,7 @@ pub fn draw(cfg: &PedestrianConfig, rng: &mut SimRng) -> Vec<Pedestrian> {
                 0.0
             };
             Pedestrian {
-                phase_m: phase,
+                cycle_m: phase,
                 ..p
             }
         })
@@ -175,14 +222,54 @@ mod tests {
 
     #[test]
     fn walks_back_and_forth() {
-        let p = Pedestrian::new(
+        let mut p = Pedestrian::new(
             vec![Vec2::new(0.0, 0.0), Vec2::new(4.0, 0.0)],
             1.0,
             0.0,
             0.2,
         );
-        assert!((p.position(1.0).x - 1.0).abs() < 1e-12);
-        assert!((p.position(5.0).x - 3.0).abs() < 1e-12);
-        assert!((p.position(9.0).x - 1.0).abs() < 1e-12);
+        let far = Vec2::new(100.0, 100.0);
+        let at = |p: &mut Pedestrian, secs: usize| {
+            for _ in 0..secs * 4 {
+                p.advance(0.25, far, 0.6);
+            }
+            p.position().x
+        };
+        assert!((at(&mut p, 1) - 1.0).abs() < 1e-12);
+        assert!((at(&mut p, 4) - 3.0).abs() < 1e-12);
+        assert!((at(&mut p, 4) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn turns_round_before_walking_into_the_robot() {
+        let mut p = Pedestrian::new(
+            vec![Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0)],
+            1.0,
+            0.0,
+            0.2,
+        );
+        let robot = Vec2::new(5.0, 0.0);
+        for _ in 0..200 {
+            p.advance(0.05, robot, 0.6);
+            assert!((p.position() - robot).norm() >= 0.6 - 1e-9);
+        }
+        assert!(p.position().x < 4.5);
+    }
+
+    /// At the end of its path both ways lead to the robot: the person squeezes past rather
+    /// than standing in front of the robot for ever.
+    #[test]
+    fn squeezes_past_the_robot_at_the_end_of_its_path() {
+        let mut p = Pedestrian::new(
+            vec![Vec2::new(0.0, 0.0), Vec2::new(10.0, 0.0)],
+            1.0,
+            0.0,
+            0.2,
+        );
+        let robot = Vec2::new(0.9, 0.0);
+        for _ in 0..100 {
+            p.advance(0.05, robot, 0.6);
+        }
+        assert!(p.position().x > 2.0, "stuck at {:?}", p.position());
     }
 }

@@ -7,6 +7,9 @@
 //! new poses and steps; the route tracker measures progress on the true trajectory. Every
 //! `1 / laser.rate_hz` seconds a scan is taken and a frame recorded. A lap ends when progress
 //! reaches a whole route length. Door states change only between laps.
+//!
+//! Each run starts at its start waypoint facing along the route, at rest, with the odometry at
+//! (0, 0, 0) as on a robot just switched on; odometry is continuous across the run's laps.
 
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::sim::laser::Laser;
@@ -185,10 +188,9 @@ impl<'a> RunSim<'a> {
     }
 
     fn update_discs(&mut self) {
-        let t = self.time_s - self.lap_start_s;
         self.discs.clear();
         self.discs
-            .extend(self.pedestrians.iter().map(|p| p.disc(t)));
+            .extend(self.pedestrians.iter().map(Pedestrian::disc));
     }
 
     pub fn truth(&self) -> Pose2 {
@@ -224,9 +226,11 @@ impl<'a> RunSim<'a> {
         let next = integrate(self.truth, v, w, dt);
         self.odometry.update(vl * dt, vr * dt, &mut self.odom_rng);
         self.time_s += dt;
-        let t = self.time_s - self.lap_start_s;
-        for (i, p) in self.pedestrians.iter().enumerate() {
-            self.physics.set_pedestrian_next(i, p.position(t));
+        // People keep a hand's width off the robot's body.
+        let keep_away = cfg.radius_m + self.scn.pedestrians.radius_m + 0.1;
+        for (i, p) in self.pedestrians.iter_mut().enumerate() {
+            p.advance(dt, next.position(), keep_away);
+            self.physics.set_pedestrian_next(i, p.position());
         }
         self.physics.set_robot_next(next);
         self.physics.step();
@@ -277,9 +281,6 @@ impl<'a> RunSim<'a> {
     /// Drives lap `lap` to its end.
     pub fn run_lap(&mut self, lap: usize) -> Result<LapLog, SimError> {
         self.begin_lap(lap);
-        if lap == 0 && self.time_s == 0.0 {
-            self.next_scan_s = 0.0;
-        }
         let goal = (lap + 1) as f64 * self.tracker.length_m();
         let mut frames = Vec::new();
         while self.tracker.progress_m() < goal {

@@ -390,13 +390,18 @@ pub fn parse_scenario(
                 states,
             }),
             None => {
-                v.err(
-                    name.span(),
+                let what = if world.door_index(n).is_some() {
+                    format!(
+                        "`{n}` is a door, not a door configuration; name a set of open doors in \
+                         [door_configs], e.g. only-{n} = [\"{n}\"], and use its name"
+                    )
+                } else {
                     format!(
                         "unknown door configuration `{n}`{}",
                         hint(n, &config_names, "configurations")
-                    ),
-                );
+                    )
+                };
+                v.err(name.span(), what);
                 None
             }
         }
@@ -530,9 +535,9 @@ pub fn parse_scenario(
                 "pedestrians need somewhere to walk; add areas = [..] or paths_m = [..]".into(),
             );
         }
-        pedestrians.speed_min_m_s = v.positive(&p.speed_min_m_s, 0.5);
-        pedestrians.speed_max_m_s = v.positive(&p.speed_max_m_s, 1.2);
-        pedestrians.radius_m = v.positive(&p.radius_m, 0.2);
+        pedestrians.speed_min_m_s = v.positive("speed_min_m_s", &p.speed_min_m_s, 0.5);
+        pedestrians.speed_max_m_s = v.positive("speed_max_m_s", &p.speed_max_m_s, 1.2);
+        pedestrians.radius_m = v.positive("radius_m", &p.radius_m, 0.2);
         if pedestrians.speed_max_m_s < pedestrians.speed_min_m_s
             && let Some(s) = &p.speed_max_m_s
         {
@@ -560,13 +565,17 @@ pub fn parse_scenario(
         }),
     };
     let mut laser = LaserConfig::preset(preset);
-    laser.max_range_m = v.positive(&l.max_range_m, laser.max_range_m);
-    laser.range_noise_m = v.non_negative(&l.range_noise_m, laser.range_noise_m);
+    laser.max_range_m = v.positive("max_range_m", &l.max_range_m, laser.max_range_m);
+    laser.range_noise_m = v.non_negative("range_noise_m", &l.range_noise_m, laser.range_noise_m);
     laser.angle_error_rad = v
-        .non_negative(&l.angle_error_deg, laser.angle_error_rad.to_degrees())
+        .non_negative(
+            "angle_error_deg",
+            &l.angle_error_deg,
+            laser.angle_error_rad.to_degrees(),
+        )
         .to_radians();
-    laser.rate_hz = v.positive(&l.rate_hz, laser.rate_hz);
-    laser.mount_x_m = v.finite(&l.mount_x_m, laser.mount_x_m);
+    laser.rate_hz = v.positive("rate_hz", &l.rate_hz, laser.rate_hz);
+    laser.mount_x_m = v.finite("mount_x_m", &l.mount_x_m, laser.mount_x_m);
 
     // Odometry.
     let o = &spec.odometry;
@@ -594,7 +603,7 @@ pub fn parse_scenario(
             let d = [0.01, 0.01, 0.01, 0.01];
             let mut a = [0.0; 4];
             for i in 0..4 {
-                a[i] = v.non_negative(alphas[i], d[i]);
+                a[i] = v.non_negative(ALPHA_NAMES[i], alphas[i], d[i]);
             }
             OdometryModel::Thrun { alpha: a }
         }
@@ -616,37 +625,65 @@ pub fn parse_scenario(
                 }
             }
             OdometryModel::Proportional {
-                translation_ratio: v.non_negative(&o.translation_error_ratio, 0.0075),
-                rotation_ratio: v.non_negative(&o.rotation_error_ratio, 0.0075),
+                translation_ratio: v.non_negative(
+                    "translation_error_ratio",
+                    &o.translation_error_ratio,
+                    0.0075,
+                ),
+                rotation_ratio: v.non_negative(
+                    "rotation_error_ratio",
+                    &o.rotation_error_ratio,
+                    0.0075,
+                ),
             }
         }
     };
     let odometry = OdometryConfig {
         model,
-        wheel_radius_bias_ratio: v.finite(&o.wheel_radius_bias_ratio, 0.0),
-        wheel_radius_mismatch_ratio: v.finite(&o.wheel_radius_mismatch_ratio, 0.0),
+        wheel_radius_bias_ratio: v.finite(
+            "wheel_radius_bias_ratio",
+            &o.wheel_radius_bias_ratio,
+            0.0,
+        ),
+        wheel_radius_mismatch_ratio: v.finite(
+            "wheel_radius_mismatch_ratio",
+            &o.wheel_radius_mismatch_ratio,
+            0.0,
+        ),
     };
 
     // Robot.
     let r = &spec.robot;
     let d = RobotConfig::default();
     let robot = RobotConfig {
-        radius_m: v.positive(&r.radius_m, d.radius_m),
-        axle_track_m: v.positive(&r.axle_track_m, d.axle_track_m),
-        cruise_speed_m_s: v.positive(&r.cruise_speed_m_s, d.cruise_speed_m_s),
-        max_speed_m_s: v.positive(&r.max_speed_m_s, d.max_speed_m_s),
+        radius_m: v.positive("radius_m", &r.radius_m, d.radius_m),
+        axle_track_m: v.positive("axle_track_m", &r.axle_track_m, d.axle_track_m),
+        cruise_speed_m_s: v.positive("cruise_speed_m_s", &r.cruise_speed_m_s, d.cruise_speed_m_s),
+        max_speed_m_s: v.positive("max_speed_m_s", &r.max_speed_m_s, d.max_speed_m_s),
         max_turn_rate_rad_s: v
-            .positive(&r.max_turn_rate_deg_s, d.max_turn_rate_rad_s.to_degrees())
+            .positive(
+                "max_turn_rate_deg_s",
+                &r.max_turn_rate_deg_s,
+                d.max_turn_rate_rad_s.to_degrees(),
+            )
             .to_radians(),
-        accel_m_s2: v.positive(&r.accel_m_s2, d.accel_m_s2),
+        accel_m_s2: v.positive("accel_m_s2", &r.accel_m_s2, d.accel_m_s2),
         turn_accel_rad_s2: v
-            .positive(&r.turn_accel_deg_s2, d.turn_accel_rad_s2.to_degrees())
+            .positive(
+                "turn_accel_deg_s2",
+                &r.turn_accel_deg_s2,
+                d.turn_accel_rad_s2.to_degrees(),
+            )
             .to_radians(),
-        lookahead_m: v.positive(&r.lookahead_m, d.lookahead_m),
-        stop_distance_m: v.non_negative(&r.stop_distance_m, d.stop_distance_m),
-        slow_distance_m: v.non_negative(&r.slow_distance_m, d.slow_distance_m),
-        blocked_timeout_s: v.positive(&r.blocked_timeout_s, d.blocked_timeout_s),
-        step_s: v.positive(&r.step_s, d.step_s),
+        lookahead_m: v.positive("lookahead_m", &r.lookahead_m, d.lookahead_m),
+        stop_distance_m: v.non_negative("stop_distance_m", &r.stop_distance_m, d.stop_distance_m),
+        slow_distance_m: v.non_negative("slow_distance_m", &r.slow_distance_m, d.slow_distance_m),
+        blocked_timeout_s: v.positive(
+            "blocked_timeout_s",
+            &r.blocked_timeout_s,
+            d.blocked_timeout_s,
+        ),
+        step_s: v.positive("step_s", &r.step_s, d.step_s),
     };
     if robot.cruise_speed_m_s > robot.max_speed_m_s
         && let Some(c) = &r.cruise_speed_m_s
@@ -721,6 +758,8 @@ pub fn parse_scenario(
     })
 }
 
+const ALPHA_NAMES: [&str; 4] = ["alpha1", "alpha2", "alpha3", "alpha4"];
+
 const RESERVED: [&str; 3] = ["all-closed", "all-open", "random"];
 
 struct Validator<'a> {
@@ -740,7 +779,14 @@ impl Validator<'_> {
         });
     }
 
-    fn check(&mut self, x: &Option<S<f64>>, default: f64, ok: fn(f64) -> bool, what: &str) -> f64 {
+    fn check(
+        &mut self,
+        key: &str,
+        x: &Option<S<f64>>,
+        default: f64,
+        ok: fn(f64) -> bool,
+        what: &str,
+    ) -> f64 {
         match x {
             None => default,
             Some(s) => {
@@ -750,7 +796,9 @@ impl Validator<'_> {
                 } else {
                     self.err(
                         s.span(),
-                        format!("{val} is not allowed here; use a {what} number"),
+                        format!(
+                            "{key} = {val} is out of range; use a {what} number (default {default})"
+                        ),
                     );
                     default
                 }
@@ -758,16 +806,22 @@ impl Validator<'_> {
         }
     }
 
-    fn positive(&mut self, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(x, default, |v| v.is_finite() && v > 0.0, "positive")
+    fn positive(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
+        self.check(key, x, default, |v| v.is_finite() && v > 0.0, "positive")
     }
 
-    fn non_negative(&mut self, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(x, default, |v| v.is_finite() && v >= 0.0, "non-negative")
+    fn non_negative(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
+        self.check(
+            key,
+            x,
+            default,
+            |v| v.is_finite() && v >= 0.0,
+            "non-negative",
+        )
     }
 
-    fn finite(&mut self, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(x, default, f64::is_finite, "finite")
+    fn finite(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
+        self.check(key, x, default, f64::is_finite, "finite")
     }
 }
 
@@ -778,7 +832,7 @@ fn find_key(src: &str, header: &str) -> Range<usize> {
     at..at
 }
 
-/// "; did you mean `x`?" for the closest name, or "; known <what>: a, b, c".
+/// "; did you mean `x`?" for the closest name, or "; known `what`: a, b, c".
 pub fn hint(name: &str, known: &[&str], what: &str) -> String {
     let best = known
         .iter()

@@ -17,8 +17,51 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The small loop as these tests know it (a copy, so that edits to `worlds/` do not move the
+/// geometry the assertions rely on): 20 × 8 m, corridors 2 m wide, doors `d-south` (hinge
+/// (5, 2), closed along +x, opens to +y) and `d-north`, route `lap`.
+const LOOP_WORLD: &str = r#"format_version = 1
+name = "loop-small"
+
+[robot_home]
+x_m = 1.0
+y_m = 1.0
+heading_deg = 0.0
+
+[[walls]]
+id = "outer"
+points_m = [[0.0, 0.0], [20.0, 0.0], [20.0, 8.0], [0.0, 8.0]]
+closed = true
+
+[[walls]]
+id = "inner-south-east"
+points_m = [[5.9, 2.0], [18.0, 2.0], [18.0, 6.0], [12.9, 6.0]]
+
+[[walls]]
+id = "inner-north-west"
+points_m = [[12.0, 6.0], [2.0, 6.0], [2.0, 2.0], [5.0, 2.0]]
+
+[[doors]]
+id = "d-south"
+hinge_m = [5.0, 2.0]
+width_m = 0.9
+closed_heading_deg = 0.0
+open_heading_deg = 90.0
+
+[[doors]]
+id = "d-north"
+hinge_m = [12.9, 6.0]
+width_m = 0.9
+closed_heading_deg = 180.0
+open_heading_deg = 270.0
+
+[[routes]]
+id = "lap"
+waypoints_m = [[1.0, 1.0], [19.0, 1.0], [19.0, 7.0], [1.0, 7.0]]
+"#;
+
 fn loop_small() -> World {
-    placewords::spec::world::load_world(&root().join("worlds/loop-small.toml")).unwrap()
+    parse_world(LOOP_WORLD, "loop-small.toml").unwrap()
 }
 
 /// A scenario over an in-memory world.
@@ -166,7 +209,7 @@ fn pedestrians_show_up_in_scans() {
 #[test]
 fn pedestrians_show_up_in_simulated_scans() {
     let scn = scenario(
-        &std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap(),
+        LOOP_WORLD,
         r#"
 format_version = 1
 world = "w.toml"
@@ -207,6 +250,36 @@ paths_m = [[[3.0, 0.6], [17.0, 0.6]], [[19.4, 1.0], [19.4, 7.0]]]
         }
     }
     assert!(unexplained > 100, "only {unexplained} hits off the walls");
+}
+
+/// The controller keeps the robot's body off the walls all round the small loop, and a person
+/// walking on the route makes it stop and wait, then carry on.
+#[test]
+fn the_robot_keeps_off_walls_and_waits_for_people() {
+    let world = LOOP_WORLD.to_string();
+    let base = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 5\n[[runs]]\nlaps = 2\ndoors = \"all-open\"\n";
+    let scn = scenario(&world, base).unwrap();
+    let mut sim = placewords::sim::runner::RunSim::new(&scn, 0);
+    for lap in 0..2 {
+        sim.run_lap(lap).unwrap();
+    }
+    assert_eq!(sim.contact_steps(), 0, "the robot touched a wall or door");
+
+    let scn = scenario(
+        &world,
+        &format!("{base}[pedestrians]\ncount = 1\npaths_m = [[[4.0, 1.0], [17.0, 1.0]]]\nspeed_min_m_s = 0.5\nspeed_max_m_s = 0.5\n"),
+    )
+    .unwrap();
+    let runs = simulate(&scn, Some(1), &|| {}).unwrap();
+    let frames: Vec<_> = runs[0].frames().collect();
+    let stopped = frames
+        .windows(2)
+        .filter(|w| w[0].time_s > 3.0 && w[0].truth.0.distance(&w[1].truth.0) < 1e-3)
+        .count();
+    assert!(
+        stopped >= 5,
+        "the robot never waited ({stopped} still frames)"
+    );
 }
 
 proptest! {
@@ -427,7 +500,7 @@ fn a_blocked_robot_ends_the_run_with_an_error_naming_the_place() {
 /// Problems in a scenario are reported with their line and column, all at once.
 #[test]
 fn a_malformed_scenario_gives_located_errors() {
-    let world = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let world = LOOP_WORLD.to_string();
     let src = r#"format_version = 1
 world = "w.toml"
 route = "lapp"
@@ -506,6 +579,7 @@ fn simulate_command_writes_carmen_logs_and_a_manifest() {
                 "--laps",
                 "1",
                 "--quiet",
+                "--svg",
                 "-o",
             ])
             .arg(d.path())
@@ -553,4 +627,87 @@ fn simulate_command_writes_carmen_logs_and_a_manifest() {
     assert_eq!(manifest["seed"], 42);
     assert_eq!(manifest["runs"][0]["file"], "run-000.log");
     assert_eq!(manifest["runs"][0]["laps"][0]["door_config"], "all-closed");
+    let svg = std::fs::read_to_string(dirs[0].path().join("run-000.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("<polyline"));
+}
+
+/// Presets, overrides, the Thrun model, door plans and the pass-through blocks are read as
+/// written.
+#[test]
+fn scenario_settings_are_read_with_units_converted() {
+    use placewords::sim::odometry::OdometryModel;
+    use placewords::spec::scenario::DoorPlan;
+    let world = LOOP_WORLD.to_string();
+    let scn = scenario(
+        &world,
+        r#"format_version = 1
+world = "w"
+route = "lap"
+seed = 3
+[door_configs]
+north = ["d-north"]
+[[runs]]
+laps = 3
+start_waypoint = 2
+doors_cycle = ["all-closed", "north", "all-open"]
+[[runs]]
+laps = 1
+doors_random = { open_probability = 0.25 }
+[laser]
+preset = "lms200-mm"
+angle_error_deg = 0.1
+[odometry]
+model = "thrun"
+alpha1 = 0.02
+alpha3 = 0.03
+wheel_radius_mismatch_ratio = 0.001
+[robot]
+cruise_speed_m_s = 0.5
+max_turn_rate_deg_s = 90
+[recognizer]
+levels = 3
+anything = { nested = true }
+[evaluation]
+tp_radius_m = 1.5
+[[expect.levels]]
+levels = 2
+min_precision = 0.9
+"#,
+    )
+    .unwrap();
+    assert_eq!(scn.laser.max_range_m, 8.191);
+    assert!((scn.laser.angle_error_rad - 0.1f64.to_radians()).abs() < 1e-15);
+    assert_eq!(
+        scn.odometry.model,
+        OdometryModel::Thrun {
+            alpha: [0.02, 0.01, 0.03, 0.01]
+        }
+    );
+    assert_eq!(scn.odometry.wheel_radius_mismatch_ratio, 0.001);
+    assert_eq!(scn.robot.cruise_speed_m_s, 0.5);
+    assert!((scn.robot.max_turn_rate_rad_s - std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert_eq!(scn.runs[0].start_waypoint, 2);
+    match &scn.runs[0].doors {
+        DoorPlan::Cycle(c) => {
+            let names: Vec<&str> = c.iter().map(|d| d.name.as_str()).collect();
+            assert_eq!(names, ["all-closed", "north", "all-open"]);
+            assert_eq!(c[1].states.open, [false, true]);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(
+        scn.runs[1].doors,
+        DoorPlan::Random {
+            open_probability: 0.25
+        }
+    );
+    assert_eq!(scn.recognizer["levels"].as_integer(), Some(3));
+    assert_eq!(scn.evaluation.tp_radius_m, 1.5);
+    assert_eq!(scn.expect.levels[0].min_precision, Some(0.9));
+    // Door states per lap follow the plan.
+    let (name, st) = placewords::sim::runner::door_states(&scn, 0, 4);
+    assert_eq!(
+        (name.as_str(), st.open.as_slice()),
+        ("north", &[false, true][..])
+    );
 }
