@@ -16,6 +16,12 @@ use std::time::Duration;
 
 const FLOOR_SEED: u64 = 42;
 
+/// `cargo bench` passes `--bench`; without it (`cargo test --benches`, CI) criterion runs each
+/// benchmark once, and short histories keep that quick.
+fn full_run() -> bool {
+    std::env::args().any(|a| a == "--bench")
+}
+
 /// One lap of (odometry, scan) on the 200 m loop floor, doors drawn from `seed`.
 fn lap_inputs(seed: u64) -> Vec<(OdomPose, Scan)> {
     let floor = LoopFloor::institute();
@@ -108,14 +114,14 @@ fn matching(c: &mut Criterion) {
     let mut g = c.benchmark_group("matching_per_lap");
     g.sample_size(10);
     g.measurement_time(Duration::from_secs(4));
-    let history_max = 40;
-    let laps = observation_laps(history_max + 1, 1, None);
+    let histories: &[usize] = if full_run() { &[1, 10, 40] } else { &[1, 2] };
+    let laps = observation_laps(histories[histories.len() - 1] + 1, 1, None);
     for levels in 1..=3 {
         let cfg = RecognizerConfig {
             levels,
             ..Default::default()
         };
-        for history in [1usize, 10, 40] {
+        for &history in histories {
             let mut m = WordMatcher::new(&cfg).unwrap();
             for lap in &laps[..history] {
                 for o in lap {
@@ -152,7 +158,8 @@ fn whole_recognizer(c: &mut Criterion) {
     let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
     let mut rec = Recognizer::new(cfg).unwrap();
     let mut done = 0usize;
-    for history in [1usize, 40] {
+    let histories: &[usize] = if full_run() { &[1, 40] } else { &[1, 2] };
+    for &history in histories {
         while done < history {
             for (o, s) in &laps[done % laps.len()] {
                 rec.push(*o, s);

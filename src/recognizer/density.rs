@@ -83,7 +83,7 @@ pub struct DensityKernel {
 #[derive(Clone, Debug, Default)]
 pub struct RayDeltas {
     stride: isize,
-    deltas: Vec<isize>,
+    deltas: Vec<i32>,
     ray_starts: Vec<usize>,
 }
 
@@ -161,7 +161,7 @@ impl DensityKernel {
             deltas: self
                 .offsets
                 .iter()
-                .map(|&(ox, oy)| oy as isize * stride + ox as isize)
+                .map(|&(ox, oy)| (oy as isize * stride + ox as isize) as i32)
                 .collect(),
             ray_starts: self.ray_starts.clone(),
         }
@@ -185,7 +185,7 @@ impl DensityKernel {
         let mut count = 0u32;
         for r in 0..deltas.ray_starts.len() - 1 {
             for &d in &deltas.deltas[deltas.ray_starts[r]..deltas.ray_starts[r + 1]] {
-                let i = (base as isize).wrapping_add(d) as usize & mask;
+                let i = (base as isize).wrapping_add(d as isize) as usize & mask;
                 let v = cells[i];
                 if v >= CELL_OCCUPIED_FROM {
                     break;
