@@ -79,8 +79,13 @@ impl DensityFrontEnd {
         Some(obs)
     }
 
-    /// Starts a new run: the grid is cleared and the jump to the new start is not travel.
+    /// Starts a new run: the grid is cleared and the jump to the new start is not travel. Does
+    /// nothing while the current run has had no input (so calling it before every run, the first
+    /// included, is fine).
     pub fn start_run(&mut self) {
+        if self.last_odom.is_none() {
+            return;
+        }
         self.run += 1;
         self.grid.clear();
         self.last_odom = None;

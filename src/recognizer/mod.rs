@@ -56,7 +56,8 @@ impl Recognizer {
     }
 
     /// Ends the current run and starts the next: the grid is cleared, the last word of the run
-    /// is closed (its matches are returned) and no predecessor links cross the boundary.
+    /// is closed (its matches are returned) and no predecessor links cross the boundary. Does
+    /// nothing before the run's first input, so it may be called before every run.
     pub fn start_run(&mut self) -> Vec<Match> {
         self.front.start_run();
         self.back.start_run()

@@ -11,7 +11,8 @@ pub type ObsId = usize;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Observation {
     pub id: ObsId,
-    /// Run the observation belongs to (counts `start_run` calls, the first run is 0).
+    /// Run the observation belongs to (counts `start_run` calls that ended a run with inputs;
+    /// the first run is 0).
     pub run: usize,
     /// Index of the `push` call (0-based, counted across runs) whose scan made it.
     pub input_index: usize,

@@ -369,10 +369,16 @@ fn runs_break_predecessor_chains() {
     let cfg = RecognizerConfig::default();
     let lap = random_stretches(3, 20);
     let mut m = WordMatcher::new(&cfg).unwrap();
+    assert!(
+        m.start_run().is_empty(),
+        "before any input start_run is a no-op"
+    );
+    assert_eq!(m.words().run(), 0);
     let first = synth::observations(&lap, 0.1, 0, None);
     for o in &first {
         m.push_observation(o);
     }
+    m.start_run();
     m.start_run();
     let n0 = m.words().level(0).count();
     let second = synth::observations(&lap, 0.1, 1, first.last());
@@ -566,6 +572,39 @@ fn front_end_corridor_and_bifurcation_with_any_layout() {
             );
         }
     }
+}
+
+/// Runs: `start_run` before the first input is a no-op, the jump to a run's start is not
+/// travel, and observations carry their run and input index.
+#[test]
+fn recognizer_runs_and_input_indices() {
+    let inputs = corridor_inputs(&synth::lms200());
+    let mut rec = Recognizer::new(RecognizerConfig::default()).unwrap();
+    rec.start_run();
+    for (o, s) in &inputs[..300] {
+        rec.push(*o, s);
+    }
+    rec.start_run();
+    for (o, s) in &inputs[..300] {
+        rec.push(*o, s);
+    }
+    rec.finish();
+    let obs = rec.observations();
+    let first_of_second = obs.iter().position(|o| o.run == 1).unwrap();
+    assert!(obs[..first_of_second].iter().all(|o| o.run == 0));
+    assert!(obs[first_of_second..].iter().all(|o| o.run == 1));
+    assert!(obs.iter().all(|o| o.run <= 1));
+    let jump = obs[first_of_second].travel_m - obs[first_of_second - 1].travel_m;
+    assert!(
+        jump > 0.0 && jump < 0.2,
+        "travel across the run boundary: {jump}"
+    );
+    for (k, o) in obs.iter().enumerate() {
+        assert_eq!(o.id, k);
+        let (pose, _) = &inputs[o.input_index % 300];
+        assert_eq!(o.odom_pose, *pose);
+    }
+    assert!(obs[first_of_second].input_index >= 300);
 }
 
 /// Two laps of a loop floor through the whole recognizer: lap 2 is recognized, and every
