@@ -150,6 +150,17 @@ fn matching(c: &mut Criterion) {
     g.finish();
 }
 
+/// CPU time of this thread so far, nanoseconds (Linux; `None` elsewhere). Wall-clock figures on
+/// a shared machine include time spent waiting for a core; this does not.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
 fn whole_recognizer(c: &mut Criterion) {
     let mut g = c.benchmark_group("recognizer_per_lap");
     g.sample_size(10);
@@ -168,6 +179,20 @@ fn whole_recognizer(c: &mut Criterion) {
         }
         // Lap inputs restart at the same odometry: the loop is closed in odometry too.
         let next = &laps[history % laps.len()];
+        if let Some(c0) = thread_cpu_ns() {
+            let mut r = rec.clone();
+            let c1 = thread_cpu_ns().unwrap_or(c0);
+            let pairs: usize = next
+                .iter()
+                .flat_map(|(o, s)| r.push(*o, s))
+                .map(|m| m.pairs.len())
+                .sum();
+            let c2 = thread_cpu_ns().unwrap_or(c1);
+            eprintln!(
+                "recognizer_per_lap/3_levels/{history}_laps_history: thread CPU time {:.1} ms for one lap ({pairs} aligned pairs)",
+                (c2 - c1) as f64 / 1e6
+            );
+        }
         g.bench_function(format!("3_levels/{history}_laps_history"), |b| {
             b.iter_batched(
                 || rec.clone(),

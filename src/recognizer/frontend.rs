@@ -61,9 +61,9 @@ impl DensityFrontEnd {
         if self.travel_m + 1e-9 < self.next_obs_travel_m {
             return None;
         }
-        while self.next_obs_travel_m <= self.travel_m + 1e-9 {
-            self.next_obs_travel_m += self.spacing_m;
-        }
+        // The next multiple of the spacing after the current travel (one step, even after a jump).
+        let skipped = ((self.travel_m + 1e-9 - self.next_obs_travel_m) / self.spacing_m).floor();
+        self.next_obs_travel_m += (skipped + 1.0) * self.spacing_m;
         let psi = self
             .grid
             .psi_at(&self.kernel, &self.deltas, odom.0.x, odom.0.y);

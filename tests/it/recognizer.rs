@@ -607,6 +607,34 @@ fn recognizer_runs_and_input_indices() {
     assert!(obs[first_of_second].input_index >= 300);
 }
 
+/// An odometry jump (a log gap, a teleport) makes one observation, not one per skipped 0.10 m,
+/// and odd inputs do not panic.
+#[test]
+fn odometry_jumps_and_odd_inputs() {
+    let layout = synth::lms200();
+    let scan = synth::scan_of(
+        &synth::corridor_with_branch(10.0, 2.0, 5.0, 2.0),
+        Pose2::IDENTITY,
+        &layout,
+        0.0,
+    );
+    let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+    assert!(fe.push(OdomPose(Pose2::IDENTITY), &scan).is_none());
+    let far = Pose2::new(1.0e7, -3.0e6, 1.0);
+    let o = fe
+        .push(OdomPose(far), &scan)
+        .expect("an observation after the jump");
+    assert!((0.0..=1.0).contains(&o.psi));
+    assert!(
+        fe.push(OdomPose(far), &scan).is_none(),
+        "no travel, no observation"
+    );
+    let mut odd = scan.clone();
+    odd.ranges_m = vec![f64::NAN, -1.0, 0.0, f64::INFINITY, 1e300];
+    fe.push(OdomPose(Pose2::new(1.0e7 + 0.2, -3.0e6, 1.0)), &odd);
+    fe.push(OdomPose(Pose2::new(f64::NAN, 0.0, 0.0)), &scan);
+}
+
 /// Two laps of a loop floor through the whole recognizer: lap 2 is recognized, and every
 /// aligned pair is within 1 m (odometry is exact here, so it is the truth).
 #[test]
