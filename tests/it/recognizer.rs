@@ -780,3 +780,128 @@ proptest! {
         }
     }
 }
+
+/// Longest chain of matching word pairs ending at (c, p) in level configuration k (words of
+/// levels < k), by plain recursion over the predecessor lists.
+fn brute_chain(
+    w: &WordLevels,
+    cfg: &RecognizerConfig,
+    k: usize,
+    c: u32,
+    p: u32,
+    memo: &mut std::collections::HashMap<(u32, u32), usize>,
+) -> usize {
+    if let Some(&v) = memo.get(&(c, p)) {
+        return v;
+    }
+    let (cw, pw) = (w.word(c), w.word(p));
+    let (sa, sb) = (cw.size as f64, pw.size as f64);
+    let mut da = (cw.angle_deg - pw.angle_deg).abs() % 360.0;
+    if da > 180.0 {
+        da = 360.0 - da;
+    }
+    let ok = cw.level < k
+        && pw.level < k
+        && cw.class == pw.class
+        && (sa - sb).abs() <= cfg.size_tolerance_ratio * sa.max(sb) + 1e-9
+        && da <= cfg.angle_tolerance_deg + 1e-9
+        && pw.end_travel_m + cfg.min_gap_m <= cw.start_travel_m + 1e-9;
+    let v = if !ok {
+        0
+    } else {
+        let mut best = 0;
+        for &cp in cw.pred_ids() {
+            for &pp in pw.pred_ids() {
+                best = best.max(brute_chain(w, cfg, k, cp, pp, memo));
+            }
+        }
+        1 + best
+    };
+    memo.insert((c, p), v);
+    v
+}
+
+/// Earliest start travel of the current word `back` steps before (c, p) over all longest chains.
+fn earliest_first(
+    w: &WordLevels,
+    cfg: &RecognizerConfig,
+    k: usize,
+    c: u32,
+    p: u32,
+    back: usize,
+    memo: &mut std::collections::HashMap<(u32, u32), usize>,
+) -> f64 {
+    if back == 0 {
+        return w.word(c).start_travel_m;
+    }
+    let len = brute_chain(w, cfg, k, c, p, memo);
+    let (cw, pw) = (w.word(c), w.word(p));
+    let mut best = f64::INFINITY;
+    for &cp in cw.pred_ids() {
+        for &pp in pw.pred_ids() {
+            if brute_chain(w, cfg, k, cp, pp, memo) + 1 == len {
+                best = best.min(earliest_first(w, cfg, k, cp, pp, back - 1, memo));
+            }
+        }
+    }
+    best
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The memoised chain lengths are the longest chains: every word pair whose longest chain
+    /// reaches a configuration's threshold (with the gap met by its whole n-gram when the chain
+    /// is exactly that long) is reported in that configuration, and every reported pair matches.
+    #[test]
+    fn matching_finds_every_long_enough_chain(seed in 0u64..100_000) {
+        let cfg = config(|c| {
+            c.min_word_size = 2;
+            c.min_ngram = vec![3, 4, 5];
+            c.min_gap_m = 2.0;
+        });
+        let mut r = SplitMix::new(seed);
+        let base: Vec<Stretch> = (0..25)
+            .map(|_| Stretch::new(class_psi(r.int(0, 2) * 3, 8), r.int(2, 9), [0.0, 90.0][r.int(0, 1)]))
+            .collect();
+        // The sequence twice with small size changes, so that long chains exist.
+        let mut stretches = base.clone();
+        stretches.extend(base.iter().map(|s| Stretch::new(s.psi, (s.size + r.int(0, 1)).max(2), s.turn_deg)));
+        let obs = synth::observations(&stretches, 0.1, 0, None);
+        let (m, matches) = run_matcher(&cfg, &obs);
+        let w = m.words();
+        let id_of = |r: WordRef| -> u32 {
+            w.all_words().iter().position(|x| x.level == r.level && x.index == r.index).unwrap() as u32
+        };
+        for k in 1..=3 {
+            let tau = cfg.min_ngram[k - 1];
+            let reported: std::collections::HashSet<(u32, u32)> = matches
+                .iter()
+                .filter(|mt| mt.levels == k)
+                .flat_map(|mt| mt.word_pairs.iter().map(|&(c, p)| (id_of(c), id_of(p))))
+                .collect();
+            let mut memo = std::collections::HashMap::new();
+            let n = w.all_words().len() as u32;
+            for c in 0..n {
+                for p in 0..c {
+                    let len = brute_chain(w, &cfg, k, c, p, &mut memo);
+                    if reported.contains(&(c, p)) {
+                        prop_assert!(len >= 1, "reported pair ({c}, {p}) does not match");
+                    }
+                    // A chain exactly τ long is one n-gram: reported when its first current
+                    // word begins min_gap_m after p ends. Ties between longest chains may put
+                    // that word in different places: check when the earliest of them passes.
+                    if len == tau {
+                        let first = earliest_first(w, &cfg, k, c, p, tau - 1, &mut memo);
+                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.min_gap_m {
+                            prop_assert!(
+                                reported.contains(&(c, p)),
+                                "configuration {k}: chain of {len} ending at ({c}, {p}) not reported"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
