@@ -134,6 +134,7 @@ impl WordLevels {
         }
     }
 
+    /// Density class of Ψ: min(floor(classes·Ψ), classes − 1) (NaN gives class 0).
     pub fn class_of(&self, psi: f64) -> u8 {
         let c = (psi * self.classes as f64).floor();
         (c.max(0.0) as usize).min(self.classes - 1) as u8
