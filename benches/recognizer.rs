@@ -16,6 +16,12 @@ use std::time::Duration;
 
 const FLOOR_SEED: u64 = 42;
 
+/// `cargo bench` passes `--bench`; without it (`cargo test --benches`, CI) criterion runs each
+/// benchmark once, and short histories keep that quick.
+fn full_run() -> bool {
+    std::env::args().any(|a| a == "--bench")
+}
+
 /// One lap of (odometry, scan) on the 200 m loop floor, doors drawn from `seed`.
 fn lap_inputs(seed: u64) -> Vec<(OdomPose, Scan)> {
     let floor = LoopFloor::institute();
@@ -108,14 +114,14 @@ fn matching(c: &mut Criterion) {
     let mut g = c.benchmark_group("matching_per_lap");
     g.sample_size(10);
     g.measurement_time(Duration::from_secs(4));
-    let history_max = 40;
-    let laps = observation_laps(history_max + 1, 1, None);
+    let histories: &[usize] = if full_run() { &[1, 10, 40] } else { &[1, 2] };
+    let laps = observation_laps(histories[histories.len() - 1] + 1, 1, None);
     for levels in 1..=3 {
         let cfg = RecognizerConfig {
             levels,
             ..Default::default()
         };
-        for history in [1usize, 10, 40] {
+        for &history in histories {
             let mut m = WordMatcher::new(&cfg).unwrap();
             for lap in &laps[..history] {
                 for o in lap {
@@ -144,6 +150,17 @@ fn matching(c: &mut Criterion) {
     g.finish();
 }
 
+/// CPU time of this thread so far, nanoseconds (Linux; `None` elsewhere). Wall-clock figures on
+/// a shared machine include time spent waiting for a core; this does not.
+fn thread_cpu_ns() -> Option<u64> {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
+}
+
 fn whole_recognizer(c: &mut Criterion) {
     let mut g = c.benchmark_group("recognizer_per_lap");
     g.sample_size(10);
@@ -152,7 +169,8 @@ fn whole_recognizer(c: &mut Criterion) {
     let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
     let mut rec = Recognizer::new(cfg).unwrap();
     let mut done = 0usize;
-    for history in [1usize, 40] {
+    let histories: &[usize] = if full_run() { &[1, 40] } else { &[1, 2] };
+    for &history in histories {
         while done < history {
             for (o, s) in &laps[done % laps.len()] {
                 rec.push(*o, s);
@@ -161,6 +179,20 @@ fn whole_recognizer(c: &mut Criterion) {
         }
         // Lap inputs restart at the same odometry: the loop is closed in odometry too.
         let next = &laps[history % laps.len()];
+        if let Some(c0) = thread_cpu_ns() {
+            let mut r = rec.clone();
+            let c1 = thread_cpu_ns().unwrap_or(c0);
+            let pairs: usize = next
+                .iter()
+                .flat_map(|(o, s)| r.push(*o, s))
+                .map(|m| m.pairs.len())
+                .sum();
+            let c2 = thread_cpu_ns().unwrap_or(c1);
+            eprintln!(
+                "recognizer_per_lap/3_levels/{history}_laps_history: thread CPU time {:.1} ms for one lap ({pairs} aligned pairs)",
+                (c2 - c1) as f64 / 1e6
+            );
+        }
         g.bench_function(format!("3_levels/{history}_laps_history"), |b| {
             b.iter_batched(
                 || rec.clone(),

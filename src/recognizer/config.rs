@@ -237,12 +237,6 @@ impl RecognizerConfig {
         }
     }
 
-    /// Density class of Ψ: min(floor(classes·Ψ), classes − 1).
-    pub fn class_of(&self, psi: f64) -> u8 {
-        let c = (psi * self.classes as f64).floor();
-        (c.max(0.0) as usize).min(self.classes - 1) as u8
-    }
-
     /// Kernel radius in grid cells (rounded).
     pub fn kernel_radius_cells(&self) -> usize {
         (self.kernel_radius_m / self.grid_cell_m).round() as usize

@@ -61,9 +61,9 @@ impl DensityFrontEnd {
         if self.travel_m + 1e-9 < self.next_obs_travel_m {
             return None;
         }
-        while self.next_obs_travel_m <= self.travel_m + 1e-9 {
-            self.next_obs_travel_m += self.spacing_m;
-        }
+        // The next multiple of the spacing after the current travel (one step, even after a jump).
+        let skipped = ((self.travel_m + 1e-9 - self.next_obs_travel_m) / self.spacing_m).floor();
+        self.next_obs_travel_m += (skipped + 1.0) * self.spacing_m;
         let psi = self
             .grid
             .psi_at(&self.kernel, &self.deltas, odom.0.x, odom.0.y);
@@ -79,8 +79,13 @@ impl DensityFrontEnd {
         Some(obs)
     }
 
-    /// Starts a new run: the grid is cleared and the jump to the new start is not travel.
+    /// Starts a new run: the grid is cleared and the jump to the new start is not travel. Does
+    /// nothing while the current run has had no input (so calling it before every run, the first
+    /// included, is fine).
     pub fn start_run(&mut self) {
+        if self.last_odom.is_none() {
+            return;
+        }
         self.run += 1;
         self.grid.clear();
         self.last_odom = None;

@@ -98,15 +98,17 @@ impl WordMatcher {
     /// calling it.
     pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
         let mut out = Vec::new();
-        while obs.run > self.words.run() {
-            out.extend(self.start_run());
+        if obs.run > self.words.run() {
+            let closed = self.words.begin_run(obs.run);
+            out = self.match_words(&closed);
         }
         let closed = self.words.push(obs);
         out.extend(self.match_words(&closed));
         out
     }
 
-    /// Closes the current run (its last word is matched) and starts a new one.
+    /// Closes the current run (its last word is matched) and starts a new one; does nothing
+    /// while the current run has no observation.
     pub fn start_run(&mut self) -> Vec<Match> {
         let closed = self.words.start_run();
         self.match_words(&closed)

@@ -1,7 +1,6 @@
 //! The place recognizer of the paper: local grid, density Ψ, density classes, words, multi-level
 //! words, incremental n-gram matching and fine alignment. It takes odometry poses and scans and
-//! never sees ground truth: its inputs are [`OdomPose`](crate::geom::OdomPose) and
-//! [`Scan`](crate::scan::Scan) only.
+//! never sees ground truth: its inputs are [`OdomPose`] and [`Scan`] only.
 //!
 //! Two halves, usable apart so that a threshold sweep computes observations once:
 //! - [`DensityFrontEnd`]: scans → local grid → one [`Observation`] (Ψ) per 0.10 m of travel;
@@ -57,7 +56,8 @@ impl Recognizer {
     }
 
     /// Ends the current run and starts the next: the grid is cleared, the last word of the run
-    /// is closed (its matches are returned) and no predecessor links cross the boundary.
+    /// is closed (its matches are returned) and no predecessor links cross the boundary. Does
+    /// nothing before the run's first input, so it may be called before every run.
     pub fn start_run(&mut self) -> Vec<Match> {
         self.front.start_run();
         self.back.start_run()

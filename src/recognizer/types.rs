@@ -11,7 +11,8 @@ pub type ObsId = usize;
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Observation {
     pub id: ObsId,
-    /// Run the observation belongs to (counts `start_run` calls, the first run is 0).
+    /// Run the observation belongs to (counts `start_run` calls that ended a run with inputs;
+    /// the first run is 0).
     pub run: usize,
     /// Index of the `push` call (0-based, counted across runs) whose scan made it.
     pub input_index: usize,
@@ -39,14 +40,19 @@ pub struct AlignedPair {
 }
 
 /// A recognized revisit: an n-gram of current words matched to an n-gram of past words.
+///
+/// Each word pair is reported once per level configuration: the first time a chain of matching
+/// word pairs reaches the configuration's minimum n-gram size τ, the match carries the τ pairs of
+/// that n-gram; when later words extend the chain, each extension is a match carrying only the
+/// new pair. The matches of an L-level run are those with `levels` ≤ L.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Match {
     /// The level configuration that found it: 1 = level 0 only, 2 = levels 0-1, ...
     pub levels: usize,
-    /// Number of word pairs in the n-gram.
+    /// Number of word pairs in the matched n-gram (the chain ending at the last word pair).
     pub ngram_len: usize,
-    /// Matched word pairs (current, past), oldest first.
+    /// The word pairs (current, past) this match newly covers, oldest first.
     pub word_pairs: Vec<(WordRef, WordRef)>,
-    /// Observation pairs after fine alignment.
+    /// Observation pairs of those word pairs after fine alignment.
     pub pairs: Vec<AlignedPair>,
 }

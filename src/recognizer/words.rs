@@ -134,6 +134,7 @@ impl WordLevels {
         }
     }
 
+    /// Density class of Ψ: min(floor(classes·Ψ), classes − 1) (NaN gives class 0).
     pub fn class_of(&self, psi: f64) -> u8 {
         let c = (psi * self.classes as f64).floor();
         (c.max(0.0) as usize).min(self.classes - 1) as u8
@@ -208,11 +209,27 @@ impl WordLevels {
         self.close_word(open)
     }
 
-    /// Closes the current run and starts a new one: no word will have a predecessor across.
+    /// Closes the current run and starts the next one: no word will have a predecessor across.
+    /// Does nothing while the current run has no observation (so calling it before every run,
+    /// the first included, is fine).
     pub fn start_run(&mut self) -> Vec<WordId> {
+        if self.run_range(self.run).is_empty() {
+            return Vec::new();
+        }
+        let next = self.run + 1;
+        self.begin_run(next)
+    }
+
+    /// Closes the current run and makes `run` (later than the current one) the current run.
+    pub fn begin_run(&mut self, run: usize) -> Vec<WordId> {
         let closed = self.finish_run();
-        self.run += 1;
-        self.run_starts.push(self.observations.len());
+        if run <= self.run {
+            return closed;
+        }
+        while self.run_starts.len() <= run {
+            self.run_starts.push(self.observations.len());
+        }
+        self.run = run;
         self.run_first_l0 = self.by_level[0].len();
         self.next_preds.clear();
         closed

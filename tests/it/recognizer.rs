@@ -369,10 +369,16 @@ fn runs_break_predecessor_chains() {
     let cfg = RecognizerConfig::default();
     let lap = random_stretches(3, 20);
     let mut m = WordMatcher::new(&cfg).unwrap();
+    assert!(
+        m.start_run().is_empty(),
+        "before any input start_run is a no-op"
+    );
+    assert_eq!(m.words().run(), 0);
     let first = synth::observations(&lap, 0.1, 0, None);
     for o in &first {
         m.push_observation(o);
     }
+    m.start_run();
     m.start_run();
     let n0 = m.words().level(0).count();
     let second = synth::observations(&lap, 0.1, 1, first.last());
@@ -568,6 +574,67 @@ fn front_end_corridor_and_bifurcation_with_any_layout() {
     }
 }
 
+/// Runs: `start_run` before the first input is a no-op, the jump to a run's start is not
+/// travel, and observations carry their run and input index.
+#[test]
+fn recognizer_runs_and_input_indices() {
+    let inputs = corridor_inputs(&synth::lms200());
+    let mut rec = Recognizer::new(RecognizerConfig::default()).unwrap();
+    rec.start_run();
+    for (o, s) in &inputs[..300] {
+        rec.push(*o, s);
+    }
+    rec.start_run();
+    for (o, s) in &inputs[..300] {
+        rec.push(*o, s);
+    }
+    rec.finish();
+    let obs = rec.observations();
+    let first_of_second = obs.iter().position(|o| o.run == 1).unwrap();
+    assert!(obs[..first_of_second].iter().all(|o| o.run == 0));
+    assert!(obs[first_of_second..].iter().all(|o| o.run == 1));
+    assert!(obs.iter().all(|o| o.run <= 1));
+    let jump = obs[first_of_second].travel_m - obs[first_of_second - 1].travel_m;
+    assert!(
+        jump > 0.0 && jump < 0.2,
+        "travel across the run boundary: {jump}"
+    );
+    for (k, o) in obs.iter().enumerate() {
+        assert_eq!(o.id, k);
+        let (pose, _) = &inputs[o.input_index % 300];
+        assert_eq!(o.odom_pose, *pose);
+    }
+    assert!(obs[first_of_second].input_index >= 300);
+}
+
+/// An odometry jump (a log gap, a teleport) makes one observation, not one per skipped 0.10 m,
+/// and odd inputs do not panic.
+#[test]
+fn odometry_jumps_and_odd_inputs() {
+    let layout = synth::lms200();
+    let scan = synth::scan_of(
+        &synth::corridor_with_branch(10.0, 2.0, 5.0, 2.0),
+        Pose2::IDENTITY,
+        &layout,
+        0.0,
+    );
+    let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+    assert!(fe.push(OdomPose(Pose2::IDENTITY), &scan).is_none());
+    let far = Pose2::new(1.0e7, -3.0e6, 1.0);
+    let o = fe
+        .push(OdomPose(far), &scan)
+        .expect("an observation after the jump");
+    assert!((0.0..=1.0).contains(&o.psi));
+    assert!(
+        fe.push(OdomPose(far), &scan).is_none(),
+        "no travel, no observation"
+    );
+    let mut odd = scan.clone();
+    odd.ranges_m = vec![f64::NAN, -1.0, 0.0, f64::INFINITY, 1e300];
+    fe.push(OdomPose(Pose2::new(1.0e7 + 0.2, -3.0e6, 1.0)), &odd);
+    fe.push(OdomPose(Pose2::new(f64::NAN, 0.0, 0.0)), &scan);
+}
+
 /// Two laps of a loop floor through the whole recognizer: lap 2 is recognized, and every
 /// aligned pair is within 1 m (odometry is exact here, so it is the truth).
 #[test]
@@ -709,6 +776,131 @@ proptest! {
             for (c, p) in &mt.word_pairs {
                 let (c, p) = (m.words().get(*c).unwrap(), m.words().get(*p).unwrap());
                 prop_assert!(c.start_travel_m - p.end_travel_m >= gap - 1e-9);
+            }
+        }
+    }
+}
+
+/// Longest chain of matching word pairs ending at (c, p) in level configuration k (words of
+/// levels < k), by plain recursion over the predecessor lists.
+fn brute_chain(
+    w: &WordLevels,
+    cfg: &RecognizerConfig,
+    k: usize,
+    c: u32,
+    p: u32,
+    memo: &mut std::collections::HashMap<(u32, u32), usize>,
+) -> usize {
+    if let Some(&v) = memo.get(&(c, p)) {
+        return v;
+    }
+    let (cw, pw) = (w.word(c), w.word(p));
+    let (sa, sb) = (cw.size as f64, pw.size as f64);
+    let mut da = (cw.angle_deg - pw.angle_deg).abs() % 360.0;
+    if da > 180.0 {
+        da = 360.0 - da;
+    }
+    let ok = cw.level < k
+        && pw.level < k
+        && cw.class == pw.class
+        && (sa - sb).abs() <= cfg.size_tolerance_ratio * sa.max(sb) + 1e-9
+        && da <= cfg.angle_tolerance_deg + 1e-9
+        && pw.end_travel_m + cfg.min_gap_m <= cw.start_travel_m + 1e-9;
+    let v = if !ok {
+        0
+    } else {
+        let mut best = 0;
+        for &cp in cw.pred_ids() {
+            for &pp in pw.pred_ids() {
+                best = best.max(brute_chain(w, cfg, k, cp, pp, memo));
+            }
+        }
+        1 + best
+    };
+    memo.insert((c, p), v);
+    v
+}
+
+/// Earliest start travel of the current word `back` steps before (c, p) over all longest chains.
+fn earliest_first(
+    w: &WordLevels,
+    cfg: &RecognizerConfig,
+    k: usize,
+    c: u32,
+    p: u32,
+    back: usize,
+    memo: &mut std::collections::HashMap<(u32, u32), usize>,
+) -> f64 {
+    if back == 0 {
+        return w.word(c).start_travel_m;
+    }
+    let len = brute_chain(w, cfg, k, c, p, memo);
+    let (cw, pw) = (w.word(c), w.word(p));
+    let mut best = f64::INFINITY;
+    for &cp in cw.pred_ids() {
+        for &pp in pw.pred_ids() {
+            if brute_chain(w, cfg, k, cp, pp, memo) + 1 == len {
+                best = best.min(earliest_first(w, cfg, k, cp, pp, back - 1, memo));
+            }
+        }
+    }
+    best
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    /// The memoised chain lengths are the longest chains: every word pair whose longest chain
+    /// reaches a configuration's threshold (with the gap met by its whole n-gram when the chain
+    /// is exactly that long) is reported in that configuration, and every reported pair matches.
+    #[test]
+    fn matching_finds_every_long_enough_chain(seed in 0u64..100_000) {
+        let cfg = config(|c| {
+            c.min_word_size = 2;
+            c.min_ngram = vec![3, 4, 5];
+            c.min_gap_m = 2.0;
+        });
+        let mut r = SplitMix::new(seed);
+        let base: Vec<Stretch> = (0..25)
+            .map(|_| Stretch::new(class_psi(r.int(0, 2) * 3, 8), r.int(2, 9), [0.0, 90.0][r.int(0, 1)]))
+            .collect();
+        // The sequence twice with small size changes, so that long chains exist.
+        let mut stretches = base.clone();
+        stretches.extend(base.iter().map(|s| Stretch::new(s.psi, (s.size + r.int(0, 1)).max(2), s.turn_deg)));
+        let obs = synth::observations(&stretches, 0.1, 0, None);
+        let (m, matches) = run_matcher(&cfg, &obs);
+        let w = m.words();
+        let id_of = |r: WordRef| -> u32 {
+            w.all_words().iter().position(|x| x.level == r.level && x.index == r.index).unwrap() as u32
+        };
+        for k in 1..=3 {
+            let tau = cfg.min_ngram[k - 1];
+            let reported: std::collections::HashSet<(u32, u32)> = matches
+                .iter()
+                .filter(|mt| mt.levels == k)
+                .flat_map(|mt| mt.word_pairs.iter().map(|&(c, p)| (id_of(c), id_of(p))))
+                .collect();
+            let mut memo = std::collections::HashMap::new();
+            let n = w.all_words().len() as u32;
+            for c in 0..n {
+                for p in 0..c {
+                    let len = brute_chain(w, &cfg, k, c, p, &mut memo);
+                    if reported.contains(&(c, p)) {
+                        prop_assert!(len >= 1, "reported pair ({c}, {p}) does not match");
+                    }
+                    // A chain exactly τ long is one n-gram: reported when its first current
+                    // word begins min_gap_m after p ends. Ties between longest chains may put
+                    // that word in different places: check when the earliest of them passes.
+                    if len == tau {
+                        let first = earliest_first(w, &cfg, k, c, p, tau - 1, &mut memo);
+                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.min_gap_m {
+                            prop_assert!(
+                                reported.contains(&(c, p)),
+                                "configuration {k}: chain of {len} ending at ({c}, {p}) not reported"
+                            );
+                        }
+                    }
+                }
             }
         }
     }
