@@ -17,7 +17,6 @@ use crate::report::json::Report;
 use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
-use crate::spec::diag::{Diagnostic, line_col};
 use crate::spec::evaluation::EvaluationSpec;
 use crate::spec::scenario::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -85,59 +84,9 @@ pub fn progress_bar(len: u64, message: &str, quiet: bool) -> ProgressBar {
     bar
 }
 
-/// The recognizer settings of a scenario: its `[recognizer]` table over the defaults, checked,
-/// with problems located in the scenario file.
+/// The recognizer settings of a scenario (checked when the scenario was loaded).
 pub fn recognizer_config(scn: &Scenario) -> Result<RecognizerConfig, SpecError> {
-    let src = std::fs::read_to_string(&scn.path).unwrap_or_default();
-    let file = scn.path.display().to_string();
-    let locate = |key: Option<&str>| -> (usize, usize) {
-        let table = src.find("[recognizer]");
-        let at = match (table, key) {
-            (Some(t), Some(k)) => src[t..]
-                .find(&format!("\n{k}"))
-                .map(|i| t + i + 1)
-                .unwrap_or(t),
-            (Some(t), None) => t,
-            _ => 0,
-        };
-        line_col(&src, at)
-    };
-    let cfg: RecognizerConfig =
-        scn.recognizer
-            .clone()
-            .try_into()
-            .map_err(|e: toml::de::Error| {
-                let msg = e.message().trim().to_string();
-                let key = msg
-                    .split('`')
-                    .nth(1)
-                    .filter(|_| msg.starts_with("unknown field"));
-                let (line, col) = locate(key);
-                SpecError::Invalid(vec![Diagnostic {
-                    path: file.clone(),
-                    line,
-                    col,
-                    message: format!("[recognizer]: {msg}"),
-                }])
-            })?;
-    let problems = cfg.problems();
-    if problems.is_empty() {
-        return Ok(cfg);
-    }
-    Err(SpecError::Invalid(
-        problems
-            .into_iter()
-            .map(|p| {
-                let (line, col) = locate(Some(p.field));
-                Diagnostic {
-                    path: file.clone(),
-                    line,
-                    col,
-                    message: format!("[recognizer] {}: {}", p.field, p.problem),
-                }
-            })
-            .collect(),
-    ))
+    Ok(scn.recognizer.clone())
 }
 
 /// `base` with `levels` level configurations (thresholds unchanged).

@@ -10,6 +10,9 @@ use std::fmt;
 pub struct RecognizerConfig {
     /// Odometric travel between two observations, metres. Default 0.10.
     pub observation_spacing_m: f64,
+    /// Integrate every scan into the local grid, instead of one scan per observation step as the
+    /// authors' code does. Default false.
+    pub integrate_every_scan: bool,
     /// Side of a local grid cell, metres. Default 0.05.
     pub grid_cell_m: f64,
     /// Radius of the local grid around the robot, metres; cells farther away are forgotten.
@@ -46,6 +49,7 @@ impl Default for RecognizerConfig {
     fn default() -> Self {
         RecognizerConfig {
             observation_spacing_m: 0.10,
+            integrate_every_scan: false,
             grid_cell_m: 0.05,
             grid_radius_m: 3.0,
             kernel_radius_m: 2.5,

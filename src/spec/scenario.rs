@@ -46,6 +46,7 @@
 //! Every problem is reported as `file:line:col: what is wrong; what to try`.
 
 use crate::geom::Vec2;
+use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
 use crate::sim::odometry::{OdometryConfig, OdometryModel};
 use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
@@ -247,8 +248,8 @@ pub struct Scenario {
     pub laser: LaserConfig,
     pub odometry: OdometryConfig,
     pub robot: RobotConfig,
-    /// Recognizer settings, passed through for the recognizer to interpret.
-    pub recognizer: toml::Table,
+    /// Recognizer settings: the `[recognizer]` table over the defaults.
+    pub recognizer: RecognizerConfig,
     pub evaluation: EvaluationSpec,
     pub expect: ExpectSpec,
 }
@@ -730,6 +731,9 @@ pub fn parse_scenario(
         }
     }
 
+    // Recognizer settings: the table over the defaults; each problem at its key.
+    let recognizer = recognizer_settings(&spec.recognizer, src, &mut v);
+
     if !v.diags.is_empty() {
         return Err(SpecError::Invalid(v.diags));
     }
@@ -752,7 +756,7 @@ pub fn parse_scenario(
         laser,
         odometry,
         robot,
-        recognizer: spec.recognizer.clone(),
+        recognizer,
         evaluation: spec.evaluation.clone(),
         expect: spec.expect.clone(),
     })
@@ -827,6 +831,58 @@ impl Validator<'_> {
 
 /// Byte offset of a table header, for problems found after deserializing (start of file if
 /// absent).
+/// The `[recognizer]` table as settings; unknown keys (with "did you mean") and bad values are
+/// reported at the key's line.
+fn recognizer_settings(table: &toml::Table, src: &str, v: &mut Validator) -> RecognizerConfig {
+    let section = src.find("[recognizer]").unwrap_or(0);
+    let key_at = |key: &str| -> Range<usize> {
+        let at = src[section..]
+            .find(&format!("\n{key}"))
+            .map(|i| section + i + 1)
+            .unwrap_or(section);
+        at..at
+    };
+    let known: Vec<String> = match toml::Table::try_from(RecognizerConfig::default()) {
+        Ok(t) => t.keys().cloned().collect(),
+        Err(_) => Vec::new(),
+    };
+    let known_refs: Vec<&str> = known.iter().map(String::as_str).collect();
+    let mut unknown = false;
+    for key in table.keys() {
+        if !known.contains(key) {
+            unknown = true;
+            v.err(
+                key_at(key),
+                format!(
+                    "unknown key `{key}` in [recognizer]{}",
+                    hint(key, &known_refs, "keys")
+                ),
+            );
+        }
+    }
+    if unknown {
+        return RecognizerConfig::default();
+    }
+    match table.clone().try_into::<RecognizerConfig>() {
+        Ok(cfg) => {
+            for p in cfg.problems() {
+                v.err(
+                    key_at(p.field),
+                    format!("[recognizer] {}: {}", p.field, p.problem),
+                );
+            }
+            cfg
+        }
+        Err(e) => {
+            v.err(
+                key_at("[recognizer]"),
+                format!("[recognizer]: {}", serde_message(e.message())),
+            );
+            RecognizerConfig::default()
+        }
+    }
+}
+
 fn find_key(src: &str, header: &str) -> Range<usize> {
     let at = src.find(header).unwrap_or(0);
     at..at

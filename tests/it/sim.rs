@@ -74,6 +74,13 @@ fn scenario(world_toml: &str, scenario_toml: &str) -> Result<Scenario, SpecError
     )
 }
 
+/// A world built from its file without validation: for geometry the validator would refuse on
+/// purpose (a bare corridor without a route, a door that blocks the route).
+fn unchecked_world(src: &str) -> World {
+    let spec: placewords::spec::world::WorldSpec = toml::from_str(src).unwrap();
+    World::from_spec(&spec)
+}
+
 fn exact_laser(preset: LaserPreset) -> Laser {
     let cfg = LaserConfig {
         angle_error_rad: 0.0,
@@ -116,7 +123,7 @@ points_m = [[-20.0, -1.0], [20.0, -1.0]]
 /// Beams in a straight corridor (walls' faces at y = ±0.95) hit where trigonometry says.
 #[test]
 fn scan_in_a_known_corridor_matches_analytic_distances() {
-    let world = parse_world(CORRIDOR, "corridor").unwrap();
+    let world = unchecked_world(CORRIDOR);
     let caster = SweepCaster::for_world(&world, &DoorStates::all_closed(&world));
     let laser = exact_laser(LaserPreset::Lms200);
     let robot = Pose2::new(0.0, 0.2, 0.0);
@@ -186,7 +193,7 @@ fn opening_a_door_changes_only_the_beams_through_its_doorway() {
 /// A person in front of the laser shortens the beams that hit them.
 #[test]
 fn pedestrians_show_up_in_scans() {
-    let world = parse_world(CORRIDOR, "corridor").unwrap();
+    let world = unchecked_world(CORRIDOR);
     let caster = SweepCaster::for_world(&world, &DoorStates::all_closed(&world));
     let laser = exact_laser(LaserPreset::Lms200);
     let disc = Disc {
@@ -482,9 +489,10 @@ fn a_blocked_robot_ends_the_run_with_an_error_naming_the_place() {
     let world = format!(
         "{TINY_LOOP}\n[[doors]]\nid = \"gate\"\nhinge_m = [5.0, 0.0]\nwidth_m = 2.0\nclosed_heading_deg = 90.0\nopen_heading_deg = 0.0\n"
     );
-    let scn = scenario(
-        &world,
+    let scn = parse_scenario(
         "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 1\n[[runs]]\nlaps = 1\ndoors = \"all-closed\"\n",
+        Path::new("mem/test.toml"),
+        &move |_p: &Path| Ok(unchecked_world(&world)),
     )
     .unwrap();
     match simulate(&scn, None, &|| {}) {
@@ -666,7 +674,7 @@ cruise_speed_m_s = 0.5
 max_turn_rate_deg_s = 90
 [recognizer]
 levels = 3
-anything = { nested = true }
+min_word_size = 4
 [evaluation]
 tp_radius_m = 1.5
 [[expect.levels]]
@@ -701,7 +709,8 @@ min_precision = 0.9
             open_probability: 0.25
         }
     );
-    assert_eq!(scn.recognizer["levels"].as_integer(), Some(3));
+    assert_eq!(scn.recognizer.levels, 3);
+    assert_eq!(scn.recognizer.min_word_size, 4);
     assert_eq!(scn.evaluation.tp_radius_m, 1.5);
     assert_eq!(scn.expect.levels[0].min_precision, Some(0.9));
     // Door states per lap follow the plan.

@@ -21,13 +21,11 @@ fn check_world_file(path: &Path) -> Result<(), String> {
     load_world(path).map(|_| ()).map_err(|e| e.to_string())
 }
 
-/// Scenario files have no loader yet: until the scenario issue adds one, check their TOML
-/// syntax only. Replace the body with the scenario loader when it exists.
+/// Scenario files load with their world, runs, door configurations and recognizer settings.
 fn check_scenario_file(path: &Path) -> Result<(), String> {
-    let src = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
-    toml::from_str::<toml::Table>(&src)
+    placewords::spec::scenario::load_scenario(path)
         .map(|_| ())
-        .map_err(|e| format!("{}: {e}", path.display()))
+        .map_err(|e| e.to_string())
 }
 
 /// Each folder of authored files with the loader that checks its files. Extend here.
