@@ -21,8 +21,11 @@
 //! length). The result of an L-level run is the union of the matches with `levels` ≤ L.
 //!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
-//! d ∈ [−Δmax, Δmax] minimising the mean squared Ψ difference between current observation
-//! s₂ + i and past observation s₁ + i + d, i < min(S₁, S₂). Shifts whose whole window lies in
+//! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
+//! observations. The paper searches d ∈ (−Δmax, Δmax) from the words' starts; since matched
+//! words may differ in size by the size tolerance (25 %), we let the smaller word's window sit
+//! anywhere inside the larger word, plus ±Δmax beyond: with Δmax alone a long corridor word
+//! whose boundary moved by more than Δmax was paired up to metres off. Shifts whose whole window lies in
 //! the past word's run are preferred (near a run's start or end, those with the largest overlap);
 //! ties go to the smallest |d|. The aligned pairs whose travel differs by
 //! less than `min_gap_m` are dropped.
@@ -308,38 +311,52 @@ impl WordMatcher {
         let obs = self.words.observations();
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
-        let n = cw.size.min(pw.size) as i64;
+        let (sc, sp) = (cw.size as i64, pw.size as i64);
+        let n = sc.min(sp);
         let (s2, s1) = (cw.first_obs as i64, pw.first_obs as i64);
         let run = self.words.run_range(pw.run);
         let (lo, hi) = (run.start as i64, run.end as i64);
-        // For shift d, the i with s1 + i + d inside the past word's run.
-        let overlap = |d: i64| (lo - s1 - d).max(0)..(hi - s1 - d).min(n);
         let dmax = self.params.max_offset as i64;
-        // Shifts whose whole window exists come first (Eq. 2 sums over all n observations);
-        // near a run's ends, the shifts with the largest overlap.
-        let mut best: Option<(i64, f64, i64)> = None;
-        for m in 0..=2 * dmax {
-            let d = if m % 2 == 1 { (m + 1) / 2 } else { -(m / 2) };
-            let r = overlap(d);
+        // Offset k = past index − current index. The n-window of the smaller word may sit
+        // anywhere inside the larger one (sizes differ by up to the size tolerance), and ±Δmax
+        // beyond that: a = start in the current word, b = a + k start in the past word.
+        let window = |k: i64| -> (i64, i64, std::ops::Range<i64>) {
+            let a = (-k).clamp(0, sc - n);
+            let b = a + k;
+            // Keep the past window inside the past word's run.
+            let r = (lo - s1 - b).max(0)..(hi - s1 - b).min(n);
+            (a, b, r)
+        };
+        let (kmin, kmax) = (-(sc - n) - dmax, (sp - n) + dmax);
+        // Whole windows first (Eq. 2 sums over all n observations), then the least mean squared
+        // Ψ difference, then the smallest shift from the words' starts.
+        let mut best: Option<(i64, f64, i64, i64)> = None;
+        for k in kmin..=kmax {
+            let (a, b, r) = window(k);
             let count = r.end - r.start;
             if count <= 0 {
                 continue;
             }
-            let past = &psi[(s1 + d + r.start) as usize..(s1 + d + r.end) as usize];
-            let cur = &psi[(s2 + r.start) as usize..(s2 + r.end) as usize];
-            let sum = squared_error(past, cur);
-            let cost = sum / count as f64;
+            let past = &psi[(s1 + b + r.start) as usize..(s1 + b + r.end) as usize];
+            let cur = &psi[(s2 + a + r.start) as usize..(s2 + a + r.end) as usize];
+            let cost = squared_error(past, cur) / count as f64;
             let better = match best {
                 None => true,
-                Some((bc, bcost, _)) => count > bc || (count == bc && cost < bcost - 1e-15),
+                Some((bc, bcost, bk, _)) => {
+                    count > bc
+                        || (count == bc
+                            && (cost < bcost - 1e-15
+                                || ((cost - bcost).abs() <= 1e-15 && k.abs() < bk.abs())))
+                }
             };
             if better {
-                best = Some((count, cost, d));
+                best = Some((count, cost, k, 0));
             }
         }
-        let Some((_, _, d)) = best else { return };
-        for i in overlap(d) {
-            let (q, pst) = (&obs[(s2 + i) as usize], &obs[(s1 + i + d) as usize]);
+        let Some((_, _, k, _)) = best else { return };
+        let (a, b, r) = window(k);
+        for i in r {
+            let (q, pst) = (&obs[(s2 + a + i) as usize], &obs[(s1 + b + i) as usize]);
             if q.travel_m - pst.travel_m + 1e-9 < self.params.min_gap_m {
                 continue;
             }
