@@ -29,6 +29,8 @@ pub enum Purpose {
     LaserAngles = 4,
     /// Odometry noise.
     Odometry = 5,
+    /// The robot's sideways wander from the route in a lap.
+    PathWander = 6,
 }
 
 /// The stream for (seed, run, lap, purpose).

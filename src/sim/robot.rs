@@ -32,6 +32,10 @@ pub struct RobotConfig {
     pub blocked_timeout_s: f64,
     /// Simulation time step, seconds. Default 0.05.
     pub step_s: f64,
+    /// Largest sideways offset from the route the robot wanders by, metres: each lap it follows
+    /// the route shifted sideways by a smooth random function of arc length (a real robot does
+    /// not retrace its path to the millimetre). Default 0 (it follows the route exactly).
+    pub path_wander_m: f64,
 }
 
 impl Default for RobotConfig {
@@ -49,6 +53,7 @@ impl Default for RobotConfig {
             slow_distance_m: 1.2,
             blocked_timeout_s: 30.0,
             step_s: 0.05,
+            path_wander_m: 0.0,
         }
     }
 }
@@ -179,6 +184,47 @@ impl RouteTracker {
     }
 }
 
+/// A lap's sideways wander: offset(s) = amplitude · Σₖ aₖ sin(2π s / λₖ + φₖ) with Σ aₖ = 1,
+/// three components of wavelength 8-30 m, so |offset| ≤ amplitude and it varies smoothly.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Wander {
+    amplitude_m: f64,
+    waves: [(f64, f64, f64); 3],
+}
+
+impl Wander {
+    /// A wander of at most `amplitude_m`, drawn from `rng`.
+    pub fn draw(amplitude_m: f64, rng: &mut crate::sim::rng::SimRng) -> Self {
+        use rand::RngExt;
+        let mut waves = [(0.0, 1.0, 0.0); 3];
+        let mut total = 0.0;
+        for w in &mut waves {
+            let a: f64 = rng.random_range(0.2..1.0);
+            let lambda: f64 = rng.random_range(8.0..30.0);
+            let phase: f64 = rng.random_range(0.0..std::f64::consts::TAU);
+            *w = (a, lambda, phase);
+            total += a;
+        }
+        for w in &mut waves {
+            w.0 /= total;
+        }
+        Wander { amplitude_m, waves }
+    }
+
+    /// Sideways offset at arc length `s`, metres (positive to the left of the route).
+    pub fn offset_m(&self, s: f64) -> f64 {
+        if self.amplitude_m == 0.0 {
+            return 0.0;
+        }
+        self.amplitude_m
+            * self
+                .waves
+                .iter()
+                .map(|(a, l, ph)| a * (std::f64::consts::TAU * s / l + ph).sin())
+                .sum::<f64>()
+    }
+}
+
 /// The controller's state: current commanded speeds.
 #[derive(Clone, Debug, Default)]
 pub struct Controller {
@@ -194,10 +240,13 @@ impl Controller {
         cfg: &RobotConfig,
         pose: Pose2,
         tracker: &RouteTracker,
+        wander: &Wander,
         free_ahead_m: f64,
     ) -> (f64, f64) {
         let dt = cfg.step_s;
-        let (target, _) = tracker.point_at(tracker.arc_m() + cfg.lookahead_m);
+        let s = tracker.arc_m() + cfg.lookahead_m;
+        let (on_route, dir) = tracker.point_at(s);
+        let target = on_route + Vec2::new(-dir.y, dir.x) * wander.offset_m(s);
         let to = target - pose.position();
         let alpha = wrap_angle(to.y.atan2(to.x) - pose.theta);
         // Speed: cruise, less when the route bends away, and less near obstacles.

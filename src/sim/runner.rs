@@ -16,7 +16,7 @@ use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
-use crate::sim::robot::{Controller, RouteTracker, free_ahead, integrate, wheel_speeds};
+use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
 use crate::sim::{Frame, LapLog, RunLog};
 use crate::spec::scenario::{DoorPlan, Scenario};
 use crate::world::DoorStates;
@@ -113,6 +113,7 @@ pub struct RunSim<'a> {
     door_config: String,
     open_doors: Vec<String>,
     contact_steps: usize,
+    wander: Wander,
 }
 
 impl<'a> RunSim<'a> {
@@ -159,6 +160,7 @@ impl<'a> RunSim<'a> {
             door_config: "all-closed".into(),
             open_doors: Vec::new(),
             contact_steps: 0,
+            wander: Wander::default(),
         }
     }
 
@@ -181,6 +183,8 @@ impl<'a> RunSim<'a> {
         self.pedestrians = pedestrians::draw(&scn.pedestrians, &mut prng);
         self.laser_rng = stream(scn.seed, run, lap as u64, Purpose::LaserNoise);
         self.odom_rng = stream(scn.seed, run, lap as u64, Purpose::Odometry);
+        let mut wrng = stream(scn.seed, run, lap as u64, Purpose::PathWander);
+        self.wander = Wander::draw(scn.robot.path_wander_m, &mut wrng);
         self.lap = lap;
         self.lap_start_s = self.time_s;
         self.stall_mark = (self.tracker.progress_m(), self.time_s);
@@ -221,7 +225,7 @@ impl<'a> RunSim<'a> {
         let dt = cfg.step_s;
         let (v, w) = self
             .controller
-            .command(cfg, self.truth, &self.tracker, self.free_ahead_m);
+            .command(cfg, self.truth, &self.tracker, &self.wander, self.free_ahead_m);
         let (vl, vr) = wheel_speeds(v, w, cfg.axle_track_m);
         let next = integrate(self.truth, v, w, dt);
         self.odometry.update(vl * dt, vr * dt, &mut self.odom_rng);

@@ -35,7 +35,7 @@
 //!
 //! [robot]                               # cruise_speed_m_s, max_speed_m_s, max_turn_rate_deg_s,
 //!                                       # accel_m_s2, turn_accel_deg_s2, radius_m, axle_track_m,
-//!                                       # lookahead_m, stop_distance_m, slow_distance_m,
+//!                                       # lookahead_m, path_wander_m, stop_distance_m, slow_distance_m,
 //!                                       # blocked_timeout_s, step_s
 //! [recognizer]                          # any table, for the recognizer
 //! [evaluation]                          # crate::spec::evaluation::EvaluationSpec
@@ -192,6 +192,8 @@ pub struct RobotSpec {
     pub axle_track_m: Option<S<f64>>,
     #[serde(default)]
     pub lookahead_m: Option<S<f64>>,
+    #[serde(default)]
+    pub path_wander_m: Option<S<f64>>,
     #[serde(default)]
     pub stop_distance_m: Option<S<f64>>,
     #[serde(default)]
@@ -685,7 +687,16 @@ pub fn parse_scenario(
             d.blocked_timeout_s,
         ),
         step_s: v.positive("step_s", &r.step_s, d.step_s),
+        path_wander_m: v.non_negative("path_wander_m", &r.path_wander_m, d.path_wander_m),
     };
+    if robot.path_wander_m > 0.5
+        && let Some(w) = &r.path_wander_m
+    {
+        v.err(
+            w.span(),
+            "path_wander_m above 0.5 m takes the robot off 2 m corridors; use 0.1-0.3".into(),
+        );
+    }
     if robot.cruise_speed_m_s > robot.max_speed_m_s
         && let Some(c) = &r.cruise_speed_m_s
     {
