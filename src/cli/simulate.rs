@@ -48,7 +48,12 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     if args.svg {
         for r in &logs_ {
             let p = args.out.join(format!("run-{:03}.svg", r.run));
-            let svg = placewords::sim::picture::run_svg(&scn.world, r);
+            let title = format!("{}: run {}, true path and odometry", scn.name, r.run);
+            let svg = placewords::experiment::picture::trajectory_svg(
+                &scn.world,
+                std::slice::from_ref(r),
+                &title,
+            );
             placewords::io::atomic::write_atomic(&p, svg.as_bytes())
                 .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", p.display()))?;
             files.push(p);

@@ -2,6 +2,7 @@
 //! checked bound, `<failure>` for a missed bound, `<error>` for a scenario that could not run.
 //! The dialect is the common one Jenkins, GitLab and GitHub test reporters read.
 
+pub use super::xml::escape;
 use crate::eval::gate::Outcome;
 
 /// What `check` knows about one scenario.
@@ -15,27 +16,6 @@ pub struct Suite {
     pub error: Option<String>,
     /// Wall-clock seconds the scenario took.
     pub seconds: f64,
-}
-
-/// Escapes text for XML 1.0 attributes and character data. Characters XML 1.0 cannot carry
-/// (most control characters) become U+FFFD.
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            '\t' => out.push_str("&#9;"),
-            '\n' => out.push_str("&#10;"),
-            '\r' => out.push_str("&#13;"),
-            c if (c as u32) < 0x20 || c == '\u{FFFE}' || c == '\u{FFFF}' => out.push('\u{FFFD}'),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 /// The JUnit XML document of `suites`.

@@ -6,5 +6,6 @@ pub mod plot;
 pub mod svg;
 pub mod table;
 pub mod world_render;
+pub mod xml;
 
 pub use world_render::{LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg};

@@ -3,22 +3,7 @@
 
 use std::fmt::Write;
 
-/// Escapes text for SVG element content and attribute values.
-pub fn escape(s: &str) -> String {
-    let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&apos;"),
-            c if (c as u32) < 0x20 && c != '\n' && c != '\t' => out.push(' '),
-            c => out.push(c),
-        }
-    }
-    out
-}
+pub use super::xml::escape;
 
 /// Formats a pixel coordinate compactly (two decimals, no trailing zeros).
 pub fn num(x: f64) -> String {

@@ -8,7 +8,6 @@ pub mod laser;
 pub mod logs;
 pub mod odometry;
 pub mod pedestrians;
-pub mod picture;
 pub mod rng;
 pub mod robot;
 pub mod runner;

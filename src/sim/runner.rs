@@ -223,9 +223,13 @@ impl<'a> RunSim<'a> {
     pub fn step(&mut self) -> Result<Option<Frame>, SimError> {
         let cfg = &self.scn.robot;
         let dt = cfg.step_s;
-        let (v, w) = self
-            .controller
-            .command(cfg, self.truth, &self.tracker, &self.wander, self.free_ahead_m);
+        let (v, w) = self.controller.command(
+            cfg,
+            self.truth,
+            &self.tracker,
+            &self.wander,
+            self.free_ahead_m,
+        );
         let (vl, vr) = wheel_speeds(v, w, cfg.axle_track_m);
         let next = integrate(self.truth, v, w, dt);
         self.odometry.update(vl * dt, vr * dt, &mut self.odom_rng);
