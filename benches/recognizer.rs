@@ -82,7 +82,7 @@ fn front_end(c: &mut Criterion) {
             |mut fe| {
                 let mut n = 0;
                 for (o, s) in &inputs {
-                    n += fe.push(*o, s).is_some() as usize;
+                    n += fe.push(*o, s).len();
                 }
                 n
             },

@@ -49,10 +49,12 @@ impl Recognizer {
 
     /// Integrates one scan taken at `odom`; returns the matches that became known with it.
     pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
-        match self.front.push(odom, scan) {
-            Some(obs) => self.back.push_observation(&obs),
-            None => Vec::new(),
+        let observations = self.front.push(odom, scan);
+        let mut out = Vec::new();
+        for obs in &observations {
+            out.extend(self.back.push_observation(obs));
         }
+        out
     }
 
     /// Ends the current run and starts the next: the grid is cleared, the last word of the run

@@ -513,8 +513,33 @@ fn front_end_psi(layout: &BeamLayout) -> Vec<Observation> {
     let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
     corridor_inputs(layout)
         .iter()
-        .filter_map(|(o, s)| fe.push(*o, s))
+        .flat_map(|(o, s)| fe.push(*o, s))
         .collect()
+}
+
+/// Sparse scans (one every 0.5 m, as in the Intel log) still give an observation every 0.10 m,
+/// at poses along the path between them.
+#[test]
+fn sparse_scans_are_observed_every_spacing_along_the_path() {
+    let layout = synth::lms200();
+    let walls = synth::corridor_with_branch(30.0, 2.0, 15.0, 2.0);
+    let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+    let mut obs = Vec::new();
+    for i in 0..40 {
+        let pose = Pose2::new(i as f64 * 0.5, 0.0, 0.0);
+        obs.extend(fe.push(
+            OdomPose(pose),
+            &synth::scan_of(&walls, pose, &layout, i as f64),
+        ));
+    }
+    assert!(obs.len() >= 190, "{} observations over 19.5 m", obs.len());
+    for w in obs.windows(2) {
+        let dx = w[1].odom_pose.0.x - w[0].odom_pose.0.x;
+        assert!(
+            (dx - 0.1).abs() < 1e-6,
+            "observations 0.10 m apart, got {dx}"
+        );
+    }
 }
 
 /// The front end on analytic corridor scans: an observation every 0.10 m, low Ψ in the
@@ -619,14 +644,13 @@ fn odometry_jumps_and_odd_inputs() {
         0.0,
     );
     let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
-    assert!(fe.push(OdomPose(Pose2::IDENTITY), &scan).is_none());
+    assert!(fe.push(OdomPose(Pose2::IDENTITY), &scan).is_empty());
     let far = Pose2::new(1.0e7, -3.0e6, 1.0);
-    let o = fe
-        .push(OdomPose(far), &scan)
-        .expect("an observation after the jump");
-    assert!((0.0..=1.0).contains(&o.psi));
+    let after_jump = fe.push(OdomPose(far), &scan);
+    assert_eq!(after_jump.len(), 1, "one observation after a long jump");
+    assert!((0.0..=1.0).contains(&after_jump[0].psi));
     assert!(
-        fe.push(OdomPose(far), &scan).is_none(),
+        fe.push(OdomPose(far), &scan).is_empty(),
         "no travel, no observation"
     );
     let mut odd = scan.clone();
@@ -744,7 +768,7 @@ proptest! {
             pose = pose.compose(&Pose2::new(r.range(0.0, 0.1), 0.0, r.range(-0.2, 0.2)));
             let ranges_m = (0..layout.count).map(|_| r.range(0.0, 40.0)).collect();
             let scan = placewords::scan::Scan { layout: layout.clone(), ranges_m, time_s: i as f64 };
-            if let Some(o) = fe.push(OdomPose(pose), &scan) {
+            for o in fe.push(OdomPose(pose), &scan) {
                 prop_assert!((0.0..=1.0).contains(&o.psi));
             }
         }
