@@ -71,7 +71,7 @@ pub fn write_record(out: &mut String, rec: &LogRecord) {
         LogRecord::Laser(l) => {
             let _ = write!(out, "FLASER {}", l.ranges_m.len());
             for r in &l.ranges_m {
-                let _ = write!(out, " {r:.3}");
+                push_range(out, *r);
             }
             let _ = writeln!(
                 out,
@@ -104,6 +104,20 @@ pub fn write_record(out: &mut String, rec: &LogRecord) {
         LogRecord::Param { name, value } => {
             let _ = writeln!(out, "PARAM {name} {value}");
         }
+    }
+}
+
+/// Appends ` r` with three decimals. Ranges in millimetres are written as integers (the same
+/// text as `{:.3}`, several times faster: 40 laps make 250 MB of ranges).
+fn push_range(out: &mut String, r: f64) {
+    let mm = (r * 1000.0).round();
+    if mm.is_finite() && mm.abs() < 1e15 {
+        let mm = mm as i64;
+        let sign = if mm < 0 { "-" } else { "" };
+        let (whole, frac) = (mm.unsigned_abs() / 1000, mm.unsigned_abs() % 1000);
+        let _ = write!(out, " {sign}{whole}.{frac:03}");
+    } else {
+        let _ = write!(out, " {r:.3}");
     }
 }
 
@@ -596,6 +610,18 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn ranges_are_written_as_the_float_formatter_writes_them() {
+        for r in [0.0, 0.001, 0.5, 1.25, 7.999, 32.767, 81.92, 123.456, -1.5, 8.191] {
+            let mut fast = String::new();
+            super::push_range(&mut fast, r);
+            assert_eq!(fast, format!(" {r:.3}"), "range {r}");
+        }
+        let mut odd = String::new();
+        super::push_range(&mut odd, f64::NAN);
+        assert_eq!(odd, " NaN");
+    }
+
     use super::*;
 
     const SAMPLE: &str = "# comment\n\nPARAM robot_front_laser_max 50 1.0 host 1.0\n\
