@@ -6,7 +6,7 @@ use super::common::write_file;
 use clap::Args;
 use placewords::experiment::{self, ExperimentOptions};
 use placewords::report::json::TableReport;
-use placewords::report::table::{markdown_table_i, thresholds_note};
+use placewords::report::table::{markdown_table_i, markdown_visit_recall, thresholds_note};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -53,9 +53,10 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         reports.push(exp.report);
     }
     let md = format!(
-        "{}\n{}",
+        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized):\n\n{}",
         markdown_table_i(&reports),
-        thresholds_note(&reports)
+        thresholds_note(&reports),
+        markdown_visit_recall(&reports)
     );
     print!("{md}");
     write_file(&args.out.join("table.md"), md.as_bytes())?;

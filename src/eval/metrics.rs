@@ -60,6 +60,12 @@ pub struct Metrics {
     pub recall: f64,
     /// Like `recall`, counting an observation on either side of a correct pair.
     pub recall_either_side: f64,
+    /// Visit recall: over every observation with a revisit, the share of the earlier laps that
+    /// passed there (same direction, beyond the gap) it was correctly paired with. Unlike
+    /// `recall`, which one earlier lap in the same door state satisfies, this rewards matching
+    /// across door changes. Computed at `tp_radius_m` only (0 elsewhere).
+    #[serde(default)]
+    pub visit_recall: f64,
     /// Pairs naming an observation id the recognizer never reported (not scored).
     pub unresolved_pairs: usize,
 }
@@ -88,7 +94,8 @@ pub struct Evaluation {
 /// door configuration.
 pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
     let scorer = Scorer::new(&rec.observations, &rec.truth, spec);
-    let (main, door_configs) = scorer.score(&rec.matches, spec.tp_radius_m, true);
+    let (mut main, door_configs) = scorer.score(&rec.matches, spec.tp_radius_m, true);
+    main.visit_recall = scorer.visit_recall(&rec.matches, spec.tp_radius_m);
     let sensitivity = spec
         .sensitivity_radii_m
         .iter()
@@ -168,6 +175,8 @@ struct ObsTruth {
     travel_m: f64,
     /// Door configuration index.
     config: usize,
+    /// Global lap index (`GroundTruth::laps`).
+    lap: usize,
 }
 
 /// Observations joined with their truth, reusable across radii.
@@ -213,6 +222,7 @@ impl Scorer {
                     theta: f.pose.0.theta,
                     travel_m: o.travel_m,
                     config: lap_config[f.lap_slot],
+                    lap: f.lap_slot,
                 })
             })
             .collect();
@@ -264,6 +274,59 @@ impl Scorer {
             grid.entry((cx, cy)).or_default().push(i);
         }
         has
+    }
+
+    /// The visit recall of `matches` at radius `r` (see [`Metrics::visit_recall`]): earlier laps
+    /// an observation was correctly paired with ÷ earlier laps that revisit it.
+    pub fn visit_recall(&self, matches: &[Match], r: f64) -> f64 {
+        if r <= 0.0 || !r.is_finite() {
+            return 0.0;
+        }
+        let r2 = r * r;
+        // Laps each query observation was correctly paired with.
+        let mut matched: HashMap<usize, HashSet<usize>> = HashMap::new();
+        for p in matches.iter().flat_map(|m| &m.pairs) {
+            let (Some(&qi), Some(&pi)) = (self.index_of.get(&p.query), self.index_of.get(&p.past))
+            else {
+                continue;
+            };
+            if let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi])
+                && (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
+            {
+                matched.entry(qi).or_default().insert(pa.lap);
+            }
+        }
+        let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
+        let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+        let (mut visits, mut found) = (0usize, 0usize);
+        let mut laps: HashSet<usize> = HashSet::new();
+        for (i, o) in self.obs.iter().enumerate() {
+            let Some(o) = o else { continue };
+            let (cx, cy) = cell(o.x, o.y);
+            laps.clear();
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for &j in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
+                        let p = self.obs[j].expect("only observations with truth are inserted");
+                        if o.travel_m - p.travel_m < self.min_gap_m {
+                            break;
+                        }
+                        if (o.x - p.x).powi(2) + (o.y - p.y).powi(2) <= r2
+                            && crate::geom::wrap_angle(o.theta - p.theta).abs()
+                                <= self.heading_tol_rad
+                        {
+                            laps.insert(p.lap);
+                        }
+                    }
+                }
+            }
+            visits += laps.len();
+            if let Some(m) = matched.get(&i) {
+                found += laps.iter().filter(|l| m.contains(l)).count();
+            }
+            grid.entry((cx, cy)).or_default().push(i);
+        }
+        ratio(found, visits)
     }
 
     /// Scores `matches` at radius `r`; with `breakdown`, also per door configuration.
@@ -411,6 +474,7 @@ impl Counts {
             recalled: self.recalled,
             recall: ratio(self.recalled, self.revisits),
             recall_either_side: ratio(self.recalled_any, self.revisits),
+            visit_recall: 0.0,
             unresolved_pairs: self.unresolved,
         }
     }
@@ -528,6 +592,30 @@ pub(crate) mod tests {
         assert_eq!(m.recall, 1.0);
         assert_eq!(m.match_precision, 1.0);
         assert!(!m.no_pairs);
+    }
+
+    /// Visit recall counts earlier laps: pairing each observation with its nearest earlier
+    /// neighbour only (one lap) recalls every observation but not every visit; pairing it with
+    /// its neighbour in every earlier lap recalls every visit.
+    #[test]
+    fn visit_recall_counts_every_earlier_lap() {
+        let (obs, gt) = circle(4, 40.0);
+        let spec = EvaluationSpec::default();
+        let scorer = Scorer::new(&obs, &gt, &spec);
+        let nearest = vec![one_match(oracle(&obs, &gt, &spec))];
+        let m = scorer.score(&nearest, 1.0, false).0;
+        assert_eq!(m.recall, 1.0);
+        let one_lap = scorer.visit_recall(&nearest, 1.0);
+        assert!(one_lap > 0.4 && one_lap < 0.8, "nearest lap only: {one_lap}");
+        // Every earlier lap: the same arc position 400 observations (one 40 m lap) back.
+        let per_lap = 400;
+        let all: Vec<AlignedPair> = (0..obs.len())
+            .flat_map(|q| (1..=q / per_lap).map(move |k| (q, q - k * per_lap)))
+            .map(|(q, p)| pair(&obs, q, p))
+            .collect();
+        let every = scorer.visit_recall(&[one_match(all)], 1.0);
+        assert!(every > 0.97, "every earlier lap: {every}");
+        assert_eq!(scorer.visit_recall(&[], 1.0), 0.0);
     }
 
     #[test]

@@ -612,7 +612,9 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
 mod tests {
     #[test]
     fn ranges_are_written_as_the_float_formatter_writes_them() {
-        for r in [0.0, 0.001, 0.5, 1.25, 7.999, 32.767, 81.92, 123.456, -1.5, 8.191] {
+        for r in [
+            0.0, 0.001, 0.5, 1.25, 7.999, 32.767, 81.92, 123.456, -1.5, 8.191,
+        ] {
             let mut fast = String::new();
             super::push_range(&mut fast, r);
             assert_eq!(fast, format!(" {r:.3}"), "range {r}");

@@ -39,6 +39,10 @@ pub struct Scores {
     pub correct_matches: usize,
     pub revisits: usize,
     pub recall_either_side: f64,
+    /// Share of (observation, earlier lap through the same spot) pairs recognized: rewards
+    /// matching across door changes (see `eval::metrics::Metrics::visit_recall`).
+    #[serde(default)]
+    pub visit_recall: f64,
     pub recognize_seconds_per_lap: f64,
     /// Scores at each sensitivity radius.
     pub sensitivity: Vec<Metrics>,
@@ -61,6 +65,7 @@ impl Scores {
             correct_matches: m.correct_matches,
             revisits: m.revisits,
             recall_either_side: m.recall_either_side,
+            visit_recall: m.visit_recall,
             recognize_seconds_per_lap,
             sensitivity: e.sensitivity.clone(),
             door_configs: e.door_configs.clone(),

@@ -76,6 +76,7 @@ pub fn text_table(report: &Report) -> String {
                 label,
                 fmt_p(s),
                 format!("{:.3}", s.recall),
+                format!("{:.3}", s.visit_recall),
                 format!("{:.3}", s.match_precision),
                 s.pairs.to_string(),
                 s.matches.to_string(),
@@ -89,6 +90,7 @@ pub fn text_table(report: &Report) -> String {
             "levels [τ]",
             "precision",
             "recall",
+            "visit R",
             "match P",
             "pairs",
             "matches",
@@ -172,6 +174,45 @@ pub fn markdown_table_i(reports: &[Report]) -> String {
         None => " – | – |".to_string(),
     };
     for lv in &level_rows {
+        let _ = write!(out, "| {lv} |");
+        for r in reports {
+            out.push_str(&cell(r.level(*lv).map(|l| &l.scores)));
+        }
+        out.push('\n');
+    }
+    if reports.iter().any(|r| r.icp.is_some()) {
+        out.push_str("| ICP |");
+        for r in reports {
+            out.push_str(&cell(r.icp.as_ref().map(|i| &i.scores)));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Precision – visit recall per level row and scenario (the companion of Table I that rewards
+/// matching across door changes), in Markdown.
+pub fn markdown_visit_recall(reports: &[Report]) -> String {
+    let mut out = String::from("| levels |");
+    for r in reports {
+        let _ = write!(out, " {} P – visit R |", r.scenario);
+    }
+    out.push_str("\n|---|");
+    for _ in reports {
+        out.push_str("---|");
+    }
+    out.push('\n');
+    let mut rows: Vec<usize> = reports
+        .iter()
+        .flat_map(|r| r.levels.iter().map(|l| l.levels))
+        .collect();
+    rows.sort_unstable();
+    rows.dedup();
+    let cell = |s: Option<&Scores>| match s {
+        Some(s) => format!(" {:.3} – {:.3} |", s.precision, s.visit_recall),
+        None => " – |".to_string(),
+    };
+    for lv in &rows {
         let _ = write!(out, "| {lv} |");
         for r in reports {
             out.push_str(&cell(r.level(*lv).map(|l| &l.scores)));
