@@ -606,7 +606,10 @@ pub(crate) mod tests {
         let m = scorer.score(&nearest, 1.0, false).0;
         assert_eq!(m.recall, 1.0);
         let one_lap = scorer.visit_recall(&nearest, 1.0);
-        assert!(one_lap > 0.4 && one_lap < 0.8, "nearest lap only: {one_lap}");
+        assert!(
+            one_lap > 0.4 && one_lap < 0.8,
+            "nearest lap only: {one_lap}"
+        );
         // Every earlier lap: the same arc position 400 observations (one 40 m lap) back.
         let per_lap = 400;
         let all: Vec<AlignedPair> = (0..obs.len())
