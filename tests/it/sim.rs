@@ -720,3 +720,45 @@ min_precision = 0.9
         ("north", &[false, true][..])
     );
 }
+
+/// The logs `simulate` writes load back through the CARMEN reader: one FLASER of 181 ranges per
+/// frame, odometry poses as written, and TRUEPOS lines on the route.
+#[test]
+fn simulated_logs_read_back_through_the_carmen_reader() {
+    use placewords::io::carmen::{LogRecord, ReadOptions, read_log};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scn = load_scenario(&root.join("scenarios/smoke.toml")).unwrap();
+    let runs = simulate(&scn, Some(1), &|| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let files = placewords::sim::logs::write_logs(&scn, &runs, Some(1), dir.path()).unwrap();
+    let log = files
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == "log"))
+        .expect("a log file");
+    let read = read_log(log, ReadOptions { lenient: false }).unwrap();
+    let lasers: Vec<_> = read
+        .records
+        .iter()
+        .filter_map(|r| match r {
+            LogRecord::Laser(l) => Some(l),
+            _ => None,
+        })
+        .collect();
+    let frames: Vec<_> = runs[0].frames().collect();
+    assert_eq!(lasers.len(), frames.len());
+    for (l, f) in lasers.iter().zip(&frames) {
+        assert_eq!(l.ranges_m.len(), 181);
+        assert!((l.odom.x - f.odom.0.x).abs() < 1e-5 && (l.odom.y - f.odom.0.y).abs() < 1e-5);
+    }
+    let route = &scn.route;
+    for r in &read.records {
+        if let LogRecord::TruePos(t) = r {
+            let d = route
+                .legs()
+                .iter()
+                .map(|s| s.distance_to_point(t.truth.position()))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 0.6, "true pose {:?} is {d:.2} m off the route", t.truth);
+        }
+    }
+}
