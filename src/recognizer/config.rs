@@ -36,7 +36,8 @@ pub struct RecognizerConfig {
     /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3.
     pub levels: usize,
     /// Minimum n-gram size (words) per level configuration: index k applies to configuration
-    /// k + 1. Needs at least `levels` entries. Default [6, 9, 12, 15].
+    /// k + 1. Needs at least `levels` entries; 0 and 1 both accept every matching word pair (the
+    /// paper's Fig. 8 sweeps from 0). Default [6, 9, 12, 15].
     pub min_ngram: Vec<usize>,
     /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
     pub max_alignment_offset: usize,
@@ -208,15 +209,11 @@ impl RecognizerConfig {
                     self.levels
                 ),
             );
-        } else if self
-            .min_ngram
-            .iter()
-            .take(self.levels)
-            .any(|&n| n == 0 || n > 10_000)
-        {
+        } else if self.min_ngram.iter().take(self.levels).any(|&n| n > 10_000) {
             bad(
                 "min_ngram",
-                "every size must be between 1 and 10000 words".to_string(),
+                "every size must be between 0 and 10000 words (0 and 1 both accept any chain)"
+                    .to_string(),
             );
         }
         if !(self.min_gap_m.is_finite() && self.min_gap_m >= 0.0) {

@@ -76,7 +76,7 @@ impl WordMatcher {
         config.validate()?;
         let mut min_ngram = [usize::MAX; MAX_LEVELS];
         for (k, m) in min_ngram.iter_mut().enumerate().take(config.levels) {
-            *m = config.min_ngram[k];
+            *m = config.min_ngram[k].max(1);
         }
         Ok(WordMatcher {
             params: Params {

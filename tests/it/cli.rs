@@ -194,3 +194,22 @@ fn a_missing_scenario_is_a_located_error_with_exit_2() {
         "{err}"
     );
 }
+
+/// `sweep` runs the whole Fig. 8 grid (τ from 0) and writes the curves as JSON and SVG.
+#[test]
+fn sweep_writes_the_fig8_curves() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = placewords(&[
+        "sweep",
+        "scenarios/smoke.toml",
+        "-q",
+        "-o",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let r = report_of(&dir.path().join("sweep.json"));
+    assert_eq!(r["results"].as_array().unwrap().len(), 10 + 7 * 19);
+    assert_eq!(r["curves"].as_array().unwrap().len(), 1 + 7);
+    let svg = std::fs::read_to_string(dir.path().join("pr-curves.svg")).unwrap();
+    assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"));
+}
