@@ -26,3 +26,40 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     placewords::io::atomic::write_atomic(path, bytes)
         .with_context(|| format!("{}: cannot write", path.display()))
 }
+
+/// Prints the experiment's table, then writes its JSON report and pictures where asked: the
+/// true and odometry paths, and the matched pairs of each level configuration (and ICP).
+pub fn print_and_write(
+    exp: &placewords::experiment::Experiment,
+    world: &placewords::world::World,
+    radius_m: f64,
+    report: Option<&Path>,
+    svg_dir: Option<&Path>,
+) -> anyhow::Result<()> {
+    use placewords::experiment::picture;
+    print!("{}", placewords::report::table::text_table(&exp.report));
+    if let Some(path) = report {
+        write_file(path, exp.report.to_json().as_bytes())?;
+        eprintln!("report: {}", path.display());
+    }
+    let Some(dir) = svg_dir else { return Ok(()) };
+    let name = &exp.report.scenario;
+    let paths = picture::trajectory_svg(world, &exp.runs, &format!("{name}: paths"));
+    write_file(&dir.join("trajectory.svg"), paths.as_bytes())?;
+    let recognitions = exp
+        .recognitions
+        .iter()
+        .map(|(levels, rec)| (format!("{levels} level(s)"), format!("levels{levels}"), rec))
+        .chain(
+            exp.icp
+                .iter()
+                .map(|rec| ("ICP".to_string(), "icp".to_string(), rec)),
+        );
+    for (what, file, rec) in recognitions {
+        let title = format!("{name}: matched pairs, {what}");
+        let svg = picture::matches_svg(world, &exp.runs, rec, radius_m, &title);
+        write_file(&dir.join(format!("matches-{file}.svg")), svg.as_bytes())?;
+    }
+    eprintln!("pictures: {}", dir.display());
+    Ok(())
+}

@@ -1,7 +1,7 @@
 //! `placewords recognize LOG`: the recognizer and evaluation on a real CARMEN log, with the same
 //! definitions and report schema as `run`.
 
-use super::common::{LevelsArg, write_file};
+use super::common::{LevelsArg, print_and_write};
 use anyhow::bail;
 use clap::{Args, ValueEnum};
 use placewords::experiment::{self, ExperimentOptions, picture};
@@ -154,26 +154,13 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         quiet: args.quiet,
     };
     let exp = experiment::evaluate_runs(&name, args.seed, vec![run], &base, &evaluation, &opts)?;
-    print!("{}", placewords::report::table::text_table(&exp.report));
-    if let Some(path) = &args.report {
-        write_file(path, exp.report.to_json().as_bytes())?;
-        eprintln!("report: {}", path.display());
-    }
-    if let Some(dir) = &args.svg {
-        let world = picture::empty_world(&exp.runs, &name);
-        write_file(
-            &dir.join("trajectory.svg"),
-            picture::trajectory_svg(&world, &exp.runs, &format!("{name}: paths")).as_bytes(),
-        )?;
-        for (levels, rec) in &exp.recognitions {
-            let title = format!("{name}: matched pairs, {levels} level(s)");
-            let svg = picture::matches_svg(&world, &exp.runs, rec, args.tp_radius_m, &title);
-            write_file(
-                &dir.join(format!("matches-levels{levels}.svg")),
-                svg.as_bytes(),
-            )?;
-        }
-        eprintln!("pictures: {}", dir.display());
-    }
+    let world = picture::empty_world(&exp.runs, &name);
+    print_and_write(
+        &exp,
+        &world,
+        args.tp_radius_m,
+        args.report.as_deref(),
+        args.svg.as_deref(),
+    )?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,8 +1,8 @@
 //! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report.
 
-use super::common::{LevelsArg, write_file};
+use super::common::{LevelsArg, print_and_write};
 use clap::Args;
-use placewords::experiment::{self, ExperimentOptions, picture};
+use placewords::experiment::{self, ExperimentOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -39,32 +39,12 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         quiet: args.quiet,
     };
     let exp = experiment::run_scenario(&scn, &opts)?;
-    print!("{}", placewords::report::table::text_table(&exp.report));
-    if let Some(path) = &args.report {
-        write_file(path, exp.report.to_json().as_bytes())?;
-        eprintln!("report: {}", path.display());
-    }
-    if let Some(dir) = &args.svg {
-        let radius = scn.evaluation.tp_radius_m;
-        write_file(
-            &dir.join("trajectory.svg"),
-            picture::trajectory_svg(&scn.world, &exp.runs, &format!("{}: paths", scn.name))
-                .as_bytes(),
-        )?;
-        for (levels, rec) in &exp.recognitions {
-            let title = format!("{}: matched pairs, {levels} level(s)", scn.name);
-            let svg = picture::matches_svg(&scn.world, &exp.runs, rec, radius, &title);
-            write_file(
-                &dir.join(format!("matches-levels{levels}.svg")),
-                svg.as_bytes(),
-            )?;
-        }
-        if let Some(rec) = &exp.icp {
-            let title = format!("{}: matched pairs, ICP", scn.name);
-            let svg = picture::matches_svg(&scn.world, &exp.runs, rec, radius, &title);
-            write_file(&dir.join("matches-icp.svg"), svg.as_bytes())?;
-        }
-        eprintln!("pictures: {}", dir.display());
-    }
+    print_and_write(
+        &exp,
+        &scn.world,
+        scn.evaluation.tp_radius_m,
+        args.report.as_deref(),
+        args.svg.as_deref(),
+    )?;
     Ok(ExitCode::SUCCESS)
 }

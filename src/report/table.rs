@@ -151,80 +151,61 @@ fn fmt_p(s: &Scores) -> String {
 /// The paper's Table I for several scenarios, in Markdown: rows 1, 2 and 3 levels and ICP
 /// (those present in any report), per scenario a "P – R" column and an "s/lap" column.
 pub fn markdown_table_i(reports: &[Report]) -> String {
-    let mut level_rows: Vec<usize> = reports
-        .iter()
-        .flat_map(|r| r.levels.iter().map(|l| l.levels))
-        .collect();
-    level_rows.sort_unstable();
-    level_rows.dedup();
-    let mut out = String::from("| levels |");
-    for r in reports {
-        let _ = write!(out, " {} P – R | {} s/lap |", r.scenario, r.scenario);
-    }
-    out.push_str("\n|---|");
-    for _ in reports {
-        out.push_str("---|---|");
-    }
-    out.push('\n');
-    let cell = |s: Option<&Scores>| match s {
-        Some(s) => format!(
-            " {:.3} – {:.3} | {:.2} |",
-            s.precision, s.recall, s.recognize_seconds_per_lap
-        ),
-        None => " – | – |".to_string(),
-    };
-    for lv in &level_rows {
-        let _ = write!(out, "| {lv} |");
-        for r in reports {
-            out.push_str(&cell(r.level(*lv).map(|l| &l.scores)));
-        }
-        out.push('\n');
-    }
-    if reports.iter().any(|r| r.icp.is_some()) {
-        out.push_str("| ICP |");
-        for r in reports {
-            out.push_str(&cell(r.icp.as_ref().map(|i| &i.scores)));
-        }
-        out.push('\n');
-    }
-    out
+    markdown_by_level(reports, &["P – R", "s/lap"], |s| {
+        vec![
+            format!("{:.3} – {:.3}", s.precision, s.recall),
+            format!("{:.2}", s.recognize_seconds_per_lap),
+        ]
+    })
 }
 
 /// Precision – visit recall per level row and scenario (the companion of Table I that rewards
 /// matching across door changes), in Markdown.
 pub fn markdown_visit_recall(reports: &[Report]) -> String {
-    let mut out = String::from("| levels |");
-    for r in reports {
-        let _ = write!(out, " {} P – visit R |", r.scenario);
-    }
-    out.push_str("\n|---|");
-    for _ in reports {
-        out.push_str("---|");
-    }
-    out.push('\n');
+    markdown_by_level(reports, &["P – visit R"], |s| {
+        vec![format!("{:.3} – {:.3}", s.precision, s.visit_recall)]
+    })
+}
+
+/// A Markdown table with a row per level configuration (and ICP when any report has it) and,
+/// per scenario, one column per entry of `columns`, filled by `cells`.
+fn markdown_by_level(
+    reports: &[Report],
+    columns: &[&str],
+    cells: impl Fn(&Scores) -> Vec<String>,
+) -> String {
     let mut rows: Vec<usize> = reports
         .iter()
         .flat_map(|r| r.levels.iter().map(|l| l.levels))
         .collect();
     rows.sort_unstable();
     rows.dedup();
-    let cell = |s: Option<&Scores>| match s {
-        Some(s) => format!(" {:.3} – {:.3} |", s.precision, s.visit_recall),
-        None => " – |".to_string(),
-    };
-    for lv in &rows {
-        let _ = write!(out, "| {lv} |");
+    let mut out = String::from("| levels |");
+    for r in reports {
+        for c in columns {
+            let _ = write!(out, " {} {c} |", r.scenario);
+        }
+    }
+    out.push_str("\n|---|");
+    out.push_str(&"---|".repeat(reports.len() * columns.len()));
+    out.push('\n');
+    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<&Scores>| {
+        let _ = write!(out, "| {label} |");
         for r in reports {
-            out.push_str(&cell(r.level(*lv).map(|l| &l.scores)));
+            match scores(r) {
+                Some(s) => cells(s).iter().for_each(|c| {
+                    let _ = write!(out, " {c} |");
+                }),
+                None => out.push_str(&" – |".repeat(columns.len())),
+            }
         }
         out.push('\n');
+    };
+    for lv in rows {
+        line(lv.to_string(), &|r| r.level(lv).map(|l| &l.scores));
     }
     if reports.iter().any(|r| r.icp.is_some()) {
-        out.push_str("| ICP |");
-        for r in reports {
-            out.push_str(&cell(r.icp.as_ref().map(|i| &i.scores)));
-        }
-        out.push('\n');
+        line("ICP".into(), &|r| r.icp.as_ref().map(|i| &i.scores));
     }
     out
 }
