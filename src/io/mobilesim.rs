@@ -95,6 +95,29 @@ pub struct MobileSimMap {
     pub home: Option<(f64, f64, f64)>,
 }
 
+/// The first N tokens of a line as finite numbers. A missing one is reported at the line's end
+/// with `missing(what)`, a bad one at its column with `bad(what, text)`.
+fn numbers<const N: usize>(
+    (name, line_no, raw): (&str, usize, &str),
+    toks: &[(usize, &str)],
+    names: [&str; N],
+    missing: impl Fn(&str) -> String,
+    bad: impl Fn(&str, &str) -> String,
+) -> Result<[f64; N], MapError> {
+    let mut v = [0.0; N];
+    for (k, what) in names.iter().enumerate() {
+        let Some(&(c, s)) = toks.get(k) else {
+            let end = raw.trim_end().chars().count() + 1;
+            return Err(malformed(name, line_no, end, missing(what)));
+        };
+        v[k] = match s.parse::<f64>() {
+            Ok(x) if x.is_finite() => x,
+            _ => return Err(malformed(name, line_no, c, bad(what, s))),
+        };
+    }
+    Ok(v)
+}
+
 fn malformed(path: &str, line: usize, col: usize, message: impl Into<String>) -> MapError {
     MapError::Malformed {
         path: path.to_string(),
@@ -173,32 +196,21 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
             Section::Data => {}
             Section::Header => {
                 if first == "Cairn:" && toks.get(1).map(|t| t.1) == Some("RobotHome") {
-                    let mut v = [0.0; 3];
-                    for (k, what) in ["x (mm)", "y (mm)", "heading (degrees)"].iter().enumerate() {
-                        let Some(&(c, s)) = toks.get(2 + k) else {
-                            return Err(malformed(
-                                name,
-                                line_no,
-                                raw.trim_end().chars().count() + 1,
-                                format!(
-                                    "RobotHome cairn ends before its {what}; write `Cairn: RobotHome x y heading \"\" ICON \"\"`"
-                                ),
-                            ));
-                        };
-                        v[k] = match s.parse::<f64>() {
-                            Ok(x) if x.is_finite() => x,
-                            _ => {
-                                return Err(malformed(
-                                    name,
-                                    line_no,
-                                    c,
-                                    format!(
-                                        "RobotHome {what} is `{s}`, not a number; write `Cairn: RobotHome x y heading …`"
-                                    ),
-                                ));
-                            }
-                        };
-                    }
+                    let v: [f64; 3] = numbers(
+                        (name, line_no, raw),
+                        &toks[2..],
+                        ["x (mm)", "y (mm)", "heading (degrees)"],
+                        |what| {
+                            format!(
+                                "RobotHome cairn ends before its {what}; write `Cairn: RobotHome x y heading \"\" ICON \"\"`"
+                            )
+                        },
+                        |what, s| {
+                            format!(
+                                "RobotHome {what} is `{s}`, not a number; write `Cairn: RobotHome x y heading …`"
+                            )
+                        },
+                    )?;
                     if home.is_none() {
                         home = Some((v[0] / 1000.0, v[1] / 1000.0, v[2]));
                     }
@@ -206,32 +218,21 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                 // Other header lines (Resolution, LineMinPos, NumLines, other cairns…) are not needed.
             }
             Section::Lines => {
-                let mut v = [0.0; 4];
-                for (k, what) in ["x1", "y1", "x2", "y2"].iter().enumerate() {
-                    let Some(&(c, s)) = toks.get(k) else {
-                        return Err(malformed(
-                            name,
-                            line_no,
-                            raw.trim_end().chars().count() + 1,
-                            format!(
-                                "line segment ends before its {what}; each line after LINES is `x1 y1 x2 y2` in millimetres"
-                            ),
-                        ));
-                    };
-                    v[k] = match s.parse::<f64>() {
-                        Ok(x) if x.is_finite() => x,
-                        _ => {
-                            return Err(malformed(
-                                name,
-                                line_no,
-                                c,
-                                format!(
-                                    "segment {what} is `{s}`, not a number; each line after LINES is `x1 y1 x2 y2` in millimetres"
-                                ),
-                            ));
-                        }
-                    };
-                }
+                let v: [f64; 4] = numbers(
+                    (name, line_no, raw),
+                    &toks,
+                    ["x1", "y1", "x2", "y2"],
+                    |what| {
+                        format!(
+                            "line segment ends before its {what}; each line after LINES is `x1 y1 x2 y2` in millimetres"
+                        )
+                    },
+                    |what, s| {
+                        format!(
+                            "segment {what} is `{s}`, not a number; each line after LINES is `x1 y1 x2 y2` in millimetres"
+                        )
+                    },
+                )?;
                 if let Some(&(c, s)) = toks.get(4) {
                     return Err(malformed(
                         name,

@@ -693,74 +693,27 @@ fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<Worl
         ok = false;
     }
 
-    let mut walls = Vec::new();
-    for (i, (at, t)) in wall_tables.into_iter().enumerate() {
-        let mut l = WallLoc {
-            table: at,
+    let (walls, wall_locs) = read_entries(wall_tables, d, &mut ok, read_wall, |table| WallLoc {
+        table,
+        ..Default::default()
+    })?;
+    let (doors, door_locs) = read_entries(door_tables, d, &mut ok, read_door, |table| DoorLoc {
+        table,
+        ..Default::default()
+    })?;
+    let (routes, route_locs) =
+        read_entries(route_tables, d, &mut ok, read_route, |table| RouteLoc {
+            table,
             ..Default::default()
-        };
-        match read_wall(t, at, i, d, &mut l) {
-            Some(w) => {
-                walls.push(w);
-                loc.walls.push(l);
-            }
-            None => ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
-    let mut doors = Vec::new();
-    for (i, (at, t)) in door_tables.into_iter().enumerate() {
-        let mut l = DoorLoc {
-            table: at,
-            ..Default::default()
-        };
-        match read_door(t, at, i, d, &mut l) {
-            Some(x) => {
-                doors.push(x);
-                loc.doors.push(l);
-            }
-            None => ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
-    let mut routes = Vec::new();
-    for (i, (at, t)) in route_tables.into_iter().enumerate() {
-        let mut l = RouteLoc {
-            table: at,
-            ..Default::default()
-        };
-        match read_route(t, at, i, d, &mut l) {
-            Some(x) => {
-                routes.push(x);
-                loc.routes.push(l);
-            }
-            None => ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
-    let mut areas = Vec::new();
-    for (i, (at, t)) in area_tables.into_iter().enumerate() {
-        let mut l = AreaLoc {
-            table: at,
-            ..Default::default()
-        };
-        match read_area(t, at, i, d, &mut l) {
-            Some(x) => {
-                areas.push(x);
-                loc.areas.push(l);
-            }
-            None => ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
+        })?;
+    let (areas, area_locs) = read_entries(area_tables, d, &mut ok, read_area, |table| AreaLoc {
+        table,
+        ..Default::default()
+    })?;
+    loc.walls.extend(wall_locs);
+    loc.doors.extend(door_locs);
+    loc.routes.extend(route_locs);
+    loc.areas.extend(area_locs);
 
     let spec = WorldSpec {
         format_version,
@@ -964,6 +917,33 @@ fn req_points(
             points(v, key, ctx, d, spans)
         }
     }
+}
+
+/// Reads every table of an array of entries (walls, doors, ...) with `read`, keeping the
+/// locations of those that read cleanly; `ok` turns false when one does not. `None` when the
+/// problem list is full.
+fn read_entries<T, L>(
+    tables: Vec<(usize, &DeTable<'_>)>,
+    d: &mut Diags,
+    ok: &mut bool,
+    read: fn(&DeTable<'_>, usize, usize, &mut Diags, &mut L) -> Option<T>,
+    new_loc: impl Fn(usize) -> L,
+) -> Option<(Vec<T>, Vec<L>)> {
+    let (mut items, mut locs) = (Vec::new(), Vec::new());
+    for (i, (at, t)) in tables.into_iter().enumerate() {
+        let mut l = new_loc(at);
+        match read(t, at, i, d, &mut l) {
+            Some(x) => {
+                items.push(x);
+                locs.push(l);
+            }
+            None => *ok = false,
+        }
+        if d.is_full() {
+            return None;
+        }
+    }
+    Some((items, locs))
 }
 
 fn read_wall(
