@@ -6,7 +6,7 @@
 //! ("not in the report"). Exit decision: 0 when every outcome passes, 1 when any missed (2, an
 //! error, is the CLI's business).
 
-use crate::report::json::{Report, Scores};
+use crate::eval::scores::{Report, Scores};
 use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
@@ -154,7 +154,7 @@ pub fn exit_code(outcomes: &[Outcome]) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
     use crate::spec::evaluation::LevelExpectation;
 
     fn expect(levels: usize, p: f64, r: f64, s: Option<f64>) -> LevelExpectation {

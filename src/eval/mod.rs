@@ -4,10 +4,12 @@
 //! [`PlaceRecognizer`] in order, keeping the ground truth of every frame to itself
 //! ([`GroundTruth`]); [`metrics::evaluate`] turns the recognizer's matches into observation pairs
 //! and scores them (DESIGN.md §6); [`sweep`] repeats this over a grid of thresholds;
+//! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
 pub mod gate;
 pub mod metrics;
+pub mod scores;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};

@@ -3,10 +3,10 @@
 
 use placewords::baseline::{IcpConfig, IcpRecognizer};
 use placewords::eval::gate::{check, exit_code};
+use placewords::eval::scores::Report;
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
 use placewords::recognizer::{AlignedPair, Match, Observation};
-use placewords::report::json::Report;
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
 use placewords::sim::{Frame, LapLog, RunLog};
