@@ -11,6 +11,7 @@ pub mod eval;
 pub mod experiment;
 pub mod geom;
 pub mod io;
+pub mod log;
 pub mod recognizer;
 pub mod report;
 pub mod scan;

@@ -13,9 +13,9 @@ pub mod scores;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};
+use crate::log::RunLog;
 use crate::recognizer::{Match, Observation};
 use crate::scan::Scan;
-use crate::sim::RunLog;
 use std::time::Instant;
 
 pub use metrics::{Metrics, evaluate};
