@@ -12,6 +12,7 @@ pub mod experiment;
 pub mod geom;
 pub mod io;
 pub mod log;
+pub mod place;
 pub mod recognizer;
 pub mod report;
 pub mod scan;

@@ -29,8 +29,8 @@
 //! Region pairs are tested in parallel (rayon) when `parallel` is set; results are collected in
 //! order, so the output does not depend on the thread count. Times are wall clock.
 
-use crate::eval::PlaceRecognizer;
 use crate::geom::{OdomPose, Pose2, Vec2};
+use crate::place::PlaceRecognizer;
 use crate::recognizer::{AlignedPair, Match, Observation};
 use crate::scan::Scan;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
