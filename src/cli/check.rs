@@ -56,7 +56,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         match outcome {
             Ok(outcomes) => {
                 for o in &outcomes {
-                    println!("{}", o.line());
+                    outln!("{}", o.line())?;
                 }
                 missed += outcomes.iter().filter(|o| !o.passed).count();
                 suites.push(Suite {
@@ -69,7 +69,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             Err(e) => {
                 errors += 1;
                 eprintln!("error: {e:#}");
-                println!("ERROR {name}");
+                outln!("ERROR {name}")?;
                 suites.push(Suite {
                     scenario: name,
                     outcomes: Vec::new(),

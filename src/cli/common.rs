@@ -37,7 +37,7 @@ pub fn print_and_write(
     svg_dir: Option<&Path>,
 ) -> anyhow::Result<()> {
     use placewords::experiment::picture;
-    print!("{}", placewords::report::table::text_table(&exp.report));
+    out!("{}", placewords::report::table::text_table(&exp.report))?;
     if let Some(path) = report {
         write_file(
             path,

@@ -39,7 +39,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let laps = runs.iter().map(|r| r.laps.len()).sum();
     let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
     let report = SweepReport::new(&scn.name, scn.seed, laps, scn.evaluation.clone(), results);
-    print!("{}", curves_table(&report.curves));
+    out!("{}", curves_table(&report.curves))?;
     write_file(
         &args.out.join("sweep.json"),
         placewords::report::json::to_json(&report).as_bytes(),

@@ -58,7 +58,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         thresholds_note(&reports),
         markdown_visit_recall(&reports)
     );
-    print!("{md}");
+    out!("{md}")?;
     write_file(&args.out.join("table.md"), md.as_bytes())?;
     let json = placewords::report::json::to_json(&TableReport { reports });
     write_file(&args.out.join("table.json"), json.as_bytes())?;

@@ -213,3 +213,39 @@ fn sweep_writes_the_fig8_curves() {
     let svg = std::fs::read_to_string(dir.path().join("pr-curves.svg")).unwrap();
     assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"));
 }
+
+/// `placewords COMMAND | head`: the reader leaves before the output is written. Output stops
+/// quietly and the command still exits 0 (it used to panic with exit 101), and it finishes its
+/// other outputs (here the JSON report).
+#[test]
+fn a_closed_stdout_ends_quietly_with_exit_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.json");
+    let report_arg = report.display().to_string();
+    for args in [
+        vec!["world", "info", "worlds/loop-small.toml"],
+        vec![
+            "run",
+            "scenarios/smoke.toml",
+            "--laps",
+            "2",
+            "-q",
+            "--report",
+            &report_arg,
+        ],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_placewords"))
+            .args(&args)
+            .current_dir(root())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader leaves at once
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    assert!(report_of(&report)["levels"].is_array());
+}
