@@ -25,7 +25,7 @@ pub struct CheckArgs {
 
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut suites = Vec::new();
-    let (mut errors, mut missed) = (0, 0);
+    let mut errors = 0;
     for path in &args.scenarios {
         let t = Instant::now();
         let name = path
@@ -58,7 +58,6 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 for o in &outcomes {
                     outln!("{}", o.line())?;
                 }
-                missed += outcomes.iter().filter(|o| !o.passed).count();
                 suites.push(Suite {
                     scenario: name,
                     outcomes,
@@ -82,11 +81,6 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.junit {
         write_file(path, junit_xml(&suites).as_bytes())?;
     }
-    Ok(if errors > 0 {
-        ExitCode::from(2)
-    } else if missed > 0 {
-        ExitCode::from(1)
-    } else {
-        ExitCode::SUCCESS
-    })
+    let outcomes = suites.iter().flat_map(|s| &s.outcomes);
+    Ok(ExitCode::from(gate::gate_exit_code(errors, outcomes)))
 }

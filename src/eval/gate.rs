@@ -3,8 +3,8 @@
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
 //! testcase): `min_precision`, `min_recall` and `max_seconds_per_lap` of each `[[expect.levels]]`
 //! entry and of `[expect.icp]`. A bound on a configuration the report does not hold fails
-//! ("not in the report"). Exit decision: 0 when every outcome passes, 1 when any missed (2, an
-//! error, is the CLI's business).
+//! ("not in the report"). Exit decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a
+//! scenario could not be run (an error), else 1 when any outcome missed, else 0.
 
 use crate::eval::scores::{Report, Scores};
 use crate::spec::evaluation::{ExpectSpec, Expectation};
@@ -144,7 +144,15 @@ fn push_bounds(
 
 /// 0 when every outcome passed, 1 when any missed.
 pub fn exit_code(outcomes: &[Outcome]) -> i32 {
-    if outcomes.iter().all(|o| o.passed) {
+    i32::from(gate_exit_code(0, outcomes))
+}
+
+/// The gate's exit code: 2 when `errors` scenarios could not be run, else 1 when any outcome
+/// missed, else 0.
+pub fn gate_exit_code<'a>(errors: usize, outcomes: impl IntoIterator<Item = &'a Outcome>) -> u8 {
+    if errors > 0 {
+        2
+    } else if outcomes.into_iter().all(|o| o.passed) {
         0
     } else {
         1
@@ -223,5 +231,6 @@ mod tests {
     fn no_expectation_passes() {
         let rep = sample("A", [0.9; 3], [0.1; 3]);
         assert_eq!(exit_code(&check(&rep, &ExpectSpec::default())), 0);
+        assert_eq!(gate_exit_code(1, &check(&rep, &ExpectSpec::default())), 2);
     }
 }
