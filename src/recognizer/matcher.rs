@@ -7,7 +7,7 @@
 //! the predecessor lists, mixing levels freely).
 //!
 //! When a word c closes, its candidates are the words of its class (a per-class occurrence list)
-//! that end at least `min_gap_m` of travel before c begins and match it. For each candidate p the
+//! that end at least `candidate_gap_m` of travel before c begins and match it. For each candidate p the
 //! longest chain ending at (c, p) is 1 + the best memoised chain of a pair (c', p') with c' a
 //! predecessor of c and p' one of p, computed for every level configuration at once; the memo
 //! holds one entry per matching pair, so the work per word is candidates × predecessors², and
@@ -15,7 +15,7 @@
 //!
 //! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
 //! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
-//! least `min_gap_m` after p ends. Each word pair is reported at most once per configuration: the
+//! least `candidate_gap_m` after p ends. Each word pair is reported at most once per configuration: the
 //! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
 //! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
 //! length). The result of an L-level run is the union of the matches with `levels` ≤ L.
@@ -28,7 +28,7 @@
 //! whose boundary moved by more than Δmax was paired up to metres off. Shifts whose whole window lies in
 //! the past word's run are preferred (near a run's start or end, those with the largest overlap);
 //! ties go to the smallest |d|. The aligned pairs whose travel differs by
-//! less than `min_gap_m` are dropped.
+//! less than `candidate_gap_m` are dropped.
 
 use super::config::{RecognizerConfig, RecognizerError};
 use super::types::{AlignedPair, Match, Observation};
@@ -53,7 +53,7 @@ struct Params {
     min_ngram: [usize; MAX_LEVELS],
     size_ratio: f64,
     angle_tol_deg: f64,
-    min_gap_m: f64,
+    candidate_gap_m: f64,
     max_offset: usize,
 }
 
@@ -84,7 +84,7 @@ impl WordMatcher {
                 min_ngram,
                 size_ratio: config.size_tolerance_ratio,
                 angle_tol_deg: config.angle_tolerance_deg,
-                min_gap_m: config.min_gap_m,
+                candidate_gap_m: config.candidate_gap_m,
                 max_offset: config.max_alignment_offset,
             },
             words: WordLevels::new(config.classes, config.min_word_size, config.levels),
@@ -99,7 +99,20 @@ impl WordMatcher {
     /// whose `run` is later than the current run starts the new run first (as
     /// [`start_run`](Self::start_run)), so a stored observation stream can be replayed without
     /// calling it.
+    ///
+    /// # Panics
+    /// When `obs.travel_m` is less than the previous observation's (or NaN): the candidate search
+    /// bisects the occurrence lists by travel, which is only correct if travel never decreases.
     pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
+        let last = self.words.observations().last().map_or(0.0, |o| o.travel_m);
+        assert!(
+            obs.travel_m >= last,
+            "observation {}: travel {} m is less than the previous observation's {} m; \
+             observations must come in order of non-decreasing travel",
+            obs.id,
+            obs.travel_m,
+            last
+        );
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
@@ -169,7 +182,7 @@ impl WordMatcher {
         let n_words = self.words.all_words().len();
         debug_assert_eq!(self.memo.len(), c as usize);
         let cw = self.word(c).clone();
-        let limit = cw.start_travel_m - self.params.min_gap_m;
+        let limit = cw.start_travel_m - self.params.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
         let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
 
@@ -282,7 +295,7 @@ impl WordMatcher {
                     continue;
                 }
                 let first_current = self.word(chain[tau - 1].0);
-                if first_current.start_travel_m + 1e-9 < past_end + self.params.min_gap_m {
+                if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
                     continue;
                 }
                 chain.truncate(fresh);
@@ -357,7 +370,7 @@ impl WordMatcher {
         let (a, b, r) = window(k);
         for i in r {
             let (q, pst) = (&obs[(s2 + a + i) as usize], &obs[(s1 + b + i) as usize]);
-            if q.travel_m - pst.travel_m + 1e-9 < self.params.min_gap_m {
+            if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
                 continue;
             }
             out.push(AlignedPair {

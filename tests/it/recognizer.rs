@@ -428,7 +428,7 @@ fn alignment_recovers_a_shift() {
     let cfg = config(|c| {
         c.levels = 1;
         c.min_ngram = vec![3];
-        c.min_gap_m = 5.0;
+        c.candidate_gap_m = 5.0;
     });
     // A corridor whose Ψ has a distinctive ramp, seen twice; the second time its words start
     // 3 observations later relative to the ramp.
@@ -784,7 +784,7 @@ proptest! {
         let cfg = config(|c| {
             c.min_word_size = 2;
             c.min_ngram = vec![2, 3, 4];
-            c.min_gap_m = gap;
+            c.candidate_gap_m = gap;
         });
         let mut r = SplitMix::new(seed);
         let stretches: Vec<Stretch> = (0..60)
@@ -829,7 +829,7 @@ fn brute_chain(
         && cw.class == pw.class
         && (sa - sb).abs() <= cfg.size_tolerance_ratio * sa.max(sb) + 1e-9
         && da <= cfg.angle_tolerance_deg + 1e-9
-        && pw.end_travel_m + cfg.min_gap_m <= cw.start_travel_m + 1e-9;
+        && pw.end_travel_m + cfg.candidate_gap_m <= cw.start_travel_m + 1e-9;
     let v = if !ok {
         0
     } else {
@@ -882,7 +882,7 @@ proptest! {
         let cfg = config(|c| {
             c.min_word_size = 2;
             c.min_ngram = vec![3, 4, 5];
-            c.min_gap_m = 2.0;
+            c.candidate_gap_m = 2.0;
         });
         let mut r = SplitMix::new(seed);
         let base: Vec<Stretch> = (0..25)
@@ -917,7 +917,7 @@ proptest! {
                     // that word in different places: check when the earliest of them passes.
                     if len == tau {
                         let first = earliest_first(w, &cfg, k, c, p, tau - 1, &mut memo);
-                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.min_gap_m {
+                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.candidate_gap_m {
                             prop_assert!(
                                 reported.contains(&(c, p)),
                                 "configuration {k}: chain of {len} ending at ({c}, {p}) not reported"
