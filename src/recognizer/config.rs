@@ -47,6 +47,27 @@ pub struct RecognizerConfig {
     pub min_ngram: Vec<usize>,
     /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
     pub max_alignment_offset: usize,
+    /// Placements the fine alignment tries: `paper` (Eq. 2 as written: the n = min(S₁, S₂)
+    /// observations from both words' starts, shifted by d ∈ (−Δmax, Δmax)) or `whole-word`
+    /// (the smaller word's n observations at every placement inside the larger word, never past
+    /// its ends). Default `whole-word`.
+    pub alignment: AlignmentMode,
+    /// Verify each match before reporting it (see the fields `verify_*`). Default true.
+    pub verify: bool,
+    /// Verification, travel: between two consecutive words of a matched n-gram, and from its
+    /// first word to each later one, the odometric travel of the current and past sides may
+    /// differ by at most this fraction of the longer, plus `verify_travel_slack_m`. Default 0.25.
+    pub verify_travel_ratio: f64,
+    /// Verification, travel: absolute slack added to the allowed difference, metres. Default 0.5.
+    pub verify_travel_slack_m: f64,
+    /// Verification, turn: between two consecutive words of a matched n-gram, and from its first
+    /// word to each later one, the odometric heading change of the two sides may differ by at
+    /// most this, degrees. Default 30.
+    pub verify_turn_deg: f64,
+    /// Verification, densities: the root mean square Ψ difference over the n-gram's aligned
+    /// observation pairs must be at most this (Ψ ∈ [0, 1]; a class is 1/`classes` wide).
+    /// Default 0.06.
+    pub verify_max_psi_rms: f64,
     /// Candidate gap: a past word must end at least this much odometric travel before the
     /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
     /// though both default to 20). Default 20.0.
@@ -70,9 +91,25 @@ impl Default for RecognizerConfig {
             levels: 3,
             min_ngram: vec![6, 9, 12, 15],
             max_alignment_offset: 10,
+            alignment: AlignmentMode::WholeWord,
+            verify: true,
+            verify_travel_ratio: 0.25,
+            verify_travel_slack_m: 0.5,
+            verify_turn_deg: 30.0,
+            verify_max_psi_rms: 0.06,
             candidate_gap_m: 20.0,
         }
     }
+}
+
+/// Where the fine alignment may place the smaller word's window (`alignment` setting).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AlignmentMode {
+    /// Eq. 2 as written: shifts d ∈ (−Δmax, Δmax) from both words' starts.
+    Paper,
+    /// Every placement of the smaller word inside the larger one.
+    WholeWord,
 }
 
 /// One invalid setting: the field's name and what is wrong with it.
@@ -232,6 +269,16 @@ impl RecognizerConfig {
                     self.candidate_gap_m
                 ),
             );
+        }
+        for (field, v) in [
+            ("verify_travel_ratio", self.verify_travel_ratio),
+            ("verify_travel_slack_m", self.verify_travel_slack_m),
+            ("verify_turn_deg", self.verify_turn_deg),
+            ("verify_max_psi_rms", self.verify_max_psi_rms),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                bad(field, format!("must be a number of at least 0, got {v}"));
+            }
         }
         if !(self.max_interpolation_m.is_finite()
             && (0.0..=20.0).contains(&self.max_interpolation_m))
