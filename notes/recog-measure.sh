@@ -4,7 +4,7 @@
 # scenarios: A, B, C at seeds 1-10 (a temp copy of each scenario with `seed =` replaced), 1 and 3 levels.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BIN=./target/release/placewords
+BIN=${BIN:-./target/release/placewords}
 D=../shared/data/carmen
 mode=${1:-logs}; shift || true
 summ() { # file -> "precision recall pairs" for levels 3 from the JSON report
