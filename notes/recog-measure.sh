@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Reproduces the figures in notes/recog.md. Usage: notes/recog-measure.sh logs|scenarios [extra recognize args]
 # logs: every real log at noise seeds 1-5 (plus Intel --scan-step 2 and 3), 3 levels.
-# scenarios: A, B, C at seeds 1-10 (a temp copy of each scenario with `seed =` replaced), 1 and 3 levels.
+# scenarios [A B C]: each at seeds 1-10 (run --seed), 1, 2 and 3 levels.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${BIN:-./target/release/placewords}
@@ -29,13 +29,13 @@ if [ "$mode" = logs ]; then
     done
   done
 else
-  for scn in A B C; do
+  # scenarios [A B C ...]: seeds 1-10 each, all three level configurations
+  for scn in ${@:-A B C}; do
     for seed in 1 2 3 4 5 6 7 8 9 10; do
-      tmp=$(mktemp -d); sed "s/^seed = .*/seed = $seed/" scenarios/$scn.toml > $tmp/$scn.toml
-      sed -i "s#\"\.\./worlds/#\"$(pwd)/worlds/#" $tmp/$scn.toml
-      $BIN run $tmp/$scn.toml --quiet --report $tmp/r.json >/dev/null || true
-      echo "$scn seed$seed $(summ $tmp/r.json | tr '\n' ' ')"
-      rm -rf $tmp
+      out=$(mktemp --suffix .json)
+      $BIN run scenarios/$scn.toml --quiet --seed $seed --report $out >/dev/null 2>&1 || true
+      echo "$scn seed$seed $(summ $out | tr '\n' ' ')"
+      rm -f $out
     done
   done
 fi
