@@ -82,7 +82,7 @@ pub fn keep_every_nth_scan(run: &mut RunLog, k: usize) {
     for lap in &mut run.laps {
         lap.frames.retain(|_| {
             i += 1;
-            (i - 1) % k == 0
+            (i - 1).is_multiple_of(k)
         });
     }
 }
