@@ -18,6 +18,9 @@ pub struct CheckArgs {
     /// Also write a JUnit XML file (one testcase per expectation).
     #[arg(long, value_name = "OUT.xml")]
     pub junit: Option<PathBuf>,
+    /// Replace the scenario's seed.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -33,7 +36,10 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| path.display().to_string());
         let outcome = (|| -> anyhow::Result<Vec<gate::Outcome>> {
-            let scn = placewords::spec::scenario::load_scenario(path)?;
+            let mut scn = placewords::spec::scenario::load_scenario(path)?;
+            if let Some(seed) = args.seed {
+                scn.seed = seed;
+            }
             let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
             levels.sort_unstable();
             levels.dedup();

@@ -25,13 +25,19 @@ pub struct RunArgs {
     /// configuration (green correct, red wrong).
     #[arg(long, value_name = "DIR")]
     pub svg: Option<PathBuf>,
+    /// Replace the scenario's seed.
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let mut scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    if let Some(seed) = args.seed {
+        scn.seed = seed;
+    }
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
