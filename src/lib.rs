@@ -6,6 +6,7 @@
 //! scans and truth; odometry and scans → [`recognizer`] → matches; matches and truth → [`eval`]
 //! → [`report`]. Real logs enter through [`io`].
 
+pub mod authoring;
 pub mod baseline;
 pub mod eval;
 pub mod experiment;

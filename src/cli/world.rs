@@ -18,6 +18,40 @@ pub enum WorldCommand {
     Info(InfoArgs),
     /// Import a MobileSim line map (.map) as a world file, with a generated lap route.
     Import(super::import::ImportArgs),
+    /// Colour every free cell by the density class the recognizer gives it (paper Fig. 2a).
+    Density(DensityArgs),
+    /// Drive a route once without noise and mark the stretches the recognizer will confuse.
+    Ambiguity(AmbiguityArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct DensityArgs {
+    /// World file (TOML).
+    pub file: PathBuf,
+    /// Output SVG file.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    pub output: PathBuf,
+    /// Doors open, by id (comma-separated or repeated); the others are closed.
+    #[arg(long, value_name = "ID,...", value_delimiter = ',')]
+    pub open: Vec<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct AmbiguityArgs {
+    /// World file (TOML).
+    pub file: PathBuf,
+    /// Route to drive, by id.
+    #[arg(long, default_value = "lap")]
+    pub route: String,
+    /// Output SVG file.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    pub output: PathBuf,
+    /// Doors open during the drive, by id (comma-separated or repeated).
+    #[arg(long, value_name = "ID,...", value_delimiter = ',')]
+    pub open: Vec<String>,
+    /// Print the ambiguous stretches as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Args)]
@@ -60,6 +94,8 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
         WorldCommand::Render(a) => render(a),
         WorldCommand::Info(a) => info(a),
         WorldCommand::Import(a) => super::import::run(a),
+        WorldCommand::Density(a) => density(a),
+        WorldCommand::Ambiguity(a) => ambiguity(a),
     }
 }
 
@@ -143,5 +179,34 @@ fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
     } else {
         print!("{info}");
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
+    let Some(world) = load(&args.file) else {
+        return Ok(ExitCode::from(2));
+    };
+    let doors = door_states(&world, &args.open, false)?;
+    let svg = placewords::authoring::density::density_picture(&world, &doors);
+    super::common::write_file(&args.output, svg.as_bytes())?;
+    eprintln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
+    let Some(world) = load(&args.file) else {
+        return Ok(ExitCode::from(2));
+    };
+    let doors = door_states(&world, &args.open, false)?;
+    let (report, svg) =
+        placewords::authoring::ambiguity::ambiguity_picture(&world, &args.route, &doors)
+            .with_context(|| format!("{}", args.file.display()))?;
+    super::common::write_file(&args.output, svg.as_bytes())?;
+    if args.json {
+        println!("{}", report.to_json());
+    } else {
+        print!("{}", report.summary());
+    }
+    eprintln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }

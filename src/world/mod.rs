@@ -4,6 +4,7 @@
 pub mod geometry;
 pub mod info;
 pub mod physics;
+pub mod raster;
 pub mod raycast;
 
 use crate::geom::{Pose2, Segment, Vec2};
