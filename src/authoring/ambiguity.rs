@@ -6,8 +6,8 @@
 //! that occurs at two places of the route in either order. A matched word pair whose two words
 //! lie more than `tp_radius_m` apart (their middle observations' true positions) is a confusion:
 //! both words' stretches of the route are ambiguous, and each is the other's partner. Stretches
-//! are merged where they overlap; stretches that are partners, directly or through others, form a
-//! group (one colour and number in the picture).
+//! confused with each other along consecutive words are merged into one pair of stretches (one
+//! colour and number in the picture).
 
 use crate::geom::Vec2;
 use crate::recognizer::{Match, Recognizer, RecognizerConfig, Word};
@@ -39,15 +39,16 @@ pub enum AmbiguityError {
 pub struct AmbiguousStretch {
     /// 1-based, in route order from the first waypoint.
     pub number: usize,
-    /// 1-based group of stretches that look alike to the recognizer.
-    pub group: usize,
+    /// 1-based pair of stretches that look alike to the recognizer (numbered by the first
+    /// stretch's start).
+    pub pair: usize,
     /// Start, metres along the route from its first waypoint.
     pub from_m: f64,
     /// End, metres along the route; less than `from_m` when the stretch passes the first
     /// waypoint.
     pub to_m: f64,
     pub length_m: f64,
-    /// Numbers of the stretches whose words match this one's.
+    /// Number of the stretch whose words match this one's.
     pub partners: Vec<usize>,
 }
 
@@ -67,7 +68,8 @@ pub struct AmbiguityReport {
     pub confused_word_pairs: usize,
     /// Share of the route inside an ambiguous stretch, 0..1.
     pub ambiguous_share: f64,
-    pub groups: usize,
+    /// Pairs of look-alike stretches.
+    pub pairs: usize,
     pub stretches: Vec<AmbiguousStretch>,
 }
 
@@ -81,6 +83,8 @@ impl AmbiguityReport {
 pub struct Drive {
     pub frames: Vec<Frame>,
     pub route_m: Vec<f64>,
+    /// Length of the route, metres.
+    pub loop_m: f64,
 }
 
 /// A scenario of one run of two laps over `route` with every noise and wander off.
@@ -152,7 +156,11 @@ pub fn drive(
             tracker.arc_m().rem_euclid(length)
         })
         .collect();
-    Ok(Drive { frames, route_m })
+    Ok(Drive {
+        frames,
+        route_m,
+        loop_m: length,
+    })
 }
 
 /// A word's stretch of the route (start, end, metres along it) and its middle true position.
@@ -179,7 +187,14 @@ fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64)
             };
             let (c0, c1, ca) = word_place(rec, drive, cw);
             let (p0, p1, pa) = word_place(rec, drive, pw);
-            if (ca - pa).norm() > radius_m {
+            // Words at the same place of the route, one lap apart, are the same place even
+            // when their alignment is off.
+            let mid = |a: f64, b: f64| a + (b - a).rem_euclid(drive.loop_m) / 2.0;
+            let along = (mid(c0, c1) - mid(p0, p1)).rem_euclid(drive.loop_m);
+            if along.min(drive.loop_m - along) <= radius_m {
+                continue;
+            }
+            if wrong_pair(rec, drive, m, cw, pw, radius_m).unwrap_or((ca - pa).norm() > radius_m) {
                 out.push(((c0, c1), (p0, p1)));
             }
         }
@@ -187,98 +202,158 @@ fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64)
     out
 }
 
-/// Route bins covered by the stretch from `a` to `b` (forward, wrapping at the route's end).
-fn bins(a: f64, b: f64, n: usize) -> impl Iterator<Item = usize> {
-    let i0 = ((a / BIN_M) as usize).min(n - 1);
-    let i1 = ((b / BIN_M) as usize).min(n - 1);
-    let count = (i1 + n - i0) % n + 1;
-    (0..count).map(move |k| (i0 + k) % n)
+/// Whether most aligned observation pairs of the word pair (`c`, `p`) lie farther apart than
+/// `radius_m` (as evaluation scores pairs); `None` when the match holds none of them.
+fn wrong_pair(
+    rec: &Recognizer,
+    drive: &Drive,
+    m: &Match,
+    c: &Word,
+    p: &Word,
+    radius_m: f64,
+) -> Option<bool> {
+    let obs = rec.observations();
+    let at = |i: usize| {
+        let f = obs[i].input_index.min(drive.frames.len() - 1);
+        drive.frames[f].truth.0.position()
+    };
+    let (cr, pr) = (c.obs_range(), p.obs_range());
+    let (mut wrong, mut all) = (0, 0);
+    for a in m
+        .pairs
+        .iter()
+        .filter(|a| cr.contains(&a.query) && pr.contains(&a.past))
+    {
+        all += 1;
+        wrong += usize::from((at(a.query) - at(a.past)).norm() > radius_m);
+    }
+    (all > 0).then_some(2 * wrong > all)
 }
 
-/// Maximal runs of marked bins on the loop, as (first bin, bin count), in route order.
-fn runs_of(marked: &[bool]) -> Vec<(usize, usize)> {
-    let n = marked.len();
-    let Some(start) = (0..n).find(|&i| !marked[i]) else {
-        return vec![(0, n)];
-    };
-    let mut out: Vec<(usize, usize)> = Vec::new();
-    let mut k = 0;
-    while k < n {
-        let i = (start + k) % n;
-        if marked[i] {
-            let len = (k..n).take_while(|&j| marked[(start + j) % n]).count();
-            out.push((i, len));
-            k += len;
-        } else {
-            k += 1;
+/// A stretch of the loop: start and length, metres along the route.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Arc {
+    start: f64,
+    len: f64,
+}
+
+/// Stretches closer than this along the route are merged, metres.
+const MERGE_GAP_M: f64 = 1.0;
+
+impl Arc {
+    fn new(from: f64, to: f64, loop_m: f64) -> Arc {
+        Arc {
+            start: from.rem_euclid(loop_m),
+            len: (to - from).rem_euclid(loop_m),
         }
     }
-    out.sort();
+
+    /// Whether the two stretches overlap or come within `MERGE_GAP_M`.
+    fn touches(&self, o: &Arc, loop_m: f64) -> bool {
+        let d = (o.start - self.start).rem_euclid(loop_m);
+        d <= self.len + MERGE_GAP_M || loop_m - d <= o.len + MERGE_GAP_M
+    }
+
+    /// The shorter stretch covering both (they touch).
+    fn union(&self, o: &Arc, loop_m: f64) -> Arc {
+        let d = (o.start - self.start).rem_euclid(loop_m);
+        let from_self = self.len.max(d + o.len);
+        let from_other = o.len.max(loop_m - d + self.len);
+        if from_self <= from_other {
+            Arc {
+                start: self.start,
+                len: from_self.min(loop_m),
+            }
+        } else {
+            Arc {
+                start: o.start,
+                len: from_other.min(loop_m),
+            }
+        }
+    }
+}
+
+/// Confusions as pairs of stretches.
+fn arcs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
+    let mut out: Vec<(Arc, Arc)> = conf
+        .iter()
+        .map(|((a, b), (c, d))| (Arc::new(*a, *b, loop_m), Arc::new(*c, *d, loop_m)))
+        .collect();
+    out.sort_by(|p, q| {
+        p.0.start
+            .total_cmp(&q.0.start)
+            .then(p.1.start.total_cmp(&q.1.start))
+    });
     out
 }
 
-/// Union-find root.
-fn root(parent: &mut [usize], i: usize) -> usize {
-    let mut r = i;
-    while parent[r] != r {
-        r = parent[r];
+/// `q` merged into `p` if their stretches touch side by side, in either order.
+fn merge(p: &(Arc, Arc), q: &(Arc, Arc), loop_m: f64) -> Option<(Arc, Arc)> {
+    if p.0.touches(&q.0, loop_m) && p.1.touches(&q.1, loop_m) {
+        Some((p.0.union(&q.0, loop_m), p.1.union(&q.1, loop_m)))
+    } else if p.0.touches(&q.1, loop_m) && p.1.touches(&q.0, loop_m) {
+        Some((p.0.union(&q.1, loop_m), p.1.union(&q.0, loop_m)))
+    } else {
+        None
     }
-    parent[i] = r;
-    r
 }
 
-/// Merged stretches with their partners and groups.
-fn stretches(conf: &[Confusion], length_m: f64) -> Vec<AmbiguousStretch> {
-    let n = ((length_m / BIN_M).ceil() as usize).max(1);
-    let mut marked = vec![false; n];
-    for ((a, b), (c, d)) in conf {
-        bins(*a, *b, n)
-            .chain(bins(*c, *d, n))
-            .for_each(|i| marked[i] = true);
-    }
-    let runs = runs_of(&marked);
-    let mut owner = vec![usize::MAX; n];
-    for (s, &(first, len)) in runs.iter().enumerate() {
-        (0..len).for_each(|k| owner[(first + k) % n] = s);
-    }
-    let mut partners = vec![std::collections::BTreeSet::new(); runs.len()];
-    let mut parent: Vec<usize> = (0..runs.len()).collect();
-    for ((a, _), (c, _)) in conf {
-        let (x, y) = (
-            owner[bins(*a, *a, n).next().unwrap_or(0)],
-            owner[bins(*c, *c, n).next().unwrap_or(0)],
-        );
-        if x == usize::MAX || y == usize::MAX {
-            continue;
-        }
-        // A stretch whose words repeat within it is its own partner.
-        partners[x].insert(y + 1);
-        if x != y {
-            partners[y].insert(x + 1);
-            let (rx, ry) = (root(&mut parent, x), root(&mut parent, y));
-            parent[rx.max(ry)] = rx.min(ry);
+/// Confused word pairs merged into pairs of stretches: two confusions join when their
+/// stretches touch side by side (consecutive words of one n-gram do, and a confusion found in
+/// both orders joins itself), until no two pairs touch. Each pair's earlier stretch comes first.
+fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
+    let mut pairs: Vec<(Arc, Arc)> = Vec::new();
+    for c in arcs(conf, loop_m) {
+        match pairs.iter().position(|p| merge(p, &c, loop_m).is_some()) {
+            Some(i) => pairs[i] = merge(&pairs[i], &c, loop_m).unwrap_or(pairs[i]),
+            None => pairs.push(c),
         }
     }
-    let mut group_of = std::collections::BTreeMap::new();
-    runs.iter()
-        .enumerate()
-        .map(|(s, &(first, len))| {
-            let r = root(&mut parent, s);
-            let next = group_of.len() + 1;
-            let group = *group_of.entry(r).or_insert(next);
-            let from_m = first as f64 * BIN_M;
-            AmbiguousStretch {
-                number: s + 1,
-                group,
-                from_m,
-                to_m: ((first + len) as f64 * BIN_M)
-                    .min(n as f64 * BIN_M)
-                    .rem_euclid(length_m),
-                length_m: (len as f64 * BIN_M).min(length_m),
-                partners: partners[s].iter().copied().collect(),
+    let mut changed = true;
+    while changed {
+        changed = false;
+        'outer: for i in 0..pairs.len() {
+            for j in i + 1..pairs.len() {
+                if let Some(m) = merge(&pairs[i], &pairs[j], loop_m) {
+                    pairs[i] = m;
+                    pairs.remove(j);
+                    changed = true;
+                    break 'outer;
+                }
             }
+        }
+    }
+    let mut out: Vec<(Arc, Arc)> = pairs
+        .into_iter()
+        .map(|(a, b)| if a.start <= b.start { (a, b) } else { (b, a) })
+        .collect();
+    out.sort_by(|p, q| p.0.start.total_cmp(&q.0.start));
+    out
+}
+
+/// The numbered stretches: pair k gives stretches 2k − 1 and 2k, each the other's partner.
+fn stretches(conf: &[Confusion], loop_m: f64) -> Vec<AmbiguousStretch> {
+    let stretch = |arc: &Arc, number: usize, pair: usize, partner: usize| AmbiguousStretch {
+        number,
+        pair,
+        from_m: round_dm(arc.start),
+        to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
+        length_m: round_dm(arc.len),
+        partners: vec![partner],
+    };
+    merged_pairs(conf, loop_m)
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (a, b))| {
+            let (na, nb) = (2 * k + 1, 2 * k + 2);
+            [stretch(a, na, k + 1, nb), stretch(b, nb, k + 1, na)]
         })
         .collect()
+}
+
+/// Rounded to 0.1 m (the route positions are no more precise).
+fn round_dm(x: f64) -> f64 {
+    (x * 10.0).round() / 10.0
 }
 
 /// Drives `route` of `world` without noise and finds every stretch whose words also occur
@@ -312,7 +387,7 @@ pub fn ambiguity(
     let conf = confusions(&rec, &drive, &matches, tp_radius_m);
     let length_m = route.length_m();
     let list = stretches(&conf, length_m);
-    let covered: f64 = list.iter().map(|s| s.length_m).sum();
+    let share = covered_share(&list, length_m);
     let report = AmbiguityReport {
         world: world.name.clone(),
         route: route.id.clone(),
@@ -321,20 +396,32 @@ pub fn ambiguity(
         min_ngram: cfg.min_ngram.iter().copied().take(cfg.levels).collect(),
         tp_radius_m,
         confused_word_pairs: conf.len(),
-        ambiguous_share: (covered / length_m).min(1.0),
-        groups: list.iter().map(|s| s.group).max().unwrap_or(0),
+        ambiguous_share: share,
+        pairs: list.iter().map(|s| s.pair).max().unwrap_or(0),
         stretches: list,
     };
     Ok((report, drive))
 }
 
-/// Distinct colours for groups of look-alike stretches (Tableau 10 without grey).
-pub const GROUP_COLORS: [&str; 9] = [
+/// Share of the loop inside at least one stretch (0.1 m resolution).
+fn covered_share(list: &[AmbiguousStretch], loop_m: f64) -> f64 {
+    let n = ((loop_m / 0.1).ceil() as usize).max(1);
+    let mut marked = vec![false; n];
+    for s in list {
+        let first = (s.from_m / 0.1) as usize;
+        let count = (s.length_m / 0.1).round() as usize;
+        (0..count.min(n)).for_each(|k| marked[(first + k) % n] = true);
+    }
+    marked.iter().filter(|m| **m).count() as f64 / n as f64
+}
+
+/// Distinct colours for pairs of look-alike stretches (Tableau 10 without grey).
+pub const PAIR_COLORS: [&str; 9] = [
     "#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
     "#17becf",
 ];
 
-/// Points of the route from `from_m` to `to_m` (forward, wrapping), every 0.25 m.
+/// Points of the route from `from_m` over `length_m` (forward, wrapping), every 0.25 m.
 fn route_points(route: &Route, from_m: f64, length_m: f64) -> Vec<Vec2> {
     let tracker = RouteTracker::new(route, 0);
     let steps = ((length_m / 0.25).ceil() as usize).max(1);
@@ -348,15 +435,11 @@ fn route_points(route: &Route, from_m: f64, length_m: f64) -> Vec<Vec2> {
 }
 
 /// The world with the route's ambiguous stretches drawn as thick bands, one colour and number
-/// per group of stretches that look alike, and a numbered list of the stretches under it.
+/// per pair of look-alike stretches joined by a thin line, and a list of the pairs under it.
 pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport) -> String {
     use crate::report::world_render::{
-        BandOverlay, LegendEntry, MarkOverlay, RenderOptions, render_world_svg,
+        BandOverlay, MarkOverlay, RenderOptions, SegmentOverlay, render_world_svg,
     };
-    let Some(route) = world.route(&report.route) else {
-        return render_world_svg(world, &RenderOptions::default());
-    };
-    let color = |g: usize| GROUP_COLORS[(g - 1) % GROUP_COLORS.len()].to_string();
     let mut opts = RenderOptions {
         doors: doors.clone(),
         title: Some(title(report)),
@@ -364,26 +447,40 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
         show_door_labels: false,
         ..RenderOptions::default()
     };
+    let Some(route) = world.route(&report.route) else {
+        return render_world_svg(world, &opts);
+    };
+    let color = |k: usize| PAIR_COLORS[(k - 1) % PAIR_COLORS.len()].to_string();
+    let mut middles = std::collections::BTreeMap::<usize, Vec<Vec2>>::new();
     for s in &report.stretches {
         let pts = route_points(route, s.from_m, s.length_m);
+        let mid = pts[pts.len() / 2];
+        middles.entry(s.pair).or_default().push(mid);
         opts.marks.push(MarkOverlay {
-            at: pts[pts.len() / 2],
-            text: s.group.to_string(),
-            color: color(s.group),
+            at: mid,
+            text: s.pair.to_string(),
+            color: color(s.pair),
             class: "ambiguous".into(),
         });
         opts.bands.push(BandOverlay {
             points: pts,
-            color: color(s.group),
-            width_px: 9.0,
+            color: color(s.pair),
+            width_px: 10.0,
         });
     }
-    for g in 1..=report.groups {
-        let members: Vec<&AmbiguousStretch> =
-            report.stretches.iter().filter(|s| s.group == g).collect();
-        opts.legend.push(LegendEntry {
-            label: format!("{g}: {} stretches look alike", members.len()),
-            color: color(g),
+    for (k, m) in &middles {
+        if let [a, b] = m.as_slice() {
+            opts.segments.push(SegmentOverlay {
+                color: color(*k),
+                a: *a,
+                b: *b,
+            });
+        }
+    }
+    if !report.stretches.is_empty() {
+        opts.legend.push(crate::report::world_render::LegendEntry {
+            label: "look-alike stretches (same number: same words)".into(),
+            color: PAIR_COLORS[0].into(),
             dashed: false,
         });
     }
@@ -394,49 +491,54 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
 fn title(report: &AmbiguityReport) -> String {
     if report.stretches.is_empty() {
         return format!(
-            "{}: route '{}' has no ambiguous stretch",
+            "{}: route '{}': no two places look alike to the recognizer",
             report.world, report.route
         );
     }
     format!(
-        "{}: route '{}', {:.0} % ambiguous ({} groups of look-alike stretches)",
+        "{}: route '{}': {} pair(s) of places look alike, {:.0} % of the route",
         report.world,
         report.route,
-        100.0 * report.ambiguous_share,
-        report.groups
+        report.pairs,
+        100.0 * report.ambiguous_share
     )
 }
 
-/// Most stretches listed under the picture.
+/// Most pairs listed under the picture.
 const MAX_NOTES: usize = 12;
 
-fn notes(report: &AmbiguityReport) -> Vec<String> {
-    let mut out: Vec<String> = report
+/// One line per pair: where its two stretches are.
+fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
+    report
         .stretches
-        .iter()
-        .take(MAX_NOTES)
-        .map(|s| {
-            let partners: Vec<String> = s.partners.iter().map(|p| format!("#{p}")).collect();
+        .chunks(2)
+        .map(|c| {
+            let at = |s: &AmbiguousStretch| format!("{:.1}-{:.1} m", s.from_m, s.to_m);
+            let other = c.get(1).map(at).unwrap_or_default();
             format!(
-                "group {}: stretch #{} at {:.1}-{:.1} m along the route ({:.1} m) looks like {}",
-                s.group,
-                s.number,
-                s.from_m,
-                s.to_m,
-                s.length_m,
-                partners.join(", ")
+                "{}: {} ({:.1} m) looks like {} (metres along the route from waypoint 1)",
+                c[0].pair,
+                at(&c[0]),
+                c[0].length_m,
+                other
             )
         })
-        .collect();
-    if report.stretches.len() > MAX_NOTES {
+        .collect()
+}
+
+fn notes(report: &AmbiguityReport) -> Vec<String> {
+    let lines = pair_lines(report);
+    let mut out: Vec<String> = lines.iter().take(MAX_NOTES).cloned().collect();
+    if lines.len() > MAX_NOTES {
         out.push(format!(
-            "... and {} more stretches (see --json)",
-            report.stretches.len() - MAX_NOTES
+            "... and {} more pairs (see --json)",
+            lines.len() - MAX_NOTES
         ));
     }
-    if report.stretches.is_empty() {
+    if lines.is_empty() {
         out.push(format!(
-            "no n-gram of words occurs at two places (levels {}, n-gram sizes {:?})",
+            "no n-gram of words occurs at two places (levels {}, n-gram sizes {:?}); \
+             the recognizer's matches on this route can only be right",
             report.levels, report.min_ngram
         ));
     }
@@ -444,40 +546,33 @@ fn notes(report: &AmbiguityReport) -> Vec<String> {
 }
 
 impl AmbiguityReport {
-    /// A few lines for people: the share of the route that is ambiguous and each stretch.
+    /// A few lines for people: the share of the route that is ambiguous and each pair.
     pub fn summary(&self) -> String {
         let mut out = format!(
-            "{}: route '{}' ({:.0} m): {} ambiguous stretch(es) in {} group(s), {:.0} % of the route\n",
+            "{}: route '{}' ({:.0} m): {} pair(s) of look-alike stretches, {:.0} % of the route\n",
             self.world,
             self.route,
             self.route_length_m,
-            self.stretches.len(),
-            self.groups,
+            self.pairs,
             100.0 * self.ambiguous_share
         );
-        for s in &self.stretches {
-            let partners: Vec<String> = s.partners.iter().map(|p| format!("#{p}")).collect();
-            out.push_str(&format!(
-                "  #{} (group {}): {:.1}-{:.1} m, looks like {}\n",
-                s.number,
-                s.group,
-                s.from_m,
-                s.to_m,
-                partners.join(", ")
-            ));
+        for line in pair_lines(self) {
+            out.push_str(&format!("  {line}\n"));
         }
         out
     }
 }
-
-/// The report and picture `placewords world ambiguity` writes: default recognizer settings
-/// (all three level configurations), pairs farther apart than 1 m are different places.
+/// The report and picture `placewords world ambiguity` writes: default recognizer settings,
+/// searching `levels` level configurations (default all three); words farther apart than the
+/// default true-positive radius (1 m) are different places.
 pub fn ambiguity_picture(
     world: &World,
     route_id: &str,
     doors: &DoorStates,
+    levels: Option<usize>,
 ) -> Result<(AmbiguityReport, String), AmbiguityError> {
-    let cfg = RecognizerConfig::default();
+    let mut cfg = RecognizerConfig::default();
+    cfg.levels = levels.unwrap_or(cfg.levels);
     let tp_radius_m = crate::spec::evaluation::EvaluationSpec::default().tp_radius_m;
     let (report, _) = ambiguity(world, route_id, doors, &cfg, tp_radius_m)?;
     let svg = ambiguity_svg(world, doors, &report);

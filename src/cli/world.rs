@@ -52,6 +52,9 @@ pub struct AmbiguityArgs {
     /// Print the ambiguous stretches as JSON on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Search this many level configurations (1 = level-0 words only; default 3, as `run`).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4))]
+    pub levels: Option<u8>,
 }
 
 #[derive(Debug, Args)]
@@ -198,15 +201,26 @@ fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::from(2));
     };
     let doors = door_states(&world, &args.open, false)?;
+    let levels = args.levels.map(usize::from);
     let (report, svg) =
-        placewords::authoring::ambiguity::ambiguity_picture(&world, &args.route, &doors)
+        placewords::authoring::ambiguity::ambiguity_picture(&world, &args.route, &doors, levels)
             .with_context(|| format!("{}", args.file.display()))?;
     super::common::write_file(&args.output, svg.as_bytes())?;
-    if args.json {
-        println!("{}", report.to_json());
+    let text = if args.json {
+        format!("{}\n", report.to_json())
     } else {
-        print!("{}", report.summary());
-    }
+        report.summary()
+    };
+    print_quietly(&text)?;
     eprintln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Writes to stdout; a closed pipe (`| head`) ends quietly.
+fn print_quietly(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    match std::io::stdout().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
 }
