@@ -22,6 +22,27 @@ pub enum WorldCommand {
     Density(DensityArgs),
     /// Drive a route once without noise and mark the stretches the recognizer will confuse.
     Ambiguity(AmbiguityArgs),
+    /// Write a random valid floor (corridor loop, offices with doors, niches, a lap route).
+    Generate(GenerateArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Seed: the same seed and options give the same file.
+    #[arg(long)]
+    pub seed: u64,
+    /// Floor size in metres, x and y (each 24-2000).
+    #[arg(long = "size-m", value_name = "W,H", value_delimiter = ',', num_args = 2, default_values_t = [40.0, 30.0])]
+    pub size_m: Vec<f64>,
+    /// Number of offices, each with one door.
+    #[arg(long, default_value_t = 12)]
+    pub doors: usize,
+    /// Corridors of the loop: 4, 6, 8, 10 or 12.
+    #[arg(long, default_value_t = 4)]
+    pub corridors: usize,
+    /// Output world file (TOML).
+    #[arg(short = 'o', long = "output", value_name = "WORLD.toml")]
+    pub output: PathBuf,
 }
 
 #[derive(Debug, Args)]
@@ -99,6 +120,7 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
         WorldCommand::Import(a) => super::import::run(a),
         WorldCommand::Density(a) => density(a),
         WorldCommand::Ambiguity(a) => ambiguity(a),
+        WorldCommand::Generate(a) => generate(a),
     }
 }
 
@@ -223,4 +245,18 @@ fn print_quietly(text: &str) -> anyhow::Result<()> {
         Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
         _ => Ok(()),
     }
+}
+
+fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
+    use placewords::world::generate::{GenerateOptions, generate_toml};
+    let opts = GenerateOptions {
+        seed: args.seed,
+        size_m: (args.size_m[0], args.size_m[1]),
+        doors: args.doors,
+        corridors: args.corridors,
+    };
+    let text = generate_toml(&opts)?;
+    super::common::write_file(&args.output, text.as_bytes())?;
+    eprintln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
 }

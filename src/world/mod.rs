@@ -1,6 +1,7 @@
 //! The validated world model: walls, doors and their states, routes, home, walking areas, and the
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
+pub mod generate;
 pub mod geometry;
 pub mod info;
 pub mod physics;
