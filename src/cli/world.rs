@@ -32,7 +32,7 @@ pub struct GenerateArgs {
     #[arg(long)]
     pub seed: u64,
     /// Floor size in metres, x and y (each 24-2000).
-    #[arg(long = "size-m", value_name = "W,H", value_delimiter = ',', num_args = 2, default_values_t = [40.0, 30.0])]
+    #[arg(long = "size-m", value_name = "W,H", value_delimiter = ',', default_values_t = [40.0, 30.0])]
     pub size_m: Vec<f64>,
     /// Number of offices, each with one door.
     #[arg(long, default_value_t = 12)]
@@ -249,9 +249,12 @@ fn print_quietly(text: &str) -> anyhow::Result<()> {
 
 fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
     use placewords::world::generate::{GenerateOptions, generate_toml};
+    let [w, h] = args.size_m[..] else {
+        bail!("--size-m takes two numbers, W,H (e.g. --size-m 40,30)");
+    };
     let opts = GenerateOptions {
         seed: args.seed,
-        size_m: (args.size_m[0], args.size_m[1]),
+        size_m: (w, h),
         doors: args.doors,
         corridors: args.corridors,
     };
