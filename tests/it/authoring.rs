@@ -198,10 +198,10 @@ fn a_hundred_generated_floors_pass_the_checks() {
         let opts = GenerateOptions {
             seed,
             size_m: (
-                40.0 + 10.0 * (seed % 3) as f64,
-                30.0 + 10.0 * (seed % 2) as f64,
+                50.0 + 10.0 * (seed % 3) as f64,
+                40.0 + 10.0 * (seed % 2) as f64,
             ),
-            doors: 3 + (seed % 3) as usize,
+            doors: 2 + (seed % 3) as usize,
             corridors: 4 + 2 * (seed % 5) as usize,
         };
         let text = generate_toml(&opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
