@@ -116,7 +116,7 @@ pub fn density_map(
     let cell_m = cfg.grid_cell_m;
     let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.ray_step_deg);
     // Half a cell of dilation keeps thin diagonal walls closed for the kernel's rays.
-    let raster = Raster::new(&obstacles(world, doors), cell_m, 1.0, cell_m * 0.5);
+    let raster = Raster::new(&obstacles(world, doors), &[], cell_m, 1.0, cell_m * 0.5);
     let pad = kernel.radius_cells() + 1;
     let cells = kernel_cells(world, &raster, pad);
     let stride = raster.width + 2 * pad;

@@ -24,13 +24,24 @@ pub struct Raster {
 
 impl Raster {
     /// Draws `items` into cells of `cell_m` (grown when the area would exceed [`MAX_CELLS`])
-    /// over their bounds plus `margin_m` on every side. A cell is occupied when its centre lies
-    /// within the item's half thickness plus `dilate_m` of its centre line.
-    pub fn new(items: &[ThickSegment], cell_m: f64, margin_m: f64, dilate_m: f64) -> Self {
+    /// over their bounds and the points `also`, plus `margin_m` on every side. A cell is
+    /// occupied when its centre lies within the item's half thickness plus `dilate_m` of its
+    /// centre line.
+    pub fn new(
+        items: &[ThickSegment],
+        also: &[Vec2],
+        cell_m: f64,
+        margin_m: f64,
+        dilate_m: f64,
+    ) -> Self {
         let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
         for t in items {
             lo = lo.inf(&t.seg.a).inf(&t.seg.b);
             hi = hi.sup(&t.seg.a).sup(&t.seg.b);
+        }
+        for p in also {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
         }
         if !lo.x.is_finite() {
             (lo, hi) = (Vec2::zeros(), Vec2::zeros());
@@ -154,7 +165,7 @@ mod tests {
             wall(4.0, 4.0, 0.0, 4.0),
             wall(0.0, 4.0, 0.0, 0.0),
         ];
-        let r = Raster::new(&walls, 0.05, 1.0, 0.0);
+        let r = Raster::new(&walls, &[], 0.05, 1.0, 0.0);
         let inside = r.reachable(&[Vec2::new(2.0, 2.0)]);
         assert!(!r.touches_border(&inside));
         assert!(
