@@ -6,6 +6,7 @@
 
 pub mod ambiguity;
 pub mod density;
+pub mod problems;
 
 pub use ambiguity::{AmbiguityReport, AmbiguousStretch, ambiguity, ambiguity_svg};
 pub use density::{DensityMap, density_map, density_svg};

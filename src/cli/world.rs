@@ -101,6 +101,12 @@ pub struct RenderArgs {
     /// Title above the picture (default: the world's name).
     #[arg(long)]
     pub title: Option<String>,
+    /// Draw a coordinate grid with labelled metres.
+    #[arg(long)]
+    pub grid: bool,
+    /// Number the route waypoints (from 1, as messages count them).
+    #[arg(long)]
+    pub waypoints: bool,
 }
 
 #[derive(Debug, Args)]
@@ -177,19 +183,37 @@ fn door_states(world: &World, open: &[String], all_open: bool) -> anyhow::Result
     Ok(states)
 }
 
+/// Renders a world; an invalid one is drawn as far as it could be read with its problems
+/// marked (numbered in the order they are printed), and exits 2.
 fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
-    let Some(world) = load(&args.file) else {
-        return Ok(ExitCode::from(2));
-    };
-    let doors = door_states(&world, &args.open, args.all_open)?;
-    let opts = RenderOptions {
-        doors,
+    let src = std::fs::read_to_string(&args.file)
+        .with_context(|| format!("{}: cannot read", args.file.display()))?;
+    let path = args.file.display().to_string();
+    let base = RenderOptions {
         title: args.title.clone(),
+        show_grid: args.grid,
+        show_waypoints: args.waypoints,
         ..RenderOptions::default()
     };
+    let world = match placewords::spec::world::parse_world(&src, &path) {
+        Ok(w) => w,
+        Err(_) => {
+            let (svg, diags) = placewords::authoring::problems::problems_svg(&src, &path, &base);
+            diags.iter().for_each(|d| eprintln!("{d}"));
+            if let Some(svg) = svg {
+                super::common::write_file(&args.output, svg.as_bytes())?;
+                eprintln!(
+                    "wrote {} with the problems above marked 1..",
+                    args.output.display()
+                );
+            }
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let doors = door_states(&world, &args.open, args.all_open)?;
+    let opts = RenderOptions { doors, ..base };
     let svg = render_world_svg(&world, &opts);
-    placewords::io::atomic::write_atomic(&args.output, svg.as_bytes())
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    super::common::write_file(&args.output, svg.as_bytes())?;
     eprintln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }

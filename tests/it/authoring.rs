@@ -260,3 +260,59 @@ fn a_scenario_over_a_generated_floor_runs() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("generated-laps"));
 }
+
+#[test]
+fn render_of_an_invalid_world_marks_each_problem_and_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bad.svg");
+    let run = placewords(&[
+        "world",
+        "render",
+        "tests/fixtures/invalid/leg-through-wall.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--grid",
+        "--waypoints",
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("leg-through-wall.toml:28:"));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let class = |c: &str| {
+        doc.descendants()
+            .filter(|n| n.attribute("class") == Some(c))
+            .count()
+    };
+    assert_eq!(class("problem"), 1);
+    assert_eq!(class("waypoint"), 6);
+    assert!(doc.descendants().any(|n| n.attribute("id") == Some("grid")));
+    // The problem sits on the waypoint its message points at (waypoint 4 of the route).
+    let mark = doc
+        .descendants()
+        .find(|n| n.attribute("class") == Some("problem"))
+        .and_then(|g| g.first_element_child())
+        .unwrap();
+    let wp4 = doc
+        .descendants()
+        .filter(|n| n.attribute("class") == Some("waypoint"))
+        .nth(3)
+        .and_then(|g| g.first_element_child())
+        .unwrap();
+    assert_eq!(mark.attribute("cx"), wp4.attribute("cx"));
+    assert_eq!(mark.attribute("cy"), wp4.attribute("cy"));
+}
+
+#[test]
+fn render_of_a_file_that_is_not_toml_writes_no_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bad.svg");
+    let run = placewords(&[
+        "world",
+        "render",
+        "tests/fixtures/invalid/syntax-unclosed-string.toml",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(!out.exists());
+}
