@@ -259,7 +259,7 @@ fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)]) -> Vec<WallSpec> {
 /// Generates a floor (see the module docs) as file structures.
 pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError> {
     let (w, h) = opts.size_m;
-    if !(opts.corridors >= 4 && opts.corridors <= 12 && opts.corridors % 2 == 0) {
+    if !((4..=12).contains(&opts.corridors) && opts.corridors.is_multiple_of(2)) {
         return Err(GenerateError::Corridors(opts.corridors));
     }
     if !((24.0..=2000.0).contains(&w) && (24.0..=2000.0).contains(&h)) {
