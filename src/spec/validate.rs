@@ -725,6 +725,15 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
 fn doors_fit_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
         let panel = door_panel(door, false);
+        // A door whose ends are off the walls is reported as not spanning a gap already.
+        let off_wall = |p: Vec2| {
+            walls
+                .nearest(Segment::new(p, p), 1.0)
+                .is_none_or(|(_, c)| c > DOOR_GAP_TOLERANCE_M)
+        };
+        if off_wall(panel.a) || off_wall(panel.b) {
+            continue;
+        }
         let steps = (door.width_m / 0.01).round().max(1.0) as usize;
         let inside = |k: usize| -> Option<usize> {
             let p = panel.a + (panel.b - panel.a) * (k as f64 / steps as f64);

@@ -170,7 +170,7 @@ mod tests {
         assert!(!r.touches_border(&inside));
         assert!(
             !inside[{
-                let (x, y) = r.cell(Vec2::new(5.0, 2.0)).unwrap();
+                let (x, y) = r.cell(Vec2::new(4.5, 2.0)).unwrap();
                 y * r.width + x
             }]
         );
