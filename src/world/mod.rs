@@ -2,9 +2,11 @@
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
 pub mod cell_grid;
+pub mod generate;
 pub mod geometry;
 pub mod info;
 pub mod physics;
+pub mod raster;
 pub mod raycast;
 
 use crate::geom::{Pose2, Segment, Vec2};
