@@ -31,6 +31,8 @@ pub enum Purpose {
     Odometry = 5,
     /// The robot's sideways wander from the route in a lap.
     PathWander = 6,
+    /// The lap's variation plan: lanes, speeds, stops, turns on the spot.
+    LapVariation = 7,
 }
 
 /// The stream for (seed, run, lap, purpose).
