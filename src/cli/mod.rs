@@ -9,6 +9,7 @@ pub mod common;
 pub mod import;
 pub mod recognize;
 pub mod run;
+pub mod score;
 pub mod simulate;
 pub mod sweep;
 pub mod table;
@@ -40,6 +41,8 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
     Recognize(recognize::RecognizeArgs),
+    /// Score any recognizer's matches file against the logs `simulate` wrote.
+    Score(score::ScoreArgs),
 }
 
 pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -51,5 +54,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),
+        Command::Score(a) => score::run(a),
     }
 }

@@ -25,6 +25,10 @@ pub struct RunArgs {
     /// configuration (green correct, red wrong).
     #[arg(long, value_name = "DIR")]
     pub svg: Option<PathBuf>,
+    /// Write the matched scan pairs of the last level configuration run (`--levels N`) as a
+    /// matches file for `placewords score` (docs/scoring.md).
+    #[arg(long, value_name = "FILE")]
+    pub export_matches: Option<PathBuf>,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -39,6 +43,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         quiet: args.quiet,
     };
     let exp = experiment::run_scenario(&scn, &opts)?;
+    if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
+        super::score::export(path, rec, &exp.runs)?;
+    }
     print_and_write(
         &exp,
         &scn.world,

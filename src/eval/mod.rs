@@ -8,6 +8,7 @@
 
 pub mod gate;
 pub mod metrics;
+pub mod pair_recall;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};
