@@ -21,8 +21,8 @@ pub struct RunArgs {
     /// Write the JSON report here (schema in the README).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
-    /// Write pictures here: the true and odometry paths, and the matched pairs of each level
-    /// configuration (green correct, red wrong).
+    /// Write pictures here: the true and odometry paths; per level configuration, the true path
+    /// coloured where revisits were recognized, wrong or missed, and recall and precision per lap.
     #[arg(long, value_name = "DIR")]
     pub svg: Option<PathBuf>,
     /// Write the matched scan pairs of the last level configuration run (`--levels N`) as a
