@@ -128,11 +128,17 @@ pub fn matches_svg(
     };
     opts.legend = vec![
         legend(
-            format!("revisit recognized ({} obs.)", counts(Kind::Recognized)),
+            format!(
+                "recognized, most pairs correct ({} obs.)",
+                counts(Kind::Recognized)
+            ),
             CORRECT_COLOR,
         ),
         legend(
-            format!("recognized wrongly ({} obs.)", counts(Kind::Wrong)),
+            format!(
+                "recognized, most pairs wrong ({} obs.)",
+                counts(Kind::Wrong)
+            ),
             WRONG_COLOR,
         ),
         legend(
@@ -162,9 +168,9 @@ const CLUSTER_CELL_M: f64 = 5.0;
 pub enum Kind {
     /// No revisit and no pair.
     Plain,
-    /// The query of at least one correct pair.
+    /// The query of pairs, at least half of them correct.
     Recognized,
-    /// The query of pairs, none correct.
+    /// The query of pairs, most of them wrong.
     Wrong,
     /// A revisit with no pair at all.
     Missed,
@@ -235,7 +241,7 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
     }
     let kinds = (0..n)
         .map(|i| match pair_counts[i] {
-            (c, _) if c > 0 => Kind::Recognized,
+            (c, t) if c > 0 && 2 * c >= t => Kind::Recognized,
             (_, t) if t > 0 => Kind::Wrong,
             _ if revisits[i] => Kind::Missed,
             _ => Kind::Plain,
@@ -303,7 +309,8 @@ pub fn worst_wrong_clusters(
         )
     };
     type Acc = (crate::geom::Vec2, crate::geom::Vec2, usize);
-    let mut groups: HashMap<((i64, i64), (i64, i64)), Acc> = HashMap::new();
+    type Cells = ((i64, i64), (i64, i64));
+    let mut groups: HashMap<Cells, Acc> = HashMap::new();
     for &(a, b) in wrong {
         let g = groups.entry((cell(a), cell(b))).or_insert((
             crate::geom::Vec2::zeros(),
@@ -314,7 +321,7 @@ pub fn worst_wrong_clusters(
         g.1 += b;
         g.2 += 1;
     }
-    let mut list: Vec<(_, Acc)> = groups.into_iter().collect();
+    let mut list: Vec<(Cells, Acc)> = groups.into_iter().collect();
     // Largest first; ties by cell so the picture does not depend on hash order.
     list.sort_by(|x, y| y.1.2.cmp(&x.1.2).then(x.0.cmp(&y.0)));
     list.into_iter()
@@ -336,7 +343,7 @@ pub fn lap_strip_svg(rec: &Recognition, spec: &EvaluationSpec, title: &str) -> S
         let a = &mut acc[slot];
         if status.revisits[i] {
             a.0 += 1;
-            a.1 += (status.kinds[i] == Kind::Recognized) as usize;
+            a.1 += (status.pair_counts[i].0 > 0) as usize;
         }
         a.2 += status.pair_counts[i].1;
         a.3 += status.pair_counts[i].0;
