@@ -20,6 +20,7 @@ pub mod import;
 pub mod out;
 pub mod recognize;
 pub mod run;
+pub mod score;
 pub mod simulate;
 pub mod sweep;
 pub mod table;
@@ -51,6 +52,8 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
     Recognize(recognize::RecognizeArgs),
+    /// Score any recognizer's matches file against the logs `simulate` wrote.
+    Score(score::ScoreArgs),
 }
 
 pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -62,5 +65,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),
+        Command::Score(a) => score::run(a),
     }
 }

@@ -21,13 +21,17 @@ pub struct RunArgs {
     /// Write the JSON report here (schema in the README).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
-    /// Write pictures here: the true and odometry paths, and the matched pairs of each level
-    /// configuration (green correct, red wrong).
+    /// Write pictures here: the true and odometry paths; per level configuration, the true path
+    /// coloured where revisits were recognized, wrong or missed, and recall and precision per lap.
     #[arg(long, value_name = "DIR")]
     pub svg: Option<PathBuf>,
     /// Replace the scenario's seed.
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
+    /// Write the matched scan pairs of the last level configuration run (`--levels N`) as a
+    /// matches file for `placewords score` (docs/scoring.md).
+    #[arg(long, value_name = "FILE")]
+    pub export_matches: Option<PathBuf>,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -45,6 +49,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         quiet: args.quiet,
     };
     let exp = experiment::run_scenario(&scn, &opts)?;
+    if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
+        super::score::export(path, rec, &exp.runs)?;
+    }
     print_and_write(
         &exp,
         &scn.world,

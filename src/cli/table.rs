@@ -53,7 +53,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         reports.push(exp.report);
     }
     let md = format!(
-        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized):\n\n{}",
+        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized) and pair recall (share of every pair that could be found):\n\n{}",
         markdown_table_i(&reports),
         thresholds_note(&reports),
         markdown_visit_recall(&reports)

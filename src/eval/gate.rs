@@ -1,7 +1,8 @@
 //! The CI gate: a report against a scenario's `[expect]` block.
 //!
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
-//! testcase): `min_precision`, `min_recall` and `max_seconds_per_lap` of each `[[expect.levels]]`
+//! testcase): `min_precision`, `min_recall`, `min_visit_recall`, `min_pair_recall` and
+//! `max_seconds_per_lap` of each `[[expect.levels]]`
 //! entry and of `[expect.icp]`. A bound on a configuration the report does not hold fails
 //! ("not in the report"). Exit decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a
 //! scenario could not be run (an error), else 1 when any outcome missed, else 0.
@@ -16,6 +17,8 @@ use serde::{Deserialize, Serialize};
 pub enum Bound {
     MinPrecision,
     MinRecall,
+    MinVisitRecall,
+    MinPairRecall,
     MaxSecondsPerLap,
 }
 
@@ -48,6 +51,8 @@ impl Outcome {
         match self.bound {
             Bound::MinPrecision => ("precision", ">="),
             Bound::MinRecall => ("recall", ">="),
+            Bound::MinVisitRecall => ("visit recall", ">="),
+            Bound::MinPairRecall => ("pair recall", ">="),
             Bound::MaxSecondsPerLap => ("s/lap", "<="),
         }
     }
@@ -117,6 +122,8 @@ fn push_bounds(
     let bounds = [
         (Bound::MinPrecision, e.min_precision),
         (Bound::MinRecall, e.min_recall),
+        (Bound::MinVisitRecall, e.min_visit_recall),
+        (Bound::MinPairRecall, e.min_pair_recall),
         (Bound::MaxSecondsPerLap, e.max_seconds_per_lap),
     ];
     for (bound, limit) in bounds {
@@ -124,6 +131,8 @@ fn push_bounds(
         let actual = scores.map(|s| match bound {
             Bound::MinPrecision => s.precision,
             Bound::MinRecall => s.recall,
+            Bound::MinVisitRecall => s.visit_recall,
+            Bound::MinPairRecall => s.pair_recall,
             Bound::MaxSecondsPerLap => s.recognize_seconds_per_lap,
         });
         let passed = match (bound, actual) {
@@ -170,6 +179,8 @@ mod tests {
             levels,
             min_precision: Some(p),
             min_recall: Some(r),
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: s,
         }
     }

@@ -10,6 +10,7 @@
 pub mod gate;
 pub mod metrics;
 pub mod scores;
+pub mod pair_recall;
 pub mod sweep;
 
 use crate::geom::TruePose;

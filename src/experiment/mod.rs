@@ -5,6 +5,7 @@
 
 pub mod picture;
 pub mod real;
+pub mod score;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::scores::Report;

@@ -10,7 +10,7 @@ use crate::io::atomic::write_atomic;
 use crate::io::carmen::{LaserRecord, LogRecord, OdomRecord, TruePosRecord, write_record};
 use crate::log::RunLog;
 use crate::spec::scenario::Scenario;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Host name written in every record.
@@ -84,7 +84,7 @@ pub fn carmen_log(scn: &Scenario, run: &RunLog) -> String {
 }
 
 /// The JSON manifest of a simulation.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Manifest {
     pub placewords_version: String,
     pub scenario: String,
@@ -96,7 +96,7 @@ pub struct Manifest {
     pub runs: Vec<ManifestRun>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ManifestRun {
     pub run: usize,
     pub file: String,
@@ -105,7 +105,7 @@ pub struct ManifestRun {
     pub laps: Vec<ManifestLap>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ManifestLap {
     pub lap: usize,
     pub door_config: String,

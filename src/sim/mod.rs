@@ -11,6 +11,7 @@ pub mod pedestrians;
 pub mod rng;
 pub mod robot;
 pub mod runner;
+pub mod variation;
 
 pub use runner::{SimError, simulate};
 

@@ -48,6 +48,12 @@ pub struct LevelExpectation {
     /// Minimum same-direction recall in [0, 1].
     #[serde(default)]
     pub min_recall: Option<f64>,
+    /// Minimum visit recall in [0, 1].
+    #[serde(default)]
+    pub min_visit_recall: Option<f64>,
+    /// Minimum pair recall in [0, 1].
+    #[serde(default)]
+    pub min_pair_recall: Option<f64>,
     /// Maximum recognition time per lap, seconds.
     #[serde(default)]
     pub max_seconds_per_lap: Option<f64>,
@@ -59,6 +65,8 @@ impl LevelExpectation {
         Expectation {
             min_precision: self.min_precision,
             min_recall: self.min_recall,
+            min_visit_recall: self.min_visit_recall,
+            min_pair_recall: self.min_pair_recall,
             max_seconds_per_lap: self.max_seconds_per_lap,
         }
     }
@@ -72,6 +80,10 @@ pub struct Expectation {
     pub min_precision: Option<f64>,
     /// Minimum same-direction recall in [0, 1].
     pub min_recall: Option<f64>,
+    /// Minimum visit recall in [0, 1].
+    pub min_visit_recall: Option<f64>,
+    /// Minimum pair recall in [0, 1].
+    pub min_pair_recall: Option<f64>,
     /// Maximum recognition time per lap, seconds.
     pub max_seconds_per_lap: Option<f64>,
 }

@@ -29,14 +29,19 @@
 //! preset = "lms200"                     # max_range_m, range_noise_m, angle_error_deg, rate_hz, mount_x_m
 //!
 //! [odometry]                            # model "proportional" (default) or "thrun"
-//! model = "proportional"                # translation_error_ratio, rotation_error_ratio (0.0075)
+//! model = "proportional"                # translation_error_ratio, rotation_error_ratio (0.0075),
+//!                                       # proportional_error "each-update" (default) | "random-walk"
 //! # model = "thrun"                     # alpha1..alpha4
 //! # wheel_radius_bias_ratio = 0.0, wheel_radius_mismatch_ratio = 0.0
 //!
 //! [robot]                               # cruise_speed_m_s, max_speed_m_s, max_turn_rate_deg_s,
 //!                                       # accel_m_s2, turn_accel_deg_s2, radius_m, axle_track_m,
 //!                                       # lookahead_m, path_wander_m, stop_distance_m, slow_distance_m,
-//!                                       # blocked_timeout_s, step_s
+//!                                       # blocked_timeout_s, step_s; lap variation
+//!                                       # (crate::sim::variation): lane_offset_ratio,
+//!                                       # lane_margin_m, lap_speed_spread_ratio, speed_wave_ratio,
+//!                                       # stop_spacing_m, stop_duration_s, spin_spacing_m,
+//!                                       # spin_angle_deg
 //! [recognizer]                          # any table, for the recognizer
 //! [evaluation]                          # crate::spec::evaluation::EvaluationSpec
 //! [expect]                              # crate::spec::evaluation::ExpectSpec
@@ -48,9 +53,10 @@
 use crate::geom::Vec2;
 use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
-use crate::sim::odometry::{OdometryConfig, OdometryModel};
+use crate::sim::odometry::{OdometryConfig, OdometryModel, ProportionalError};
 use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
 use crate::sim::robot::RobotConfig;
+use crate::sim::variation::LapVariationConfig;
 use crate::spec::SpecError;
 use crate::spec::diag::{Diagnostic, line_col};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
@@ -159,6 +165,9 @@ pub struct OdometrySpec {
     pub translation_error_ratio: Option<S<f64>>,
     #[serde(default)]
     pub rotation_error_ratio: Option<S<f64>>,
+    /// "each-update" (MobileSim, default) or "random-walk".
+    #[serde(default)]
+    pub proportional_error: Option<S<String>>,
     #[serde(default)]
     pub alpha1: Option<S<f64>>,
     #[serde(default)]
@@ -202,6 +211,22 @@ pub struct RobotSpec {
     pub blocked_timeout_s: Option<S<f64>>,
     #[serde(default)]
     pub step_s: Option<S<f64>>,
+    #[serde(default)]
+    pub lane_offset_ratio: Option<S<f64>>,
+    #[serde(default)]
+    pub lane_margin_m: Option<S<f64>>,
+    #[serde(default)]
+    pub lap_speed_spread_ratio: Option<S<f64>>,
+    #[serde(default)]
+    pub speed_wave_ratio: Option<S<f64>>,
+    #[serde(default)]
+    pub stop_spacing_m: Option<S<f64>>,
+    #[serde(default)]
+    pub stop_duration_s: Option<S<f64>>,
+    #[serde(default)]
+    pub spin_spacing_m: Option<S<f64>>,
+    #[serde(default)]
+    pub spin_angle_deg: Option<S<f64>>,
 }
 
 /// A named set of door states.
@@ -643,6 +668,7 @@ pub fn parse_scenario(
     };
     let odometry = OdometryConfig {
         model,
+        proportional: proportional_error(&o.proportional_error, &mut v),
         wheel_radius_bias_ratio: v.finite(
             "wheel_radius_bias_ratio",
             &o.wheel_radius_bias_ratio,
@@ -688,6 +714,7 @@ pub fn parse_scenario(
         ),
         step_s: v.positive("step_s", &r.step_s, d.step_s),
         path_wander_m: v.non_negative("path_wander_m", &r.path_wander_m, d.path_wander_m),
+        variation: lap_variation(r, &mut v),
     };
     if robot.path_wander_m > 0.5
         && let Some(w) = &r.path_wander_m
@@ -837,6 +864,65 @@ impl Validator<'_> {
 
     fn finite(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
         self.check(key, x, default, f64::is_finite, "finite")
+    }
+}
+
+/// `[odometry] proportional_error`.
+fn proportional_error(x: &Option<S<String>>, v: &mut Validator) -> ProportionalError {
+    match x.as_ref().map(|s| (s.get_ref().as_str(), s.span())) {
+        None | Some(("each-update", _)) => ProportionalError::EachUpdate,
+        Some(("random-walk", _)) => ProportionalError::RandomWalk,
+        Some((other, span)) => {
+            v.err(
+                span,
+                format!(
+                    "unknown proportional_error `{other}`{}",
+                    hint(other, &["each-update", "random-walk"], "forms")
+                ),
+            );
+            ProportionalError::EachUpdate
+        }
+    }
+}
+
+/// The lap variation keys of `[robot]` (see `crate::sim::variation`).
+fn lap_variation(r: &RobotSpec, v: &mut Validator) -> LapVariationConfig {
+    let d = LapVariationConfig::default();
+    let ratio = |v: &mut Validator, key: &str, x: &Option<S<f64>>, default: f64, max: f64| {
+        let val = v.non_negative(key, x, default);
+        if val > max
+            && let Some(x) = x
+        {
+            v.err(
+                x.span(),
+                format!("{key} = {val} is above {max}; use 0-{max}"),
+            );
+            return default;
+        }
+        val
+    };
+    LapVariationConfig {
+        lane_offset_ratio: ratio(v, "lane_offset_ratio", &r.lane_offset_ratio, 0.0, 1.0),
+        lane_margin_m: v.non_negative("lane_margin_m", &r.lane_margin_m, d.lane_margin_m),
+        lap_speed_spread_ratio: ratio(
+            v,
+            "lap_speed_spread_ratio",
+            &r.lap_speed_spread_ratio,
+            0.0,
+            0.9,
+        ),
+        speed_wave_ratio: ratio(v, "speed_wave_ratio", &r.speed_wave_ratio, 0.0, 0.9),
+        stop_spacing_m: v.non_negative("stop_spacing_m", &r.stop_spacing_m, d.stop_spacing_m),
+        stop_duration_s: v.non_negative("stop_duration_s", &r.stop_duration_s, d.stop_duration_s),
+        spin_spacing_m: v.non_negative("spin_spacing_m", &r.spin_spacing_m, d.spin_spacing_m),
+        spin_angle_rad: ratio(
+            v,
+            "spin_angle_deg",
+            &r.spin_angle_deg,
+            d.spin_angle_rad.to_degrees(),
+            720.0,
+        )
+        .to_radians(),
     }
 }
 

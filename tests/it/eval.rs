@@ -279,6 +279,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             levels: 1,
             min_precision: Some(0.5),
             min_recall: Some(0.5),
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: None,
         }],
         icp: Some(Expectation {
@@ -293,6 +295,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             levels: 1,
             min_precision: Some(1.01),
             min_recall: None,
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: None,
         }],
         icp: None,

@@ -384,7 +384,8 @@ fn stats(v: &[f64]) -> (f64, f64) {
 }
 
 /// Over 400 laps, per-lap odometry errors in distance and turned angle have the configured
-/// bias and spread (within 10 %).
+/// bias and spread (within 10 %), for the random-walk form of the proportional model (the
+/// each-update form is checked in `sim::odometry`'s unit tests).
 #[test]
 fn odometry_error_statistics_over_many_laps_match_the_model() {
     let runs: String = (0..80).map(|_| "[[runs]]\nlaps = 5\n").collect();
@@ -398,6 +399,7 @@ route = "lap"
 seed = 11
 [odometry]
 model = "proportional"
+proportional_error = "random-walk"
 translation_error_ratio = 0.0075
 rotation_error_ratio = 0.0075
 wheel_radius_bias_ratio = 0.02
