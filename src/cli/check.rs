@@ -33,7 +33,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| path.display().to_string());
         let outcome = (|| -> anyhow::Result<Vec<gate::Outcome>> {
-            let scn = placewords::spec::scenario::load_scenario(path)?;
+            let scn = placewords::experiment::load_scenario(path)?;
             let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
             levels.sort_unstable();
             levels.dedup();

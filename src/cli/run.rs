@@ -31,7 +31,7 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
@@ -41,7 +41,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let exp = experiment::run_scenario(&scn, &opts)?;
     print_and_write(
         &exp,
-        &scn.world,
+        &scn.sim.world,
         scn.evaluation.tp_radius_m,
         args.report.as_deref(),
         args.svg.as_deref(),

@@ -66,7 +66,7 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
 fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for f in &args.files {
-        match placewords::spec::world::load_world(f) {
+        match placewords::world::load_world(f) {
             Ok(w) => println!(
                 "{}: ok ({} walls, {} doors, {} routes)",
                 f.display(),
@@ -89,7 +89,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
 
 /// Loads a world; on invalid input prints every located problem and returns `None`.
 fn load(path: &std::path::Path) -> Option<World> {
-    match placewords::spec::world::load_world(path) {
+    match placewords::world::load_world(path) {
         Ok(w) => Some(w),
         Err(e) => {
             eprintln!("{e}");

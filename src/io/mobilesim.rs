@@ -32,7 +32,7 @@ use std::collections::{HashMap, VecDeque};
 pub const WALL_THICKNESS_M: f64 = 0.05;
 
 /// Most wall segments a world may hold (the world checks' limit).
-pub const MAX_SEGMENTS: usize = 100_000;
+pub const MAX_SEGMENTS: usize = crate::spec::world::MAX_SEGMENTS;
 
 /// Largest extent of a world, corner to corner, metres (the world checks' limit).
 pub const MAX_EXTENT_M: f64 = 10_000.0;

@@ -8,10 +8,12 @@ pub mod laser;
 pub mod logs;
 pub mod odometry;
 pub mod pedestrians;
+pub mod plan;
 pub mod rng;
 pub mod robot;
 pub mod runner;
 
+pub use plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 pub use runner::{SimError, simulate};
 
 use crate::geom::{OdomPose, TruePose};
