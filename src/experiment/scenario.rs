@@ -1,4 +1,7 @@
-//! The scenario file format (TOML, `format_version = 1`) and its validation.
+//! A checked scenario: the file read by `spec::scenario`, checked against its world and built
+//! into the simulator's plan and the recognizer's, evaluation's and gate's settings. Every
+//! problem is reported at once, each at its value. The format (all keys, units, defaults,
+//! limits) is `docs/scenario-format.md`.
 //!
 //! ```toml
 //! format_version = 1
@@ -43,22 +46,21 @@
 //! ```
 //!
 //! At most one of `doors`, `doors_cycle`, `doors_random` per run; none means all closed.
-//! Every problem is reported as `file:line:col: what is wrong; what to try`.
 
 use crate::geom::Vec2;
 use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
-use crate::sim::odometry::{OdometryConfig, OdometryModel};
+use crate::sim::odometry::{DEFAULT_THRUN_ALPHA, OdometryConfig, OdometryModel};
 use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
 use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 use crate::sim::robot::RobotConfig;
-use crate::spec::SpecError;
-use crate::spec::diag::{Diagnostic, line_col};
+use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
-use crate::spec::scenario::ScenarioSpec;
-use crate::world::{DoorStates, World, WorldCheck};
+use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
+use crate::spec::suggest::hint;
+use crate::spec::{SpecError, scenario::read_scenario};
+use crate::world::{DoorStates, Route, World, WorldCheck};
 use std::collections::BTreeMap;
-use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
@@ -76,700 +78,550 @@ pub struct Scenario {
     pub expect: ExpectSpec,
 }
 
-/// Reads and validates a scenario file and the world it names.
+/// Loads a world file checked for a robot (tests pass a closure that parses a string).
+pub type WorldLoader<'a> = &'a dyn Fn(&Path, &WorldCheck) -> Result<World, SpecError>;
+
+/// Reads and checks a scenario file and the world it names.
 pub fn load_scenario(path: &Path) -> Result<Scenario, SpecError> {
-    let src = crate::spec::diag::read_text(path)?;
+    let src = read_text(path)?;
     parse_scenario(&src, path, &crate::world::load_world_for)
 }
 
-/// Parses and validates a scenario's text. `path` names the file in messages and anchors the
-/// world path; `load_world` loads the world (tests pass a closure that parses a string).
+/// Parses and checks a scenario's text. `path` names the file in messages and anchors the world
+/// path. Every problem of the file is reported, then those of its world.
 pub fn parse_scenario(
     src: &str,
     path: &Path,
-    load_world: &dyn Fn(&Path, &WorldCheck) -> Result<World, SpecError>,
+    load_world: WorldLoader,
 ) -> Result<Scenario, SpecError> {
     let file = path.display().to_string();
-    let spec: ScenarioSpec = match toml::from_str(src) {
-        Ok(s) => s,
-        Err(e) => {
-            let (line, col) = e.span().map(|s| line_col(src, s.start)).unwrap_or((1, 1));
-            return Err(SpecError::Invalid(vec![Diagnostic {
-                path: file,
-                line,
-                col,
-                message: serde_message(e.message()),
-            }]));
-        }
-    };
-    let mut v = Validator {
-        src,
-        file: &file,
-        diags: Vec::new(),
-    };
-    if *spec.format_version.get_ref() != 1 {
-        v.err(
-            spec.format_version.span(),
-            format!(
-                "format_version {} is not supported; use format_version = 1",
-                spec.format_version.get_ref()
-            ),
-        );
+    let mut d = Diags::new(src, &file);
+    let mut world_problems = Vec::new();
+    let built = read_scenario(src, &mut d).and_then(|spec| {
+        let models = Models::build(&spec, &mut d);
+        let world_path = resolve(path, spec.world.get_ref());
+        let check = WorldCheck {
+            robot_radius_m: models.robot.radius_m,
+        };
+        let world = load_for(
+            &spec,
+            &world_path,
+            &check,
+            load_world,
+            &mut d,
+            &mut world_problems,
+        )?;
+        let sim = plan(&spec, world, models, path, world_path, &mut d)?;
+        Some((spec, sim))
+    });
+    let mut diags = d.into_sorted();
+    diags.append(&mut world_problems);
+    match built {
+        Some((spec, sim)) if diags.is_empty() => Ok(Scenario {
+            recognizer: sim.1,
+            sim: sim.0,
+            description: spec.description,
+            evaluation: spec.evaluation,
+            expect: spec.expect,
+        }),
+        _ if diags.is_empty() => Err(SpecError::Invalid(vec![Diagnostic::error(
+            &file,
+            (1, 1),
+            "the file could not be read as a scenario; check it against scenarios/smoke.toml",
+        )])),
+        _ => Err(SpecError::Invalid(diags)),
     }
-    let world_rel = PathBuf::from(spec.world.get_ref());
-    let world_path = match path.parent() {
-        Some(dir) if !world_rel.is_absolute() => dir.join(&world_rel),
-        _ => world_rel.clone(),
-    };
-    // The world is checked for this scenario's robot, so a larger robot is refused here, not
-    // found "blocked" halfway through a run.
-    let check = WorldCheck {
-        robot_radius_m: spec
-            .robot
-            .radius_m
-            .as_ref()
-            .map(|r| *r.get_ref())
-            .filter(|r| r.is_finite() && *r > 0.0)
-            .unwrap_or(RobotConfig::default().radius_m),
-    };
-    let world = match load_world(&world_path, &check) {
-        Ok(w) => w,
+}
+
+/// The world path, relative to the scenario's folder unless absolute.
+fn resolve(scenario: &Path, world: &str) -> PathBuf {
+    let rel = PathBuf::from(world);
+    match scenario.parent() {
+        Some(dir) if !rel.is_absolute() => dir.join(rel),
+        _ => rel,
+    }
+}
+
+/// The world, checked for this scenario's robot, so a larger robot is refused here rather than
+/// found "blocked" halfway through a run. The world's own problems go to `extra`.
+fn load_for(
+    spec: &ScenarioSpec,
+    world_path: &Path,
+    check: &WorldCheck,
+    load_world: WorldLoader,
+    d: &mut Diags,
+    extra: &mut Vec<Diagnostic>,
+) -> Option<World> {
+    let at = spec.world.span().start;
+    let shown = echo(&world_path.display().to_string());
+    match load_world(world_path, check) {
+        Ok(w) => Some(w),
         Err(SpecError::Io { source, .. }) => {
-            v.err(
-                spec.world.span(),
-                format!(
-                    "cannot read world file `{}`: {source}; the path is relative to the scenario file",
-                    world_path.display()
-                ),
-            );
-            return Err(SpecError::Invalid(v.diags));
-        }
-        Err(SpecError::Invalid(mut d)) => {
-            v.err(
-                spec.world.span(),
-                format!(
-                    "world `{}` is invalid; fix the problems listed below",
-                    world_path.display()
-                ),
-            );
-            v.diags.append(&mut d);
-            return Err(SpecError::Invalid(v.diags));
-        }
-    };
-    let route = match world.route(spec.route.get_ref()) {
-        Some(r) => Some(r.clone()),
-        None => {
-            let ids: Vec<&str> = world.routes.iter().map(|r| r.id.as_str()).collect();
-            v.err(
-                spec.route.span(),
-                format!(
-                    "unknown route `{}`{}",
-                    spec.route.get_ref(),
-                    hint(spec.route.get_ref(), &ids, "routes")
-                ),
-            );
+            d.at(at, format!(
+                "cannot read world file `{shown}`: {source}; the path is relative to the scenario file"));
             None
         }
-    };
-    let seed = *spec.seed.get_ref();
-    if seed < 0 {
-        v.err(
-            spec.seed.span(),
-            "seed must be 0 or more; pick any non-negative integer".into(),
-        );
-    }
-
-    // Door configurations.
-    let door_ids: Vec<&str> = world.doors.iter().map(|d| d.id.as_str()).collect();
-    let mut door_configs = BTreeMap::new();
-    for (name, ids) in &spec.door_configs {
-        if RESERVED.contains(&name.as_str()) {
-            v.err(
-                ids.span(),
-                format!("door configuration name `{name}` is reserved; rename it"),
-            );
-        }
-        let mut st = DoorStates::all_closed(&world);
-        for id in ids.get_ref() {
-            match world.door_index(id.get_ref()) {
-                Some(i) => st.open[i] = true,
-                None => v.err(
-                    id.span(),
-                    format!(
-                        "unknown door `{}`{}",
-                        id.get_ref(),
-                        hint(id.get_ref(), &door_ids, "doors")
-                    ),
-                ),
-            }
-        }
-        door_configs.insert(name.clone(), st);
-    }
-    let config_names: Vec<&str> = RESERVED
-        .iter()
-        .copied()
-        .filter(|n| *n != "random")
-        .chain(spec.door_configs.keys().map(String::as_str))
-        .collect();
-    let choice = |v: &mut Validator, name: &S<String>| -> Option<DoorChoice> {
-        let n = name.get_ref().as_str();
-        let states = match n {
-            "all-closed" => Some(DoorStates::all_closed(&world)),
-            "all-open" => Some(DoorStates::all_open(&world)),
-            _ => door_configs.get(n).cloned(),
-        };
-        match states {
-            Some(states) => Some(DoorChoice {
-                name: n.to_string(),
-                states,
-            }),
-            None => {
-                let what = if world.door_index(n).is_some() {
-                    format!(
-                        "`{n}` is a door, not a door configuration; name a set of open doors in \
-                         [door_configs], e.g. only-{n} = [\"{n}\"], and use its name"
-                    )
-                } else {
-                    format!(
-                        "unknown door configuration `{n}`{}",
-                        hint(n, &config_names, "configurations")
-                    )
-                };
-                v.err(name.span(), what);
-                None
-            }
-        }
-    };
-
-    // Runs.
-    let mut runs = Vec::new();
-    if spec.runs.get_ref().is_empty() {
-        v.err(
-            spec.runs.span(),
-            "no runs; add a [[runs]] entry with laps = 1 or more".into(),
-        );
-    }
-    for r in spec.runs.get_ref() {
-        let laps = *r.laps.get_ref();
-        if laps < 1 {
-            v.err(
-                r.laps.span(),
-                format!("laps = {laps}; a run needs 1 lap or more"),
-            );
-        }
-        let start = r.start_waypoint.as_ref().map(|s| *s.get_ref()).unwrap_or(0);
-        if let (Some(s), Some(route)) = (&r.start_waypoint, &route)
-            && (start < 0 || start as usize >= route.waypoints.len())
-        {
-            v.err(
-                s.span(),
-                format!(
-                    "start_waypoint {start} is not a waypoint of route `{}`; use 0 to {}",
-                    route.id,
-                    route.waypoints.len().saturating_sub(1)
-                ),
-            );
-        }
-        let given = [
-            r.doors.is_some(),
-            r.doors_cycle.is_some(),
-            r.doors_random.is_some(),
-        ]
-        .iter()
-        .filter(|b| **b)
-        .count();
-        if given > 1 {
-            v.err(
-                r.laps.span(),
-                "this run sets more than one of doors, doors_cycle and doors_random; keep one"
-                    .into(),
-            );
-        }
-        let doors = if let Some(d) = &r.doors {
-            choice(&mut v, d).map(DoorPlan::Fixed)
-        } else if let Some(c) = &r.doors_cycle {
-            if c.get_ref().is_empty() {
-                v.err(
-                    c.span(),
-                    "doors_cycle is empty; list at least one configuration".into(),
-                );
-            }
-            let list: Vec<_> = c
-                .get_ref()
-                .iter()
-                .filter_map(|n| choice(&mut v, n))
-                .collect();
-            Some(DoorPlan::Cycle(list))
-        } else if let Some(rd) = &r.doors_random {
-            let p = &rd.get_ref().open_probability;
-            if !(0.0..=1.0).contains(p.get_ref()) {
-                v.err(
-                    p.span(),
-                    format!("open_probability {} is outside 0..1", p.get_ref()),
-                );
-            }
-            Some(DoorPlan::Random {
-                open_probability: *p.get_ref(),
-            })
-        } else {
-            Some(DoorPlan::Fixed(DoorChoice {
-                name: "all-closed".into(),
-                states: DoorStates::all_closed(&world),
-            }))
-        };
-        if let Some(doors) = doors {
-            runs.push(RunPlan {
-                start_waypoint: start.max(0) as usize,
-                laps: laps.max(0) as usize,
-                doors,
-            });
-        }
-    }
-
-    // Pedestrians.
-    let mut pedestrians = PedestrianConfig::default();
-    if let Some(p) = &spec.pedestrians {
-        let count = *p.count.get_ref();
-        if count < 0 {
-            v.err(p.count.span(), "count must be 0 or more".into());
-        }
-        pedestrians.count = count.max(0) as usize;
-        let area_ids: Vec<&str> = world.areas.iter().map(|a| a.id.as_str()).collect();
-        for a in &p.areas {
-            match world.areas.iter().find(|w| w.id == *a.get_ref()) {
-                Some(area) => pedestrians.sources.push(WalkSource::Area(area.clone())),
-                None => v.err(
-                    a.span(),
-                    format!(
-                        "unknown area `{}`{}",
-                        a.get_ref(),
-                        hint(a.get_ref(), &area_ids, "areas")
-                    ),
-                ),
-            }
-        }
-        for path in &p.paths_m {
-            let pts: Vec<Vec2> = path
-                .get_ref()
-                .iter()
-                .map(|q| Vec2::new(q[0], q[1]))
-                .collect();
-            if pts.len() < 2 || pts.iter().any(|q| !q.x.is_finite() || !q.y.is_finite()) {
-                v.err(
-                    path.span(),
-                    "a path needs at least two finite points [x, y]".into(),
-                );
+        Err(SpecError::Invalid(mut problems)) => {
+            let robot = if *check == WorldCheck::default() {
+                String::new()
             } else {
-                pedestrians.sources.push(WalkSource::Path(pts));
-            }
-        }
-        if count > 0 && p.areas.is_empty() && p.paths_m.is_empty() {
-            v.err(
-                p.count.span(),
-                "pedestrians need somewhere to walk; add areas = [..] or paths_m = [..]".into(),
+                format!(
+                    " for this scenario's robot (radius_m = {})",
+                    check.robot_radius_m
+                )
+            };
+            d.at(
+                at,
+                format!("world `{shown}` is invalid{robot}; fix the problems listed below"),
             );
-        }
-        pedestrians.speed_min_m_s = v.positive("speed_min_m_s", &p.speed_min_m_s, 0.5);
-        pedestrians.speed_max_m_s = v.positive("speed_max_m_s", &p.speed_max_m_s, 1.2);
-        pedestrians.radius_m = v.positive("radius_m", &p.radius_m, 0.2);
-        if pedestrians.speed_max_m_s < pedestrians.speed_min_m_s
-            && let Some(s) = &p.speed_max_m_s
-        {
-            v.err(
-                s.span(),
-                "speed_max_m_s is below speed_min_m_s; swap them".into(),
-            );
+            extra.append(&mut problems);
+            None
         }
     }
+}
 
-    // Laser.
-    let l = &spec.laser;
-    let preset = match &l.preset {
-        None => LaserPreset::Lms200,
-        Some(p) => LaserPreset::from_name(p.get_ref()).unwrap_or_else(|| {
-            v.err(
-                p.span(),
-                format!(
-                    "unknown laser preset `{}`{}",
-                    p.get_ref(),
-                    hint(p.get_ref(), &LaserPreset::NAMES, "presets")
-                ),
-            );
-            LaserPreset::Lms200
-        }),
+/// The settings that need no world: laser, odometry, robot, recognizer.
+struct Models {
+    laser: LaserConfig,
+    odometry: OdometryConfig,
+    robot: RobotConfig,
+    recognizer: RecognizerConfig,
+}
+
+impl Models {
+    fn build(spec: &ScenarioSpec, d: &mut Diags) -> Models {
+        Models {
+            laser: laser(&spec.laser, d),
+            odometry: odometry(&spec.odometry, d),
+            robot: robot(&spec.robot, d),
+            recognizer: recognizer(&spec.recognizer, d),
+        }
+    }
+}
+
+/// What a number must be.
+#[derive(Clone, Copy)]
+enum Rule {
+    Positive,
+    NonNegative,
+    Finite,
+}
+
+/// The number given for `key`, or `default` (the model's own) when absent or out of range.
+fn value(d: &mut Diags, s: &Settings, key: &str, default: f64, rule: Rule) -> f64 {
+    let Some(x) = s.get(key) else {
+        return default;
     };
-    let mut laser = LaserConfig::preset(preset);
-    laser.max_range_m = v.positive("max_range_m", &l.max_range_m, laser.max_range_m);
-    laser.range_noise_m = v.non_negative("range_noise_m", &l.range_noise_m, laser.range_noise_m);
-    laser.angle_error_rad = v
-        .non_negative(
-            "angle_error_deg",
-            &l.angle_error_deg,
-            laser.angle_error_rad.to_degrees(),
-        )
-        .to_radians();
-    laser.rate_hz = v.positive("rate_hz", &l.rate_hz, laser.rate_hz);
-    laser.mount_x_m = v.finite("mount_x_m", &l.mount_x_m, laser.mount_x_m);
+    let v = *x.get_ref();
+    let (ok, what) = match rule {
+        Rule::Positive => (v > 0.0, "positive"),
+        Rule::NonNegative => (v >= 0.0, "non-negative"),
+        Rule::Finite => (true, "finite"),
+    };
+    if ok && v.is_finite() {
+        return v;
+    }
+    d.at(
+        x.span().start,
+        format!("{key} = {v} is out of range; use a {what} number (default {default})"),
+    );
+    default
+}
 
-    // Odometry.
-    let o = &spec.odometry;
-    let model_name = o
-        .model
+/// A name out of `known`, or an error with a "did you mean".
+fn named<'a>(d: &mut Diags, name: &S<String>, known: &[&'a str], what: &str) -> Option<&'a str> {
+    let n = name.get_ref().as_str();
+    let found = known.iter().find(|k| **k == n).copied();
+    if found.is_none() {
+        let h = hint(n, known.iter().copied(), &format!("{what}s"));
+        d.at(
+            name.span().start,
+            format!("unknown {what} `{}`; {h}", echo(n)),
+        );
+    }
+    found
+}
+
+fn laser(s: &Settings, d: &mut Diags) -> LaserConfig {
+    let preset = s
+        .name
         .as_ref()
-        .map(|m| m.get_ref().as_str())
-        .unwrap_or("proportional");
-    let alphas = [&o.alpha1, &o.alpha2, &o.alpha3, &o.alpha4];
-    let model = match model_name {
-        "thrun" => {
-            for (k, t) in [
-                ("translation_error_ratio", &o.translation_error_ratio),
-                ("rotation_error_ratio", &o.rotation_error_ratio),
-            ] {
-                if let Some(t) = t {
-                    v.err(
-                        t.span(),
-                        format!(
-                            "{k} applies to model = \"proportional\"; remove it or change the model"
-                        ),
-                    );
-                }
-            }
-            let d = [0.01, 0.01, 0.01, 0.01];
-            let mut a = [0.0; 4];
-            for i in 0..4 {
-                a[i] = v.non_negative(ALPHA_NAMES[i], alphas[i], d[i]);
-            }
-            OdometryModel::Thrun { alpha: a }
-        }
-        other => {
-            if other != "proportional"
-                && let Some(m) = &o.model
-            {
-                v.err(
-                    m.span(),
-                    format!(
-                        "unknown odometry model `{other}`{}",
-                        hint(other, &["proportional", "thrun"], "models")
-                    ),
-                );
-            }
-            for (i, a) in alphas.iter().enumerate() {
-                if let Some(a) = a {
-                    v.err(a.span(), format!("alpha{} applies to model = \"thrun\"; remove it or set model = \"thrun\"", i + 1));
-                }
-            }
-            OdometryModel::Proportional {
-                translation_ratio: v.non_negative(
-                    "translation_error_ratio",
-                    &o.translation_error_ratio,
-                    0.0075,
-                ),
-                rotation_ratio: v.non_negative(
-                    "rotation_error_ratio",
-                    &o.rotation_error_ratio,
-                    0.0075,
-                ),
-            }
-        }
-    };
-    let odometry = OdometryConfig {
-        model,
-        wheel_radius_bias_ratio: v.finite(
-            "wheel_radius_bias_ratio",
-            &o.wheel_radius_bias_ratio,
-            0.0,
-        ),
-        wheel_radius_mismatch_ratio: v.finite(
-            "wheel_radius_mismatch_ratio",
-            &o.wheel_radius_mismatch_ratio,
-            0.0,
-        ),
-    };
+        .and_then(|p| named(d, p, &LaserPreset::NAMES, "laser preset"))
+        .and_then(LaserPreset::from_name)
+        .unwrap_or(LaserPreset::Lms200);
+    let mut l = LaserConfig::preset(preset);
+    l.max_range_m = value(d, s, "max_range_m", l.max_range_m, Rule::Positive);
+    l.range_noise_m = value(d, s, "range_noise_m", l.range_noise_m, Rule::NonNegative);
+    let angle_deg = l.angle_error_rad.to_degrees();
+    l.angle_error_rad = value(d, s, "angle_error_deg", angle_deg, Rule::NonNegative).to_radians();
+    l.rate_hz = value(d, s, "rate_hz", l.rate_hz, Rule::Positive);
+    l.mount_x_m = value(d, s, "mount_x_m", l.mount_x_m, Rule::Finite);
+    l
+}
 
-    // Robot.
-    let r = &spec.robot;
-    let d = RobotConfig::default();
-    let robot = RobotConfig {
-        radius_m: v.positive("radius_m", &r.radius_m, d.radius_m),
-        axle_track_m: v.positive("axle_track_m", &r.axle_track_m, d.axle_track_m),
-        cruise_speed_m_s: v.positive("cruise_speed_m_s", &r.cruise_speed_m_s, d.cruise_speed_m_s),
-        max_speed_m_s: v.positive("max_speed_m_s", &r.max_speed_m_s, d.max_speed_m_s),
-        max_turn_rate_rad_s: v
-            .positive(
-                "max_turn_rate_deg_s",
-                &r.max_turn_rate_deg_s,
-                d.max_turn_rate_rad_s.to_degrees(),
-            )
-            .to_radians(),
-        accel_m_s2: v.positive("accel_m_s2", &r.accel_m_s2, d.accel_m_s2),
-        turn_accel_rad_s2: v
-            .positive(
-                "turn_accel_deg_s2",
-                &r.turn_accel_deg_s2,
-                d.turn_accel_rad_s2.to_degrees(),
-            )
-            .to_radians(),
-        lookahead_m: v.positive("lookahead_m", &r.lookahead_m, d.lookahead_m),
-        stop_distance_m: v.non_negative("stop_distance_m", &r.stop_distance_m, d.stop_distance_m),
-        slow_distance_m: v.non_negative("slow_distance_m", &r.slow_distance_m, d.slow_distance_m),
-        blocked_timeout_s: v.positive(
-            "blocked_timeout_s",
-            &r.blocked_timeout_s,
-            d.blocked_timeout_s,
-        ),
-        step_s: v.positive("step_s", &r.step_s, d.step_s),
-        path_wander_m: v.non_negative("path_wander_m", &r.path_wander_m, d.path_wander_m),
+const ALPHA_NAMES: [&str; 4] = ["alpha1", "alpha2", "alpha3", "alpha4"];
+const RATIO_NAMES: [&str; 2] = ["translation_error_ratio", "rotation_error_ratio"];
+
+fn odometry(s: &Settings, d: &mut Diags) -> OdometryConfig {
+    let mut o = OdometryConfig::default();
+    let thrun = match &s.name {
+        Some(m) => named(d, m, &["proportional", "thrun"], "odometry model") == Some("thrun"),
+        None => false,
     };
-    if robot.path_wander_m > 0.5
-        && let Some(w) = &r.path_wander_m
-    {
-        v.err(
-            w.span(),
+    // Keys of the other model are a mistake, not silently ignored.
+    let (other, fix) = if thrun {
+        (
+            &RATIO_NAMES[..],
+            "proportional\"; remove it or change the model",
+        )
+    } else {
+        (
+            &ALPHA_NAMES[..],
+            "thrun\"; remove it or set model = \"thrun\"",
+        )
+    };
+    for key in other {
+        if let Some(x) = s.get(key) {
+            d.at(x.span().start, format!("{key} applies to model = \"{fix}"));
+        }
+    }
+    o.model = match (thrun, o.model) {
+        (true, _) => {
+            let mut alpha = DEFAULT_THRUN_ALPHA;
+            for (a, key) in alpha.iter_mut().zip(ALPHA_NAMES) {
+                *a = value(d, s, key, *a, Rule::NonNegative);
+            }
+            OdometryModel::Thrun { alpha }
+        }
+        (
+            false,
+            OdometryModel::Proportional {
+                translation_ratio,
+                rotation_ratio,
+            },
+        ) => OdometryModel::Proportional {
+            translation_ratio: value(d, s, RATIO_NAMES[0], translation_ratio, Rule::NonNegative),
+            rotation_ratio: value(d, s, RATIO_NAMES[1], rotation_ratio, Rule::NonNegative),
+        },
+        (false, model) => model,
+    };
+    let bias = o.wheel_radius_bias_ratio;
+    o.wheel_radius_bias_ratio = value(d, s, "wheel_radius_bias_ratio", bias, Rule::Finite);
+    let mismatch = o.wheel_radius_mismatch_ratio;
+    o.wheel_radius_mismatch_ratio =
+        value(d, s, "wheel_radius_mismatch_ratio", mismatch, Rule::Finite);
+    o
+}
+
+fn robot(s: &Settings, d: &mut Diags) -> RobotConfig {
+    use Rule::*;
+    let mut r = RobotConfig::default();
+    r.radius_m = value(d, s, "radius_m", r.radius_m, Positive);
+    r.axle_track_m = value(d, s, "axle_track_m", r.axle_track_m, Positive);
+    r.cruise_speed_m_s = value(d, s, "cruise_speed_m_s", r.cruise_speed_m_s, Positive);
+    r.max_speed_m_s = value(d, s, "max_speed_m_s", r.max_speed_m_s, Positive);
+    let turn_deg = r.max_turn_rate_rad_s.to_degrees();
+    r.max_turn_rate_rad_s = value(d, s, "max_turn_rate_deg_s", turn_deg, Positive).to_radians();
+    r.accel_m_s2 = value(d, s, "accel_m_s2", r.accel_m_s2, Positive);
+    let turn_accel_deg = r.turn_accel_rad_s2.to_degrees();
+    r.turn_accel_rad_s2 = value(d, s, "turn_accel_deg_s2", turn_accel_deg, Positive).to_radians();
+    r.lookahead_m = value(d, s, "lookahead_m", r.lookahead_m, Positive);
+    r.stop_distance_m = value(d, s, "stop_distance_m", r.stop_distance_m, NonNegative);
+    r.slow_distance_m = value(d, s, "slow_distance_m", r.slow_distance_m, NonNegative);
+    // Their ranges were checked while reading (the limits that keep a run finite).
+    r.blocked_timeout_s = value(d, s, "blocked_timeout_s", r.blocked_timeout_s, Finite);
+    r.step_s = value(d, s, "step_s", r.step_s, Finite);
+    r.path_wander_m = value(d, s, "path_wander_m", r.path_wander_m, NonNegative);
+    robot_cross_checks(s, &r, d);
+    r
+}
+
+fn robot_cross_checks(s: &Settings, r: &RobotConfig, d: &mut Diags) {
+    if let Some(w) = s.get("path_wander_m").filter(|_| r.path_wander_m > 0.5) {
+        d.at(
+            w.span().start,
             "path_wander_m above 0.5 m takes the robot off 2 m corridors; use 0.1-0.3".into(),
         );
     }
-    if robot.cruise_speed_m_s > robot.max_speed_m_s
-        && let Some(c) = &r.cruise_speed_m_s
+    if let Some(c) = s
+        .get("cruise_speed_m_s")
+        .filter(|_| r.cruise_speed_m_s > r.max_speed_m_s)
     {
-        v.err(
-            c.span(),
+        d.at(
+            c.span().start,
             format!(
                 "cruise_speed_m_s exceeds max_speed_m_s ({}); lower it",
-                robot.max_speed_m_s
+                r.max_speed_m_s
             ),
         );
     }
-    if let Some(s) = &r.step_s
-        && *s.get_ref() > 0.5
-    {
-        v.err(
-            s.span(),
-            "step_s above 0.5 s is too coarse; use 0.05".into(),
-        );
-    }
+}
 
-    // Evaluation sanity.
-    let ev = &spec.evaluation;
-    if !(ev.tp_radius_m > 0.0 && ev.min_gap_m >= 0.0 && ev.heading_tolerance_deg > 0.0) {
-        v.err(
-            find_key(src, "[evaluation]"),
-            "tp_radius_m and heading_tolerance_deg must be positive and min_gap_m 0 or more".into(),
-        );
-    }
-    for l in &spec.expect.levels {
-        if !(1..=3).contains(&l.levels) {
-            v.err(
-                find_key(src, "[[expect.levels]]"),
-                format!("levels = {}; use 1, 2 or 3", l.levels),
+/// The `[recognizer]` keys over [`RecognizerConfig::default`]; each problem at its key.
+fn recognizer(entries: &[(S<String>, toml::Value)], d: &mut Diags) -> RecognizerConfig {
+    let defaults = toml::Table::try_from(RecognizerConfig::default()).unwrap_or_default();
+    let known: Vec<&str> = defaults.keys().map(String::as_str).collect();
+    let mut table = defaults.clone();
+    let mut ok = true;
+    for (key, v) in entries {
+        let k = key.get_ref();
+        if !known.contains(&k.as_str()) {
+            let h = hint(k, known.iter().copied(), "keys here");
+            d.at(
+                key.span().start,
+                format!("unknown key `{}` in [recognizer]; {h}", echo(k)),
             );
+            ok = false;
+            continue;
         }
-        for p in [l.min_precision, l.min_recall].into_iter().flatten() {
-            if !(0.0..=1.0).contains(&p) {
-                v.err(
-                    find_key(src, "[[expect.levels]]"),
-                    format!("threshold {p} is outside 0..1"),
-                );
-            }
+        let mut one = defaults.clone();
+        one.insert(k.clone(), v.clone());
+        if let Err(e) = one.try_into::<RecognizerConfig>() {
+            let msg = e.message().trim().replace('\n', " ");
+            d.at(key.span().start, format!("[recognizer] {k}: {msg}"));
+            ok = false;
         }
+        table.insert(k.clone(), v.clone());
     }
-
-    // Recognizer settings: the table over the defaults; each problem at its key.
-    let recognizer = recognizer_settings(&spec.recognizer, src, &mut v);
-
-    if !v.diags.is_empty() {
-        return Err(SpecError::Invalid(v.diags));
+    let cfg = match table.try_into::<RecognizerConfig>() {
+        Ok(cfg) if ok => cfg,
+        _ => return RecognizerConfig::default(),
+    };
+    for p in cfg.problems() {
+        let at = entries.iter().find(|(k, _)| k.get_ref() == p.field);
+        let at = at
+            .or(entries.first())
+            .map(|(k, _)| k.span().start)
+            .unwrap_or(0);
+        d.at(at, format!("[recognizer] {}: {}", p.field, p.problem));
     }
+    cfg
+}
+
+/// The simulation plan and recognizer settings: everything checked against the world.
+fn plan(
+    spec: &ScenarioSpec,
+    world: World,
+    models: Models,
+    path: &Path,
+    world_path: PathBuf,
+    d: &mut Diags,
+) -> Option<(SimPlan, RecognizerConfig)> {
+    let route = route(spec, &world, d);
+    let door_configs = door_configs(spec, &world, d);
+    let doors = Doors {
+        world: &world,
+        configs: &door_configs,
+    };
+    let runs: Vec<RunPlan> = spec
+        .runs
+        .iter()
+        .filter_map(|r| run(r, route.as_ref(), &doors, d))
+        .collect();
+    let pedestrians = pedestrians(spec.pedestrians.as_ref(), &world, d);
     let name = spec.name.clone().unwrap_or_else(|| {
         path.file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "scenario".into())
     });
-    Ok(Scenario {
-        sim: SimPlan {
-            name,
-            path: path.to_path_buf(),
-            world_path,
-            world,
-            route: route.expect("checked above"),
-            seed: seed as u64,
-            runs,
-            door_configs,
-            pedestrians,
-            laser,
-            odometry,
-            robot,
-        },
-        description: spec.description.clone(),
-        recognizer,
-        evaluation: spec.evaluation.clone(),
-        expect: spec.expect.clone(),
-    })
+    let sim = SimPlan {
+        name,
+        path: path.to_path_buf(),
+        world_path,
+        route: route?,
+        seed: *spec.seed.get_ref(),
+        runs,
+        door_configs,
+        pedestrians,
+        laser: models.laser,
+        odometry: models.odometry,
+        robot: models.robot,
+        world,
+    };
+    Some((sim, models.recognizer))
 }
 
-const ALPHA_NAMES: [&str; 4] = ["alpha1", "alpha2", "alpha3", "alpha4"];
+fn route(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> Option<Route> {
+    let id = spec.route.get_ref();
+    let found = world.route(id).cloned();
+    if found.is_none() {
+        let h = hint(id, world.routes.iter().map(|r| r.id.as_str()), "routes");
+        d.at(
+            spec.route.span().start,
+            format!("unknown route `{}`; {h}", echo(id)),
+        );
+    }
+    found
+}
 
+/// Door configuration names a file may not define.
 const RESERVED: [&str; 3] = ["all-closed", "all-open", "random"];
 
-struct Validator<'a> {
-    src: &'a str,
-    file: &'a str,
-    diags: Vec<Diagnostic>,
-}
-
-impl Validator<'_> {
-    fn err(&mut self, span: Range<usize>, message: String) {
-        let (line, col) = line_col(self.src, span.start);
-        self.diags.push(Diagnostic {
-            path: self.file.to_string(),
-            line,
-            col,
-            message,
-        });
-    }
-
-    fn check(
-        &mut self,
-        key: &str,
-        x: &Option<S<f64>>,
-        default: f64,
-        ok: fn(f64) -> bool,
-        what: &str,
-    ) -> f64 {
-        match x {
-            None => default,
-            Some(s) => {
-                let val = *s.get_ref();
-                if ok(val) {
-                    val
-                } else {
-                    self.err(
-                        s.span(),
-                        format!(
-                            "{key} = {val} is out of range; use a {what} number (default {default})"
-                        ),
-                    );
-                    default
-                }
-            }
-        }
-    }
-
-    fn positive(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(key, x, default, |v| v.is_finite() && v > 0.0, "positive")
-    }
-
-    fn non_negative(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(
-            key,
-            x,
-            default,
-            |v| v.is_finite() && v >= 0.0,
-            "non-negative",
-        )
-    }
-
-    fn finite(&mut self, key: &str, x: &Option<S<f64>>, default: f64) -> f64 {
-        self.check(key, x, default, f64::is_finite, "finite")
-    }
-}
-
-/// Byte offset of a table header, for problems found after deserializing (start of file if
-/// absent).
-/// The `[recognizer]` table as settings; unknown keys (with "did you mean") and bad values are
-/// reported at the key's line.
-fn recognizer_settings(table: &toml::Table, src: &str, v: &mut Validator) -> RecognizerConfig {
-    let section = src.find("[recognizer]").unwrap_or(0);
-    let key_at = |key: &str| -> Range<usize> {
-        let at = src[section..]
-            .find(&format!("\n{key}"))
-            .map(|i| section + i + 1)
-            .unwrap_or(section);
-        at..at
-    };
-    let known: Vec<String> = match toml::Table::try_from(RecognizerConfig::default()) {
-        Ok(t) => t.keys().cloned().collect(),
-        Err(_) => Vec::new(),
-    };
-    let known_refs: Vec<&str> = known.iter().map(String::as_str).collect();
-    let mut unknown = false;
-    for key in table.keys() {
-        if !known.contains(key) {
-            unknown = true;
-            v.err(
-                key_at(key),
+fn door_configs(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> BTreeMap<String, DoorStates> {
+    let mut out = BTreeMap::new();
+    for (name, ids) in &spec.door_configs {
+        if RESERVED.contains(&name.get_ref().as_str()) {
+            d.at(
+                name.span().start,
                 format!(
-                    "unknown key `{key}` in [recognizer]{}",
-                    hint(key, &known_refs, "keys")
+                    "door configuration name `{}` is reserved; rename it",
+                    name.get_ref()
                 ),
             );
         }
+        let mut st = DoorStates::all_closed(world);
+        for id in ids {
+            match world.door_index(id.get_ref()) {
+                Some(i) => st.open[i] = true,
+                None => {
+                    let h = hint(
+                        id.get_ref(),
+                        world.doors.iter().map(|x| x.id.as_str()),
+                        "doors",
+                    );
+                    d.at(
+                        id.span().start,
+                        format!("unknown door `{}`; {h}", echo(id.get_ref())),
+                    );
+                }
+            }
+        }
+        out.insert(name.get_ref().clone(), st);
     }
-    if unknown {
-        return RecognizerConfig::default();
+    out
+}
+
+/// What a run's door names are looked up in.
+struct Doors<'a> {
+    world: &'a World,
+    configs: &'a BTreeMap<String, DoorStates>,
+}
+
+impl Doors<'_> {
+    fn choice(&self, name: &S<String>, d: &mut Diags) -> Option<DoorChoice> {
+        let n = name.get_ref().as_str();
+        let states = match n {
+            "all-closed" => Some(DoorStates::all_closed(self.world)),
+            "all-open" => Some(DoorStates::all_open(self.world)),
+            _ => self.configs.get(n).cloned(),
+        };
+        if let Some(states) = states {
+            return Some(DoorChoice {
+                name: n.to_string(),
+                states,
+            });
+        }
+        let what = if self.world.door_index(n).is_some() {
+            format!(
+                "`{n}` is a door, not a door configuration; name a set of open doors in \
+                 [door_configs], e.g. only-{n} = [\"{n}\"], and use its name"
+            )
+        } else {
+            let names = RESERVED[..2]
+                .iter()
+                .copied()
+                .chain(self.configs.keys().map(String::as_str));
+            format!(
+                "unknown door configuration `{}`; {}",
+                echo(n),
+                hint(n, names, "configurations")
+            )
+        };
+        d.at(name.span().start, what);
+        None
     }
-    match table.clone().try_into::<RecognizerConfig>() {
-        Ok(cfg) => {
-            for p in cfg.problems() {
-                v.err(
-                    key_at(p.field),
-                    format!("[recognizer] {}: {}", p.field, p.problem),
+}
+
+fn run(r: &RunSpec, route: Option<&Route>, doors: &Doors, d: &mut Diags) -> Option<RunPlan> {
+    let start = r.start_waypoint.as_ref().map(|s| *s.get_ref()).unwrap_or(0);
+    if let (Some(s), Some(route)) = (&r.start_waypoint, route) {
+        let n = route.waypoints.len();
+        if start < 0 || start as usize >= n {
+            d.at(s.span().start, format!(
+                "start_waypoint {start} is not a waypoint of route `{}`; use 0 (the first) to {} \
+                 (the last); messages about the world count waypoints from 1",
+                route.id, n.saturating_sub(1)));
+        }
+    }
+    let plan = match &r.doors {
+        None => DoorPlan::Fixed(DoorChoice {
+            name: "all-closed".into(),
+            states: DoorStates::all_closed(doors.world),
+        }),
+        Some(DoorsSpec::Fixed(name)) => DoorPlan::Fixed(doors.choice(name, d)?),
+        Some(DoorsSpec::Cycle(list)) => {
+            if list.get_ref().is_empty() {
+                d.at(
+                    list.span().start,
+                    "doors_cycle is empty; list at least one configuration".into(),
                 );
             }
-            cfg
+            DoorPlan::Cycle(
+                list.get_ref()
+                    .iter()
+                    .filter_map(|n| doors.choice(n, d))
+                    .collect(),
+            )
         }
-        Err(e) => {
-            v.err(
-                key_at("[recognizer]"),
-                format!("[recognizer]: {}", serde_message(e.message())),
-            );
-            RecognizerConfig::default()
+        Some(DoorsSpec::Random(p)) => DoorPlan::Random {
+            open_probability: *p.get_ref(),
+        },
+    };
+    Some(RunPlan {
+        start_waypoint: start.max(0) as usize,
+        laps: *r.laps.get_ref(),
+        doors: plan,
+    })
+}
+
+fn pedestrians(p: Option<&PedestriansSpec>, world: &World, d: &mut Diags) -> PedestrianConfig {
+    let mut cfg = PedestrianConfig::default();
+    let Some(p) = p else {
+        return cfg;
+    };
+    cfg.count = *p.count.get_ref();
+    for a in &p.areas {
+        match world.areas.iter().find(|w| w.id == *a.get_ref()) {
+            Some(area) => cfg.sources.push(WalkSource::Area(area.clone())),
+            None => {
+                let h = hint(
+                    a.get_ref(),
+                    world.areas.iter().map(|x| x.id.as_str()),
+                    "areas",
+                );
+                d.at(
+                    a.span().start,
+                    format!("unknown area `{}`; {h}", echo(a.get_ref())),
+                );
+            }
         }
     }
-}
-
-fn find_key(src: &str, header: &str) -> Range<usize> {
-    let at = src.find(header).unwrap_or(0);
-    at..at
-}
-
-/// "; did you mean `x`?" for the closest name, or "; known `what`: a, b, c".
-pub fn hint(name: &str, known: &[&str], what: &str) -> String {
-    let best = known
-        .iter()
-        .map(|k| (strsim::jaro_winkler(name, k), *k))
-        .filter(|(s, _)| *s > 0.8)
-        .max_by(|a, b| a.0.total_cmp(&b.0));
-    match best {
-        Some((_, k)) => format!("; did you mean `{k}`?"),
-        None if known.is_empty() => format!("; there are no {what}"),
-        None => format!("; known {what}: {}", known.join(", ")),
+    for path in &p.paths_m {
+        let pts = path
+            .get_ref()
+            .iter()
+            .map(|q| Vec2::new(q[0], q[1]))
+            .collect();
+        cfg.sources.push(WalkSource::Path(pts));
     }
-}
-
-/// Serde's message, lowercase, with a "did you mean" for unknown fields.
-fn serde_message(msg: &str) -> String {
-    let msg = msg.trim();
-    if let Some(rest) = msg.strip_prefix("unknown field `")
-        && let Some((field, tail)) = rest.split_once('`')
-    {
-        let expected: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
-        return format!(
-            "unknown field `{field}`{}",
-            hint(field, &expected, "fields")
+    if cfg.count > 0 && p.areas.is_empty() && p.paths_m.is_empty() {
+        d.at(
+            p.count.span().start,
+            "pedestrians need somewhere to walk; add areas = [..] or paths_m = [..]".into(),
         );
     }
-    if let Some(rest) = msg.strip_prefix("unknown variant `")
-        && let Some((v, tail)) = rest.split_once('`')
+    let s = &p.settings;
+    cfg.speed_min_m_s = value(d, s, "speed_min_m_s", cfg.speed_min_m_s, Rule::Positive);
+    cfg.speed_max_m_s = value(d, s, "speed_max_m_s", cfg.speed_max_m_s, Rule::Positive);
+    cfg.radius_m = value(d, s, "radius_m", cfg.radius_m, Rule::Positive);
+    if let Some(x) = s
+        .get("speed_max_m_s")
+        .filter(|_| cfg.speed_max_m_s < cfg.speed_min_m_s)
     {
-        let expected: Vec<&str> = tail.split('`').skip(1).step_by(2).collect();
-        return format!("unknown value `{v}`{}", hint(v, &expected, "values"));
+        d.at(
+            x.span().start,
+            "speed_max_m_s is below speed_min_m_s; swap them".into(),
+        );
     }
-    let mut m = msg.replace('\n', " ");
-    if let Some(f) = m.get(0..1) {
-        m = f.to_lowercase() + &m[1..];
-    }
-    if m.starts_with("missing field") {
-        m.push_str("; add it");
-    }
-    m
+    cfg
 }

@@ -37,6 +37,9 @@ pub enum OdometryModel {
     Thrun { alpha: [f64; 4] },
 }
 
+/// Thrun's α1..α4 when a file names `model = "thrun"` without giving them.
+pub const DEFAULT_THRUN_ALPHA: [f64; 4] = [0.01; 4];
+
 /// Odometry parameters. Default: proportional 0.0075 m/m and rad/rad, no systematic error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct OdometryConfig {

@@ -7,7 +7,7 @@
 //! key is looked up, checked and located independently, so one mistake never hides the next.
 //! The file structs stay plain (`WorldSpec`, `ScenarioSpec`), with their defaults in one place.
 
-use crate::spec::diag::Diags;
+use crate::spec::diag::{Diags, echo};
 use crate::spec::suggest;
 use crate::spec::world::MAX_SEGMENTS;
 use toml::Spanned;
@@ -62,7 +62,7 @@ pub(crate) fn unknown_keys(t: &DeTable<'_>, known: &[&str], ctx: &str, d: &mut D
             let hint = suggest::hint(name, known.iter().copied(), "keys here");
             d.at(
                 k.span().start,
-                format!("unknown key `{name}` in {ctx}; {hint}"),
+                format!("unknown key `{}` in {ctx}; {hint}", echo(name)),
             );
         }
     }
@@ -274,7 +274,8 @@ pub(crate) fn id(
         d.at(
             at,
             format!(
-                "id {s:?} in {ctx} is not a plain id; use letters, digits, `-`, `_` or `.` only (e.g. \"n-03\")"
+                "id {:?} in {ctx} is not a plain id; use letters, digits, `-`, `_` or `.` only (e.g. \"n-03\")",
+                echo(&s)
             ),
         );
         return (None, at);
@@ -462,4 +463,100 @@ pub(crate) fn read_entries<T, L>(
         }
     }
     Some((items, locs))
+}
+
+/// The table under `key`, or an error when it is something else; `None` when absent.
+pub(crate) fn table<'t, 'i>(
+    top: &'t DeTable<'i>,
+    key: &str,
+    d: &mut Diags,
+) -> Option<(usize, &'t DeTable<'i>)> {
+    let (kat, v) = get(top, key)?;
+    match v.get_ref() {
+        DeValue::Table(t) => Some((v.span().start, t)),
+        other => {
+            d.at(
+                kat,
+                format!(
+                    "`{key}` must be a table, found {}; write it as a `[{key}]` section",
+                    type_name(other)
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// An integer; reports other types.
+pub(crate) fn integer(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<i64> {
+    let at = v.span().start;
+    match v.get_ref() {
+        DeValue::Integer(i) => {
+            let n = parse_int(i.as_str(), i.radix());
+            if n.is_none() {
+                d.at(
+                    at,
+                    format!("`{key}` in {ctx} is out of range; use a smaller whole number"),
+                );
+            }
+            n
+        }
+        other => {
+            d.at(
+                at,
+                format!(
+                    "`{key}` in {ctx} must be a whole number, found {}; write e.g. `{key} = 1`",
+                    type_name(other)
+                ),
+            );
+            None
+        }
+    }
+}
+
+/// A list of strings, each with its offset.
+pub(crate) fn strings(
+    v: &Val<'_>,
+    key: &str,
+    ctx: &str,
+    d: &mut Diags,
+) -> Option<Vec<Spanned<String>>> {
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(
+            v.span().start,
+            format!(
+                "`{key}` in {ctx} must be a list of strings, found {}; write e.g. `[\"a\", \"b\"]`",
+                type_name(v.get_ref())
+            ),
+        );
+        return None;
+    };
+    let mut out = Vec::with_capacity(a.len().min(MAX_SEGMENTS));
+    for e in a.iter() {
+        let s = string(e, key, ctx, d)?;
+        out.push(Spanned::new(e.span(), s));
+    }
+    Some(out)
+}
+
+/// A value as a plain `toml::Value` (for tables whose keys a model above `spec` knows).
+pub(crate) fn plain(v: &DeValue<'_>) -> Option<toml::Value> {
+    use toml::Value;
+    Some(match v {
+        DeValue::String(s) => Value::String(s.to_string()),
+        DeValue::Integer(i) => Value::Integer(parse_int(i.as_str(), i.radix())?),
+        DeValue::Float(f) => Value::Float(f.as_str().replace('_', "").parse().ok()?),
+        DeValue::Boolean(b) => Value::Boolean(*b),
+        DeValue::Datetime(t) => Value::Datetime(*t),
+        DeValue::Array(a) => Value::Array(
+            a.iter()
+                .map(|e| plain(e.get_ref()))
+                .collect::<Option<_>>()?,
+        ),
+        DeValue::Table(t) => Value::Table(
+            t.iter()
+                .map(|(k, e)| Some((k.get_ref().to_string(), plain(e.get_ref())?)))
+                .collect::<Option<_>>()?,
+        ),
+    })
 }

@@ -1,154 +1,582 @@
 //! The scenario file format (TOML, `format_version = 1`): the structures of the file as
-//! written, with the span of every value so later checks can point at it. The checks against the
-//! world and the models built from these live in `experiment::scenario`.
+//! written, each value with its span so later checks can point at it, read with the one reader
+//! ([`crate::spec::read`]). The checks against the world and the models built from these live
+//! one layer up, in `experiment::scenario`.
 //!
-//! The full reference, with every key, its unit, default and limits, is
-//! `docs/scenario-format.md`.
+//! The reference, with every key, its unit, default and limits, is `docs/scenario-format.md`;
+//! the key tables below are what the reader accepts (a test holds the two together).
 
+use crate::spec::diag::{Diags, echo};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
-use serde::Deserialize;
-use std::collections::BTreeMap;
+use crate::spec::read::{
+    Val, get, integer, missing, number, parse_int, plain, points, string, strings, table,
+    table_array, type_name, unknown_keys,
+};
 use toml::Spanned;
+use toml::de::{DeTable, DeValue};
 
 type S<T> = Spanned<T>;
 
+/// Most laps one run may drive: a run keeps every lap in memory until it is evaluated.
+pub const MAX_LAPS: usize = 1_000;
+/// Most people walking at once: every person is stepped and cast against every scan.
+pub const MAX_PEDESTRIANS: usize = 200;
+/// Smallest simulation step, seconds: a lap takes (lap time / step) steps.
+pub const MIN_STEP_S: f64 = 0.001;
+/// Largest simulation step, seconds: coarser steps make the robot jump through the world.
+pub const MAX_STEP_S: f64 = 0.5;
+/// Longest the robot may wait for a blocked route before the run fails, seconds.
+pub const MAX_BLOCKED_TIMEOUT_S: f64 = 600.0;
+
+/// Keys of the top level.
+pub const TOP_KEYS: &[&str] = &[
+    "format_version",
+    "name",
+    "description",
+    "world",
+    "route",
+    "seed",
+    "runs",
+    "door_configs",
+    "pedestrians",
+    "laser",
+    "odometry",
+    "robot",
+    "recognizer",
+    "evaluation",
+    "expect",
+];
+/// Keys of a `[[runs]]` entry.
+pub const RUN_KEYS: &[&str] = &[
+    "start_waypoint",
+    "laps",
+    "doors",
+    "doors_cycle",
+    "doors_random",
+];
+/// Keys of a run's `doors_random` table.
+pub const DOORS_RANDOM_KEYS: &[&str] = &["open_probability"];
+/// Keys of `[pedestrians]`.
+pub const PEDESTRIAN_KEYS: &[&str] = &[
+    "count",
+    "areas",
+    "paths_m",
+    "speed_min_m_s",
+    "speed_max_m_s",
+    "radius_m",
+];
+/// Keys of `[laser]`.
+pub const LASER_KEYS: &[&str] = &[
+    "preset",
+    "max_range_m",
+    "range_noise_m",
+    "angle_error_deg",
+    "rate_hz",
+    "mount_x_m",
+];
+/// Keys of `[odometry]`.
+pub const ODOMETRY_KEYS: &[&str] = &[
+    "model",
+    "translation_error_ratio",
+    "rotation_error_ratio",
+    "alpha1",
+    "alpha2",
+    "alpha3",
+    "alpha4",
+    "wheel_radius_bias_ratio",
+    "wheel_radius_mismatch_ratio",
+];
+/// Keys of `[robot]`.
+pub const ROBOT_KEYS: &[&str] = &[
+    "cruise_speed_m_s",
+    "max_speed_m_s",
+    "max_turn_rate_deg_s",
+    "accel_m_s2",
+    "turn_accel_deg_s2",
+    "radius_m",
+    "axle_track_m",
+    "lookahead_m",
+    "path_wander_m",
+    "stop_distance_m",
+    "slow_distance_m",
+    "blocked_timeout_s",
+    "step_s",
+];
+
 /// A whole scenario file, as written.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug)]
 pub struct ScenarioSpec {
-    pub format_version: S<i64>,
-    #[serde(default)]
     pub name: Option<String>,
-    #[serde(default)]
     pub description: Option<String>,
     /// World file, relative to the scenario file.
     pub world: S<String>,
     /// Route id in the world.
     pub route: S<String>,
-    pub seed: S<i64>,
-    pub runs: S<Vec<RunSpec>>,
-    #[serde(default)]
-    pub door_configs: BTreeMap<String, S<Vec<S<String>>>>,
-    #[serde(default)]
+    pub seed: S<u64>,
+    pub runs: Vec<RunSpec>,
+    /// `[door_configs]`: name and the door ids it opens, in file order.
+    pub door_configs: Vec<(S<String>, Vec<S<String>>)>,
     pub pedestrians: Option<PedestriansSpec>,
-    #[serde(default)]
-    pub laser: LaserSpec,
-    #[serde(default)]
-    pub odometry: OdometrySpec,
-    #[serde(default)]
-    pub robot: RobotSpec,
-    #[serde(default)]
-    pub recognizer: toml::Table,
-    #[serde(default)]
+    pub laser: Settings,
+    pub odometry: Settings,
+    pub robot: Settings,
+    /// `[recognizer]`: each key with its value; the recognizer's model knows the keys.
+    pub recognizer: Vec<(S<String>, toml::Value)>,
     pub evaluation: EvaluationSpec,
-    #[serde(default)]
     pub expect: ExpectSpec,
 }
 
 /// One `[[runs]]` entry.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Clone, Debug)]
 pub struct RunSpec {
-    #[serde(default)]
+    /// Where the entry starts.
+    pub at: usize,
+    /// Index into the route's waypoints, 0 for the first. Default 0.
     pub start_waypoint: Option<S<i64>>,
-    pub laps: S<i64>,
-    #[serde(default)]
-    pub doors: Option<S<String>>,
-    #[serde(default)]
-    pub doors_cycle: Option<S<Vec<S<String>>>>,
-    #[serde(default)]
-    pub doors_random: Option<S<DoorsRandomSpec>>,
+    pub laps: S<usize>,
+    /// How the doors are set; `None`: all closed.
+    pub doors: Option<DoorsSpec>,
 }
 
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DoorsRandomSpec {
-    pub open_probability: S<f64>,
+/// A run's door setting: exactly one of `doors`, `doors_cycle`, `doors_random`.
+#[derive(Clone, Debug)]
+pub enum DoorsSpec {
+    Fixed(S<String>),
+    Cycle(S<Vec<S<String>>>),
+    /// `open_probability`.
+    Random(S<f64>),
 }
 
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+/// `[pedestrians]`.
+#[derive(Clone, Debug)]
 pub struct PedestriansSpec {
-    pub count: S<i64>,
-    #[serde(default)]
+    pub count: S<usize>,
     pub areas: Vec<S<String>>,
-    #[serde(default)]
     pub paths_m: Vec<S<Vec<[f64; 2]>>>,
-    #[serde(default)]
-    pub speed_min_m_s: Option<S<f64>>,
-    #[serde(default)]
-    pub speed_max_m_s: Option<S<f64>>,
-    #[serde(default)]
-    pub radius_m: Option<S<f64>>,
+    /// `speed_min_m_s`, `speed_max_m_s`, `radius_m`.
+    pub settings: Settings,
 }
 
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LaserSpec {
-    #[serde(default)]
-    pub preset: Option<S<String>>,
-    #[serde(default)]
-    pub max_range_m: Option<S<f64>>,
-    #[serde(default)]
-    pub range_noise_m: Option<S<f64>>,
-    #[serde(default)]
-    pub angle_error_deg: Option<S<f64>>,
-    #[serde(default)]
-    pub rate_hz: Option<S<f64>>,
-    #[serde(default)]
-    pub mount_x_m: Option<S<f64>>,
+/// A table of model settings: an optional name (`preset`, `model`) and numbers by key.
+#[derive(Clone, Debug, Default)]
+pub struct Settings {
+    pub name: Option<S<String>>,
+    pub numbers: Vec<(&'static str, S<f64>)>,
 }
 
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OdometrySpec {
-    #[serde(default)]
-    pub model: Option<S<String>>,
-    #[serde(default)]
-    pub translation_error_ratio: Option<S<f64>>,
-    #[serde(default)]
-    pub rotation_error_ratio: Option<S<f64>>,
-    #[serde(default)]
-    pub alpha1: Option<S<f64>>,
-    #[serde(default)]
-    pub alpha2: Option<S<f64>>,
-    #[serde(default)]
-    pub alpha3: Option<S<f64>>,
-    #[serde(default)]
-    pub alpha4: Option<S<f64>>,
-    #[serde(default)]
-    pub wheel_radius_bias_ratio: Option<S<f64>>,
-    #[serde(default)]
-    pub wheel_radius_mismatch_ratio: Option<S<f64>>,
+impl Settings {
+    /// The number given for `key`, if any.
+    pub fn get(&self, key: &str) -> Option<&S<f64>> {
+        self.numbers.iter().find(|(k, _)| *k == key).map(|(_, v)| v)
+    }
 }
 
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RobotSpec {
-    #[serde(default)]
-    pub cruise_speed_m_s: Option<S<f64>>,
-    #[serde(default)]
-    pub max_speed_m_s: Option<S<f64>>,
-    #[serde(default)]
-    pub max_turn_rate_deg_s: Option<S<f64>>,
-    #[serde(default)]
-    pub accel_m_s2: Option<S<f64>>,
-    #[serde(default)]
-    pub turn_accel_deg_s2: Option<S<f64>>,
-    #[serde(default)]
-    pub radius_m: Option<S<f64>>,
-    #[serde(default)]
-    pub axle_track_m: Option<S<f64>>,
-    #[serde(default)]
-    pub lookahead_m: Option<S<f64>>,
-    #[serde(default)]
-    pub path_wander_m: Option<S<f64>>,
-    #[serde(default)]
-    pub stop_distance_m: Option<S<f64>>,
-    #[serde(default)]
-    pub slow_distance_m: Option<S<f64>>,
-    #[serde(default)]
-    pub blocked_timeout_s: Option<S<f64>>,
-    #[serde(default)]
-    pub step_s: Option<S<f64>>,
+/// Reads a scenario file's text, reporting every syntax, key, type and limit problem to `d`.
+/// `None` when a required part could not be read.
+pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
+    let doc = crate::spec::read::parse_document(src, d)?;
+    let top = doc.get_ref();
+    unknown_keys(top, TOP_KEYS, "the scenario file", d);
+    // Every part is read before any is required, so one problem never hides the next.
+    let head = read_head(top, d);
+    let runs = read_runs(top, d);
+    let door_configs = read_door_configs(top, d);
+    let pedestrians = read_pedestrians(top, d);
+    let laser = read_settings(top, "laser", LASER_KEYS, "preset", d);
+    let odometry = read_settings(top, "odometry", ODOMETRY_KEYS, "model", d);
+    let robot = read_settings(top, "robot", ROBOT_KEYS, "", d);
+    check_robot_limits(&robot, d);
+    let recognizer = read_recognizer(top, d);
+    let evaluation = crate::spec::evaluation::read_evaluation(top, d);
+    let expect = crate::spec::evaluation::read_expect(top, d);
+    let (name, description, world, route, seed) = head?;
+    Some(ScenarioSpec {
+        name,
+        description,
+        world,
+        route,
+        seed,
+        runs: runs?,
+        door_configs,
+        pedestrians,
+        laser,
+        odometry,
+        robot,
+        recognizer,
+        evaluation,
+        expect,
+    })
+}
+
+/// `name`, `description`, `world`, `route`, `seed`.
+type Head = (Option<String>, Option<String>, S<String>, S<String>, S<u64>);
+
+/// `format_version`, then the [`Head`].
+fn read_head(top: &DeTable<'_>, d: &mut Diags) -> Option<Head> {
+    let ctx = "the scenario file";
+    match get(top, "format_version") {
+        None => missing(
+            top,
+            "format_version",
+            TOP_KEYS,
+            0,
+            "missing key `format_version`; add `format_version = 1` as the first line".into(),
+            d,
+        ),
+        Some((_, v)) => match integer(v, "format_version", ctx, d) {
+            Some(1) | None => {}
+            Some(n) => d.at(
+                v.span().start,
+                format!("format_version {n} is not supported; use format_version = 1"),
+            ),
+        },
+    }
+    let name = get(top, "name").and_then(|(_, v)| string(v, "name", ctx, d));
+    let description = get(top, "description").and_then(|(_, v)| string(v, "description", ctx, d));
+    let world = required_string(top, "world", "the world file, relative to this file", d);
+    let route = required_string(top, "route", "a route id of the world", d);
+    let seed = match get(top, "seed") {
+        None => {
+            missing(
+                top,
+                "seed",
+                TOP_KEYS,
+                0,
+                "missing key `seed`; add `seed = 1`".into(),
+                d,
+            );
+            None
+        }
+        Some((_, v)) => seed(v, d),
+    };
+    Some((name, description, world?, route?, seed?))
+}
+
+fn seed(v: &Val<'_>, d: &mut Diags) -> Option<S<u64>> {
+    let n = integer(v, "seed", "the scenario file", d)?;
+    if n < 0 {
+        d.at(
+            v.span().start,
+            "seed must be 0 or more; pick any non-negative integer".into(),
+        );
+        return None;
+    }
+    Some(Spanned::new(v.span(), n as u64))
+}
+
+fn required_string(top: &DeTable<'_>, key: &str, what: &str, d: &mut Diags) -> Option<S<String>> {
+    let Some((_, v)) = get(top, key) else {
+        let msg = format!("missing key `{key}`; add `{key} = \"...\"` ({what})");
+        missing(top, key, TOP_KEYS, 0, msg, d);
+        return None;
+    };
+    string(v, key, "the scenario file", d).map(|s| Spanned::new(v.span(), s))
+}
+
+/// `[[runs]]`: at least one.
+fn read_runs(top: &DeTable<'_>, d: &mut Diags) -> Option<Vec<RunSpec>> {
+    let Some((kat, _)) = get(top, "runs") else {
+        let msg = "no runs; add a [[runs]] entry with laps = 1 or more".to_string();
+        missing(top, "runs", TOP_KEYS, 0, msg, d);
+        return None;
+    };
+    let tables = table_array(top, "runs", d);
+    if tables.is_empty() {
+        d.at(
+            kat,
+            "no runs; add a [[runs]] entry with laps = 1 or more".into(),
+        );
+        return None;
+    }
+    // A run with a problem is left out; the problem is reported, so the file still fails.
+    let runs = tables.into_iter().enumerate();
+    Some(
+        runs.filter_map(|(i, (at, t))| read_run(t, at, i, d))
+            .collect(),
+    )
+}
+
+fn read_run(t: &DeTable<'_>, at: usize, i: usize, d: &mut Diags) -> Option<RunSpec> {
+    let ctx = format!("run #{}", i + 1);
+    unknown_keys(t, RUN_KEYS, &ctx, d);
+    let laps = match get(t, "laps") {
+        None => {
+            let msg = format!("missing key `laps` in {ctx}; add `laps = 1` or more");
+            missing(t, "laps", RUN_KEYS, at, msg, d);
+            None
+        }
+        Some((_, v)) => laps(v, &ctx, d),
+    };
+    let start_waypoint = get(t, "start_waypoint").and_then(|(_, v)| {
+        integer(v, "start_waypoint", &ctx, d).map(|n| Spanned::new(v.span(), n))
+    });
+    let doors = read_run_doors(t, at, &ctx, d);
+    Some(RunSpec {
+        at,
+        start_waypoint,
+        laps: laps?,
+        doors: doors?,
+    })
+}
+
+/// A lap count within 1..=[`MAX_LAPS`]; the one rule for files and for `--laps`.
+pub fn check_laps(n: i64) -> Result<usize, String> {
+    if n < 1 {
+        Err(format!("laps = {n}; a run needs 1 lap or more"))
+    } else if n as u64 > MAX_LAPS as u64 {
+        Err(format!(
+            "laps = {n} is more than {MAX_LAPS}, the most one run may drive (every lap is kept \
+             in memory until evaluated); split the laps over several [[runs]]"
+        ))
+    } else {
+        Ok(n as usize)
+    }
+}
+
+fn laps(v: &Val<'_>, ctx: &str, d: &mut Diags) -> Option<S<usize>> {
+    let at = v.span().start;
+    let n = match v.get_ref() {
+        // A whole number too large for i64 is still a lap count, just far too many.
+        DeValue::Integer(i) => parse_int(i.as_str(), i.radix()).unwrap_or(i64::MAX),
+        _ => integer(v, "laps", ctx, d)?,
+    };
+    match check_laps(n) {
+        Ok(n) => Some(Spanned::new(v.span(), n)),
+        Err(msg) => {
+            // Reported; a stand-in keeps the rest of the file checked against its world.
+            d.at(at, msg);
+            Some(Spanned::new(v.span(), 1))
+        }
+    }
+}
+
+/// `Some(None)`: no door key (all closed); `None`: a problem was reported.
+fn read_run_doors(
+    t: &DeTable<'_>,
+    at: usize,
+    ctx: &str,
+    d: &mut Diags,
+) -> Option<Option<DoorsSpec>> {
+    let given: Vec<&str> = ["doors", "doors_cycle", "doors_random"]
+        .into_iter()
+        .filter(|k| get(t, k).is_some())
+        .collect();
+    if given.len() > 1 {
+        let at = get(t, given[1]).map(|(k, _)| k).unwrap_or(at);
+        d.at(
+            at,
+            "this run sets more than one of doors, doors_cycle and doors_random; keep one".into(),
+        );
+        return None;
+    }
+    let Some(&key) = given.first() else {
+        return Some(None);
+    };
+    let (_, v) = get(t, key)?;
+    let doors = match key {
+        "doors" => DoorsSpec::Fixed(Spanned::new(v.span(), string(v, key, ctx, d)?)),
+        "doors_cycle" => DoorsSpec::Cycle(Spanned::new(v.span(), strings(v, key, ctx, d)?)),
+        _ => DoorsSpec::Random(open_probability(v, ctx, d)?),
+    };
+    Some(Some(doors))
+}
+
+fn open_probability(v: &Val<'_>, ctx: &str, d: &mut Diags) -> Option<S<f64>> {
+    let DeValue::Table(t) = v.get_ref() else {
+        d.at(v.span().start, format!(
+            "`doors_random` in {ctx} must be a table, found {}; write `doors_random = {{ open_probability = 0.3 }}`",
+            type_name(v.get_ref())));
+        return None;
+    };
+    unknown_keys(t, DOORS_RANDOM_KEYS, "doors_random", d);
+    let Some((_, p)) = get(t, "open_probability") else {
+        d.at(
+            v.span().start,
+            "missing key `open_probability` in doors_random; add `open_probability = 0.3`".into(),
+        );
+        return None;
+    };
+    let x = number(p, "open_probability", "doors_random", d)?;
+    if !(0.0..=1.0).contains(&x) {
+        d.at(
+            p.span().start,
+            format!("open_probability {x} is outside 0..1"),
+        );
+        return None;
+    }
+    Some(Spanned::new(p.span(), x))
+}
+
+/// `[door_configs]`: name = [door ids].
+fn read_door_configs(top: &DeTable<'_>, d: &mut Diags) -> Vec<(S<String>, Vec<S<String>>)> {
+    let Some((_, t)) = table(top, "door_configs", d) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (k, v) in t.iter() {
+        let name = k.get_ref().to_string();
+        if let Some(ids) = strings(v, &name, "[door_configs]", d) {
+            out.push((Spanned::new(k.span(), name), ids));
+        }
+    }
+    out
+}
+
+fn read_pedestrians(top: &DeTable<'_>, d: &mut Diags) -> Option<PedestriansSpec> {
+    let (at, t) = table(top, "pedestrians", d)?;
+    let ctx = "[pedestrians]";
+    unknown_keys(t, PEDESTRIAN_KEYS, ctx, d);
+    let count = match get(t, "count") {
+        None => {
+            missing(
+                t,
+                "count",
+                PEDESTRIAN_KEYS,
+                at,
+                "missing key `count` in [pedestrians]; add `count = 1`".into(),
+                d,
+            );
+            None
+        }
+        Some((_, v)) => pedestrian_count(v, d),
+    };
+    let areas = get(t, "areas")
+        .and_then(|(_, v)| strings(v, "areas", ctx, d))
+        .unwrap_or_default();
+    let paths_m = get(t, "paths_m")
+        .map(|(_, v)| walk_paths(v, d))
+        .unwrap_or_default();
+    let settings = settings_of(t, &PEDESTRIAN_KEYS[3..], "", ctx, d);
+    Some(PedestriansSpec {
+        count: count?,
+        areas,
+        paths_m,
+        settings,
+    })
+}
+
+fn pedestrian_count(v: &Val<'_>, d: &mut Diags) -> Option<S<usize>> {
+    let at = v.span().start;
+    let n = match v.get_ref() {
+        DeValue::Integer(i) => parse_int(i.as_str(), i.radix()).unwrap_or(i64::MAX),
+        _ => integer(v, "count", "[pedestrians]", d)?,
+    };
+    if n < 0 {
+        d.at(at, "count must be 0 or more".into());
+        return None;
+    }
+    if n as u64 > MAX_PEDESTRIANS as u64 {
+        d.at(
+            at,
+            format!(
+                "count = {n} is more than {MAX_PEDESTRIANS}, the most people a scenario may hold \
+             (each is simulated every step); use fewer"
+            ),
+        );
+        return None;
+    }
+    Some(Spanned::new(v.span(), n as usize))
+}
+
+fn walk_paths(v: &Val<'_>, d: &mut Diags) -> Vec<S<Vec<[f64; 2]>>> {
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(v.span().start, format!(
+            "`paths_m` in [pedestrians] must be a list of paths, found {}; write e.g. `[[[1.0, 1.0], [5.0, 1.0]]]`",
+            type_name(v.get_ref())));
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for p in a.iter() {
+        let mut spans = Vec::new();
+        if let Some(pts) = points(p, "paths_m", "[pedestrians]", d, &mut spans) {
+            if pts.len() < 2 {
+                d.at(
+                    p.span().start,
+                    "a path needs at least two finite points [x, y]".into(),
+                );
+            } else {
+                out.push(Spanned::new(p.span(), pts));
+            }
+        }
+    }
+    out
+}
+
+/// A model table (`[laser]`, `[odometry]`, `[robot]`); absent means all defaults.
+fn read_settings(
+    top: &DeTable<'_>,
+    key: &str,
+    known: &'static [&'static str],
+    name_key: &str,
+    d: &mut Diags,
+) -> Settings {
+    match table(top, key, d) {
+        None => Settings::default(),
+        Some((_, t)) => {
+            let ctx = format!("[{key}]");
+            unknown_keys(t, known, &ctx, d);
+            settings_of(t, known, name_key, &ctx, d)
+        }
+    }
+}
+
+fn settings_of(
+    t: &DeTable<'_>,
+    known: &'static [&'static str],
+    name_key: &str,
+    ctx: &str,
+    d: &mut Diags,
+) -> Settings {
+    let mut out = Settings::default();
+    for &key in known {
+        let Some((_, v)) = get(t, key) else { continue };
+        if key == name_key {
+            out.name = string(v, key, ctx, d).map(|s| Spanned::new(v.span(), s));
+        } else if let Some(x) = number(v, key, ctx, d) {
+            out.numbers.push((key, Spanned::new(v.span(), x)));
+        }
+    }
+    out
+}
+
+/// The limits that keep a run finite: the step and the blocked timeout.
+fn check_robot_limits(robot: &Settings, d: &mut Diags) {
+    if let Some(s) = robot.get("step_s")
+        && !(MIN_STEP_S..=MAX_STEP_S).contains(s.get_ref())
+    {
+        d.at(s.span().start, format!(
+            "step_s = {} is outside {MIN_STEP_S}..{MAX_STEP_S} s (a lap takes lap time / step_s \
+             steps); use 0.05", s.get_ref()));
+    }
+    if let Some(s) = robot.get("blocked_timeout_s")
+        && !(*s.get_ref() > 0.0 && *s.get_ref() <= MAX_BLOCKED_TIMEOUT_S)
+    {
+        d.at(
+            s.span().start,
+            format!(
+                "blocked_timeout_s = {} is outside (0, {MAX_BLOCKED_TIMEOUT_S}] s; a robot blocked \
+             longer is stuck: use 10",
+                s.get_ref()
+            ),
+        );
+    }
+}
+
+/// `[recognizer]` as plain keys and values; the recognizer's model checks them.
+fn read_recognizer(top: &DeTable<'_>, d: &mut Diags) -> Vec<(S<String>, toml::Value)> {
+    let Some((_, t)) = table(top, "recognizer", d) else {
+        return Vec::new();
+    };
+    t.iter()
+        .filter_map(|(k, v)| {
+            let value = plain(v.get_ref());
+            if value.is_none() {
+                d.at(
+                    v.span().start,
+                    format!("`{}` in [recognizer] is out of range", echo(k.get_ref())),
+                );
+            }
+            Some((Spanned::new(k.span(), k.get_ref().to_string()), value?))
+        })
+        .collect()
 }

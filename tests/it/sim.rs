@@ -546,7 +546,9 @@ doors = "onee"
     .unwrap_err();
     let all = err.to_string();
     assert!(
-        all.starts_with("mem/test.toml:5:1: unknown field `runz`; did you mean `runs`?"),
+        all.starts_with(
+            "mem/test.toml:5:1: unknown key `runz` in the scenario file; did you mean `runs`?"
+        ),
         "{all}"
     );
 
