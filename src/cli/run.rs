@@ -16,7 +16,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub icp: bool,
     /// Replace every run's lap count (for a quick look).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// Write the JSON report here (schema in the README).
     #[arg(long, value_name = "OUT.json")]

@@ -11,7 +11,7 @@ pub struct SimulateArgs {
     /// Scenario file (TOML).
     pub scenario: PathBuf,
     /// Laps per run, replacing the scenario's counts.
-    #[arg(long)]
+    #[arg(long, value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// Output folder for the logs and manifest.
     #[arg(short, long)]

@@ -112,6 +112,78 @@ impl SpecError {
     }
 }
 
+/// How problems are printed: for people, or one JSON object per line for editors and CI (as
+/// cargo's `--message-format json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MessageFormat {
+    /// `file:line:col: error: what is wrong; what to try`, the first [`SHOWN_PROBLEMS`], then a
+    /// count.
+    #[default]
+    Human,
+    /// `{"path":..,"line":..,"col":..,"severity":"error","message":..}`, every problem.
+    Json,
+}
+
+impl MessageFormat {
+    /// The format named `human` or `json`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "human" => Some(MessageFormat::Human),
+            "json" => Some(MessageFormat::Json),
+            _ => None,
+        }
+    }
+}
+
+/// Problems printed in human form before the rest are only counted.
+pub const SHOWN_PROBLEMS: usize = 20;
+
+impl Diagnostic {
+    /// One line in `format`.
+    pub fn render(&self, format: MessageFormat) -> String {
+        match format {
+            MessageFormat::Human => format!(
+                "{}:{}:{}: error: {}",
+                self.path, self.line, self.col, self.message
+            ),
+            MessageFormat::Json => serde_json::json!({
+                "path": self.path,
+                "line": self.line,
+                "col": self.col,
+                "severity": "error",
+                "message": self.message,
+            })
+            .to_string(),
+        }
+    }
+}
+
+impl SpecError {
+    /// Every problem as lines in `format` (human form: the first few, then a count).
+    pub fn render(&self, format: MessageFormat) -> Vec<String> {
+        let diags = match self {
+            SpecError::Invalid(d) => d.clone(),
+            SpecError::Io { path, source } => vec![Diagnostic::error(
+                &path.display().to_string(),
+                (1, 1),
+                format!("cannot read: {source}; check the path"),
+            )],
+        };
+        let shown = match format {
+            MessageFormat::Human => SHOWN_PROBLEMS.min(diags.len()),
+            MessageFormat::Json => diags.len(),
+        };
+        let mut out: Vec<String> = diags[..shown].iter().map(|d| d.render(format)).collect();
+        if shown < diags.len() {
+            out.push(format!(
+                "{} more problems not shown; fix the ones above and check again",
+                diags.len() - shown
+            ));
+        }
+        out
+    }
+}
+
 fn join(d: &[Diagnostic]) -> String {
     d.iter()
         .map(ToString::to_string)

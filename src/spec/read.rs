@@ -19,8 +19,11 @@ pub(crate) fn parse_document<'i>(src: &'i str, d: &mut Diags) -> Option<Spanned<
     if errors.is_empty() {
         return Some(doc);
     }
-    for e in &errors {
-        let at = e.span().map(|s| s.start).unwrap_or(0);
+    // One message, at the first error: those after it are the parser losing its footing.
+    let first = errors
+        .iter()
+        .min_by_key(|e| e.span().map(|s| s.start).unwrap_or(0));
+    if let Some(e) = first {
         let msg = e
             .message()
             .lines()
@@ -29,12 +32,37 @@ pub(crate) fn parse_document<'i>(src: &'i str, d: &mut Diags) -> Option<Spanned<
             .collect::<Vec<_>>()
             .join(" ");
         let msg = lowercase_first(msg.trim_end_matches('.'));
-        d.at(
-            at,
-            format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
-        );
+        let at = e.span().map(|s| s.start).unwrap_or(0);
+        match unclosed_before(src, at) {
+            Some(end) => d.at(
+                end,
+                format!("toml syntax error: {msg} on the next line; a `]` or `}}` is probably missing at the end of this line"),
+            ),
+            None => d.at(
+                at,
+                format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
+            ),
+        }
     }
     None
+}
+
+/// When an error sits at the start of a line while an array or inline table opened on an
+/// earlier line is still open, the end of the last non-blank line before it (where the closing
+/// bracket belongs).
+fn unclosed_before(src: &str, at: usize) -> Option<usize> {
+    let before = &src[..at.min(src.len())];
+    let line_start = before.rfind('\n').map(|i| i + 1).unwrap_or(0);
+    if !before[line_start..].trim().is_empty() || line_start == 0 {
+        return None;
+    }
+    let prev = before[..line_start].trim_end();
+    let depth = prev.bytes().fold(0i64, |n, b| match b {
+        b'[' | b'{' => n + 1,
+        b']' | b'}' => n - 1,
+        _ => n,
+    });
+    (depth > 0 && !prev.ends_with(',')).then_some(prev.len())
 }
 
 pub(crate) fn lowercase_first(s: &str) -> String {

@@ -259,9 +259,9 @@ fn seed(v: &Val<'_>, d: &mut Diags) -> Option<S<u64>> {
             v.span().start,
             "seed must be 0 or more; pick any non-negative integer".into(),
         );
-        return None;
     }
-    Some(Spanned::new(v.span(), n as u64))
+    // A negative seed is reported; the stand-in keeps the rest checked against the world.
+    Some(Spanned::new(v.span(), n.max(0) as u64))
 }
 
 fn required_string(top: &DeTable<'_>, key: &str, what: &str, d: &mut Diags) -> Option<S<String>> {

@@ -238,9 +238,22 @@ pub const MAX_SEGMENTS: usize = 10_000;
 /// list is full); the geometric checks are the world model's (`crate::world::validate`).
 pub fn read_world(src: &str, d: &mut Diags) -> Option<(WorldSpec, WorldLoc)> {
     let doc = crate::spec::read::parse_document(src, d)?;
+    if is_scenario(doc.get_ref()) {
+        d.at(
+            0,
+            "this is a scenario file, not a world; check it with `placewords scenario check`"
+                .into(),
+        );
+        return None;
+    }
     let mut loc = WorldLoc::default();
     let spec = read_top(doc.get_ref(), d, &mut loc)?;
     Some((spec, loc))
+}
+
+/// Whether a document is a scenario (it names a world and has runs) rather than a world.
+fn is_scenario(top: &DeTable<'_>) -> bool {
+    get(top, "runs").is_some() && get(top, "world").is_some()
 }
 
 fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<WorldSpec> {

@@ -5,4 +5,5 @@ mod eval;
 mod io;
 mod recognizer;
 mod sim;
+mod spec;
 mod world;
