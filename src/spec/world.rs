@@ -1,5 +1,7 @@
 //! The world file format (TOML, `format_version = 1`): walls, doors, routes, home pose, areas.
 //!
+//! The reference, with every key, unit, default and limit, is `docs/world-format.md`.
+//!
 //! These structs describe the file only; `world::World` is the validated model built
 //! from them. Units are in every physical key; angles are degrees here and radians in the model.
 //!

@@ -190,3 +190,57 @@ fn scenario_check_reports_every_file() {
     }
     assert!(out.lines().count() >= 4, "{out}");
 }
+
+/// Every key the readers accept is in the format reference (as `` `key` ``): the key tables
+/// the readers check unknown keys against are the list.
+#[test]
+fn the_format_reference_names_every_key() {
+    use placewords::spec::{evaluation as ev, scenario as sc, world as wo};
+    let recognizer =
+        toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
+    let recognizer_keys: Vec<&str> = recognizer.keys().map(String::as_str).collect();
+    let docs: [(&str, Vec<&[&str]>); 2] = [
+        (
+            "docs/world-format.md",
+            vec![
+                wo::TOP_KEYS,
+                wo::HOME_KEYS,
+                wo::WALL_KEYS,
+                wo::DOOR_KEYS,
+                wo::ROUTE_KEYS,
+                wo::AREA_KEYS,
+            ],
+        ),
+        (
+            "docs/scenario-format.md",
+            vec![
+                sc::TOP_KEYS,
+                sc::RUN_KEYS,
+                sc::DOORS_RANDOM_KEYS,
+                sc::PEDESTRIAN_KEYS,
+                sc::LASER_KEYS,
+                sc::ODOMETRY_KEYS,
+                sc::ROBOT_KEYS,
+                ev::EVALUATION_KEYS,
+                ev::EXPECT_KEYS,
+                ev::EXPECT_LEVEL_KEYS,
+                ev::EXPECT_ICP_KEYS,
+                &recognizer_keys,
+            ],
+        ),
+    ];
+    let mut missing = Vec::new();
+    for (doc, tables) in docs {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        for key in tables.into_iter().flatten() {
+            if !text.contains(&format!("`{key}`")) {
+                missing.push(format!("{doc}: `{key}`"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "keys the parser accepts but the reference lacks:\n{}",
+        missing.join("\n")
+    );
+}
