@@ -268,23 +268,7 @@ fn odometry(s: &Settings, d: &mut Diags) -> OdometryConfig {
         Some(m) => named(d, m, &["proportional", "thrun"], "odometry model") == Some("thrun"),
         None => false,
     };
-    // Keys of the other model are a mistake, not silently ignored.
-    let (other, fix) = if thrun {
-        (
-            &RATIO_NAMES[..],
-            "proportional\"; remove it or change the model",
-        )
-    } else {
-        (
-            &ALPHA_NAMES[..],
-            "thrun\"; remove it or set model = \"thrun\"",
-        )
-    };
-    for key in other {
-        if let Some(x) = s.get(key) {
-            d.at(x.span().start, format!("{key} applies to model = \"{fix}"));
-        }
-    }
+    other_model_keys(s, thrun, d);
     o.model = match (thrun, o.model) {
         (true, _) => {
             let mut alpha = DEFAULT_THRUN_ALPHA;
@@ -610,7 +594,12 @@ fn pedestrians(p: Option<&PedestriansSpec>, world: &World, d: &mut Diags) -> Ped
             "pedestrians need somewhere to walk; add areas = [..] or paths_m = [..]".into(),
         );
     }
-    let s = &p.settings;
+    walker_settings(&p.settings, &mut cfg, d);
+    cfg
+}
+
+/// Speeds and size of the people, over [`PedestrianConfig::default`].
+fn walker_settings(s: &Settings, cfg: &mut PedestrianConfig, d: &mut Diags) {
     cfg.speed_min_m_s = value(d, s, "speed_min_m_s", cfg.speed_min_m_s, Rule::Positive);
     cfg.speed_max_m_s = value(d, s, "speed_max_m_s", cfg.speed_max_m_s, Rule::Positive);
     cfg.radius_m = value(d, s, "radius_m", cfg.radius_m, Rule::Positive);
@@ -623,5 +612,24 @@ fn pedestrians(p: Option<&PedestriansSpec>, world: &World, d: &mut Diags) -> Ped
             "speed_max_m_s is below speed_min_m_s; swap them".into(),
         );
     }
-    cfg
+}
+
+/// Keys of the other odometry model are a mistake, not silently ignored.
+fn other_model_keys(s: &Settings, thrun: bool, d: &mut Diags) {
+    let (other, fix) = if thrun {
+        (
+            &RATIO_NAMES[..],
+            "proportional\"; remove it or change the model",
+        )
+    } else {
+        (
+            &ALPHA_NAMES[..],
+            "thrun\"; remove it or set model = \"thrun\"",
+        )
+    };
+    for key in other {
+        if let Some(x) = s.get(key) {
+            d.at(x.span().start, format!("{key} applies to model = \"{fix}"));
+        }
+    }
 }
