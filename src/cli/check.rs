@@ -36,9 +36,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| path.display().to_string());
         let outcome = (|| -> anyhow::Result<Vec<gate::Outcome>> {
-            let mut scn = placewords::spec::scenario::load_scenario(path)?;
+            let mut scn = placewords::experiment::load_scenario(path)?;
             if let Some(seed) = args.seed {
-                scn.seed = seed;
+                scn.sim.seed = seed;
             }
             let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
             levels.sort_unstable();

@@ -16,7 +16,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub icp: bool,
     /// Replace every run's lap count (for a quick look).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// Write the JSON report here (schema in the README).
     #[arg(long, value_name = "OUT.json")]
@@ -38,9 +38,9 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let mut scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
     if let Some(seed) = args.seed {
-        scn.seed = seed;
+        scn.sim.seed = seed;
     }
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
@@ -54,7 +54,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     }
     print_and_write(
         &exp,
-        &scn.world,
+        &scn.sim.world,
         scn.evaluation.tp_radius_m,
         args.report.as_deref(),
         args.svg.as_deref(),

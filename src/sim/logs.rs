@@ -9,7 +9,7 @@ use crate::geom::{Pose2, wrap_angle};
 use crate::io::atomic::write_atomic;
 use crate::io::carmen::{LaserRecord, LogRecord, OdomRecord, TruePosRecord, write_record};
 use crate::log::RunLog;
-use crate::spec::scenario::Scenario;
+use crate::sim::plan::SimPlan;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 pub const HOST: &str = "placewords-sim";
 
 /// The CARMEN text of one run.
-pub fn carmen_log(scn: &Scenario, run: &RunLog) -> String {
+pub fn carmen_log(scn: &SimPlan, run: &RunLog) -> String {
     let mut out = String::new();
     out.push_str(&format!(
         "# placewords simulation: scenario {}, seed {}, run {}, route {} of world {}\n",
@@ -118,7 +118,7 @@ pub fn log_file_name(run: usize) -> String {
     format!("run-{run:03}.log")
 }
 
-pub fn manifest(scn: &Scenario, runs: &[RunLog], laps_override: Option<usize>) -> Manifest {
+pub fn manifest(scn: &SimPlan, runs: &[RunLog], laps_override: Option<usize>) -> Manifest {
     Manifest {
         placewords_version: env!("CARGO_PKG_VERSION").into(),
         scenario: scn.path.display().to_string(),
@@ -152,7 +152,7 @@ pub fn manifest(scn: &Scenario, runs: &[RunLog], laps_override: Option<usize>) -
 /// Writes `run-NNN.log` per run and `manifest.json` into `dir`, each atomically; returns the
 /// paths written.
 pub fn write_logs(
-    scn: &Scenario,
+    scn: &SimPlan,
     runs: &[RunLog],
     laps_override: Option<usize>,
     dir: &Path,

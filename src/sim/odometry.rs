@@ -55,6 +55,9 @@ pub enum ProportionalError {
 
 /// Odometry parameters. Default: proportional 0.0075 m/m and rad/rad drawn at each update
 /// (MobileSim), no systematic error.
+/// Thrun's α1..α4 when a file names `model = "thrun"` without giving them.
+pub const DEFAULT_THRUN_ALPHA: [f64; 4] = [0.01; 4];
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct OdometryConfig {
     pub model: OdometryModel,

@@ -45,7 +45,7 @@ pub struct RobotConfig {
 impl Default for RobotConfig {
     fn default() -> Self {
         RobotConfig {
-            radius_m: 0.25,
+            radius_m: crate::world::validate::ROBOT_RADIUS_M,
             axle_track_m: 0.357,
             cruise_speed_m_s: 0.4,
             max_speed_m_s: 1.0,

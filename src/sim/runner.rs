@@ -16,10 +16,10 @@ use crate::log::{Frame, LapLog, RunLog};
 use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
+use crate::sim::plan::{DoorPlan, SimPlan};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
 use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
 use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
-use crate::spec::scenario::{DoorPlan, Scenario};
 use crate::world::DoorStates;
 use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
@@ -44,7 +44,7 @@ pub enum SimError {
 }
 
 /// The door states of `run`'s lap `lap`, and the configuration's name.
-pub fn door_states(scn: &Scenario, run: usize, lap: usize) -> (String, DoorStates) {
+pub fn door_states(scn: &SimPlan, run: usize, lap: usize) -> (String, DoorStates) {
     match &scn.runs[run].doors {
         DoorPlan::Fixed(c) => (c.name.clone(), c.states.clone()),
         DoorPlan::Cycle(list) => {
@@ -67,7 +67,7 @@ pub fn door_states(scn: &Scenario, run: usize, lap: usize) -> (String, DoorState
 /// Simulates every run (in parallel; results are identical whatever the thread count).
 /// `laps_override` replaces each run's lap count; `progress` is called once per finished lap.
 pub fn simulate(
-    scn: &Scenario,
+    scn: &SimPlan,
     laps_override: Option<usize>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunLog>, SimError> {
@@ -91,7 +91,7 @@ pub fn simulate(
 
 /// The state of one run: robot, odometry, laser, physics, pedestrians, time.
 pub struct RunSim<'a> {
-    scn: &'a Scenario,
+    scn: &'a SimPlan,
     run: usize,
     laser: Laser,
     odometry: Odometry,
@@ -137,7 +137,7 @@ const SPIN_RATE_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
 
 impl<'a> RunSim<'a> {
     /// A run at its start waypoint, with all doors closed until the first lap sets them.
-    pub fn new(scn: &'a Scenario, run: usize) -> Self {
+    pub fn new(scn: &'a SimPlan, run: usize) -> Self {
         let plan = &scn.runs[run];
         let tracker = RouteTracker::new(&scn.route, plan.start_waypoint);
         let truth = tracker.start_pose();

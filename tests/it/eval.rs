@@ -363,9 +363,8 @@ fn icp_cost_over_twenty_laps() {
 #[test]
 #[ignore]
 fn icp_cost_on_institute_floor() {
-    let world =
-        placewords::spec::world::load_world(std::path::Path::new("worlds/institute-floor.toml"))
-            .expect("the shipped world loads");
+    let world = placewords::world::load_world(std::path::Path::new("worlds/institute-floor.toml"))
+        .expect("the shipped world loads");
     let walls = world.obstacle_outline(&placewords::world::DoorStates::all_closed(&world));
     let route = world.route("lap").expect("route lap").waypoints.clone();
     let laps = 6;
