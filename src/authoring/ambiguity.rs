@@ -125,11 +125,7 @@ fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::s
 }
 
 /// Drives `route` twice without noise.
-pub fn drive(
-    world: &World,
-    route: &Route,
-    doors: &DoorStates,
-) -> Result<Drive, AmbiguityError> {
+pub fn drive(world: &World, route: &Route, doors: &DoorStates) -> Result<Drive, AmbiguityError> {
     let scn = noise_free_plan(world, route, doors);
     let runs = crate::sim::simulate(&scn, None, &|| {})?;
     let frames: Vec<Frame> = runs

@@ -6,8 +6,8 @@ use crate::geom::Vec2;
 use crate::report::world_render::{MarkOverlay, RenderOptions, render_world_svg};
 use crate::spec::Diagnostic;
 use crate::spec::world::{WorldLoc, WorldSpec};
-use crate::world::load::read_world_lenient;
 use crate::world::World;
+use crate::world::load::read_world_lenient;
 
 const PROBLEM_COLOR: &str = "#d62728";
 /// Most problem messages written under the picture.

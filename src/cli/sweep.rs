@@ -38,7 +38,13 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let (runs, _) = experiment::simulate(&scn, &opts)?;
     let laps = runs.iter().map(|r| r.laps.len()).sum();
     let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
-    let report = SweepReport::new(&scn.sim.name, scn.sim.seed, laps, scn.evaluation.clone(), results);
+    let report = SweepReport::new(
+        &scn.sim.name,
+        scn.sim.seed,
+        laps,
+        scn.evaluation.clone(),
+        results,
+    );
     out!("{}", curves_table(&report.curves))?;
     write_file(
         &args.out.join("sweep.json"),

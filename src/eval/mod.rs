@@ -9,8 +9,8 @@
 
 pub mod gate;
 pub mod metrics;
-pub mod scores;
 pub mod pair_recall;
+pub mod scores;
 pub mod sweep;
 
 use crate::geom::TruePose;

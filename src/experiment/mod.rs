@@ -5,8 +5,8 @@
 
 pub mod picture;
 pub mod real;
-pub mod score;
 pub mod scenario;
+pub mod score;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::scores::Report;

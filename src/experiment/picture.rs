@@ -6,11 +6,11 @@
 use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
 use crate::eval::pair_recall::heading_agrees;
+use crate::log::RunLog;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
     LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
 };
-use crate::log::RunLog;
 use crate::spec::evaluation::EvaluationSpec;
 use crate::world::World;
 use std::collections::{HashMap, HashSet};

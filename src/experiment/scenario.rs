@@ -51,10 +51,10 @@ use crate::geom::Vec2;
 use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
 use crate::sim::odometry::{DEFAULT_THRUN_ALPHA, OdometryConfig, OdometryModel, ProportionalError};
-use crate::sim::variation::LapVariationConfig;
 use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
 use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 use crate::sim::robot::RobotConfig;
+use crate::sim::variation::LapVariationConfig;
 use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
@@ -315,7 +315,10 @@ fn bounded(d: &mut Diags, s: &Settings, key: &str, default: f64, max: f64) -> f6
     let v = value(d, s, key, default, Rule::NonNegative);
     match s.get(key) {
         Some(x) if v > max => {
-            d.at(x.span().start, format!("{key} = {v} is above {max}; use 0-{max}"));
+            d.at(
+                x.span().start,
+                format!("{key} = {v} is above {max}; use 0-{max}"),
+            );
             default
         }
         _ => v,
@@ -329,7 +332,13 @@ fn lap_variation(s: &Settings, d: &mut Diags) -> LapVariationConfig {
     LapVariationConfig {
         lane_offset_ratio: bounded(d, s, "lane_offset_ratio", v.lane_offset_ratio, 1.0),
         lane_margin_m: value(d, s, "lane_margin_m", v.lane_margin_m, NonNegative),
-        lap_speed_spread_ratio: bounded(d, s, "lap_speed_spread_ratio", v.lap_speed_spread_ratio, 0.9),
+        lap_speed_spread_ratio: bounded(
+            d,
+            s,
+            "lap_speed_spread_ratio",
+            v.lap_speed_spread_ratio,
+            0.9,
+        ),
         speed_wave_ratio: bounded(d, s, "speed_wave_ratio", v.speed_wave_ratio, 0.9),
         stop_spacing_m: value(d, s, "stop_spacing_m", v.stop_spacing_m, NonNegative),
         stop_duration_s: value(d, s, "stop_duration_s", v.stop_duration_s, NonNegative),

@@ -57,7 +57,10 @@ pub fn load_world_for(path: &Path, check: &WorldCheck) -> Result<World, SpecErro
 pub fn read_world_lenient(
     src: &str,
     path: &str,
-) -> (Option<(WorldSpec, crate::spec::world::WorldLoc)>, Vec<Diagnostic>) {
+) -> (
+    Option<(WorldSpec, crate::spec::world::WorldLoc)>,
+    Vec<Diagnostic>,
+) {
     let mut d = Diags::new(src, path);
     let read = read_world(src, &mut d);
     if let Some((spec, loc)) = &read {
