@@ -6,8 +6,10 @@
 //! and scores them (DESIGN.md §6); [`sweep`] repeats this over a grid of thresholds;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
+pub mod distribution;
 pub mod gate;
 pub mod metrics;
+pub mod suite;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};

@@ -5,6 +5,7 @@
 
 pub mod picture;
 pub mod real;
+pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};

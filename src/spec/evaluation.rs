@@ -28,12 +28,25 @@ impl Default for EvaluationSpec {
     }
 }
 
-/// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`.
+/// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`, checked over the
+/// seeds run: each bound applies to the worst seed, or with `quantile = q` to the q-quantile
+/// (nearest rank, counted from the worst seed; `quantile = 0.1` lets the worst tenth miss).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExpectSpec {
     pub levels: Vec<LevelExpectation>,
     pub icp: Option<Expectation>,
+    /// Bounds apply to this quantile of the seeds instead of the worst seed, in [0, 1).
+    /// Default: none (the worst seed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantile: Option<f64>,
+}
+
+impl ExpectSpec {
+    /// Whether the block sets no bound at all.
+    pub fn is_empty(&self) -> bool {
+        self.levels.is_empty() && self.icp.is_none()
+    }
 }
 
 /// What one level configuration must achieve.

@@ -4,6 +4,7 @@
 pub mod diag;
 pub mod evaluation;
 pub mod scenario;
+pub mod seeds;
 pub mod suggest;
 pub mod validate;
 pub mod world;

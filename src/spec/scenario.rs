@@ -5,7 +5,8 @@
 //! name = "smoke"                        # optional; default: the file stem
 //! world = "../worlds/loop-small.toml"   # relative to this file
 //! route = "lap"
-//! seed = 42
+//! seed = 42                             # the seed of `run` (and of `check` without `seeds`)
+//! seeds = "1..20"                       # optional: the seeds `check` runs (both ends included)
 //!
 //! [door_configs]                        # named sets of open doors
 //! south-open = ["d-south"]
@@ -54,6 +55,7 @@ use crate::sim::robot::RobotConfig;
 use crate::spec::SpecError;
 use crate::spec::diag::{Diagnostic, line_col};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
+use crate::spec::seeds::SeedRange;
 use crate::world::{DoorStates, Route, World};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -77,6 +79,9 @@ pub struct ScenarioSpec {
     /// Route id in the world.
     pub route: S<String>,
     pub seed: S<i64>,
+    /// Seeds `check` runs by default, e.g. "1..20" (both ends included).
+    #[serde(default)]
+    pub seeds: Option<S<String>>,
     pub runs: S<Vec<RunSpec>>,
     #[serde(default)]
     pub door_configs: BTreeMap<String, S<Vec<S<String>>>>,
@@ -244,6 +249,8 @@ pub struct Scenario {
     pub world: World,
     pub route: Route,
     pub seed: u64,
+    /// The seeds `check` runs by default (`seeds = "1..20"`); `None`: only `seed`.
+    pub seeds: Option<SeedRange>,
     pub runs: Vec<RunPlan>,
     pub door_configs: BTreeMap<String, DoorStates>,
     pub pedestrians: PedestrianConfig,
@@ -347,6 +354,13 @@ pub fn parse_scenario(
             "seed must be 0 or more; pick any non-negative integer".into(),
         );
     }
+    let seeds = spec.seeds.as_ref().and_then(|s| match s.get_ref().parse::<SeedRange>() {
+        Ok(r) => Some(r),
+        Err(e) => {
+            v.err(s.span(), e);
+            None
+        }
+    });
 
     // Door configurations.
     let door_ids: Vec<&str> = world.doors.iter().map(|d| d.id.as_str()).collect();
@@ -742,6 +756,15 @@ pub fn parse_scenario(
         }
     }
 
+    if let Some(q) = spec.expect.quantile
+        && !(0.0..1.0).contains(&q)
+    {
+        v.err(
+            find_key(src, "quantile"),
+            format!("quantile = {q} is outside 0..1; use 0.1 for the 10th percentile"),
+        );
+    }
+
     // Recognizer settings: the table over the defaults; each problem at its key.
     let recognizer = recognizer_settings(&spec.recognizer, src, &mut v);
 
@@ -761,6 +784,7 @@ pub fn parse_scenario(
         world,
         route: route.expect("checked above"),
         seed: seed as u64,
+        seeds,
         runs,
         door_configs,
         pedestrians,
