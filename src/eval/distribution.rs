@@ -112,8 +112,11 @@ pub struct ConfigSpread {
     /// Level count (none for ICP).
     pub levels: Option<usize>,
     pub thresholds: Vec<usize>,
-    /// Per metric (in [`Metric::ALL`] order, metrics no seed has left out).
-    pub metrics: Vec<(Metric, Spread)>,
+    /// `None` when no seed matched anything.
+    pub precision: Option<Spread>,
+    pub recall: Option<Spread>,
+    pub visit_recall: Option<Spread>,
+    pub seconds_per_lap: Option<Spread>,
     /// Seeds at which the recognizer made no pair at all.
     pub no_match_seeds: Vec<u64>,
 }
@@ -121,7 +124,12 @@ pub struct ConfigSpread {
 impl ConfigSpread {
     /// The spread of `metric`, if any seed has a value.
     pub fn get(&self, metric: Metric) -> Option<&Spread> {
-        self.metrics.iter().find(|(m, _)| *m == metric).map(|(_, s)| s)
+        match metric {
+            Metric::Precision => self.precision.as_ref(),
+            Metric::Recall => self.recall.as_ref(),
+            Metric::VisitRecall => self.visit_recall.as_ref(),
+            Metric::SecondsPerLap => self.seconds_per_lap.as_ref(),
+        }
     }
 }
 
@@ -165,22 +173,23 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
     subjects
         .into_iter()
         .map(|(subject, levels, thresholds)| {
-            let metrics = Metric::ALL
-                .iter()
-                .filter_map(|&m| {
-                    Spread::of(&samples(reports, &subject, m), m.higher_is_better()).map(|s| (m, s))
-                })
-                .collect();
+            let spread = |m: Metric| Spread::of(&samples(reports, &subject, m), m.higher_is_better());
             let no_match_seeds = reports
                 .iter()
                 .filter(|r| scores_of(r, &subject).is_some_and(|s| s.no_pairs))
                 .map(|r| r.seed)
                 .collect();
+            let (precision, recall) = (spread(Metric::Precision), spread(Metric::Recall));
+            let visit_recall = spread(Metric::VisitRecall);
+            let seconds_per_lap = spread(Metric::SecondsPerLap);
             ConfigSpread {
                 subject,
                 levels,
                 thresholds,
-                metrics,
+                precision,
+                recall,
+                visit_recall,
+                seconds_per_lap,
                 no_match_seeds,
             }
         })

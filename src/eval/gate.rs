@@ -51,6 +51,8 @@ pub struct Outcome {
     pub seed: Option<u64>,
     /// Seeds with a value for the metric.
     pub seeds: usize,
+    /// Seeds checked (those that matched nothing included).
+    pub runs: usize,
     /// Why there is no figure: "not in the report" or "no matches".
     pub missing: Option<String>,
     pub passed: bool,
@@ -95,12 +97,16 @@ impl Outcome {
         match (self.actual, self.seed) {
             (Some(a), Some(seed)) => {
                 let op = if self.passed { op } else { negate(op) };
+                let of = if self.seeds == self.runs {
+                    format!("of {}", self.runs)
+                } else {
+                    format!("of {}; {} matched nothing", self.runs, self.runs - self.seeds)
+                };
                 format!(
-                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed} of {})",
+                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed} {of})",
                     self.scenario,
                     self.subject,
                     fmt_value(self.bound, a),
-                    self.seeds
                 )
             }
             _ => format!(
@@ -206,6 +212,7 @@ fn check_bound(
         actual: at.map(|a| a.1),
         seed: at.map(|a| a.0),
         seeds: samples.len(),
+        runs: reports.len(),
         missing,
         passed,
         seconds,

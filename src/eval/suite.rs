@@ -179,6 +179,17 @@ impl SuiteReport {
         }
     }
 
+    /// The exit code of `check` and `merge`: the tally's for a whole run; a part exits 0
+    /// unless something failed to run (2), since its seeds are not the distribution.
+    pub fn exit_code(&self) -> u8 {
+        let t = self.tally();
+        match self.shard {
+            Some(_) if t.errors == 0 => 0,
+            Some(_) => 2,
+            None => t.exit_code(),
+        }
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a suite report always serializes")
     }

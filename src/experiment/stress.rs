@@ -13,7 +13,7 @@ use crate::experiment::{ExperimentOptions, progress_bar, run_scenario};
 use crate::spec::scenario::{Scenario, load_scenario};
 use crate::spec::seeds::{SeedRange, Shard};
 use rayon::prelude::*;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// What to run over seeds.
@@ -191,4 +191,65 @@ fn stem(file: &str) -> String {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| file.to_string())
+}
+
+/// Why parts could not be read and merged, or outputs written.
+#[derive(Debug, thiserror::Error)]
+pub enum StressError {
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}:{col}: not a part written by `check --shard K/N --report`: {message}")]
+    Parse {
+        path: String,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    #[error(transparent)]
+    Merge(#[from] crate::eval::suite::MergeError),
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        path: String,
+        source: std::io::Error,
+    },
+}
+
+/// Reads the parts at `paths` and merges them into the whole run's report.
+pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
+    let mut parts = Vec::new();
+    for path in paths {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| StressError::Read {
+            path: file.clone(),
+            source,
+        })?;
+        let part = SuiteReport::from_json(&text).map_err(|e| StressError::Parse {
+            path: file.clone(),
+            line: e.line(),
+            col: e.column(),
+            message: e.to_string(),
+        })?;
+        parts.push((file, part));
+    }
+    Ok(crate::eval::suite::merge(parts)?)
+}
+
+/// Writes `file` atomically, naming it in the error.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StressError> {
+    crate::io::atomic::write_atomic(path, bytes).map_err(|source| StressError::Write {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`.
+pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
+    use crate::report::{junit, suite as format};
+    write_file(&dir.join("report.json"), suite.to_json().as_bytes())?;
+    write_file(&dir.join("table.md"), format::markdown(suite).as_bytes())?;
+    let xml = junit::junit_xml(&junit::suites(suite));
+    write_file(&dir.join("junit.xml"), xml.as_bytes())
 }
