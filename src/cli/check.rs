@@ -7,8 +7,8 @@ use super::common::SeedsArg;
 use anyhow::Context;
 use clap::Args;
 use placewords::eval::suite::SuiteReport;
-use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::ExperimentOptions;
+use placewords::experiment::stress::{self, StressOptions};
 use placewords::report::{junit, suite as format};
 use placewords::spec::seeds::Shard;
 use std::path::{Path, PathBuf};
@@ -73,7 +73,12 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if let Some(path) = &args.report {
         stress::write_file(path, suite.to_json().as_bytes())?;
     }
-    finish(&suite, args.out.as_deref(), args.junit.as_deref(), args.json)
+    finish(
+        &suite,
+        args.out.as_deref(),
+        args.junit.as_deref(),
+        args.json,
+    )
 }
 
 /// Prints a stress run's verdict, writes the outputs asked for, and gives the exit code (a

@@ -173,7 +173,8 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
     subjects
         .into_iter()
         .map(|(subject, levels, thresholds)| {
-            let spread = |m: Metric| Spread::of(&samples(reports, &subject, m), m.higher_is_better());
+            let spread =
+                |m: Metric| Spread::of(&samples(reports, &subject, m), m.higher_is_better());
             let no_match_seeds = reports
                 .iter()
                 .filter(|r| scores_of(r, &subject).is_some_and(|s| s.no_pairs))

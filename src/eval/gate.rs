@@ -100,7 +100,11 @@ impl Outcome {
                 let of = if self.seeds == self.runs {
                     format!("of {}", self.runs)
                 } else {
-                    format!("of {}; {} matched nothing", self.runs, self.runs - self.seeds)
+                    format!(
+                        "of {}; {} matched nothing",
+                        self.runs,
+                        self.runs - self.seeds
+                    )
                 };
                 format!(
                     "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed} {of})",
@@ -166,7 +170,14 @@ pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> V
         ];
         for (bound, limit) in bounds {
             let Some(limit) = limit else { continue };
-            out.push(check_bound(scenario, reports, &subject, bound, limit, expect.quantile));
+            out.push(check_bound(
+                scenario,
+                reports,
+                &subject,
+                bound,
+                limit,
+                expect.quantile,
+            ));
         }
     }
     out
@@ -199,8 +210,7 @@ fn check_bound(
     let seconds = reports
         .iter()
         .filter_map(|r| {
-            distribution::scores_of(r, subject)
-                .map(|s| s.recognize_seconds_per_lap * r.laps as f64)
+            distribution::scores_of(r, subject).map(|s| s.recognize_seconds_per_lap * r.laps as f64)
         })
         .sum();
     Outcome {
@@ -336,7 +346,11 @@ mod tests {
         spec.quantile = Some(0.2);
         let p20 = check_seeds("A", &reports, &spec);
         assert!(p20[0].passed, "{}", p20[0].line());
-        assert!(p20[0].line().contains("precision p20 0.900"), "{}", p20[0].line());
+        assert!(
+            p20[0].line().contains("precision p20 0.900"),
+            "{}",
+            p20[0].line()
+        );
     }
 
     #[test]
@@ -350,7 +364,11 @@ mod tests {
         };
         let o = check(&rep, &spec);
         assert!(!o[0].passed);
-        assert!(o[0].line().ends_with("no matches at any seed"), "{}", o[0].line());
+        assert!(
+            o[0].line().ends_with("no matches at any seed"),
+            "{}",
+            o[0].line()
+        );
         assert!(o[1].passed, "recall 0 >= 0");
     }
 }

@@ -52,7 +52,10 @@ pub struct ScenarioResult {
 impl ScenarioResult {
     /// The reports of the seeds that ran.
     pub fn reports(&self) -> Vec<Report> {
-        self.results.iter().filter_map(|r| r.report.clone()).collect()
+        self.results
+            .iter()
+            .filter_map(|r| r.report.clone())
+            .collect()
     }
 
     /// Wall-clock seconds over all seeds.
@@ -220,7 +223,9 @@ pub fn labels(scenarios: &[(String, String)]) -> Vec<String> {
 pub enum MergeError {
     #[error("no parts to merge; give the PART.json files of every shard")]
     NoParts,
-    #[error("{0} is a whole run, not a part; merge takes the files of `check --shard K/N --report`")]
+    #[error(
+        "{0} is a whole run, not a part; merge takes the files of `check --shard K/N --report`"
+    )]
     NotAPart(String),
     #[error("{file} is part {shard}, but {first} is a part of {count}; merge the parts of one run")]
     OtherCount {
@@ -251,7 +256,9 @@ pub fn merge(parts: Vec<(String, SuiteReport)>) -> Result<SuiteReport, MergeErro
         .count;
     let mut seen: Vec<Option<&String>> = vec![None; count];
     for (file, part) in &parts {
-        let shard = part.shard.ok_or_else(|| MergeError::NotAPart(file.clone()))?;
+        let shard = part
+            .shard
+            .ok_or_else(|| MergeError::NotAPart(file.clone()))?;
         if shard.count != count {
             return Err(MergeError::OtherCount {
                 file: file.clone(),
@@ -351,7 +358,10 @@ mod tests {
 
     fn part(k: usize, seeds: &[u64]) -> (String, SuiteReport) {
         let shard = Shard::new(k, 2).unwrap();
-        (format!("p{k}.json"), SuiteReport::new(Some(shard), true, vec![scenario(seeds)]))
+        (
+            format!("p{k}.json"),
+            SuiteReport::new(Some(shard), true, vec![scenario(seeds)]),
+        )
     }
 
     #[test]

@@ -51,9 +51,7 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
             let scenario = load_scenario(path).map_err(|e| e.to_string());
             let (seeds, options) = match &scenario {
                 Ok(scn) => (
-                    opts.seeds
-                        .or(scn.seeds)
-                        .unwrap_or(SeedRange::one(scn.seed)),
+                    opts.seeds.or(scn.seeds).unwrap_or(SeedRange::one(scn.seed)),
                     options_for(scn, opts),
                 ),
                 Err(_) => (opts.seeds.unwrap_or(SeedRange::one(0)), None),
@@ -173,7 +171,11 @@ fn assemble(
             name,
             file,
             seeds: p.seeds,
-            expect: p.scenario.as_ref().map(|s| s.expect.clone()).unwrap_or_default(),
+            expect: p
+                .scenario
+                .as_ref()
+                .map(|s| s.expect.clone())
+                .unwrap_or_default(),
             error: p.scenario.err(),
             results: Vec::new(),
             summary: Vec::new(),

@@ -211,7 +211,12 @@ mod tests {
             Some("FAIL B<&> levels=3 precision worst 0.900 < 0.950 (seed 7 of 1)")
         );
         assert_eq!(cases[0].attribute("name"), Some("B<&>/levels=3/precision"));
-        assert!(failure.text().unwrap().contains("placewords run scenarios/B.toml --seed 7"));
+        assert!(
+            failure
+                .text()
+                .unwrap()
+                .contains("placewords run scenarios/B.toml --seed 7")
+        );
         let value = cases[0]
             .descendants()
             .find(|n| n.attribute("name") == Some("value"))

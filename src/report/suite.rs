@@ -117,12 +117,7 @@ fn worst_seeds(sc: &ScenarioResult) -> String {
     }
     if sc.results.len() > 1 {
         for (seed, what) in seeds {
-            let _ = writeln!(
-                out,
-                "worst {}: {}",
-                what.join(", "),
-                sc.reproduce(seed)
-            );
+            let _ = writeln!(out, "worst {}: {}", what.join(", "), sc.reproduce(seed));
         }
     }
     out
@@ -159,7 +154,11 @@ pub fn check_text(suite: &SuiteReport) -> String {
 pub fn markdown(suite: &SuiteReport) -> String {
     let mut out = String::from("# placewords stress run\n");
     for sc in &suite.scenarios {
-        let _ = writeln!(out, "\n## {} (`{}`), seeds {}\n", sc.label, sc.file, sc.seeds);
+        let _ = writeln!(
+            out,
+            "\n## {} (`{}`), seeds {}\n",
+            sc.label, sc.file, sc.seeds
+        );
         for e in sc.errors() {
             let _ = writeln!(out, "- error: {}", e.replace('\n', " "));
         }
@@ -170,7 +169,13 @@ pub fn markdown(suite: &SuiteReport) -> String {
         }
         for c in &sc.summary {
             for m in Metric::ALL {
-                let _ = writeln!(out, "| {} | {} | {} |", label(c), m.name(), md_cells(c.get(m)));
+                let _ = writeln!(
+                    out,
+                    "| {} | {} | {} |",
+                    label(c),
+                    m.name(),
+                    md_cells(c.get(m))
+                );
             }
         }
         if !sc.outcomes.is_empty() {
@@ -198,9 +203,10 @@ fn md_cells(s: Option<&Spread>) -> String {
 }
 
 fn md_outcome(o: &Outcome) -> String {
-    let value = o
-        .actual
-        .map_or_else(|| o.missing.clone().unwrap_or_default(), |a| fmt_value(o.bound, a));
+    let value = o.actual.map_or_else(
+        || o.missing.clone().unwrap_or_default(),
+        |a| fmt_value(o.bound, a),
+    );
     let seed = o.seed.map_or("–".into(), |s| s.to_string());
     let result = if o.passed { "pass" } else { "**FAIL**" };
     format!(
@@ -312,7 +318,10 @@ mod tests {
     fn the_terminal_table_shows_mean_worst_and_how_to_reproduce_it() {
         let t = text_table(&suite());
         assert!(t.contains("0.367") && t.contains("0.100 (seed 2)"), "{t}");
-        assert!(t.contains("worst recall at levels=3: placewords run scenarios/B.toml --seed 2"), "{t}");
+        assert!(
+            t.contains("worst recall at levels=3: placewords run scenarios/B.toml --seed 2"),
+            "{t}"
+        );
         assert!(t.contains("no matches at seed(s) [2]"), "{t}");
     }
 
@@ -320,11 +329,17 @@ mod tests {
     fn markdown_and_json_carry_the_gate() {
         let s = suite();
         let md = markdown(&s);
-        assert!(md.contains("| `B/levels=3/recall` | worst | 0.100 | 0.200 | 2 | **FAIL** |"), "{md}");
+        assert!(
+            md.contains("| `B/levels=3/recall` | worst | 0.100 | 0.200 | 2 | **FAIL** |"),
+            "{md}"
+        );
         assert!(md.ends_with("0 passed, 1 failed\n"), "{md}");
         let v: serde_json::Value = serde_json::from_str(&summary_json(&s)).unwrap();
         assert_eq!(v["failed"], 1);
         assert_eq!(v["exit_code"], 1);
-        assert_eq!(v["outcomes"][0]["reproduce"], "placewords run scenarios/B.toml --seed 2");
+        assert_eq!(
+            v["outcomes"][0]["reproduce"],
+            "placewords run scenarios/B.toml --seed 2"
+        );
     }
 }

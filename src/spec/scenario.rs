@@ -354,13 +354,16 @@ pub fn parse_scenario(
             "seed must be 0 or more; pick any non-negative integer".into(),
         );
     }
-    let seeds = spec.seeds.as_ref().and_then(|s| match s.get_ref().parse::<SeedRange>() {
-        Ok(r) => Some(r),
-        Err(e) => {
-            v.err(s.span(), e);
-            None
-        }
-    });
+    let seeds = spec
+        .seeds
+        .as_ref()
+        .and_then(|s| match s.get_ref().parse::<SeedRange>() {
+            Ok(r) => Some(r),
+            Err(e) => {
+                v.err(s.span(), e);
+                None
+            }
+        });
 
     // Door configurations.
     let door_ids: Vec<&str> = world.doors.iter().map(|d| d.id.as_str()).collect();

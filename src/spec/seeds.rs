@@ -178,9 +178,19 @@ mod tests {
 
     #[test]
     fn bad_ranges_say_what_to_write() {
-        assert!("20..1".parse::<SeedRange>().unwrap_err().contains("\"1..20\""));
+        assert!(
+            "20..1"
+                .parse::<SeedRange>()
+                .unwrap_err()
+                .contains("\"1..20\"")
+        );
         assert!("a..3".parse::<SeedRange>().unwrap_err().contains("`a`"));
-        assert!("0..99999".parse::<SeedRange>().unwrap_err().contains("10000"));
+        assert!(
+            "0..99999"
+                .parse::<SeedRange>()
+                .unwrap_err()
+                .contains("10000")
+        );
     }
 
     #[test]

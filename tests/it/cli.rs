@@ -231,8 +231,16 @@ fn without_timings(v: &mut serde_json::Value) {
     }
 }
 
-/// (suite, testcase, class, properties, failure text) of every JUnit test case; no times.
-fn junit_cases(path: &Path) -> Vec<(String, String, String, Vec<(String, String)>, Option<String>)> {
+/// (suite, testcase, class, properties, failure text) of one JUnit test case.
+type Case = (
+    String,
+    String,
+    String,
+    Vec<(String, String)>,
+    Option<String>,
+);
+
+fn junit_cases(path: &Path) -> Vec<Case> {
     let xml = std::fs::read_to_string(path).unwrap();
     let doc = roxmltree::Document::parse(&xml).expect("valid JUnit XML");
     let attr = |n: roxmltree::Node, a: &str| n.attribute(a).unwrap_or("").to_string();
@@ -264,50 +272,109 @@ fn sharded_check_then_merge_equals_the_unsharded_run() {
     std::fs::create_dir_all(&a).unwrap();
     std::fs::create_dir_all(&b).unwrap();
     // the same name twice; one bound that always holds, one that no seed meets
-    let gate = "[expect]\nlevels = [{ levels = 1, min_recall = 0.0 }, { levels = 3, min_recall = 1.0 }]\n";
+    let gate =
+        "[expect]\nlevels = [{ levels = 1, min_recall = 0.0 }, { levels = 3, min_recall = 1.0 }]\n";
     let s1 = smoke_variant(&a, "smoke", gate);
     let s2 = smoke_variant(&b, "smoke", gate);
     let (s1, s2) = (s1.to_str().unwrap(), s2.to_str().unwrap());
     let whole = dir.path().join("whole");
-    let o = placewords(&["check", "-q", s1, s2, "--seeds", "1..3", "-o", whole.to_str().unwrap()]);
+    let o = placewords(&[
+        "check",
+        "-q",
+        s1,
+        s2,
+        "--seeds",
+        "1..3",
+        "-o",
+        whole.to_str().unwrap(),
+    ]);
     let stdout = String::from_utf8_lossy(&o.stdout).to_string();
-    assert_eq!(o.status.code(), Some(1), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
-    assert!(stdout.trim_end().ends_with("2 passed, 2 failed"), "{stdout}");
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        stdout.trim_end().ends_with("2 passed, 2 failed"),
+        "{stdout}"
+    );
     assert!(stdout.contains("; reproduce: placewords run "), "{stdout}");
 
     let mut parts = Vec::new();
     for k in 1..=4 {
         let part = dir.path().join(format!("part{k}.json"));
         let shard = format!("{k}/4");
-        let o = placewords(&["check", "-q", s1, s2, "--seeds", "1..3", "--shard", &shard, "--report", part.to_str().unwrap()]);
-        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        let o = placewords(&[
+            "check",
+            "-q",
+            s1,
+            s2,
+            "--seeds",
+            "1..3",
+            "--shard",
+            &shard,
+            "--report",
+            part.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
         parts.push(part.to_str().unwrap().to_string());
     }
     let merged = dir.path().join("merged");
     let mut args = vec!["merge", "-o", merged.to_str().unwrap()];
     args.extend(parts.iter().rev().map(String::as_str));
     let o = placewords(&args);
-    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert!(String::from_utf8_lossy(&o.stdout).contains("2 passed, 2 failed"));
 
     let cases = junit_cases(&whole.join("junit.xml"));
     assert_eq!(cases, junit_cases(&merged.join("junit.xml")));
     assert_eq!(cases.len(), 4);
-    assert_ne!(cases[0].0, cases[2].0, "twins get their file in the suite name");
+    assert_ne!(
+        cases[0].0, cases[2].0,
+        "twins get their file in the suite name"
+    );
     assert!(cases[0].0.contains("a/smoke.toml"), "{:?}", cases[0]);
-    assert!(cases[1].2.ends_with("a/smoke.toml"), "the class is the file: {:?}", cases[1]);
-    assert_eq!(cases[1].1, format!("{}/levels=3/recall", cases[1].0), "no bound in a name");
+    assert!(
+        cases[1].2.ends_with("a/smoke.toml"),
+        "the class is the file: {:?}",
+        cases[1]
+    );
+    assert_eq!(
+        cases[1].1,
+        format!("{}/levels=3/recall", cases[1].0),
+        "no bound in a name"
+    );
     let props: Vec<&str> = cases[1].3.iter().map(|p| p.0.as_str()).collect();
-    assert_eq!(props, ["value", "statistic", "bound", "seeds", "seed", "reproduce"]);
+    assert_eq!(
+        props,
+        ["value", "statistic", "bound", "seeds", "seed", "reproduce"]
+    );
     let failure = cases[1].4.as_deref().expect("the recall bound fails");
-    assert!(failure.contains("recall worst") && failure.contains("< 1.000"), "{failure}");
+    assert!(
+        failure.contains("recall worst") && failure.contains("< 1.000"),
+        "{failure}"
+    );
     assert!(failure.contains("--seed "), "{failure}");
 
     let mut want = report_of(&whole.join("report.json"));
     let mut got = report_of(&merged.join("report.json"));
     without_timings(&mut want);
     without_timings(&mut got);
-    assert_eq!(want, got, "merged report.json differs from the unsharded one");
+    assert_eq!(
+        want, got,
+        "merged report.json differs from the unsharded one"
+    );
     assert_eq!(want["scenarios"][0]["results"].as_array().unwrap().len(), 3);
     let table = |d: &Path| {
         std::fs::read_to_string(d.join("table.md"))
@@ -319,7 +386,13 @@ fn sharded_check_then_merge_equals_the_unsharded_run() {
     };
     assert_eq!(table(&whole), table(&merged));
 
-    let o = placewords(&["merge", "-o", merged.to_str().unwrap(), &parts[0], &parts[1]]);
+    let o = placewords(&[
+        "merge",
+        "-o",
+        merged.to_str().unwrap(),
+        &parts[0],
+        &parts[1],
+    ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("part 3/4 is missing"));
 }
@@ -334,9 +407,20 @@ fn check_without_expect_is_an_error_unless_allowed() {
     let o = placewords(&["check", "-q", bare]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("no [expect] block") && err.contains("--allow-no-expect"), "{err}");
+    assert!(
+        err.contains("no [expect] block") && err.contains("--allow-no-expect"),
+        "{err}"
+    );
     let o = placewords(&["check", "-q", "--json", "--allow-no-expect", bare]);
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
-    assert_eq!((v["passed"].as_u64(), v["failed"].as_u64()), (Some(0), Some(0)));
+    assert_eq!(
+        (v["passed"].as_u64(), v["failed"].as_u64()),
+        (Some(0), Some(0))
+    );
 }
