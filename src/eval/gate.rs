@@ -225,8 +225,18 @@ fn check_bound(
         runs: reports.len(),
         missing,
         passed,
-        seconds,
+        seconds: recognize_seconds(reports, subject),
     }
+}
+
+/// Seconds `subject` spent recognizing, over all `reports`.
+fn recognize_seconds(reports: &[Report], subject: &str) -> f64 {
+    reports
+        .iter()
+        .filter_map(|r| {
+            distribution::scores_of(r, subject).map(|s| s.recognize_seconds_per_lap * r.laps as f64)
+        })
+        .sum()
 }
 
 /// 0 when every outcome passed, 1 when any missed.

@@ -249,13 +249,36 @@ pub enum MergeError {
 
 /// Joins parts (with the files they came from, for messages) into the whole run's suite.
 pub fn merge(parts: Vec<(String, SuiteReport)>) -> Result<SuiteReport, MergeError> {
+    check_parts(&parts)?;
+    let first = &parts[0].1;
+    let mut scenarios = first.scenarios.clone();
+    for (i, sc) in scenarios.iter_mut().enumerate() {
+        sc.results = parts
+            .iter()
+            .flat_map(|(_, p)| p.scenarios[i].results.iter().cloned())
+            .collect();
+        sc.results.sort_by_key(|r| r.seed);
+        if let Some(w) = sc.results.windows(2).find(|w| w[0].seed == w[1].seed) {
+            let n = sc.results.iter().filter(|r| r.seed == w[0].seed).count();
+            return Err(MergeError::SeedTwice {
+                label: sc.label.clone(),
+                seed: w[0].seed,
+                n,
+            });
+        }
+    }
+    Ok(SuiteReport::new(None, first.gated, scenarios))
+}
+
+/// Checks that `parts` are parts 1..N of one plan, each once.
+fn check_parts(parts: &[(String, SuiteReport)]) -> Result<(), MergeError> {
     let (first_file, first) = parts.first().ok_or(MergeError::NoParts)?;
     let count = first
         .shard
         .ok_or_else(|| MergeError::NotAPart(first_file.clone()))?
         .count;
     let mut seen: Vec<Option<&String>> = vec![None; count];
-    for (file, part) in &parts {
+    for (file, part) in parts {
         let shard = part
             .shard
             .ok_or_else(|| MergeError::NotAPart(file.clone()))?;
@@ -278,30 +301,13 @@ pub fn merge(parts: Vec<(String, SuiteReport)>) -> Result<SuiteReport, MergeErro
             });
         }
     }
-    if let Some(i) = seen.iter().position(Option::is_none) {
-        return Err(MergeError::Missing {
+    match seen.iter().position(Option::is_none) {
+        Some(i) => Err(MergeError::Missing {
             index: i + 1,
             count,
-        });
+        }),
+        None => Ok(()),
     }
-    let gated = first.gated;
-    let mut scenarios = first.scenarios.clone();
-    for (i, sc) in scenarios.iter_mut().enumerate() {
-        sc.results = parts
-            .iter()
-            .flat_map(|(_, p)| p.scenarios[i].results.iter().cloned())
-            .collect();
-        sc.results.sort_by_key(|r| r.seed);
-        if let Some(w) = sc.results.windows(2).find(|w| w[0].seed == w[1].seed) {
-            let n = sc.results.iter().filter(|r| r.seed == w[0].seed).count();
-            return Err(MergeError::SeedTwice {
-                label: sc.label.clone(),
-                seed: w[0].seed,
-                n,
-            });
-        }
-    }
-    Ok(SuiteReport::new(None, gated, scenarios))
 }
 
 /// Whether two parts were planned alike: same scenarios, seeds, expectations and errors.

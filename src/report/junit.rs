@@ -72,17 +72,8 @@ pub fn junit_xml(suites: &[Suite]) -> String {
             s.error.is_some() as usize,
             s.seconds
         );
-        let classname = escape(&s.file);
         if let Some(err) = &s.error {
-            let _ = writeln!(
-                x,
-                "    <testcase name=\"{}/run\" classname=\"{classname}\" time=\"{:.3}\">\n      \
-                 <error message=\"{}\" type=\"error\">{}</error>\n    </testcase>",
-                escape(&s.scenario),
-                s.seconds,
-                escape(first_line(err)),
-                escape(err)
-            );
+            x.push_str(&error_case(s, err));
         }
         for o in &s.outcomes {
             x.push_str(&testcase(o, &s.file));
@@ -93,8 +84,21 @@ pub fn junit_xml(suites: &[Suite]) -> String {
     x
 }
 
-/// One `<testcase>` with its properties and, if missed, its failure.
-fn testcase(o: &Outcome, file: &str) -> String {
+/// The `<testcase>` of a scenario (or some of its seeds) that could not run.
+fn error_case(s: &Suite, err: &str) -> String {
+    format!(
+        "    <testcase name=\"{}/run\" classname=\"{}\" time=\"{:.3}\">\n      \
+         <error message=\"{}\" type=\"error\">{}</error>\n    </testcase>\n",
+        escape(&s.scenario),
+        escape(&s.file),
+        s.seconds,
+        escape(first_line(err)),
+        escape(err)
+    )
+}
+
+/// The properties of a test case: measured value, statistic, bound, seeds, seed, command.
+fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
     let mut props = vec![
         ("statistic", o.statistic()),
         ("bound", fmt_value(o.bound, o.limit)),
@@ -107,6 +111,11 @@ fn testcase(o: &Outcome, file: &str) -> String {
         props.push(("seed", seed.to_string()));
         props.push(("reproduce", reproduce_command(file, seed)));
     }
+    props
+}
+
+/// One `<testcase>` with its properties and, if missed, its failure.
+fn testcase(o: &Outcome, file: &str) -> String {
     let mut x = format!(
         "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"{:.3}\">\n      <properties>\n",
         escape(&o.name()),
@@ -114,7 +123,7 @@ fn testcase(o: &Outcome, file: &str) -> String {
         escape(file),
         o.seconds
     );
-    for (k, v) in props {
+    for (k, v) in properties(o, file) {
         let _ = writeln!(
             x,
             "        <property name=\"{k}\" value=\"{}\"/>",
