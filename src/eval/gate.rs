@@ -207,12 +207,6 @@ fn check_bound(
         Some((_, a)) if metric.higher_is_better() => a >= limit,
         Some((_, a)) => a <= limit,
     };
-    let seconds = reports
-        .iter()
-        .filter_map(|r| {
-            distribution::scores_of(r, subject).map(|s| s.recognize_seconds_per_lap * r.laps as f64)
-        })
-        .sum();
     Outcome {
         scenario: scenario.to_string(),
         subject: subject.to_string(),
