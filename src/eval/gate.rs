@@ -107,7 +107,7 @@ impl Outcome {
                     )
                 };
                 format!(
-                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed} {of})",
+                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed}, {of})",
                     self.scenario,
                     self.subject,
                     fmt_value(self.bound, a),
@@ -270,12 +270,12 @@ mod tests {
         assert_eq!(exit_code(&o), 0);
         assert_eq!(
             o[0].line(),
-            "PASS B levels=3 precision worst 0.900 >= 0.900 (seed 7 of 1)"
+            "PASS B levels=3 precision worst 0.900 >= 0.900 (seed 7, over 1 seed)"
         );
         assert_eq!(o[0].name(), "B/levels=3/precision");
         assert_eq!(
             o[2].line(),
-            "PASS B levels=3 s/lap worst 1.50s <= 2.00s (seed 7 of 1)"
+            "PASS B levels=3 s/lap worst 1.50s <= 2.00s (seed 7, over 1 seed)"
         );
     }
 
@@ -294,7 +294,7 @@ mod tests {
         assert_eq!(exit_code(&o), 1);
         assert_eq!(
             o[0].line(),
-            "FAIL C levels=2 precision worst 0.910 < 0.950 (seed 7 of 1)"
+            "FAIL C levels=2 precision worst 0.910 < 0.950 (seed 7, over 1 seed)"
         );
         assert!(o[1].passed && o[2].passed);
         assert_eq!(o[2].subject, "icp");

@@ -217,7 +217,7 @@ mod tests {
             .expect("a failure element");
         assert_eq!(
             failure.attribute("message"),
-            Some("FAIL B<&> levels=3 precision worst 0.900 < 0.950 (seed 7 of 1)")
+            Some("FAIL B<&> levels=3 precision worst 0.900 < 0.950 (seed 7, over 1 seed)")
         );
         assert_eq!(cases[0].attribute("name"), Some("B<&>/levels=3/precision"));
         assert!(
