@@ -154,40 +154,40 @@ pub fn check_text(suite: &SuiteReport) -> String {
 pub fn markdown(suite: &SuiteReport) -> String {
     let mut out = String::from("# placewords stress run\n");
     for sc in &suite.scenarios {
-        let _ = writeln!(
-            out,
-            "\n## {} (`{}`), seeds {}\n",
-            sc.label, sc.file, sc.seeds
-        );
-        for e in sc.errors() {
-            let _ = writeln!(out, "- error: {}", e.replace('\n', " "));
-        }
-        if !sc.summary.is_empty() {
-            out.push_str(
-                "| levels | metric | mean | p10 | worst | worst seed |\n|---|---|---|---|---|---|\n",
-            );
-        }
-        for c in &sc.summary {
-            for m in Metric::ALL {
-                let _ = writeln!(
-                    out,
-                    "| {} | {} | {} |",
-                    label(c),
-                    m.name(),
-                    md_cells(c.get(m))
-                );
-            }
-        }
-        if !sc.outcomes.is_empty() {
-            out.push_str("\n| test case | statistic | value | bound | seed | result |\n");
-            out.push_str("|---|---|---|---|---|---|\n");
-            for o in &sc.outcomes {
-                let _ = writeln!(out, "{}", md_outcome(o));
-            }
-        }
+        out.push_str(&md_scenario(sc));
     }
     if suite.gated {
         let _ = writeln!(out, "\n{}", suite.tally().line());
+    }
+    out
+}
+
+/// One scenario's section of `table.md`.
+fn md_scenario(sc: &ScenarioResult) -> String {
+    let mut out = format!("\n## {} (`{}`), seeds {}\n\n", sc.label, sc.file, sc.seeds);
+    for e in sc.errors() {
+        let _ = writeln!(out, "- error: {}", e.replace('\n', " "));
+    }
+    if !sc.summary.is_empty() {
+        out.push_str("| levels | metric | mean | p10 | worst | worst seed |\n");
+        out.push_str("|---|---|---|---|---|---|\n");
+    }
+    for c in &sc.summary {
+        for m in Metric::ALL {
+            let cells = md_cells(c.get(m));
+            let _ = writeln!(out, "| {} | {} | {cells} |", label(c), m.name());
+        }
+    }
+    for c in sc.summary.iter().filter(|c| !c.no_match_seeds.is_empty()) {
+        let seeds = &c.no_match_seeds;
+        let _ = writeln!(out, "\n{}: no matches at seed(s) {seeds:?}", label(c));
+    }
+    if !sc.outcomes.is_empty() {
+        out.push_str("\n| test case | statistic | value | bound | seed | result |\n");
+        out.push_str("|---|---|---|---|---|---|\n");
+        for o in &sc.outcomes {
+            let _ = writeln!(out, "{}", md_outcome(o));
+        }
     }
     out
 }
