@@ -100,9 +100,9 @@ pub fn finish(
         eprintln!("error: {e}");
     }
     if json {
-        println!("{}", format::summary_json(suite));
+        outln!("{}", format::summary_json(suite))?;
     } else {
-        print!("{}", format::check_text(suite));
+        out!("{}", format::check_text(suite))?;
     }
     Ok(ExitCode::from(suite.exit_code()))
 }

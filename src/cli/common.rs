@@ -37,9 +37,12 @@ pub fn print_and_write(
     svg_dir: Option<&Path>,
 ) -> anyhow::Result<()> {
     use placewords::experiment::picture;
-    print!("{}", placewords::report::table::text_table(&exp.report));
+    out!("{}", placewords::report::table::text_table(&exp.report))?;
     if let Some(path) = report {
-        write_file(path, exp.report.to_json().as_bytes())?;
+        write_file(
+            path,
+            placewords::report::json::to_json(&exp.report).as_bytes(),
+        )?;
         eprintln!("report: {}", path.display());
     }
     let Some(dir) = svg_dir else { return Ok(()) };

@@ -54,13 +54,13 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
             ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt()
         })
         .sum();
-    println!(
+    outln!(
         "{}: {} walls, home ({:.2}, {:.2}), route `{}` of {n} waypoints ({len:.1} m); no doors (add them by hand)",
         args.out.display(),
         spec.walls.len(),
         spec.robot_home.x_m,
         spec.robot_home.y_m,
         route.id
-    );
+    )?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,6 +1,16 @@
 //! Subcommands, one file each. Each file holds its clap arguments and a `run` that calls the
 //! library and maps the outcome to an exit code.
 
+/// `print!` that ends quietly on a closed stdout (see [`out`]); returns `std::io::Result<()>`.
+macro_rules! out {
+    ($($arg:tt)*) => { crate::cli::out::write(format_args!($($arg)*)) };
+}
+
+/// `println!` that ends quietly on a closed stdout (see [`out`]); returns `std::io::Result<()>`.
+macro_rules! outln {
+    ($($arg:tt)*) => { crate::cli::out::write(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -8,6 +18,7 @@ pub mod check;
 pub mod common;
 pub mod import;
 pub mod merge;
+pub mod out;
 pub mod recognize;
 pub mod run;
 pub mod simulate;

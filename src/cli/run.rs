@@ -50,7 +50,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
             ..StressOptions::default()
         };
         let suite = stress::run_stress(std::slice::from_ref(&args.scenario), &stress_opts);
-        print!("{}", placewords::report::suite::text_table(&suite));
+        out!("{}", placewords::report::suite::text_table(&suite))?;
         if let Some(path) = &args.report {
             write_file(path, suite.to_json().as_bytes())?;
             eprintln!("report: {}", path.display());

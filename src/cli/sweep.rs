@@ -4,9 +4,9 @@
 
 use super::common::write_file;
 use clap::Args;
+use placewords::eval::scores::SweepReport;
 use placewords::eval::sweep::fig8_grid;
 use placewords::experiment::{self, ExperimentOptions};
-use placewords::report::json::SweepReport;
 use placewords::report::plot::pr_curves_svg;
 use placewords::report::table::curves_table;
 use std::path::PathBuf;
@@ -39,8 +39,11 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let laps = runs.iter().map(|r| r.laps.len()).sum();
     let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
     let report = SweepReport::new(&scn.name, scn.seed, laps, scn.evaluation.clone(), results);
-    print!("{}", curves_table(&report.curves));
-    write_file(&args.out.join("sweep.json"), report.to_json().as_bytes())?;
+    out!("{}", curves_table(&report.curves))?;
+    write_file(
+        &args.out.join("sweep.json"),
+        placewords::report::json::to_json(&report).as_bytes(),
+    )?;
     let title = format!("{}: precision / recall (Fig. 8)", scn.name);
     write_file(
         &args.out.join("pr-curves.svg"),

@@ -4,8 +4,8 @@
 
 use super::common::write_file;
 use clap::Args;
+use placewords::eval::scores::TableReport;
 use placewords::experiment::{self, ExperimentOptions};
-use placewords::report::json::TableReport;
 use placewords::report::table::{markdown_table_i, markdown_visit_recall, thresholds_note};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -48,7 +48,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         let exp = experiment::run_scenario(scn, &opts)?;
         write_file(
             &args.out.join(format!("report-{}.json", scn.name)),
-            exp.report.to_json().as_bytes(),
+            placewords::report::json::to_json(&exp.report).as_bytes(),
         )?;
         reports.push(exp.report);
     }
@@ -58,9 +58,9 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         thresholds_note(&reports),
         markdown_visit_recall(&reports)
     );
-    print!("{md}");
+    out!("{md}")?;
     write_file(&args.out.join("table.md"), md.as_bytes())?;
-    let json = serde_json::to_string_pretty(&TableReport { reports })?;
+    let json = placewords::report::json::to_json(&TableReport { reports });
     write_file(&args.out.join("table.json"), json.as_bytes())?;
     eprintln!("table: {}", args.out.join("table.md").display());
     Ok(ExitCode::SUCCESS)

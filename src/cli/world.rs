@@ -67,13 +67,13 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for f in &args.files {
         match placewords::spec::world::load_world(f) {
-            Ok(w) => println!(
+            Ok(w) => outln!(
                 "{}: ok ({} walls, {} doors, {} routes)",
                 f.display(),
                 w.walls.len(),
                 w.doors.len(),
                 w.routes.len()
-            ),
+            )?,
             Err(e) => {
                 eprintln!("{e}");
                 failed = true;
@@ -139,9 +139,9 @@ fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
     };
     let info = placewords::world::info::world_info(&world);
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        outln!("{}", serde_json::to_string_pretty(&info)?)?;
     } else {
-        print!("{info}");
+        out!("{info}")?;
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -7,7 +7,7 @@
 //! with `--seed`. A seed whose recognizer made no pair has no precision ("no matches"): it is
 //! left out of the precision figures and listed in `no_match_seeds`; its recall (0) counts.
 
-use crate::report::json::{Report, Scores};
+use crate::eval::scores::{Report, Scores};
 use serde::{Deserialize, Serialize};
 
 /// The quantile the `p10` figures use.
@@ -200,7 +200,7 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
 
     #[test]
     fn worst_and_p10_count_from_the_bad_end_and_name_their_seed() {

@@ -5,11 +5,11 @@
 //! entry and of `[expect.icp]`. A bound applies to the worst seed, or with `quantile = q` to the
 //! q-quantile from the worst end (`eval::distribution`). A bound on a configuration no report
 //! holds fails ("not in the report"), and so does a precision bound when no seed matched
-//! anything ("no matches"). Exit decision: 0 when every outcome passes, 1 when any missed (2, an
-//! error, is decided by whoever ran the seeds).
+//! anything ("no matches"). Exit decision ([`gate_exit_code`], the one rule the CLI uses): 2
+//! when a scenario or seed could not be run (an error), else 1 when any outcome missed, else 0.
 
 use crate::eval::distribution::{self, Metric};
-use crate::report::json::Report;
+use crate::eval::scores::Report;
 use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
@@ -235,7 +235,15 @@ fn recognize_seconds(reports: &[Report], subject: &str) -> f64 {
 
 /// 0 when every outcome passed, 1 when any missed.
 pub fn exit_code(outcomes: &[Outcome]) -> i32 {
-    if outcomes.iter().all(|o| o.passed) {
+    i32::from(gate_exit_code(0, outcomes))
+}
+
+/// The gate's exit code: 2 when `errors` scenarios could not be run, else 1 when any outcome
+/// missed, else 0.
+pub fn gate_exit_code<'a>(errors: usize, outcomes: impl IntoIterator<Item = &'a Outcome>) -> u8 {
+    if errors > 0 {
+        2
+    } else if outcomes.into_iter().all(|o| o.passed) {
         0
     } else {
         1
@@ -245,7 +253,7 @@ pub fn exit_code(outcomes: &[Outcome]) -> i32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
     use crate::spec::evaluation::LevelExpectation;
 
     fn expect(levels: usize, p: f64, r: f64, s: Option<f64>) -> LevelExpectation {
@@ -327,6 +335,7 @@ mod tests {
     fn no_expectation_passes() {
         let rep = sample("A", [0.9; 3], [0.1; 3]);
         assert_eq!(exit_code(&check(&rep, &ExpectSpec::default())), 0);
+        assert_eq!(gate_exit_code(1, &check(&rep, &ExpectSpec::default())), 2);
     }
 
     #[test]

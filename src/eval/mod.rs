@@ -4,41 +4,26 @@
 //! [`PlaceRecognizer`] in order, keeping the ground truth of every frame to itself
 //! ([`GroundTruth`]); [`metrics::evaluate`] turns the recognizer's matches into observation pairs
 //! and scores them (DESIGN.md §6); [`sweep`] repeats this over a grid of thresholds;
+//! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
 pub mod distribution;
 pub mod gate;
 pub mod metrics;
+pub mod scores;
 pub mod suite;
 pub mod sweep;
 
-use crate::geom::{OdomPose, TruePose};
+use crate::geom::TruePose;
+use crate::log::RunLog;
 use crate::recognizer::{Match, Observation};
-use crate::scan::Scan;
-use crate::sim::RunLog;
 use std::time::Instant;
 
 pub use metrics::{Metrics, evaluate};
 
-/// Anything that recognizes places from odometry and scans alone: the paper's recognizer, the
-/// ICP baseline, or a test double. It never sees ground truth.
-pub trait PlaceRecognizer {
-    /// Marks the start of a new run (no matching link crosses a run boundary). Called before
-    /// the first frame of every run, the first one included. Returns the matches that closing
-    /// the previous run produced (its last word is only complete once the run ends).
-    fn start_run(&mut self) -> Vec<Match>;
-    /// Feeds one odometry pose and its scan; returns the matches found because of it.
-    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match>;
-    /// Called after the last frame: returns the matches that closing the last run produced.
-    fn finish(&mut self) -> Vec<Match> {
-        Vec::new()
-    }
-    /// Every observation made so far, in the order made (`observations()[i].id == i` is not
-    /// required; ids are looked up).
-    fn observations(&self) -> &[Observation];
-    /// A short name for reports and progress bars ("levels=2 [6, 9]", "icp").
-    fn name(&self) -> String;
-}
+/// The interface a recognizer implements to be scored lives below `eval` and `baseline` in
+/// [`crate::place`]; re-exported here for the evaluation's users.
+pub use crate::place::PlaceRecognizer;
 
 /// What the evaluation knows about one lap.
 #[derive(Clone, Debug, PartialEq)]

@@ -8,7 +8,7 @@
 
 use crate::eval::distribution::{self, ConfigSpread};
 use crate::eval::gate::{self, Outcome};
-use crate::report::json::Report;
+use crate::eval::scores::Report;
 use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
 use serde::{Deserialize, Serialize};
@@ -111,17 +111,6 @@ pub struct Tally {
 }
 
 impl Tally {
-    /// 2 on any error, else 1 on any missed bound, else 0.
-    pub fn exit_code(&self) -> u8 {
-        if self.errors > 0 {
-            2
-        } else if self.failed > 0 {
-            1
-        } else {
-            0
-        }
-    }
-
     /// `N passed, M failed` (and `, E errors` when there are any).
     pub fn line(&self) -> String {
         let mut s = format!("{} passed, {} failed", self.passed, self.failed);
@@ -185,11 +174,10 @@ impl SuiteReport {
     /// The exit code of `check` and `merge`: the tally's for a whole run; a part exits 0
     /// unless something failed to run (2), since its seeds are not the distribution.
     pub fn exit_code(&self) -> u8 {
-        let t = self.tally();
+        let errors = self.tally().errors;
         match self.shard {
-            Some(_) if t.errors == 0 => 0,
-            Some(_) => 2,
-            None => t.exit_code(),
+            Some(_) => gate::gate_exit_code(errors, []),
+            None => gate::gate_exit_code(errors, self.scenarios.iter().flat_map(|s| &s.outcomes)),
         }
     }
 
@@ -323,7 +311,7 @@ fn same_plan(a: &SuiteReport, b: &SuiteReport) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
     use crate::spec::evaluation::LevelExpectation;
 
     fn scenario(seeds: &[u64]) -> ScenarioResult {

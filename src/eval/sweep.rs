@@ -12,8 +12,8 @@
 
 use super::metrics::{Metrics, Scorer, f1};
 use super::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs};
+use crate::log::RunLog;
 use crate::recognizer::{Match, Observation};
-use crate::sim::RunLog;
 use crate::spec::evaluation::EvaluationSpec;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

@@ -8,13 +8,13 @@ pub mod real;
 pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
+use crate::eval::scores::Report;
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs_with_progress};
 use crate::geom::OdomPose;
 use crate::recognizer::{
     DensityFrontEnd, Match, Observation, Recognizer, RecognizerConfig, WordMatcher,
 };
-use crate::report::json::Report;
 use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;

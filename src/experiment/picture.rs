@@ -3,10 +3,10 @@
 
 use crate::eval::Recognition;
 use crate::eval::metrics::scored_pairs;
+use crate::log::RunLog;
 use crate::report::world_render::{
     LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
 };
-use crate::sim::RunLog;
 use crate::world::World;
 
 /// Most segments drawn for matched pairs; beyond it every k-th pair is drawn (a picture of

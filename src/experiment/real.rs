@@ -5,7 +5,7 @@
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
 use crate::io::real_log::{RealLogError, TruthSource, load_run};
-use crate::sim::RunLog;
+use crate::log::RunLog;
 use crate::sim::odometry::{OdometryConfig, OdometryModel};
 use crate::sim::rng::{Purpose, SimRng, stream};
 use rand_distr::{Distribution, StandardNormal};

@@ -1,5 +1,5 @@
 //! Turning a real CARMEN log into the shape the recognizer and evaluation consume
-//! ([`crate::sim::RunLog`]): one run, one lap holding every laser frame, door configuration
+//! ([`crate::log::RunLog`]): one run, one lap holding every laser frame, door configuration
 //! `"unknown"`.
 //!
 //! **Corrected logs.** The Radish "corrected" logs carry no raw odometry: a laser line's `x y theta`
@@ -31,8 +31,8 @@
 
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{LaserRecord, LogReadout, LogRecord, ReadOptions, TruePosRecord, read_log};
+use crate::log::{Frame, LapLog, RunLog};
 use crate::scan::{BeamLayout, Scan};
-use crate::sim::{Frame, LapLog, RunLog};
 
 /// Used when the log names no laser maximum range, metres. SICK LMS scanners in CARMEN logs
 /// report "no return" as ~81.9 m, so readings at or beyond 80 m are treated as no return.

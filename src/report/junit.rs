@@ -155,7 +155,7 @@ fn first_line(s: &str) -> &str {
 mod tests {
     use super::*;
     use crate::eval::gate::{Bound, check};
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
     use crate::spec::evaluation::{ExpectSpec, LevelExpectation};
 
     #[test]

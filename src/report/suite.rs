@@ -258,7 +258,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
         "passed": t.passed,
         "failed": t.failed,
         "errors": t.errors,
-        "exit_code": t.exit_code(),
+        "exit_code": suite.exit_code(),
         "shard": suite.shard.map(|s| s.to_string()),
         "outcomes": outcomes,
         "error_messages": errors,
@@ -269,8 +269,8 @@ pub fn summary_json(suite: &SuiteReport) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::scores::tests::sample;
     use crate::eval::suite::SeedResult;
-    use crate::report::json::tests::sample;
     use crate::spec::evaluation::{ExpectSpec, LevelExpectation};
     use crate::spec::seeds::SeedRange;
 

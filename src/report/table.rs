@@ -1,6 +1,6 @@
 //! Tables from reports: a plain-text table for the terminal, and the paper's Table I in Markdown.
 
-use crate::report::json::{Report, Scores};
+use crate::eval::scores::{Report, Scores};
 use std::fmt::Write;
 
 /// Rows of a terminal table: (label, scores).
@@ -256,7 +256,7 @@ pub fn curves_table(curves: &[crate::eval::sweep::PrCurve]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::json::tests::sample;
+    use crate::eval::scores::tests::sample;
 
     #[test]
     fn markdown_table_has_a_row_per_configuration_and_columns_per_scenario() {

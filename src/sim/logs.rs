@@ -8,7 +8,7 @@
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::atomic::write_atomic;
 use crate::io::carmen::{LaserRecord, LogRecord, OdomRecord, TruePosRecord, write_record};
-use crate::sim::RunLog;
+use crate::log::RunLog;
 use crate::spec::scenario::Scenario;
 use serde::Serialize;
 use std::path::{Path, PathBuf};

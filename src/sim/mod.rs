@@ -1,8 +1,8 @@
 //! The simulated robot: differential drive and route-following controller, LMS200 laser model,
 //! odometry error models, pedestrians, seeded random streams, and lap generation.
 //!
-//! What a simulation produces ([`RunLog`]) is also what real logs are turned into, so the
-//! recognizer and evaluation see one shape of data.
+//! What a simulation produces ([`RunLog`], defined in [`crate::log`]) is also what real logs are
+//! turned into, so the recognizer and evaluation see one shape of data.
 
 pub mod laser;
 pub mod logs;
@@ -14,44 +14,6 @@ pub mod runner;
 
 pub use runner::{SimError, simulate};
 
-use crate::geom::{OdomPose, TruePose};
-use crate::scan::Scan;
-
-/// One laser scan with the poses at its time.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    /// Seconds since the start of the run.
-    pub time_s: f64,
-    /// Dead-reckoning pose: the only pose the recognizer may see.
-    pub odom: OdomPose,
-    /// Ground truth, for evaluation only.
-    pub truth: TruePose,
-    pub scan: Scan,
-}
-
-/// One lap of a run: the frames recorded while the robot drove it, and the doors it saw.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LapLog {
-    /// 0-based lap within the run.
-    pub lap: usize,
-    /// Name of the door configuration during this lap ("all-closed", a named set, "random").
-    pub door_config: String,
-    /// Ids of the doors open during this lap.
-    pub open_doors: Vec<String>,
-    pub frames: Vec<Frame>,
-}
-
-/// One run: consecutive laps from one start, with continuous odometry.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RunLog {
-    /// 0-based run index within the scenario.
-    pub run: usize,
-    pub laps: Vec<LapLog>,
-}
-
-impl RunLog {
-    /// All frames of the run in order.
-    pub fn frames(&self) -> impl Iterator<Item = &Frame> {
-        self.laps.iter().flat_map(|l| l.frames.iter())
-    }
-}
+/// The records a simulation produces live in the neutral [`crate::log`] module (real-log readers
+/// produce them too); re-exported here for the simulator's users.
+pub use crate::log::{Frame, LapLog, RunLog};

@@ -12,12 +12,12 @@
 //! (0, 0, 0) as on a robot just switched on; odometry is continuous across the run's laps.
 
 use crate::geom::{OdomPose, Pose2, TruePose};
+use crate::log::{Frame, LapLog, RunLog};
 use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
 use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
-use crate::sim::{Frame, LapLog, RunLog};
 use crate::spec::scenario::{DoorPlan, Scenario};
 use crate::world::DoorStates;
 use crate::world::physics::Physics;

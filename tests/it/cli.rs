@@ -426,4 +426,60 @@ fn check_without_expect_is_an_error_unless_allowed() {
         (v["passed"].as_u64(), v["failed"].as_u64()),
         (Some(0), Some(0))
     );
+
+    // --shard auto: the part from a Kubernetes Indexed Job's JOB_COMPLETION_INDEX (0-based)
+    let part = dir.path().join("part.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(["check", "-q", "--allow-no-expect", "--shard", "auto", bare])
+        .args(["--report", part.to_str().unwrap()])
+        .env("JOB_COMPLETION_INDEX", "2")
+        .env("PLACEWORDS_SHARD_COUNT", "4")
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(
+        report_of(&part)["shard"],
+        serde_json::json!({"index": 3, "count": 4})
+    );
+}
+
+/// `placewords COMMAND | head`: the reader leaves before the output is written. Output stops
+/// quietly and the command still exits 0 (it used to panic with exit 101), and it finishes its
+/// other outputs (here the JSON report).
+#[test]
+fn a_closed_stdout_ends_quietly_with_exit_0() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = dir.path().join("r.json");
+    let report_arg = report.display().to_string();
+    for args in [
+        vec!["world", "info", "worlds/loop-small.toml"],
+        vec![
+            "run",
+            "scenarios/smoke.toml",
+            "--laps",
+            "2",
+            "-q",
+            "--report",
+            &report_arg,
+        ],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_placewords"))
+            .args(&args)
+            .current_dir(root())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take()); // the reader leaves at once
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+    assert!(report_of(&report)["levels"].is_array());
 }

@@ -3,13 +3,13 @@
 
 use placewords::baseline::{IcpConfig, IcpRecognizer};
 use placewords::eval::gate::{check, exit_code};
+use placewords::eval::scores::Report;
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
+use placewords::log::{Frame, LapLog, RunLog};
 use placewords::recognizer::{AlignedPair, Match, Observation};
-use placewords::report::json::Report;
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
-use placewords::sim::{Frame, LapLog, RunLog};
 use placewords::spec::evaluation::{EvaluationSpec, ExpectSpec, Expectation, LevelExpectation};
 
 /// A corridor loop 20 × 8 m around a 16 × 4 m block, with niches and pillars so that ICP has

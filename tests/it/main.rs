@@ -1,5 +1,6 @@
 //! One integration-test binary (keeps link time down on 2 cores); one module per area.
 
+mod architecture;
 mod cli;
 mod eval;
 mod io;
