@@ -8,6 +8,7 @@
 //! [`report`] (formatting). Real logs enter through [`io`] as the same [`log`] records.
 //! Modules depend one way; ARCHITECTURE.md gives the layers.
 
+pub mod authoring;
 pub mod baseline;
 pub mod eval;
 pub mod experiment;

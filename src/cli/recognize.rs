@@ -2,7 +2,7 @@
 //! definitions and report schema as `run`.
 
 use super::common::{LevelsArg, print_and_write};
-use anyhow::bail;
+use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use placewords::experiment::{self, ExperimentOptions, picture};
 use placewords::io::real_log::TruthSource;
@@ -34,6 +34,12 @@ pub struct RecognizeArgs {
     /// Seed of the odometry noise stream.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Use every K-th scan only (K = 2 halves the scan rate), to test a recognizer on sparse logs.
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
+    pub scan_step: u64,
+    /// Recognizer settings: a TOML file whose `[recognizer]` table is read as in a scenario.
+    #[arg(long, value_name = "FILE.toml")]
+    pub config: Option<PathBuf>,
     #[command(flatten)]
     pub levels: LevelsArg,
     /// Also run the ICP baseline.
@@ -45,7 +51,7 @@ pub struct RecognizeArgs {
     /// A pair is correct when its true positions are within this distance, metres.
     #[arg(long, default_value_t = 1.0, value_name = "M")]
     pub tp_radius_m: f64,
-    /// Minimum odometric travel between matched or revisiting observations, metres.
+    /// Minimum odometric travel between revisiting observations (evaluation), metres.
     #[arg(long, default_value_t = 20.0, value_name = "M")]
     pub min_gap_m: f64,
     /// Write the JSON report here.
@@ -120,8 +126,18 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         TruthArg::Corrected => TruthSource::Corrected,
         TruthArg::Truepos => TruthSource::TruePos,
     };
-    let (run, skipped) =
+    let base = match &args.config {
+        Some(path) => {
+            let src = std::fs::read_to_string(path)
+                .with_context(|| format!("{}: cannot read", path.display()))?;
+            RecognizerConfig::from_toml_str(&src)
+                .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?
+        }
+        None => RecognizerConfig::default(),
+    };
+    let (mut run, skipped) =
         experiment::real::load_real_run(&args.log, args.lenient, truth, noise.as_ref(), args.seed)?;
+    experiment::real::keep_every_nth_scan(&mut run, args.scan_step as usize);
     if skipped > 0 {
         eprintln!(
             "{}: skipped {skipped} malformed line(s)",
@@ -142,10 +158,6 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         tp_radius_m: args.tp_radius_m,
         min_gap_m: args.min_gap_m,
         ..EvaluationSpec::default()
-    };
-    let base = RecognizerConfig {
-        min_gap_m: args.min_gap_m,
-        ..RecognizerConfig::default()
     };
     let opts = ExperimentOptions {
         levels: args.levels.levels(),

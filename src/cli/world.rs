@@ -18,6 +18,64 @@ pub enum WorldCommand {
     Info(InfoArgs),
     /// Import a MobileSim line map (.map) as a world file, with a generated lap route.
     Import(super::import::ImportArgs),
+    /// Colour every free cell by the density class the recognizer gives it (paper Fig. 2a).
+    Density(DensityArgs),
+    /// Drive a route once without noise and mark the stretches the recognizer will confuse.
+    Ambiguity(AmbiguityArgs),
+    /// Write a random valid floor (corridor loop, offices with doors, niches, a lap route).
+    Generate(GenerateArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct GenerateArgs {
+    /// Seed: the same seed and options give the same file.
+    #[arg(long)]
+    pub seed: u64,
+    /// Floor size in metres, x and y (each 24-2000).
+    #[arg(long = "size-m", value_name = "W,H", value_delimiter = ',', default_values_t = [40.0, 30.0])]
+    pub size_m: Vec<f64>,
+    /// Number of offices, each with one door.
+    #[arg(long, default_value_t = 12)]
+    pub doors: usize,
+    /// Corridors of the loop: 4, 6, 8, 10 or 12.
+    #[arg(long, default_value_t = 4)]
+    pub corridors: usize,
+    /// Output world file (TOML).
+    #[arg(short = 'o', long = "output", value_name = "WORLD.toml")]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct DensityArgs {
+    /// World file (TOML).
+    pub file: PathBuf,
+    /// Output SVG file.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    pub output: PathBuf,
+    /// Doors open, by id (comma-separated or repeated); the others are closed.
+    #[arg(long, value_name = "ID,...", value_delimiter = ',')]
+    pub open: Vec<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct AmbiguityArgs {
+    /// World file (TOML).
+    pub file: PathBuf,
+    /// Route to drive, by id.
+    #[arg(long, default_value = "lap")]
+    pub route: String,
+    /// Output SVG file.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    pub output: PathBuf,
+    /// Doors open during the drive, by id (comma-separated or repeated).
+    #[arg(long, value_name = "ID,...", value_delimiter = ',')]
+    pub open: Vec<String>,
+    /// Print the ambiguous stretches as JSON on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Search this many level configurations (1 = level-0 words only; default 3, as `run`).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=4))]
+    pub levels: Option<u8>,
 }
 
 #[derive(Debug, Args)]
@@ -43,6 +101,12 @@ pub struct RenderArgs {
     /// Title above the picture (default: the world's name).
     #[arg(long)]
     pub title: Option<String>,
+    /// Draw a coordinate grid with labelled metres.
+    #[arg(long)]
+    pub grid: bool,
+    /// Number the route waypoints (from 1, as messages count them).
+    #[arg(long)]
+    pub waypoints: bool,
 }
 
 #[derive(Debug, Args)]
@@ -60,6 +124,9 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
         WorldCommand::Render(a) => render(a),
         WorldCommand::Info(a) => info(a),
         WorldCommand::Import(a) => super::import::run(a),
+        WorldCommand::Density(a) => density(a),
+        WorldCommand::Ambiguity(a) => ambiguity(a),
+        WorldCommand::Generate(a) => generate(a),
     }
 }
 
@@ -116,19 +183,37 @@ fn door_states(world: &World, open: &[String], all_open: bool) -> anyhow::Result
     Ok(states)
 }
 
+/// Renders a world; an invalid one is drawn as far as it could be read with its problems
+/// marked (numbered in the order they are printed), and exits 2.
 fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
-    let Some(world) = load(&args.file) else {
-        return Ok(ExitCode::from(2));
-    };
-    let doors = door_states(&world, &args.open, args.all_open)?;
-    let opts = RenderOptions {
-        doors,
+    let src = std::fs::read_to_string(&args.file)
+        .with_context(|| format!("{}: cannot read", args.file.display()))?;
+    let path = args.file.display().to_string();
+    let base = RenderOptions {
         title: args.title.clone(),
+        show_grid: args.grid,
+        show_waypoints: args.waypoints,
         ..RenderOptions::default()
     };
+    let world = match placewords::spec::world::parse_world(&src, &path) {
+        Ok(w) => w,
+        Err(_) => {
+            let (svg, diags) = placewords::authoring::problems::problems_svg(&src, &path, &base);
+            diags.iter().for_each(|d| eprintln!("{d}"));
+            if let Some(svg) = svg {
+                super::common::write_file(&args.output, svg.as_bytes())?;
+                eprintln!(
+                    "wrote {} with the problems above marked 1..",
+                    args.output.display()
+                );
+            }
+            return Ok(ExitCode::from(2));
+        }
+    };
+    let doors = door_states(&world, &args.open, args.all_open)?;
+    let opts = RenderOptions { doors, ..base };
     let svg = render_world_svg(&world, &opts);
-    placewords::io::atomic::write_atomic(&args.output, svg.as_bytes())
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    super::common::write_file(&args.output, svg.as_bytes())?;
     eprintln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }
@@ -143,5 +228,62 @@ fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
     } else {
         out!("{info}")?;
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
+    let Some(world) = load(&args.file) else {
+        return Ok(ExitCode::from(2));
+    };
+    let doors = door_states(&world, &args.open, false)?;
+    let svg = placewords::authoring::density::density_picture(&world, &doors);
+    super::common::write_file(&args.output, svg.as_bytes())?;
+    eprintln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
+    let Some(world) = load(&args.file) else {
+        return Ok(ExitCode::from(2));
+    };
+    let doors = door_states(&world, &args.open, false)?;
+    let levels = args.levels.map(usize::from);
+    let (report, svg) =
+        placewords::authoring::ambiguity::ambiguity_picture(&world, &args.route, &doors, levels)
+            .with_context(|| format!("{}", args.file.display()))?;
+    super::common::write_file(&args.output, svg.as_bytes())?;
+    let text = if args.json {
+        format!("{}\n", report.to_json())
+    } else {
+        report.summary()
+    };
+    print_quietly(&text)?;
+    eprintln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes to stdout; a closed pipe (`| head`) ends quietly.
+fn print_quietly(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    match std::io::stdout().write_all(text.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
+        _ => Ok(()),
+    }
+}
+
+fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
+    use placewords::world::generate::{GenerateOptions, generate_toml};
+    let [w, h] = args.size_m[..] else {
+        bail!("--size-m takes two numbers, W,H (e.g. --size-m 40,30)");
+    };
+    let opts = GenerateOptions {
+        seed: args.seed,
+        size_m: (w, h),
+        doors: args.doors,
+        corridors: args.corridors,
+    };
+    let text = generate_toml(&opts)?;
+    super::common::write_file(&args.output, text.as_bytes())?;
+    eprintln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }

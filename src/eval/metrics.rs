@@ -144,8 +144,7 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
     let truth_of = |id: ObsId| {
         index_of
             .get(&id)
-            .and_then(|&i| rec.truth.frame(rec.observations[i].input_index))
-            .map(|f| f.pose)
+            .and_then(|&i| rec.truth.observation_pose(&rec.observations[i]))
     };
     let mut seen = HashSet::new();
     let mut out = Vec::new();
@@ -216,14 +215,18 @@ impl Scorer {
         let obs = observations
             .iter()
             .map(|o| {
-                truth.frame(o.input_index).map(|f| ObsTruth {
-                    x: f.pose.0.x,
-                    y: f.pose.0.y,
-                    theta: f.pose.0.theta,
-                    travel_m: o.travel_m,
-                    config: lap_config[f.lap_slot],
-                    lap: f.lap_slot,
-                })
+                let pose = truth.observation_pose(o);
+                truth
+                    .frame(o.input_index)
+                    .zip(pose)
+                    .map(|(f, pose)| ObsTruth {
+                        x: pose.0.x,
+                        y: pose.0.y,
+                        theta: pose.0.theta,
+                        travel_m: o.travel_m,
+                        config: lap_config[f.lap_slot],
+                        lap: f.lap_slot,
+                    })
             })
             .collect();
         Scorer {
@@ -522,6 +525,7 @@ pub(crate) mod tests {
                 let i = obs.len();
                 gt.frames.push(FrameTruth {
                     pose: TruePose(pose),
+                    odom: OdomPose(pose),
                     lap_slot: lap,
                 });
                 obs.push(Observation {

@@ -42,6 +42,8 @@ pub struct LapInfo {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameTruth {
     pub pose: TruePose,
+    /// The frame's odometry pose (to carry the truth to observations made away from the frame).
+    pub odom: crate::geom::OdomPose,
     /// Index into [`GroundTruth::laps`].
     pub lap_slot: usize,
 }
@@ -69,6 +71,7 @@ impl GroundTruth {
                 });
                 gt.frames.extend(lap.frames.iter().map(|f| FrameTruth {
                     pose: f.truth,
+                    odom: f.odom,
                     lap_slot: slot,
                 }));
             }
@@ -79,6 +82,15 @@ impl GroundTruth {
     /// Truth of input frame `input_index`, if it exists.
     pub fn frame(&self, input_index: usize) -> Option<&FrameTruth> {
         self.frames.get(input_index)
+    }
+
+    /// True pose of an observation: its frame's truth moved by the observation's odometric offset
+    /// from the frame (observations interpolated back along a long step between scans lie up to
+    /// a few metres before the frame that made them).
+    pub fn observation_pose(&self, obs: &crate::recognizer::Observation) -> Option<TruePose> {
+        let f = self.frame(obs.input_index)?;
+        let offset = f.odom.0.between(&obs.odom_pose.0);
+        Some(TruePose(f.pose.0.compose(&offset)))
     }
 
     /// The lap of input frame `input_index`.

@@ -71,6 +71,22 @@ pub fn load_real_run(
     Ok((run, readout.skipped_lines))
 }
 
+/// Keeps every `k`-th frame of `run` (the first included; `k` ≤ 1 keeps all), so a dense log can
+/// be made as sparse as many real logs are. The odometry is untouched: each kept frame still has
+/// its pose, so the recognizer sees the same path sampled less often.
+pub fn keep_every_nth_scan(run: &mut RunLog, k: usize) {
+    if k <= 1 {
+        return;
+    }
+    let mut i = 0usize;
+    for lap in &mut run.laps {
+        lap.frames.retain(|_| {
+            i += 1;
+            (i - 1).is_multiple_of(k)
+        });
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

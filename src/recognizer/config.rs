@@ -10,6 +10,12 @@ use std::fmt;
 pub struct RecognizerConfig {
     /// Odometric travel between two observations, metres. Default 0.10.
     pub observation_spacing_m: f64,
+    /// Longest step between two scans along which observations are interpolated, metres: a scan
+    /// after a step of up to this length makes one observation per spacing passed, at poses along
+    /// the step; a longer jump makes one observation at the new pose. The local grid's window
+    /// reaches this far beyond `grid_radius_m` so that those observations' kernels stay inside
+    /// it. Default 3.0 (Intel thinned to every 3rd scan has steps up to 3.1 m).
+    pub max_interpolation_m: f64,
     /// Integrate every scan into the local grid, instead of one scan per observation step as the
     /// authors' code does. Default false.
     pub integrate_every_scan: bool,
@@ -41,15 +47,40 @@ pub struct RecognizerConfig {
     pub min_ngram: Vec<usize>,
     /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
     pub max_alignment_offset: usize,
-    /// A past word must end at least this much odometric travel before the current n-gram
-    /// begins, metres. Default 20.0.
-    pub min_gap_m: f64,
+    /// Placements the fine alignment tries: `paper` (Eq. 2 as written: the n = min(S₁, S₂)
+    /// observations from both words' starts, shifted by d ∈ (−Δmax, Δmax)) or `whole-word`
+    /// (the smaller word's n observations at every placement inside the larger word, never past
+    /// its ends). Default `whole-word`.
+    pub alignment: AlignmentMode,
+    /// Verify each match before reporting it (see the fields `verify_*`). Default true.
+    pub verify: bool,
+    /// Verification, travel: between two consecutive words of a matched n-gram, and from its
+    /// first word to each later one, the odometric travel of the current and past sides may
+    /// differ by at most this fraction of the longer, plus `verify_travel_slack_m`. Default 0.15
+    /// (tuned on scenario A seed 3 and Intel; 0.25, the word size tolerance, let through false
+    /// n-grams whose words each fit but whose spacing drifts).
+    pub verify_travel_ratio: f64,
+    /// Verification, travel: absolute slack added to the allowed difference, metres. Default 0.5.
+    pub verify_travel_slack_m: f64,
+    /// Verification, turn: between two consecutive words of a matched n-gram, and from its first
+    /// word to each later one, the odometric heading change of the two sides may differ by at
+    /// most this, degrees. Default 30.
+    pub verify_turn_deg: f64,
+    /// Verification, densities: the root mean square Ψ difference over the n-gram's aligned
+    /// observation pairs must be at most this (Ψ ∈ [0, 1]; a class is 1/`classes` wide).
+    /// Default 0.04 (a third of a class of 8; tuned on scenario A seed 3 and Intel).
+    pub verify_max_psi_rms: f64,
+    /// Candidate gap: a past word must end at least this much odometric travel before the
+    /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
+    /// though both default to 20). Default 20.0.
+    pub candidate_gap_m: f64,
 }
 
 impl Default for RecognizerConfig {
     fn default() -> Self {
         RecognizerConfig {
             observation_spacing_m: 0.10,
+            max_interpolation_m: 3.0,
             integrate_every_scan: false,
             grid_cell_m: 0.05,
             grid_radius_m: 3.0,
@@ -62,9 +93,25 @@ impl Default for RecognizerConfig {
             levels: 3,
             min_ngram: vec![6, 9, 12, 15],
             max_alignment_offset: 10,
-            min_gap_m: 20.0,
+            alignment: AlignmentMode::WholeWord,
+            verify: true,
+            verify_travel_ratio: 0.15,
+            verify_travel_slack_m: 0.5,
+            verify_turn_deg: 30.0,
+            verify_max_psi_rms: 0.04,
+            candidate_gap_m: 20.0,
         }
     }
+}
+
+/// Where the fine alignment may place the smaller word's window (`alignment` setting).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AlignmentMode {
+    /// Eq. 2 as written: shifts d ∈ (−Δmax, Δmax) from both words' starts.
+    Paper,
+    /// Every placement of the smaller word inside the larger one.
+    WholeWord,
 }
 
 /// One invalid setting: the field's name and what is wrong with it.
@@ -216,12 +263,33 @@ impl RecognizerConfig {
                     .to_string(),
             );
         }
-        if !(self.min_gap_m.is_finite() && self.min_gap_m >= 0.0) {
+        if !(self.candidate_gap_m.is_finite() && self.candidate_gap_m >= 0.0) {
             bad(
-                "min_gap_m",
+                "candidate_gap_m",
                 format!(
                     "must be a distance of at least 0, got {}; the default is 20",
-                    self.min_gap_m
+                    self.candidate_gap_m
+                ),
+            );
+        }
+        for (field, v) in [
+            ("verify_travel_ratio", self.verify_travel_ratio),
+            ("verify_travel_slack_m", self.verify_travel_slack_m),
+            ("verify_turn_deg", self.verify_turn_deg),
+            ("verify_max_psi_rms", self.verify_max_psi_rms),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                bad(field, format!("must be a number of at least 0, got {v}"));
+            }
+        }
+        if !(self.max_interpolation_m.is_finite()
+            && (0.0..=20.0).contains(&self.max_interpolation_m))
+        {
+            bad(
+                "max_interpolation_m",
+                format!(
+                    "must be a distance in [0, 20], got {}; the default is 3",
+                    self.max_interpolation_m
                 ),
             );
         }
@@ -236,6 +304,39 @@ impl RecognizerConfig {
         } else {
             Err(RecognizerError::InvalidConfig(problems))
         }
+    }
+
+    /// Settings from a TOML document whose `[recognizer]` table holds them (a scenario file, or a
+    /// file with only that table); other tables are ignored, missing keys take their defaults.
+    /// Errors read `line:col: what; what to try`.
+    pub fn from_toml_str(src: &str) -> Result<Self, String> {
+        #[derive(Deserialize)]
+        struct File {
+            #[serde(default)]
+            recognizer: Option<toml::Spanned<toml::Table>>,
+        }
+        let at = |span: Option<std::ops::Range<usize>>| {
+            let offset = span.map_or(0, |r| r.start).min(src.len());
+            let line = src[..offset].matches('\n').count() + 1;
+            let col = offset - src[..offset].rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!("{line}:{col}")
+        };
+        let file: File =
+            toml::from_str(src).map_err(|e| format!("{}: {}", at(e.span()), e.message()))?;
+        let Some(table) = file.recognizer else {
+            return Err("1:1: no [recognizer] table; put the settings under [recognizer]".into());
+        };
+        let span = table.span();
+        let cfg: RecognizerConfig =
+            table
+                .into_inner()
+                .try_into()
+                .map_err(|e: toml::de::Error| {
+                    format!("{}: [recognizer]: {}", at(Some(span.clone())), e.message())
+                })?;
+        cfg.validate()
+            .map_err(|e| format!("{}: {e}", at(Some(span))))?;
+        Ok(cfg)
     }
 
     /// Kernel radius in grid cells (rounded).

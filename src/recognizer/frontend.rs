@@ -4,8 +4,15 @@
 //! of a run; every scan with `integrate_every_scan`); each time the odometric travel passes the next
 //! multiple of `observation_spacing_m` (counted from the start of the run), Ψ is computed at the
 //! robot's cell and an [`Observation`] is made. When a scan comes after a step longer than the
-//! spacing (sparse logs: Intel has a scan every ~0.5 m), the multiples it passed are observed at
-//! poses interpolated along the step, in the grid that already holds the new scan.
+//! spacing (sparse logs: Intel has a scan every ~0.7 m, fhw every ~1 m), the multiples it passed
+//! are observed at poses interpolated along the step, in the grid that already holds the new scan.
+//!
+//! The grid's window is centred on the newest scan, so an observation interpolated far back along
+//! a long step has its kernel near the window's edge. The window is a torus: a kernel crossing
+//! the edge reads cells from the far side, ahead of the robot, and Ψ there was garbage (this,
+//! with steps over 2 m observed only once, is why Intel thinned to every 2nd scan gave no pair).
+//! The window therefore reaches `max_interpolation_m` beyond `grid_radius_m`, and steps up to
+//! `max_interpolation_m` are interpolated (longer jumps make one observation at the new pose).
 
 use super::config::{RecognizerConfig, RecognizerError};
 use super::density::{DensityKernel, RayDeltas};
@@ -14,14 +21,13 @@ use super::types::Observation;
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
-/// Most observations interpolated along one step between scans (2 m at 0.10 m spacing); a
-/// longer jump makes a single observation at the new pose.
-pub const MAX_INTERPOLATED: usize = 20;
-
 /// Local grid + density: makes observations from odometry and scans.
 #[derive(Clone, Debug)]
 pub struct DensityFrontEnd {
     spacing_m: f64,
+    /// Longest step observed along its length, metres.
+    max_interpolation_m: f64,
+    kernel_cells: usize,
     integrate_every_scan: bool,
     grid: LocalGrid,
     kernel: DensityKernel,
@@ -37,10 +43,16 @@ pub struct DensityFrontEnd {
 impl DensityFrontEnd {
     pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
         config.validate()?;
-        let grid = LocalGrid::new(config.grid_cell_m, config.grid_radius_m);
+        let grid = LocalGrid::with_margin(
+            config.grid_cell_m,
+            config.grid_radius_m,
+            config.max_interpolation_m,
+        );
         let kernel = DensityKernel::new(config.kernel_radius_cells(), config.ray_step_deg);
         Ok(DensityFrontEnd {
             spacing_m: config.observation_spacing_m,
+            max_interpolation_m: config.max_interpolation_m,
+            kernel_cells: config.kernel_radius_cells(),
             integrate_every_scan: config.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),
             grid,
@@ -56,7 +68,7 @@ impl DensityFrontEnd {
 
     /// Integrates one scan taken at `odom`; returns the observations it made: usually none or
     /// one; after a step longer than the spacing (sparse logs), one per spacing passed, at poses
-    /// interpolated along the step (at most [`MAX_INTERPOLATED`]; longer jumps give one).
+    /// interpolated along the step (steps longer than `max_interpolation_m` give one).
     pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Observation> {
         let input_index = self.inputs;
         self.inputs += 1;
@@ -81,7 +93,10 @@ impl DensityFrontEnd {
             ((self.travel_m + 1e-9 - self.next_obs_travel_m) / self.spacing_m).floor() + 1.0;
         let mut at: Vec<(OdomPose, f64)> = Vec::new();
         match previous {
-            Some((last, last_travel)) if passed > 1.0 && passed <= MAX_INTERPOLATED as f64 => {
+            Some((last, last_travel))
+                if passed > 1.0
+                    && self.travel_m - last_travel <= self.max_interpolation_m + 1e-9 =>
+            {
                 let span = (self.travel_m - last_travel).max(1e-12);
                 for k in 0..passed as usize {
                     let travel = self.next_obs_travel_m + k as f64 * self.spacing_m;
@@ -102,6 +117,7 @@ impl DensityFrontEnd {
         self.next_obs_travel_m += passed * self.spacing_m;
         at.into_iter()
             .map(|(pose, travel_m)| {
+                debug_assert!(self.grid.kernel_fits(self.kernel_cells, pose.0.x, pose.0.y));
                 let psi = self
                     .grid
                     .psi_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);

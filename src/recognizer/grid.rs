@@ -85,7 +85,16 @@ pub struct LocalGrid {
 impl LocalGrid {
     /// A grid of `cell_m` cells keeping everything within `radius_m` of the robot.
     pub fn new(cell_m: f64, radius_m: f64) -> Self {
-        let half = (radius_m / cell_m).ceil() as i32 + 2;
+        Self::with_margin(cell_m, radius_m, 0.0)
+    }
+
+    /// A grid whose window reaches `margin_m` beyond `radius_m` on every side, so that a kernel
+    /// of radius up to `radius_m` centred up to `margin_m` from the robot reads only cells of its
+    /// own neighbourhood: the window is a torus, and a kernel crossing its edge would read cells
+    /// from the far side (ahead of the robot) instead. Scans are still traced only up to
+    /// `radius_m`; the margin only remembers a little longer what the robot left behind.
+    pub fn with_margin(cell_m: f64, radius_m: f64, margin_m: f64) -> Self {
+        let half = ((radius_m + margin_m.max(0.0)) / cell_m).ceil() as i32 + 2;
         let side = ((2 * half + 1) as u32).next_power_of_two() as usize;
         LocalGrid {
             cell_m,
@@ -289,6 +298,14 @@ impl LocalGrid {
         debug_assert_eq!(deltas.stride(), self.side());
         let base = self.index(cx, cy);
         kernel.count_free_at(deltas, &self.cells, base, self.mask, &mut self.visited)
+    }
+
+    /// Whether a kernel of `radius_cells` centred on the odometry position (x, y) lies inside the
+    /// window (so it reads no cell twice and none from the far side of the torus).
+    pub fn kernel_fits(&self, radius_cells: usize, x: f64, y: f64) -> bool {
+        let (cx, cy) = self.cell_of(x, y);
+        let r = radius_cells as i32;
+        self.inside(cx - r, cy - r) && self.inside(cx + r, cy + r)
     }
 
     /// Ψ at the cell holding the odometry position (x, y).

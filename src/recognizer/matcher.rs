@@ -7,7 +7,7 @@
 //! the predecessor lists, mixing levels freely).
 //!
 //! When a word c closes, its candidates are the words of its class (a per-class occurrence list)
-//! that end at least `min_gap_m` of travel before c begins and match it. For each candidate p the
+//! that end at least `candidate_gap_m` of travel before c begins and match it. For each candidate p the
 //! longest chain ending at (c, p) is 1 + the best memoised chain of a pair (c', p') with c' a
 //! predecessor of c and p' one of p, computed for every level configuration at once; the memo
 //! holds one entry per matching pair, so the work per word is candidates × predecessors², and
@@ -15,7 +15,7 @@
 //!
 //! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
 //! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
-//! least `min_gap_m` after p ends. Each word pair is reported at most once per configuration: the
+//! least `candidate_gap_m` after p ends. Each word pair is reported at most once per configuration: the
 //! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
 //! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
 //! length). The result of an L-level run is the union of the matches with `levels` ≤ L.
@@ -28,11 +28,12 @@
 //! whose boundary moved by more than Δmax was paired up to metres off. Shifts whose whole window lies in
 //! the past word's run are preferred (near a run's start or end, those with the largest overlap);
 //! ties go to the smallest |d|. The aligned pairs whose travel differs by
-//! less than `min_gap_m` are dropped.
+//! less than `candidate_gap_m` are dropped.
 
-use super::config::{RecognizerConfig, RecognizerError};
+use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::types::{AlignedPair, Match, Observation};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
+use crate::geom::wrap_angle;
 
 #[derive(Clone, Copy, Debug)]
 struct Entry {
@@ -53,8 +54,14 @@ struct Params {
     min_ngram: [usize; MAX_LEVELS],
     size_ratio: f64,
     angle_tol_deg: f64,
-    min_gap_m: f64,
+    candidate_gap_m: f64,
     max_offset: usize,
+    alignment: AlignmentMode,
+    verify: bool,
+    verify_travel_ratio: f64,
+    verify_travel_slack_m: f64,
+    verify_turn_rad: f64,
+    verify_max_psi_rms: f64,
 }
 
 /// Words, multi-level words, matching and alignment over a stream of observations.
@@ -69,6 +76,7 @@ pub struct WordMatcher {
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
     lookup: [Vec<(u32, u32)>; MAX_LEVELS],
     stamp: u32,
+    rejections: VerificationCounts,
 }
 
 impl WordMatcher {
@@ -84,9 +92,16 @@ impl WordMatcher {
                 min_ngram,
                 size_ratio: config.size_tolerance_ratio,
                 angle_tol_deg: config.angle_tolerance_deg,
-                min_gap_m: config.min_gap_m,
+                candidate_gap_m: config.candidate_gap_m,
                 max_offset: config.max_alignment_offset,
+                alignment: config.alignment,
+                verify: config.verify,
+                verify_travel_ratio: config.verify_travel_ratio,
+                verify_travel_slack_m: config.verify_travel_slack_m,
+                verify_turn_rad: config.verify_turn_deg.to_radians(),
+                verify_max_psi_rms: config.verify_max_psi_rms,
             },
+            rejections: VerificationCounts::default(),
             words: WordLevels::new(config.classes, config.min_word_size, config.levels),
             occurrences: vec![Vec::new(); config.classes],
             memo: Vec::new(),
@@ -99,7 +114,20 @@ impl WordMatcher {
     /// whose `run` is later than the current run starts the new run first (as
     /// [`start_run`](Self::start_run)), so a stored observation stream can be replayed without
     /// calling it.
+    ///
+    /// # Panics
+    /// When `obs.travel_m` is less than the previous observation's (or NaN): the candidate search
+    /// bisects the occurrence lists by travel, which is only correct if travel never decreases.
     pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
+        let last = self.words.observations().last().map_or(0.0, |o| o.travel_m);
+        assert!(
+            obs.travel_m >= last,
+            "observation {}: travel {} m is less than the previous observation's {} m; \
+             observations must come in order of non-decreasing travel",
+            obs.id,
+            obs.travel_m,
+            last
+        );
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
@@ -130,6 +158,11 @@ impl WordMatcher {
 
     pub fn observations(&self) -> &[Observation] {
         self.words.observations()
+    }
+
+    /// Candidate n-grams accepted and rejected by verification so far.
+    pub fn verification(&self) -> VerificationCounts {
+        self.rejections
     }
 
     /// Matching word pairs held in the memo (a measure of its size).
@@ -169,7 +202,7 @@ impl WordMatcher {
         let n_words = self.words.all_words().len();
         debug_assert_eq!(self.memo.len(), c as usize);
         let cw = self.word(c).clone();
-        let limit = cw.start_travel_m - self.params.min_gap_m;
+        let limit = cw.start_travel_m - self.params.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
         let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
 
@@ -252,63 +285,123 @@ impl WordMatcher {
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
         for k in 0..self.params.levels {
-            let tau = self.params.min_ngram[k];
             for idx in 0..self.memo[c as usize].len() {
-                let e = self.memo[c as usize][idx];
-                if (e.len[k] as usize) < tau {
-                    continue;
+                if let Some(m) = self.report_one(c, idx, k) {
+                    out.push(m);
                 }
-                // Walk the τ-gram ending here: check the gap, collect unreported pairs.
-                let past_end = self.word(e.past).end_travel_m;
-                let mut chain = vec![(c, idx)];
-                let mut fresh = 1usize;
-                let mut all_fresh = true;
-                let (mut wc, mut we) = (c, e);
-                while chain.len() < tau {
-                    let Some((pc, pidx)) = self.step_back(wc, &we, k) else {
-                        break;
-                    };
-                    let pe = self.memo[pc as usize][pidx];
-                    chain.push((pc, pidx));
-                    if all_fresh && pe.reported & (1 << k) == 0 {
-                        fresh += 1;
-                    } else {
-                        all_fresh = false;
-                    }
-                    wc = pc;
-                    we = pe;
-                }
-                if chain.len() < tau {
-                    continue;
-                }
-                let first_current = self.word(chain[tau - 1].0);
-                if first_current.start_travel_m + 1e-9 < past_end + self.params.min_gap_m {
-                    continue;
-                }
-                chain.truncate(fresh);
-                chain.reverse();
-                let mut word_pairs = Vec::with_capacity(chain.len());
-                let mut pairs = Vec::new();
-                for &(wc, widx) in &chain {
-                    let entry = &mut self.memo[wc as usize][widx];
-                    entry.reported |= 1 << k;
-                    let past = entry.past;
-                    word_pairs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
-                    self.align(wc, past, &mut pairs);
-                }
-                out.push(Match {
-                    levels: k + 1,
-                    ngram_len: e.len[k] as usize,
-                    word_pairs,
-                    pairs,
-                });
             }
         }
     }
 
-    /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
-    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
+    /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first, and
+    /// how many of its newest pairs are not yet reported; `None` when the chain is shorter than τ.
+    fn tau_chain(&self, c: WordId, idx: usize, k: usize) -> Option<(Vec<(WordId, usize)>, usize)> {
+        let tau = self.params.min_ngram[k];
+        let e = self.memo[c as usize][idx];
+        if (e.len[k] as usize) < tau {
+            return None;
+        }
+        let mut chain = vec![(c, idx)];
+        let (mut fresh, mut all_fresh) = (1usize, true);
+        let (mut wc, mut we) = (c, e);
+        while chain.len() < tau {
+            let (pc, pidx) = self.step_back(wc, &we, k)?;
+            let pe = self.memo[pc as usize][pidx];
+            chain.push((pc, pidx));
+            if all_fresh && pe.reported & (1 << k) == 0 {
+                fresh += 1;
+            } else {
+                all_fresh = false;
+            }
+            (wc, we) = (pc, pe);
+        }
+        Some((chain, fresh))
+    }
+
+    /// Reports the τ-gram of configuration k ending at memo entry `idx` of `c` if it is long
+    /// enough, satisfies the candidate gap, passes verification and has unreported pairs.
+    fn report_one(&mut self, c: WordId, idx: usize, k: usize) -> Option<Match> {
+        let (mut chain, fresh) = self.tau_chain(c, idx, k)?;
+        let e = self.memo[c as usize][idx];
+        let first_current = self.word(chain[chain.len() - 1].0);
+        let past_end = self.word(e.past).end_travel_m;
+        if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
+            return None;
+        }
+        chain.reverse();
+        let word_pairs: Vec<(WordId, WordId)> = chain
+            .iter()
+            .map(|&(wc, widx)| (wc, self.memo[wc as usize][widx].past))
+            .collect();
+        if self.params.verify
+            && let Some(reason) = self.verify(&word_pairs)
+        {
+            self.rejections.add(reason);
+            return None;
+        }
+        let fresh_from = chain.len() - fresh;
+        let mut pairs = Vec::new();
+        let mut refs = Vec::with_capacity(fresh);
+        for (&(wc, widx), &(_, past)) in chain.iter().zip(&word_pairs).skip(fresh_from) {
+            self.memo[wc as usize][widx].reported |= 1 << k;
+            refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
+            self.align(wc, past, &mut pairs);
+        }
+        self.rejections.accepted += 1;
+        Some(Match {
+            levels: k + 1,
+            ngram_len: e.len[k] as usize,
+            word_pairs: refs,
+            pairs,
+        })
+    }
+
+    /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
+    /// and turn between its words, from consecutive words and from its first word, must agree on
+    /// both sides; the Ψ residual of its aligned pairs must be small.
+    fn verify(&self, word_pairs: &[(WordId, WordId)]) -> Option<Rejection> {
         let obs = self.words.observations();
+        let start = |w: WordId| {
+            let w = self.word(w);
+            (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta)
+        };
+        let ok_travel = |a: f64, b: f64| {
+            (a - b).abs()
+                <= self.params.verify_travel_ratio * a.abs().max(b.abs())
+                    + self.params.verify_travel_slack_m
+        };
+        let turn_tol = self.params.verify_turn_rad;
+        let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
+        for w in word_pairs.windows(2) {
+            let (c0, c1, p0, p1) = (start(w[0].0), start(w[1].0), start(w[0].1), start(w[1].1));
+            let dc = (c1.0 - c0.0, wrap_angle(c1.1 - c0.1));
+            let dp = (p1.0 - p0.0, wrap_angle(p1.1 - p0.1));
+            cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
+            cum_p = (cum_p.0 + dp.0, cum_p.1 + dp.1);
+            if !ok_travel(dc.0, dp.0) || !ok_travel(cum_c.0, cum_p.0) {
+                return Some(Rejection::Travel);
+            }
+            if wrap_angle(dc.1 - dp.1).abs() > turn_tol || (cum_c.1 - cum_p.1).abs() > turn_tol {
+                return Some(Rejection::Turn);
+            }
+        }
+        let (mut sum, mut count) = (0.0, 0usize);
+        for &(c, p) in word_pairs {
+            if let Some(w) = self.placement(c, p) {
+                sum += w.cost * w.count() as f64;
+                count += w.count();
+            }
+        }
+        let rms = if count == 0 {
+            f64::INFINITY
+        } else {
+            (sum / count as f64).sqrt()
+        };
+        (rms > self.params.verify_max_psi_rms).then_some(Rejection::Density)
+    }
+
+    /// Eq. 2: the best placement of the two words' observation windows (see the module doc).
+    fn placement(&self, c: WordId, p: WordId) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
@@ -317,47 +410,59 @@ impl WordMatcher {
         let run = self.words.run_range(pw.run);
         let (lo, hi) = (run.start as i64, run.end as i64);
         let dmax = self.params.max_offset as i64;
-        // Offset k = past index − current index. The n-window of the smaller word may sit
-        // anywhere inside the larger one (sizes differ by up to the size tolerance), and ±Δmax
-        // beyond that: a = start in the current word, b = a + k start in the past word.
-        let window = |k: i64| -> (i64, i64, std::ops::Range<i64>) {
+        // Offset k = past index − current index, from the words' starts: a = start in the
+        // current word, b = a + k start in the past word.
+        let window = |k: i64| -> Placement {
             let a = (-k).clamp(0, sc - n);
             let b = a + k;
             // Keep the past window inside the past word's run.
             let r = (lo - s1 - b).max(0)..(hi - s1 - b).min(n);
-            (a, b, r)
+            Placement { a, b, r, cost: 0.0 }
         };
-        let (kmin, kmax) = (-(sc - n) - dmax, (sp - n) + dmax);
+        let (kmin, kmax) = match self.params.alignment {
+            // d ∈ (−Δmax, Δmax): the n-windows from both starts, the past one shifted by d.
+            AlignmentMode::Paper => (-(dmax - 1).max(0), (dmax - 1).max(0)),
+            // The smaller word at every placement inside the larger one, never past its ends.
+            AlignmentMode::WholeWord => (-(sc - n), sp - n),
+        };
         // Whole windows first (Eq. 2 sums over all n observations), then the least mean squared
         // Ψ difference, then the smallest shift from the words' starts.
-        let mut best: Option<(i64, f64, i64, i64)> = None;
+        let mut best: Option<(Placement, i64)> = None;
         for k in kmin..=kmax {
-            let (a, b, r) = window(k);
-            let count = r.end - r.start;
-            if count <= 0 {
+            let mut w = window(k);
+            let count = w.count();
+            if count == 0 {
                 continue;
             }
-            let past = &psi[(s1 + b + r.start) as usize..(s1 + b + r.end) as usize];
-            let cur = &psi[(s2 + a + r.start) as usize..(s2 + a + r.end) as usize];
-            let cost = squared_error(past, cur) / count as f64;
-            let better = match best {
+            let past = &psi[(s1 + w.b + w.r.start) as usize..(s1 + w.b + w.r.end) as usize];
+            let cur = &psi[(s2 + w.a + w.r.start) as usize..(s2 + w.a + w.r.end) as usize];
+            w.cost = squared_error(past, cur) / count as f64;
+            let better = match &best {
                 None => true,
-                Some((bc, bcost, bk, _)) => {
-                    count > bc
-                        || (count == bc
-                            && (cost < bcost - 1e-15
-                                || ((cost - bcost).abs() <= 1e-15 && k.abs() < bk.abs())))
+                Some((bw, bk)) => {
+                    count > bw.count()
+                        || (count == bw.count()
+                            && (w.cost < bw.cost - 1e-15
+                                || ((w.cost - bw.cost).abs() <= 1e-15 && k.abs() < bk.abs())))
                 }
             };
             if better {
-                best = Some((count, cost, k, 0));
+                best = Some((w, k));
             }
         }
-        let Some((_, _, k, _)) = best else { return };
-        let (a, b, r) = window(k);
-        for i in r {
-            let (q, pst) = (&obs[(s2 + a + i) as usize], &obs[(s1 + b + i) as usize]);
-            if q.travel_m - pst.travel_m + 1e-9 < self.params.min_gap_m {
+        best.map(|(w, _)| w)
+    }
+
+    /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
+    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
+        let obs = self.words.observations();
+        let Some(w) = self.placement(c, p) else {
+            return;
+        };
+        let (s2, s1) = (self.word(c).first_obs as i64, self.word(p).first_obs as i64);
+        for i in w.r {
+            let (q, pst) = (&obs[(s2 + w.a + i) as usize], &obs[(s1 + w.b + i) as usize]);
+            if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
                 continue;
             }
             out.push(AlignedPair {
@@ -366,6 +471,54 @@ impl WordMatcher {
                 query_odom: q.odom_pose,
                 past_odom: pst.odom_pose,
             });
+        }
+    }
+}
+
+/// A placement of the alignment: windows start at `a` in the current word and `b` in the past
+/// word; `r` the indices within the windows that lie in the past word's run; `cost` the mean
+/// squared Ψ difference over them.
+#[derive(Clone, Debug)]
+struct Placement {
+    a: i64,
+    b: i64,
+    r: std::ops::Range<i64>,
+    cost: f64,
+}
+
+impl Placement {
+    fn count(&self) -> usize {
+        (self.r.end - self.r.start).max(0) as usize
+    }
+}
+
+/// Why verification turned a candidate n-gram down.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rejection {
+    /// Odometric travel between its words differs between the two sides.
+    Travel,
+    /// Odometric heading change between its words differs between the two sides.
+    Turn,
+    /// The aligned raw densities differ too much.
+    Density,
+}
+
+/// Counts of candidate n-grams (τ reached, candidate gap satisfied) by outcome, summed over
+/// level configurations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct VerificationCounts {
+    pub accepted: usize,
+    pub rejected_travel: usize,
+    pub rejected_turn: usize,
+    pub rejected_density: usize,
+}
+
+impl VerificationCounts {
+    fn add(&mut self, r: Rejection) {
+        match r {
+            Rejection::Travel => self.rejected_travel += 1,
+            Rejection::Turn => self.rejected_turn += 1,
+            Rejection::Density => self.rejected_density += 1,
         }
     }
 }

@@ -36,6 +36,47 @@ pub struct LegendEntry {
     pub dashed: bool,
 }
 
+/// A raster drawn under the world, e.g. density classes. Cell (x, y) covers the square of side
+/// `cell_m` whose bottom-left corner is `origin + (x, y)·cell_m`; cells are row-major from the
+/// bottom row.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct TileLayer {
+    pub origin: Vec2,
+    pub cell_m: f64,
+    pub width: usize,
+    pub height: usize,
+    /// Index into `palette` per cell; `None` leaves the cell blank.
+    pub cells: Vec<Option<u8>>,
+    /// SVG colours.
+    pub palette: Vec<String>,
+}
+
+/// A thick translucent band along a polyline, e.g. a stretch of a route.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BandOverlay {
+    pub points: Vec<Vec2>,
+    pub color: String,
+    /// Stroke width, pixels.
+    pub width_px: f64,
+}
+
+/// A labelled marker: a filled circle with short text in it (a number), e.g. a problem or a
+/// waypoint. `class` becomes the element's SVG class.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MarkOverlay {
+    pub at: Vec2,
+    pub text: String,
+    pub color: String,
+    pub class: String,
+}
+
+/// A legend entry drawn as a filled square (a colour of a [`TileLayer`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Swatch {
+    pub label: String,
+    pub color: String,
+}
+
 /// What to draw and how.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderOptions {
@@ -57,6 +98,20 @@ pub struct RenderOptions {
     pub legend: Vec<LegendEntry>,
     /// Pixels per metre; default: fit the world into about 1500 pixels.
     pub px_per_m: Option<f64>,
+    /// A raster under the world (density classes). Default none.
+    pub tiles: Option<TileLayer>,
+    /// Bands along polylines, drawn above the routes. Default none.
+    pub bands: Vec<BandOverlay>,
+    /// Numbered markers, drawn on top of everything. Default none.
+    pub marks: Vec<MarkOverlay>,
+    /// Legend entries drawn as filled squares. Default none.
+    pub swatches: Vec<Swatch>,
+    /// A coordinate grid with labelled metres under the world. Default false.
+    pub show_grid: bool,
+    /// Number each route waypoint (from 1, as messages count them). Default false.
+    pub show_waypoints: bool,
+    /// Lines of text under the legend (e.g. the numbered problems). Default none.
+    pub notes: Vec<String>,
 }
 
 impl Default for RenderOptions {
@@ -71,6 +126,13 @@ impl Default for RenderOptions {
             segments: Vec::new(),
             legend: Vec::new(),
             px_per_m: None,
+            tiles: None,
+            bands: Vec::new(),
+            marks: Vec::new(),
+            swatches: Vec::new(),
+            show_grid: false,
+            show_waypoints: false,
+            notes: Vec::new(),
         }
     }
 }
@@ -140,6 +202,11 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         add(s.a);
         add(s.b);
     }
+    opts.bands
+        .iter()
+        .flat_map(|b| &b.points)
+        .for_each(|p| add(*p));
+    opts.marks.iter().for_each(|m| add(m.at));
     let margin_m = 1.0;
     lo -= Vec2::new(margin_m, margin_m);
     hi += Vec2::new(margin_m, margin_m);
@@ -150,11 +217,13 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         .unwrap_or_else(|| (1500.0 / w_m.max(h_m * 1.2)).clamp(2.0, 120.0));
     let pad = 20.0;
     let title_h = 56.0;
-    let legend_h = 70.0;
+    let legend_h = 70.0 + 18.0 * opts.notes.len() as f64;
     let map_w = w_m * s;
     let map_h = h_m * s;
     let width = (map_w + 2.0 * pad).max(760.0);
-    let height = title_h + map_h + legend_h + pad;
+    let legend_x = pad + nice_length(180.0 / s) * s + 40.0;
+    let height =
+        title_h + map_h + legend_h + legend_extra_h(world, opts, legend_x, width - pad) + pad;
     let f = Frame {
         min: lo,
         max: hi,
@@ -186,6 +255,13 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         world.routes.len()
     );
     svg.text((pad, 47.0), &sub, r##"font-size="13" fill="#555""##);
+
+    if opts.show_grid {
+        grid(&mut svg, &f, map_w, map_h);
+    }
+    if let Some(t) = &opts.tiles {
+        tiles(&mut svg, &f, t);
+    }
 
     // Walking areas.
     if opts.show_areas && !world.areas.is_empty() {
@@ -326,6 +402,23 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         svg.close_group();
     }
 
+    if !opts.bands.is_empty() {
+        svg.open_group(r#"id="bands" fill="none" stroke-linecap="round" stroke-linejoin="round""#);
+        for b in &opts.bands {
+            let pts: Vec<(f64, f64)> = b.points.iter().map(|q| f.p(*q)).collect();
+            svg.polyline(
+                &pts,
+                false,
+                &format!(
+                    r#"class="band" stroke="{}" stroke-width="{}" stroke-opacity="0.75""#,
+                    escape(&b.color),
+                    num(b.width_px)
+                ),
+            );
+        }
+        svg.close_group();
+    }
+
     // Overlays.
     if !opts.paths.is_empty() {
         svg.open_group(r#"id="paths" fill="none""#);
@@ -381,6 +474,11 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         svg.close_group();
     }
 
+    if opts.show_waypoints {
+        waypoint_marks(&mut svg, &f, world);
+    }
+    marks(&mut svg, &f, &opts.marks);
+
     // Scale bar, bottom left.
     let y0 = title_h + map_h + 22.0;
     let bar_m = nice_length(180.0 / s);
@@ -414,7 +512,7 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
     svg.close_group();
 
     // Legend, after the scale bar.
-    legend(
+    let legend_end = legend(
         &mut svg,
         world,
         opts,
@@ -422,6 +520,7 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         y0,
         width - pad,
     );
+    notes(&mut svg, &opts.notes, pad, legend_end.max(y0 + 24.0) + 22.0);
     svg.finish()
 }
 
@@ -488,13 +587,15 @@ fn arrows(svg: &mut Svg, f: &Frame, leg: Segment, color: &str) {
     }
 }
 
-fn legend(svg: &mut Svg, world: &World, opts: &RenderOptions, x_start: f64, y: f64, x_end: f64) {
-    enum Sym {
-        Line(String, f64, bool),
-        Arc,
-        Home,
-        Area,
-    }
+enum Sym {
+    Line(String, f64, bool),
+    Arc,
+    Home,
+    Area,
+    Swatch(String),
+}
+
+fn legend_entries(world: &World, opts: &RenderOptions) -> Vec<(Sym, String)> {
     let mut entries: Vec<(Sym, String)> = vec![
         (Sym::Line(WALL_COLOR.into(), 4.0, false), "wall".into()),
         (
@@ -523,70 +624,237 @@ fn legend(svg: &mut Svg, world: &World, opts: &RenderOptions, x_start: f64, y: f
     for l in &opts.legend {
         entries.push((Sym::Line(l.color.clone(), 2.0, l.dashed), l.label.clone()));
     }
-    svg.open_group(r##"id="legend" font-size="13" fill="#111""##);
+    for sw in &opts.swatches {
+        entries.push((Sym::Swatch(sw.color.clone()), sw.label.clone()));
+    }
+    entries
+}
+
+/// Where each legend entry goes: (x, y) per entry, wrapping at `x_end`.
+fn legend_layout(entries: &[(Sym, String)], x_start: f64, y: f64, x_end: f64) -> Vec<(f64, f64)> {
     let (mut x, mut y) = (x_start, y);
-    for (sym, label) in entries {
-        let w = 34.0 + 7.2 * label.chars().count() as f64 + 18.0;
-        if x + w > x_end && x > x_start {
-            x = x_start;
-            y += 22.0;
+    entries
+        .iter()
+        .map(|(_, label)| {
+            let w = 34.0 + 7.2 * label.chars().count() as f64 + 18.0;
+            if x + w > x_end && x > x_start {
+                x = x_start;
+                y += 22.0;
+            }
+            let at = (x, y);
+            x += w;
+            at
+        })
+        .collect()
+}
+
+/// Extra height the legend needs beyond its first two rows, pixels.
+fn legend_extra_h(world: &World, opts: &RenderOptions, x_start: f64, x_end: f64) -> f64 {
+    let layout = legend_layout(&legend_entries(world, opts), x_start, 0.0, x_end);
+    let last = layout.last().map(|p| p.1).unwrap_or(0.0);
+    (last - 22.0).max(0.0)
+}
+
+/// Draws the legend; returns the y of its last row.
+fn legend(
+    svg: &mut Svg,
+    world: &World,
+    opts: &RenderOptions,
+    x_start: f64,
+    y: f64,
+    x_end: f64,
+) -> f64 {
+    let entries = legend_entries(world, opts);
+    let layout = legend_layout(&entries, x_start, y, x_end);
+    svg.open_group(r##"id="legend" font-size="13" fill="#111""##);
+    for ((sym, label), &(x, y)) in entries.iter().zip(&layout) {
+        legend_symbol(svg, sym, x, y);
+        svg.text((x + 34.0, y + 4.5), label, "");
+    }
+    svg.close_group();
+    layout.last().map(|p| p.1).unwrap_or(y)
+}
+
+fn legend_symbol(svg: &mut Svg, sym: &Sym, x: f64, y: f64) {
+    match sym {
+        Sym::Line(c, sw, dashed) => {
+            let dash = if *dashed {
+                r#" stroke-dasharray="6 4""#
+            } else {
+                ""
+            };
+            svg.line(
+                (x, y),
+                (x + 26.0, y),
+                &format!(r#"stroke="{}" stroke-width="{sw}"{dash}"#, escape(c)),
+            );
         }
-        match sym {
-            Sym::Line(c, sw, dashed) => {
-                let dash = if dashed {
-                    r#" stroke-dasharray="6 4""#
-                } else {
-                    ""
-                };
-                svg.line(
-                    (x, y),
-                    (x + 26.0, y),
-                    &format!(r#"stroke="{}" stroke-width="{sw}"{dash}"#, escape(&c)),
-                );
-            }
-            Sym::Arc => {
-                svg.path(
-                    &format!(
-                        "M {} {} A 20 20 0 0 0 {} {}",
-                        num(x + 20.0),
-                        num(y + 6.0),
-                        num(x),
-                        num(y - 14.0)
-                    ),
-                    &format!(
-                        r#"fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3""#
-                    ),
-                );
-                svg.line(
-                    (x, y + 6.0),
-                    (x, y - 14.0),
-                    &format!(r#"stroke="{DOOR_OPEN_COLOR}" stroke-width="4""#),
-                );
-            }
-            Sym::Home => {
-                svg.circle(
-                    (x + 8.0, y),
-                    6.0,
-                    &format!(r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#),
-                );
-                svg.line(
-                    (x + 8.0, y),
-                    (x + 22.0, y),
-                    &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
-                );
-            }
-            Sym::Area => {
-                svg.rect(
-                    x,
-                    y - 6.0,
-                    26.0,
-                    12.0,
-                    &format!(r#"fill="{AREA_FILL}" fill-opacity="0.7""#),
-                );
-            }
+        Sym::Arc => {
+            svg.path(
+                &format!(
+                    "M {} {} A 20 20 0 0 0 {} {}",
+                    num(x + 20.0),
+                    num(y + 6.0),
+                    num(x),
+                    num(y - 14.0)
+                ),
+                &format!(
+                    r#"fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3""#
+                ),
+            );
+            svg.line(
+                (x, y + 6.0),
+                (x, y - 14.0),
+                &format!(r#"stroke="{DOOR_OPEN_COLOR}" stroke-width="4""#),
+            );
         }
-        svg.text((x + 34.0, y + 4.5), &label, "");
-        x += w;
+        Sym::Home => {
+            svg.circle(
+                (x + 8.0, y),
+                6.0,
+                &format!(r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#),
+            );
+            svg.line(
+                (x + 8.0, y),
+                (x + 22.0, y),
+                &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
+            );
+        }
+        Sym::Area => {
+            svg.rect(
+                x,
+                y - 6.0,
+                26.0,
+                12.0,
+                &format!(r#"fill="{AREA_FILL}" fill-opacity="0.7""#),
+            );
+        }
+        Sym::Swatch(c) => {
+            svg.rect(
+                x + 4.0,
+                y - 8.0,
+                18.0,
+                16.0,
+                &format!(r##"fill="{}" stroke="#555" stroke-width="0.5""##, escape(c)),
+            );
+        }
+    }
+}
+
+/// A light coordinate grid every `nice` metres, labelled along the bottom and left edges.
+fn grid(svg: &mut Svg, f: &Frame, map_w: f64, map_h: f64) {
+    let step = nice_length(60.0 / f.s).max(0.5);
+    svg.open_group(r##"id="grid" stroke="#d8d8d8" stroke-width="0.6" font-size="10" fill="#888""##);
+    let first = |lo: f64| (lo / step).ceil() * step;
+    let mut x = first(f.min.x);
+    while x <= f.max.x {
+        let (px, _) = f.p(Vec2::new(x, f.min.y));
+        svg.line((px, f.top), (px, f.top + map_h), "");
+        svg.text(
+            (px + 2.0, f.top + map_h - 3.0),
+            &format!("{x}"),
+            r#"stroke="none""#,
+        );
+        x += step;
+    }
+    let mut y = first(f.min.y);
+    while y <= f.max.y {
+        let (_, py) = f.p(Vec2::new(f.min.x, y));
+        svg.line((f.left, py), (f.left + map_w, py), "");
+        svg.text(
+            (f.left + 2.0, py - 2.0),
+            &format!("{y}"),
+            r#"stroke="none""#,
+        );
+        y += step;
+    }
+    svg.close_group();
+}
+
+/// The tiles, one rectangle per run of equal cells along a row.
+fn tiles(svg: &mut Svg, f: &Frame, t: &TileLayer) {
+    svg.open_group(r#"id="tiles" shape-rendering="crispEdges""#);
+    let side = t.cell_m * f.s;
+    for y in 0..t.height {
+        let row = &t.cells[y * t.width..(y + 1) * t.width];
+        let mut x = 0;
+        while x < t.width {
+            let Some(c) = row[x] else {
+                x += 1;
+                continue;
+            };
+            let run = row[x..].iter().take_while(|v| **v == Some(c)).count();
+            let top_left = t.origin + Vec2::new(x as f64, (y + 1) as f64) * t.cell_m;
+            let (px, py) = f.p(top_left);
+            let color = t
+                .palette
+                .get(c as usize)
+                .map(String::as_str)
+                .unwrap_or("#ccc");
+            svg.rect(
+                px,
+                py,
+                side * run as f64 + 0.3,
+                side + 0.3,
+                &format!(r#"fill="{}""#, escape(color)),
+            );
+            x += run;
+        }
+    }
+    svg.close_group();
+}
+
+/// A numbered marker per waypoint of every route, offset a little off the route.
+fn waypoint_marks(svg: &mut Svg, f: &Frame, world: &World) {
+    let list: Vec<MarkOverlay> = world
+        .routes
+        .iter()
+        .enumerate()
+        .flat_map(|(ri, r)| {
+            let color = ROUTE_COLORS[ri % ROUTE_COLORS.len()];
+            r.waypoints
+                .iter()
+                .enumerate()
+                .map(move |(k, p)| MarkOverlay {
+                    at: *p,
+                    text: format!("{}", k + 1),
+                    color: color.to_string(),
+                    class: "waypoint".into(),
+                })
+        })
+        .collect();
+    marks(svg, f, &list);
+}
+
+fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
+    if list.is_empty() {
+        return;
+    }
+    svg.open_group(r#"id="marks" font-size="12" font-weight="bold" text-anchor="middle""#);
+    for m in list {
+        let c = f.p(m.at);
+        let r = 6.0 + 3.5 * m.text.chars().count() as f64;
+        svg.raw(&format!(
+            r##"<g class="{class}"><circle cx="{x}" cy="{y}" r="{r}" fill="{color}" fill-opacity="0.9" stroke="white" stroke-width="1.5"/><text x="{x}" y="{ty}" fill="white">{text}</text></g>"##,
+            class = escape(&m.class),
+            x = num(c.0),
+            y = num(c.1),
+            ty = num(c.1 + 4.3),
+            r = num(r),
+            color = escape(&m.color),
+            text = escape(&m.text),
+        ));
+    }
+    svg.close_group();
+}
+
+fn notes(svg: &mut Svg, lines: &[String], x: f64, y: f64) {
+    if lines.is_empty() {
+        return;
+    }
+    svg.open_group(r##"id="notes" font-size="13" fill="#111""##);
+    for (k, line) in lines.iter().enumerate() {
+        svg.text((x, y + 18.0 * k as f64), line, "");
     }
     svg.close_group();
 }

@@ -31,6 +31,8 @@ pub enum Purpose {
     Odometry = 5,
     /// The robot's sideways wander from the route in a lap.
     PathWander = 6,
+    /// `placewords world generate` (with run and lap 0).
+    WorldGenerator = 7,
 }
 
 /// The stream for (seed, run, lap, purpose).

@@ -618,6 +618,10 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
         }
     }
 
+    doors_fit_their_gaps(spec, loc, &walls, d);
+    walls_do_not_overlap(spec, loc, d);
+    home_inside_the_building(spec, loc, d);
+
     // Routes: waypoints keep radius + margin; legs let the disc through in both door states.
     let need_wp = ROBOT_RADIUS_M + WAYPOINT_MARGIN_M;
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
@@ -713,4 +717,196 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             );
         }
     }
+}
+
+/// Closed doors whose panel runs into the wall beyond its gap (the panel is longer than the
+/// gap, or the hinge sits inside the wall): the length of panel inside a wall at each end,
+/// beyond the wall's end cap, measured every centimetre.
+fn doors_fit_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
+    for (door, l) in spec.doors.iter().zip(&loc.doors) {
+        let panel = door_panel(door, false);
+        // A door whose ends are off the walls is reported as not spanning a gap already.
+        let off_wall = |p: Vec2| {
+            walls
+                .nearest(Segment::new(p, p), 1.0)
+                .is_none_or(|(_, c)| c > DOOR_GAP_TOLERANCE_M)
+        };
+        if off_wall(panel.a) || off_wall(panel.b) {
+            continue;
+        }
+        let steps = (door.width_m / 0.01).round().max(1.0) as usize;
+        let inside = |k: usize| -> Option<usize> {
+            let p = panel.a + (panel.b - panel.a) * (k as f64 / steps as f64);
+            match walls.nearest(Segment::new(p, p), 0.0) {
+                Some((Owner::Wall(wi), c)) if c < -0.002 => Some(wi),
+                _ => None,
+            }
+        };
+        let run = |ks: &mut dyn Iterator<Item = usize>| -> Option<(usize, f64)> {
+            let mut wall = None;
+            let mut n = 0;
+            for k in ks {
+                match inside(k) {
+                    Some(wi) => (wall, n) = (Some(wi), n + 1),
+                    None => break,
+                }
+            }
+            wall.map(|wi| (wi, (n as f64 - 1.0).max(0.0) * door.width_m / steps as f64))
+        };
+        let ends = [
+            (run(&mut (0..=steps).rev()), l.width, "tip"),
+            (run(&mut (0..=steps)), l.hinge, "hinge end"),
+        ];
+        for (hit, at, which) in ends {
+            let Some((wi, depth)) = hit else { continue };
+            let over = depth - spec.walls[wi].thickness_m / 2.0;
+            if over > DOOR_GAP_TOLERANCE_M && depth < door.width_m * 0.5 {
+                d.at(
+                    at,
+                    format!(
+                        "closed door '{}' is longer than its gap: its {which} runs {over:.2} m into wall '{}'; make width_m the gap's width (about {:.2} m) or widen the gap",
+                        door.id,
+                        spec.walls[wi].id,
+                        door.width_m - over
+                    ),
+                );
+            }
+        }
+    }
+}
+
+/// Shortest overlap of two parallel wall segments that counts as overlapping walls, metres
+/// (longer than a pillar set against a wall, as the institute floor has).
+pub const WALL_OVERLAP_M: f64 = 0.5;
+
+/// Walls drawn twice or over each other: two parallel wall segments less than half their
+/// thicknesses apart that share more than [`WALL_OVERLAP_M`] of length.
+fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+    let mut segs: Vec<(usize, usize, ThickSegment)> = Vec::new();
+    for (wi, w) in spec.walls.iter().enumerate() {
+        let n = w.points_m.len();
+        let m = if w.closed { n } else { n - 1 };
+        for j in 0..m {
+            let s = Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n]));
+            if s.length() > 0.0 {
+                let half_thickness_m = w.thickness_m / 2.0;
+                segs.push((
+                    wi,
+                    j,
+                    ThickSegment {
+                        seg: s,
+                        half_thickness_m,
+                    },
+                ));
+            }
+        }
+    }
+    let index = SegmentIndex::new(segs.iter().map(|x| x.2).collect());
+    // One message per pair of walls: a duplicated wall overlaps its twin on every segment.
+    let mut reported = std::collections::HashSet::new();
+    for (i, &(wi, j, t)) in segs.iter().enumerate() {
+        for k in index.candidates(t.seg, 0.0).into_iter().filter(|&k| k < i) {
+            let (wk, _, u) = segs[k];
+            if reported.contains(&(wi, wk)) {
+                continue;
+            }
+            let Some((len, from, to)) = overlap(&u, &t) else {
+                continue;
+            };
+            reported.insert((wi, wk));
+            let w = &spec.walls[wi];
+            let at = loc.walls[wi]
+                .points
+                .get(j)
+                .copied()
+                .unwrap_or(loc.walls[wi].points_key);
+            let other = if wk == wi {
+                "itself".to_string()
+            } else {
+                format!("wall '{}'", spec.walls[wk].id)
+            };
+            d.at(
+                at,
+                format!(
+                    "wall '{}' (points {} to {}) overlaps {other} for {len:.2} m, from [{:.2}, {:.2}] to [{:.2}, {:.2}]; draw each wall once: remove the duplicate or shorten one of them",
+                    w.id,
+                    j + 1,
+                    (j + 1) % w.points_m.len() + 1,
+                    from.x,
+                    from.y,
+                    to.x,
+                    to.y
+                ),
+            );
+            break;
+        }
+    }
+}
+
+/// Length and ends of the shared stretch of two parallel thick segments lying on each other.
+fn overlap(a: &ThickSegment, b: &ThickSegment) -> Option<(f64, Vec2, Vec2)> {
+    let la = a.seg.length();
+    let u = (a.seg.b - a.seg.a) / la;
+    let db = b.seg.b - b.seg.a;
+    let cross = |p: Vec2, q: Vec2| p.x * q.y - p.y * q.x;
+    if cross(u, db / db.norm()).abs() > 0.02 {
+        return None;
+    }
+    let lateral = cross(u, b.seg.a - a.seg.a)
+        .abs()
+        .max(cross(u, b.seg.b - a.seg.a).abs());
+    if lateral >= 0.5 * (a.half_thickness_m + b.half_thickness_m) {
+        return None;
+    }
+    let (t0, t1) = ((b.seg.a - a.seg.a).dot(&u), (b.seg.b - a.seg.a).dot(&u));
+    let (lo, hi) = (t0.min(t1).max(0.0), t0.max(t1).min(la));
+    (hi - lo > WALL_OVERLAP_M).then(|| (hi - lo, a.seg.a + u * lo, a.seg.a + u * hi))
+}
+
+/// The robot's home must lie inside the building (free space around it does not reach past
+/// the walls) and in the part of it the routes drive through (not in a room closed off all
+/// round). Doors are taken open: a home behind a door is fine.
+fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+    let Some(first) = spec.routes.iter().find_map(|r| r.waypoints_m.first()) else {
+        return;
+    };
+    if !loc.home.valid {
+        return;
+    }
+    let items: Vec<ThickSegment> = spec
+        .walls
+        .iter()
+        .flat_map(|w| {
+            let n = w.points_m.len();
+            let m = if w.closed { n } else { n - 1 };
+            (0..m).map(move |j| ThickSegment {
+                seg: Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n])),
+                half_thickness_m: w.thickness_m / 2.0,
+            })
+        })
+        .collect();
+    let home = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
+    let raster = crate::world::raster::Raster::new(&items, &[home], 0.1, 1.0, 0.05);
+    let region = raster.reachable(&[home]);
+    if !region.iter().any(|r| *r) {
+        return; // on a wall: reported above
+    }
+    let message = if raster.touches_border(&region) {
+        "is outside every wall loop (free space around it reaches past all walls)"
+    } else if !spec.routes.iter().flat_map(|r| &r.waypoints_m).any(|p| {
+        raster
+            .cell(v(p))
+            .is_some_and(|(x, y)| region[y * raster.width + x])
+    }) {
+        "is in a room closed off all round (no route passes there, even with every door open)"
+    } else {
+        return;
+    };
+    d.at(
+        loc.home.x,
+        format!(
+            "robot home [{}, {}] {message}; put it beside the route, e.g. near the first waypoint of route '{}' [{}, {}]",
+            spec.robot_home.x_m, spec.robot_home.y_m, spec.routes[0].id, first[0], first[1]
+        ),
+    );
 }

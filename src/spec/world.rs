@@ -231,7 +231,7 @@ pub struct AreaLoc {
 /// file in messages. Every problem is reported, in file order.
 pub fn parse_world_spec(src: &str, path: &str) -> Result<WorldSpec, crate::spec::SpecError> {
     let mut d = Diags::new(src, path);
-    let spec = read_and_validate(src, &mut d);
+    let spec = read_and_validate(src, &mut d).map(|(spec, _)| spec);
     match (spec, d.into_sorted()) {
         (Some(spec), diags) if diags.is_empty() => Ok(spec),
         (_, mut diags) => {
@@ -249,6 +249,18 @@ pub fn parse_world_spec(src: &str, path: &str) -> Result<WorldSpec, crate::spec:
     }
 }
 
+/// What could be read of a world file even when it is invalid, for pictures of what is wrong:
+/// its structures and the offsets of its values (`None` when the text is not TOML), and every
+/// problem, in file order.
+pub fn read_world_lenient(
+    src: &str,
+    path: &str,
+) -> (Option<(WorldSpec, WorldLoc)>, Vec<Diagnostic>) {
+    let mut d = Diags::new(src, path);
+    let read = read_and_validate(src, &mut d);
+    (read, d.into_sorted())
+}
+
 /// Parses and validates a world file's text; `path` only names the file in messages.
 pub fn parse_world(src: &str, path: &str) -> Result<crate::world::World, crate::spec::SpecError> {
     parse_world_spec(src, path).map(|spec| crate::world::World::from_spec(&spec))
@@ -260,7 +272,7 @@ pub fn load_world(path: &std::path::Path) -> Result<crate::world::World, crate::
     parse_world(&src, &path.display().to_string())
 }
 
-fn read_and_validate(src: &str, d: &mut Diags) -> Option<WorldSpec> {
+fn read_and_validate(src: &str, d: &mut Diags) -> Option<(WorldSpec, WorldLoc)> {
     let (doc, errors) = DeTable::parse_recoverable(src);
     if !errors.is_empty() {
         for e in &errors {
@@ -283,7 +295,7 @@ fn read_and_validate(src: &str, d: &mut Diags) -> Option<WorldSpec> {
     let mut loc = WorldLoc::default();
     let spec = read_top(doc.get_ref(), d, &mut loc)?;
     validate::validate(&spec, &loc, d);
-    Some(spec)
+    Some((spec, loc))
 }
 
 fn lowercase_first(s: &str) -> String {

@@ -1,9 +1,12 @@
 //! The validated world model: walls, doors and their states, routes, home, walking areas, and the
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
+pub mod cell_grid;
+pub mod generate;
 pub mod geometry;
 pub mod info;
 pub mod physics;
+pub mod raster;
 pub mod raycast;
 
 use crate::geom::{Pose2, Segment, Vec2};

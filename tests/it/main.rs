@@ -1,6 +1,7 @@
 //! One integration-test binary (keeps link time down on 2 cores); one module per area.
 
 mod architecture;
+mod authoring;
 mod cli;
 mod eval;
 mod io;

@@ -428,7 +428,7 @@ fn alignment_recovers_a_shift() {
     let cfg = config(|c| {
         c.levels = 1;
         c.min_ngram = vec![3];
-        c.min_gap_m = 5.0;
+        c.candidate_gap_m = 5.0;
     });
     // A corridor whose Ψ has a distinctive ramp, seen twice; the second time its words start
     // 3 observations later relative to the ramp.
@@ -784,7 +784,7 @@ proptest! {
         let cfg = config(|c| {
             c.min_word_size = 2;
             c.min_ngram = vec![2, 3, 4];
-            c.min_gap_m = gap;
+            c.candidate_gap_m = gap;
         });
         let mut r = SplitMix::new(seed);
         let stretches: Vec<Stretch> = (0..60)
@@ -829,7 +829,7 @@ fn brute_chain(
         && cw.class == pw.class
         && (sa - sb).abs() <= cfg.size_tolerance_ratio * sa.max(sb) + 1e-9
         && da <= cfg.angle_tolerance_deg + 1e-9
-        && pw.end_travel_m + cfg.min_gap_m <= cw.start_travel_m + 1e-9;
+        && pw.end_travel_m + cfg.candidate_gap_m <= cw.start_travel_m + 1e-9;
     let v = if !ok {
         0
     } else {
@@ -882,7 +882,9 @@ proptest! {
         let cfg = config(|c| {
             c.min_word_size = 2;
             c.min_ngram = vec![3, 4, 5];
-            c.min_gap_m = 2.0;
+            c.candidate_gap_m = 2.0;
+            // This checks the chain search; verification is tested on its own.
+            c.verify = false;
         });
         let mut r = SplitMix::new(seed);
         let base: Vec<Stretch> = (0..25)
@@ -917,7 +919,7 @@ proptest! {
                     // that word in different places: check when the earliest of them passes.
                     if len == tau {
                         let first = earliest_first(w, &cfg, k, c, p, tau - 1, &mut memo);
-                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.min_gap_m {
+                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.candidate_gap_m {
                             prop_assert!(
                                 reported.contains(&(c, p)),
                                 "configuration {k}: chain of {len} ending at ({c}, {p}) not reported"
@@ -926,6 +928,182 @@ proptest! {
                     }
                 }
             }
+        }
+    }
+}
+
+/// Intel thinned to every 2nd scan (about 1 m and up to 60° of turn between scans) still
+/// matches, precisely: observations interpolated back along a long step used to read Ψ from
+/// the far side of the grid's torus, and steps over 2 m were observed once.
+#[test]
+fn thinned_real_log_still_matches() {
+    let log = Path::new("../shared/data/carmen/intel-corrected.log.gz");
+    if !log.exists() {
+        eprintln!(
+            "skipping thinned_real_log_still_matches: {} is absent",
+            log.display()
+        );
+        return;
+    }
+    use placewords::experiment::{self, ExperimentOptions, real};
+    use placewords::io::real_log::TruthSource;
+    let noise = placewords::sim::odometry::OdometryConfig::default();
+    let (mut run, _) =
+        real::load_real_run(log, false, TruthSource::Corrected, Some(&noise), 1).unwrap();
+    real::keep_every_nth_scan(&mut run, 2);
+    let opts = ExperimentOptions {
+        levels: vec![3],
+        icp: false,
+        laps: None,
+        quiet: true,
+    };
+    let spec = placewords::spec::evaluation::EvaluationSpec::default();
+    let exp = experiment::evaluate_runs(
+        "intel-step2",
+        1,
+        vec![run],
+        &RecognizerConfig::default(),
+        &spec,
+        &opts,
+    )
+    .unwrap();
+    let l = exp.report.level(3).expect("3 levels ran");
+    eprintln!(
+        "intel every 2nd scan: {} pairs, precision {:.3}, recall {:.3}",
+        l.scores.pairs, l.scores.precision, l.scores.recall
+    );
+    assert!(l.scores.pairs > 0, "no pair");
+    assert!(
+        l.scores.precision >= 0.9,
+        "precision {}",
+        l.scores.precision
+    );
+    assert!(l.scores.recall >= 0.2, "recall {}", l.scores.recall);
+}
+
+/// Observations interpolated along long steps (scans 1.5 and 2.9 m apart) have about the Ψ that
+/// dense scans give at the same places: their kernels stay inside the grid's window.
+#[test]
+fn long_steps_keep_psi_close_to_dense_scans() {
+    let layout = synth::lms200();
+    let dense = front_end_psi(&layout);
+    let inputs = corridor_inputs(&layout);
+    for every in [38, 73] {
+        let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+        let sparse: Vec<Observation> = inputs
+            .iter()
+            .step_by(every)
+            .flat_map(|(o, s)| fe.push(*o, s))
+            .collect();
+        let mut diffs = Vec::new();
+        for o in &sparse {
+            let near = dense
+                .iter()
+                .min_by(|a, b| {
+                    let d = |x: &Observation| x.odom_pose.0.distance(&o.odom_pose.0);
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap();
+            if near.odom_pose.0.distance(&o.odom_pose.0) < 0.06 && near.odom_pose.0.x > 3.0 {
+                diffs.push((near.psi - o.psi).abs());
+            }
+        }
+        let mean = diffs.iter().sum::<f64>() / diffs.len() as f64;
+        eprintln!(
+            "scans {:.2} m apart: {} compared, mean |ΔΨ| {mean:.4}",
+            every as f64 * 0.04,
+            diffs.len()
+        );
+        assert!(diffs.len() > 100, "{} observations compared", diffs.len());
+        assert!(mean <= 0.03, "mean |ΔΨ| {mean} with scans every {every}");
+    }
+}
+
+/// The grid's shortcut (one scan per observation step, beams thinned near the sensor) stays
+/// close to integrating every scan: a bound on the Ψ difference.
+#[test]
+fn one_scan_per_step_bounds_psi_against_every_scan() {
+    let layout = synth::lms200();
+    let inputs = corridor_inputs(&layout);
+    let psi = |every: bool| -> Vec<f64> {
+        let cfg = config(|c| c.integrate_every_scan = every);
+        let mut fe = DensityFrontEnd::new(&cfg).unwrap();
+        inputs
+            .iter()
+            .flat_map(|(o, s)| fe.push(*o, s))
+            .map(|o| o.psi)
+            .collect()
+    };
+    let (thin, all) = (psi(false), psi(true));
+    assert_eq!(thin.len(), all.len());
+    let diffs: Vec<f64> = thin.iter().zip(&all).map(|(a, b)| (a - b).abs()).collect();
+    let mean = diffs.iter().sum::<f64>() / diffs.len() as f64;
+    let max = diffs.iter().copied().fold(0.0, f64::max);
+    eprintln!("one scan per step vs every scan: mean |ΔΨ| {mean:.4}, max {max:.4}");
+    assert!(mean <= 0.01, "mean |ΔΨ| {mean}");
+    assert!(max <= 0.05, "max |ΔΨ| {max}");
+}
+
+/// The matcher bisects occurrence lists by travel: an observation whose travel goes back is a
+/// caller's bug, and it is refused loudly rather than matched wrongly.
+#[test]
+#[should_panic(expected = "non-decreasing travel")]
+fn decreasing_travel_is_refused() {
+    let mut m = WordMatcher::new(&RecognizerConfig::default()).unwrap();
+    let mut o = Observation {
+        id: 0,
+        run: 0,
+        input_index: 0,
+        odom_pose: OdomPose(Pose2::IDENTITY),
+        travel_m: 5.0,
+        psi: 0.5,
+    };
+    m.push_observation(&o);
+    o.id = 1;
+    o.travel_m = 4.0;
+    m.push_observation(&o);
+}
+
+/// `recognize --config` reads the `[recognizer]` table of a TOML file, as a scenario does, and
+/// names the place of a bad key.
+#[test]
+fn settings_from_a_toml_file() {
+    let c = RecognizerConfig::from_toml_str(
+        "[recognizer]\nlevels = 2\nalignment = \"paper\"\nverify = false\n",
+    )
+    .unwrap();
+    assert_eq!(c.levels, 2);
+    assert_eq!(c.alignment, placewords::recognizer::AlignmentMode::Paper);
+    assert!(!c.verify);
+    let e = RecognizerConfig::from_toml_str("x = 1\n\n[recognizer]\nlevles = 2\n").unwrap_err();
+    assert!(e.starts_with("3:1") && e.contains("levles"), "{e}");
+    let e = RecognizerConfig::from_toml_str("[recognizer]\nlevels = 9\n").unwrap_err();
+    assert!(e.contains("levels"), "{e}");
+}
+
+/// Verification turns down an n-gram whose words agree but whose raw densities do not (a second
+/// pass with Ψ shifted within every class), and says why; the same pass unshifted is accepted.
+#[test]
+fn verification_rejects_a_density_mismatch_and_counts_it() {
+    let cfg = config(|c| c.verify_max_psi_rms = 0.03);
+    let lap = random_stretches(7, 40);
+    let first = synth::observations(&lap, 0.1, 0, None);
+    for (shift, expect_pairs) in [(0.0, true), (0.05, false)] {
+        let mut second = synth::observations(&lap, 0.1, 0, first.last());
+        for o in &mut second {
+            o.psi += shift;
+        }
+        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+        let (m, matches) = run_matcher(&cfg, &all);
+        let counts = m.verification();
+        assert_eq!(
+            !matches.is_empty(),
+            expect_pairs,
+            "shift {shift}: {counts:?}"
+        );
+        assert_eq!(counts.accepted, matches.len());
+        if !expect_pairs {
+            assert!(counts.rejected_density > 0, "{counts:?}");
         }
     }
 }

@@ -1,0 +1,581 @@
+//! The ambiguity map: where on a route the recognizer will confuse places, found before any run.
+//!
+//! The simulated robot drives the route twice with no noise at all (exact laser, exact odometry,
+//! no wander, no people), and the recognizer, with its own words and thresholds, matches the
+//! drive against itself. Matching the second lap against the first finds every n-gram of words
+//! that occurs at two places of the route in either order. A matched word pair whose two words
+//! lie more than `tp_radius_m` apart (their middle observations' true positions) is a confusion:
+//! both words' stretches of the route are ambiguous, and each is the other's partner. Stretches
+//! confused with each other along consecutive words are merged into one pair of stretches (one
+//! colour and number in the picture).
+
+use crate::geom::Vec2;
+use crate::recognizer::{Match, Recognizer, RecognizerConfig, Word};
+use crate::sim::Frame;
+use crate::sim::robot::RouteTracker;
+use crate::world::{DoorStates, Route, World};
+use serde::Serialize;
+
+/// Route resolution of the stretches, metres.
+pub const BIN_M: f64 = 0.1;
+
+/// Why an ambiguity map could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum AmbiguityError {
+    #[error("world '{world}' has no route '{route}'; {hint}")]
+    UnknownRoute {
+        world: String,
+        route: String,
+        hint: String,
+    },
+    #[error("the noise-free drive failed: {0}")]
+    Sim(#[from] crate::sim::SimError),
+    #[error("{0}")]
+    Recognizer(#[from] crate::recognizer::RecognizerError),
+}
+
+/// One ambiguous stretch of the route.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AmbiguousStretch {
+    /// 1-based, in route order from the first waypoint.
+    pub number: usize,
+    /// 1-based pair of stretches that look alike to the recognizer (numbered by the first
+    /// stretch's start).
+    pub pair: usize,
+    /// Start, metres along the route from its first waypoint.
+    pub from_m: f64,
+    /// End, metres along the route; less than `from_m` when the stretch passes the first
+    /// waypoint.
+    pub to_m: f64,
+    pub length_m: f64,
+    /// Number of the stretch whose words match this one's.
+    pub partners: Vec<usize>,
+}
+
+/// Every ambiguous stretch of a route.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AmbiguityReport {
+    pub world: String,
+    pub route: String,
+    pub route_length_m: f64,
+    /// Level configuration searched (1 = level-0 words only).
+    pub levels: usize,
+    /// Minimum n-gram size per level configuration.
+    pub min_ngram: Vec<usize>,
+    /// Words farther apart than this are different places, metres.
+    pub tp_radius_m: f64,
+    /// Matched word pairs at different places.
+    pub confused_word_pairs: usize,
+    /// Share of the route inside an ambiguous stretch, 0..1.
+    pub ambiguous_share: f64,
+    /// Pairs of look-alike stretches.
+    pub pairs: usize,
+    pub stretches: Vec<AmbiguousStretch>,
+}
+
+impl AmbiguityReport {
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_else(|_| "{}".into())
+    }
+}
+
+/// The noise-free drive: frames of two laps and each frame's position along the route.
+pub struct Drive {
+    pub frames: Vec<Frame>,
+    pub route_m: Vec<f64>,
+    /// Length of the route, metres.
+    pub loop_m: f64,
+}
+
+/// A scenario of one run of two laps over `route` with every noise and wander off.
+fn noise_free_scenario(
+    world: &World,
+    route: &Route,
+    doors: &DoorStates,
+    cfg: &RecognizerConfig,
+) -> crate::spec::scenario::Scenario {
+    use crate::sim::{laser, odometry, pedestrians, robot};
+    use crate::spec::scenario::{DoorChoice, DoorPlan, RunPlan, Scenario};
+    Scenario {
+        name: format!("{}-ambiguity", world.name),
+        description: None,
+        path: Default::default(),
+        world_path: Default::default(),
+        world: world.clone(),
+        route: route.clone(),
+        seed: 0,
+        runs: vec![RunPlan {
+            start_waypoint: 0,
+            laps: 2,
+            doors: DoorPlan::Fixed(DoorChoice {
+                name: "given".into(),
+                states: doors.clone(),
+            }),
+        }],
+        door_configs: Default::default(),
+        pedestrians: pedestrians::PedestrianConfig::default(),
+        laser: laser::LaserConfig {
+            range_noise_m: 0.0,
+            angle_error_rad: 0.0,
+            ..laser::LaserConfig::default()
+        },
+        odometry: odometry::OdometryConfig {
+            model: odometry::OdometryModel::Proportional {
+                translation_ratio: 0.0,
+                rotation_ratio: 0.0,
+            },
+            ..odometry::OdometryConfig::default()
+        },
+        robot: robot::RobotConfig::default(),
+        recognizer: cfg.clone(),
+        evaluation: Default::default(),
+        expect: Default::default(),
+    }
+}
+
+/// Drives `route` twice without noise.
+pub fn drive(
+    world: &World,
+    route: &Route,
+    doors: &DoorStates,
+    cfg: &RecognizerConfig,
+) -> Result<Drive, AmbiguityError> {
+    let scn = noise_free_scenario(world, route, doors, cfg);
+    let runs = crate::sim::simulate(&scn, None, &|| {})?;
+    let frames: Vec<Frame> = runs
+        .into_iter()
+        .flat_map(|r| r.laps)
+        .flat_map(|l| l.frames)
+        .collect();
+    let mut tracker = RouteTracker::new(route, 0);
+    let length = tracker.length_m();
+    let route_m = frames
+        .iter()
+        .map(|f| {
+            tracker.update(f.truth.0.position());
+            tracker.arc_m().rem_euclid(length)
+        })
+        .collect();
+    Ok(Drive {
+        frames,
+        route_m,
+        loop_m: length,
+    })
+}
+
+/// A word's stretch of the route (start, end, metres along it) and its middle true position.
+fn word_place(rec: &Recognizer, drive: &Drive, w: &Word) -> (f64, f64, Vec2) {
+    let obs = rec.observations();
+    let frame = |i: usize| obs[i].input_index.min(drive.frames.len() - 1);
+    let r = w.obs_range();
+    let (first, last) = (frame(r.start), frame(r.end - 1));
+    let mid = frame(r.start + w.size / 2);
+    let at = drive.frames[mid].truth.0.position();
+    (drive.route_m[first], drive.route_m[last], at)
+}
+
+/// Pairs of route stretches the recognizer confused: ((from, to), (from, to)).
+type Confusion = ((f64, f64), (f64, f64));
+
+fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64) -> Vec<Confusion> {
+    let words = rec.words();
+    let mut out = Vec::new();
+    for m in matches {
+        for (c, p) in &m.word_pairs {
+            let (Some(cw), Some(pw)) = (words.get(*c), words.get(*p)) else {
+                continue;
+            };
+            let (c0, c1, ca) = word_place(rec, drive, cw);
+            let (p0, p1, pa) = word_place(rec, drive, pw);
+            // Words at the same place of the route, one lap apart, are the same place even
+            // when their alignment is off.
+            let mid = |a: f64, b: f64| a + (b - a).rem_euclid(drive.loop_m) / 2.0;
+            let along = (mid(c0, c1) - mid(p0, p1)).rem_euclid(drive.loop_m);
+            if along.min(drive.loop_m - along) <= radius_m {
+                continue;
+            }
+            if wrong_pair(rec, drive, m, cw, pw, radius_m).unwrap_or((ca - pa).norm() > radius_m) {
+                out.push(((c0, c1), (p0, p1)));
+            }
+        }
+    }
+    out
+}
+
+/// Whether most aligned observation pairs of the word pair (`c`, `p`) lie farther apart than
+/// `radius_m` (as evaluation scores pairs); `None` when the match holds none of them.
+fn wrong_pair(
+    rec: &Recognizer,
+    drive: &Drive,
+    m: &Match,
+    c: &Word,
+    p: &Word,
+    radius_m: f64,
+) -> Option<bool> {
+    let obs = rec.observations();
+    let at = |i: usize| {
+        let f = obs[i].input_index.min(drive.frames.len() - 1);
+        drive.frames[f].truth.0.position()
+    };
+    let (cr, pr) = (c.obs_range(), p.obs_range());
+    let (mut wrong, mut all) = (0, 0);
+    for a in m
+        .pairs
+        .iter()
+        .filter(|a| cr.contains(&a.query) && pr.contains(&a.past))
+    {
+        all += 1;
+        wrong += usize::from((at(a.query) - at(a.past)).norm() > radius_m);
+    }
+    (all > 0).then_some(2 * wrong > all)
+}
+
+/// A stretch of the loop: start and length, metres along the route.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Arc {
+    start: f64,
+    len: f64,
+}
+
+/// Stretches closer than this along the route are merged, metres.
+const MERGE_GAP_M: f64 = 1.0;
+
+impl Arc {
+    fn new(from: f64, to: f64, loop_m: f64) -> Arc {
+        Arc {
+            start: from.rem_euclid(loop_m),
+            len: (to - from).rem_euclid(loop_m),
+        }
+    }
+
+    /// Whether the two stretches overlap or come within `MERGE_GAP_M`.
+    fn touches(&self, o: &Arc, loop_m: f64) -> bool {
+        let d = (o.start - self.start).rem_euclid(loop_m);
+        d <= self.len + MERGE_GAP_M || loop_m - d <= o.len + MERGE_GAP_M
+    }
+
+    /// The shorter stretch covering both (they touch).
+    fn union(&self, o: &Arc, loop_m: f64) -> Arc {
+        let d = (o.start - self.start).rem_euclid(loop_m);
+        let from_self = self.len.max(d + o.len);
+        let from_other = o.len.max(loop_m - d + self.len);
+        if from_self <= from_other {
+            Arc {
+                start: self.start,
+                len: from_self.min(loop_m),
+            }
+        } else {
+            Arc {
+                start: o.start,
+                len: from_other.min(loop_m),
+            }
+        }
+    }
+}
+
+/// Confusions as pairs of stretches.
+fn arcs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
+    let mut out: Vec<(Arc, Arc)> = conf
+        .iter()
+        .map(|((a, b), (c, d))| (Arc::new(*a, *b, loop_m), Arc::new(*c, *d, loop_m)))
+        .collect();
+    out.sort_by(|p, q| {
+        p.0.start
+            .total_cmp(&q.0.start)
+            .then(p.1.start.total_cmp(&q.1.start))
+    });
+    out
+}
+
+/// `q` merged into `p` if their stretches touch side by side, in either order.
+fn merge(p: &(Arc, Arc), q: &(Arc, Arc), loop_m: f64) -> Option<(Arc, Arc)> {
+    if p.0.touches(&q.0, loop_m) && p.1.touches(&q.1, loop_m) {
+        Some((p.0.union(&q.0, loop_m), p.1.union(&q.1, loop_m)))
+    } else if p.0.touches(&q.1, loop_m) && p.1.touches(&q.0, loop_m) {
+        Some((p.0.union(&q.1, loop_m), p.1.union(&q.0, loop_m)))
+    } else {
+        None
+    }
+}
+
+/// Confused word pairs merged into pairs of stretches: two confusions join when their
+/// stretches touch side by side (consecutive words of one n-gram do, and a confusion found in
+/// both orders joins itself), until no two pairs touch. Each pair's earlier stretch comes first.
+fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
+    let mut pairs: Vec<(Arc, Arc)> = Vec::new();
+    for c in arcs(conf, loop_m) {
+        match pairs.iter().position(|p| merge(p, &c, loop_m).is_some()) {
+            Some(i) => pairs[i] = merge(&pairs[i], &c, loop_m).unwrap_or(pairs[i]),
+            None => pairs.push(c),
+        }
+    }
+    let mut changed = true;
+    while changed {
+        changed = false;
+        'outer: for i in 0..pairs.len() {
+            for j in i + 1..pairs.len() {
+                if let Some(m) = merge(&pairs[i], &pairs[j], loop_m) {
+                    pairs[i] = m;
+                    pairs.remove(j);
+                    changed = true;
+                    break 'outer;
+                }
+            }
+        }
+    }
+    let mut out: Vec<(Arc, Arc)> = pairs
+        .into_iter()
+        .map(|(a, b)| if a.start <= b.start { (a, b) } else { (b, a) })
+        .collect();
+    out.sort_by(|p, q| p.0.start.total_cmp(&q.0.start));
+    out
+}
+
+/// The numbered stretches: pair k gives stretches 2k − 1 and 2k, each the other's partner.
+fn stretches(conf: &[Confusion], loop_m: f64) -> Vec<AmbiguousStretch> {
+    let stretch = |arc: &Arc, number: usize, pair: usize, partner: usize| AmbiguousStretch {
+        number,
+        pair,
+        from_m: round_dm(arc.start),
+        to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
+        length_m: round_dm(arc.len),
+        partners: vec![partner],
+    };
+    merged_pairs(conf, loop_m)
+        .iter()
+        .enumerate()
+        .flat_map(|(k, (a, b))| {
+            let (na, nb) = (2 * k + 1, 2 * k + 2);
+            [stretch(a, na, k + 1, nb), stretch(b, nb, k + 1, na)]
+        })
+        .collect()
+}
+
+/// Rounded to 0.1 m (the route positions are no more precise).
+fn round_dm(x: f64) -> f64 {
+    (x * 10.0).round() / 10.0
+}
+
+/// Drives `route` of `world` without noise and finds every stretch whose words also occur
+/// elsewhere on it, at the recognizer settings `cfg` (all its level configurations) and with
+/// the doors in `doors`. Returns the report and the drive (for the picture).
+pub fn ambiguity(
+    world: &World,
+    route_id: &str,
+    doors: &DoorStates,
+    cfg: &RecognizerConfig,
+    tp_radius_m: f64,
+) -> Result<(AmbiguityReport, Drive), AmbiguityError> {
+    let route = world
+        .route(route_id)
+        .ok_or_else(|| AmbiguityError::UnknownRoute {
+            world: world.name.clone(),
+            route: route_id.to_string(),
+            hint: crate::spec::suggest::hint(
+                route_id,
+                world.routes.iter().map(|r| r.id.as_str()),
+                "route ids",
+            ),
+        })?;
+    let drive = drive(world, route, doors, cfg)?;
+    let mut rec = Recognizer::new(cfg.clone())?;
+    let mut matches = Vec::new();
+    for f in &drive.frames {
+        matches.extend(rec.push(f.odom, &f.scan));
+    }
+    matches.extend(rec.finish());
+    let conf = confusions(&rec, &drive, &matches, tp_radius_m);
+    let length_m = route.length_m();
+    let list = stretches(&conf, length_m);
+    let share = covered_share(&list, length_m);
+    let report = AmbiguityReport {
+        world: world.name.clone(),
+        route: route.id.clone(),
+        route_length_m: length_m,
+        levels: cfg.levels,
+        min_ngram: cfg.min_ngram.iter().copied().take(cfg.levels).collect(),
+        tp_radius_m,
+        confused_word_pairs: conf.len(),
+        ambiguous_share: share,
+        pairs: list.iter().map(|s| s.pair).max().unwrap_or(0),
+        stretches: list,
+    };
+    Ok((report, drive))
+}
+
+/// Share of the loop inside at least one stretch (0.1 m resolution).
+fn covered_share(list: &[AmbiguousStretch], loop_m: f64) -> f64 {
+    let n = ((loop_m / 0.1).ceil() as usize).max(1);
+    let mut marked = vec![false; n];
+    for s in list {
+        let first = (s.from_m / 0.1) as usize;
+        let count = (s.length_m / 0.1).round() as usize;
+        (0..count.min(n)).for_each(|k| marked[(first + k) % n] = true);
+    }
+    marked.iter().filter(|m| **m).count() as f64 / n as f64
+}
+
+/// Distinct colours for pairs of look-alike stretches (Tableau 10 without grey).
+pub const PAIR_COLORS: [&str; 9] = [
+    "#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#bcbd22",
+    "#17becf",
+];
+
+/// Points of the route from `from_m` over `length_m` (forward, wrapping), every 0.25 m.
+fn route_points(route: &Route, from_m: f64, length_m: f64) -> Vec<Vec2> {
+    let tracker = RouteTracker::new(route, 0);
+    let steps = ((length_m / 0.25).ceil() as usize).max(1);
+    (0..=steps)
+        .map(|k| {
+            tracker
+                .point_at(from_m + length_m * k as f64 / steps as f64)
+                .0
+        })
+        .collect()
+}
+
+/// The world with the route's ambiguous stretches drawn as thick bands, one colour and number
+/// per pair of look-alike stretches joined by a thin line, and a list of the pairs under it.
+pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport) -> String {
+    use crate::report::world_render::{
+        BandOverlay, MarkOverlay, RenderOptions, SegmentOverlay, render_world_svg,
+    };
+    let mut opts = RenderOptions {
+        doors: doors.clone(),
+        title: Some(title(report)),
+        show_areas: false,
+        show_door_labels: false,
+        ..RenderOptions::default()
+    };
+    let Some(route) = world.route(&report.route) else {
+        return render_world_svg(world, &opts);
+    };
+    let color = |k: usize| PAIR_COLORS[(k - 1) % PAIR_COLORS.len()].to_string();
+    let mut middles = std::collections::BTreeMap::<usize, Vec<Vec2>>::new();
+    for s in &report.stretches {
+        let pts = route_points(route, s.from_m, s.length_m);
+        let mid = pts[pts.len() / 2];
+        middles.entry(s.pair).or_default().push(mid);
+        opts.marks.push(MarkOverlay {
+            at: mid,
+            text: s.pair.to_string(),
+            color: color(s.pair),
+            class: "ambiguous".into(),
+        });
+        opts.bands.push(BandOverlay {
+            points: pts,
+            color: color(s.pair),
+            width_px: 10.0,
+        });
+    }
+    for (k, m) in &middles {
+        if let [a, b] = m.as_slice() {
+            opts.segments.push(SegmentOverlay {
+                color: color(*k),
+                a: *a,
+                b: *b,
+            });
+        }
+    }
+    if !report.stretches.is_empty() {
+        opts.legend.push(crate::report::world_render::LegendEntry {
+            label: "look-alike stretches (same number: same words)".into(),
+            color: PAIR_COLORS[0].into(),
+            dashed: false,
+        });
+    }
+    opts.notes = notes(report);
+    render_world_svg(world, &opts)
+}
+
+fn title(report: &AmbiguityReport) -> String {
+    if report.stretches.is_empty() {
+        return format!(
+            "{}: route '{}': no two places look alike to the recognizer",
+            report.world, report.route
+        );
+    }
+    format!(
+        "{}: route '{}': {} pair(s) of places look alike, {:.0} % of the route",
+        report.world,
+        report.route,
+        report.pairs,
+        100.0 * report.ambiguous_share
+    )
+}
+
+/// Most pairs listed under the picture.
+const MAX_NOTES: usize = 12;
+
+/// One line per pair: where its two stretches are.
+fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
+    report
+        .stretches
+        .chunks(2)
+        .map(|c| {
+            let at = |s: &AmbiguousStretch| format!("{:.1}-{:.1} m", s.from_m, s.to_m);
+            let other = c.get(1).map(at).unwrap_or_default();
+            format!(
+                "{}: {} ({:.1} m) looks like {} (metres along the route from waypoint 1)",
+                c[0].pair,
+                at(&c[0]),
+                c[0].length_m,
+                other
+            )
+        })
+        .collect()
+}
+
+fn notes(report: &AmbiguityReport) -> Vec<String> {
+    let lines = pair_lines(report);
+    let mut out: Vec<String> = lines.iter().take(MAX_NOTES).cloned().collect();
+    if lines.len() > MAX_NOTES {
+        out.push(format!(
+            "... and {} more pairs (see --json)",
+            lines.len() - MAX_NOTES
+        ));
+    }
+    if lines.is_empty() {
+        out.push(format!(
+            "in a noise-free drive with these doors no n-gram of words occurs at two places \
+             ({} level configuration(s), n-gram sizes {:?}); noise, doors and people can still \
+             cause wrong matches",
+            report.levels, report.min_ngram
+        ));
+    }
+    out
+}
+
+impl AmbiguityReport {
+    /// A few lines for people: the share of the route that is ambiguous and each pair.
+    pub fn summary(&self) -> String {
+        let mut out = format!(
+            "{}: route '{}' ({:.0} m): {} pair(s) of look-alike stretches, {:.0} % of the route\n",
+            self.world,
+            self.route,
+            self.route_length_m,
+            self.pairs,
+            100.0 * self.ambiguous_share
+        );
+        for line in pair_lines(self) {
+            out.push_str(&format!("  {line}\n"));
+        }
+        out
+    }
+}
+/// The report and picture `placewords world ambiguity` writes: default recognizer settings,
+/// searching `levels` level configurations (default all three); words farther apart than the
+/// default true-positive radius (1 m) are different places.
+pub fn ambiguity_picture(
+    world: &World,
+    route_id: &str,
+    doors: &DoorStates,
+    levels: Option<usize>,
+) -> Result<(AmbiguityReport, String), AmbiguityError> {
+    let mut cfg = RecognizerConfig::default();
+    cfg.levels = levels.unwrap_or(cfg.levels);
+    let tp_radius_m = crate::spec::evaluation::EvaluationSpec::default().tp_radius_m;
+    let (report, _) = ambiguity(world, route_id, doors, &cfg, tp_radius_m)?;
+    let svg = ambiguity_svg(world, doors, &report);
+    Ok((report, svg))
+}

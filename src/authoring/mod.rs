@@ -1,0 +1,12 @@
+//! Aids for people who author worlds: see before any run where the recognizer will see the same
+//! density, where it will confuse places, and what is wrong with a world that does not load.
+//!
+//! Sits above the world, the simulator and the recognizer: it drives the simulated robot and
+//! builds the recognizer's words, but changes neither.
+
+pub mod ambiguity;
+pub mod density;
+pub mod problems;
+
+pub use ambiguity::{AmbiguityReport, AmbiguousStretch, ambiguity, ambiguity_svg};
+pub use density::{DensityMap, density_map, density_svg};

@@ -1,0 +1,318 @@
+//! World authoring aids: the density map, the ambiguity map, the world generator.
+
+use placewords::authoring::ambiguity::ambiguity;
+use placewords::authoring::density::{DEFAULT_SAMPLE_M, density_map, density_svg};
+use placewords::geom::Vec2;
+use placewords::recognizer::RecognizerConfig;
+use placewords::spec::world::{load_world, parse_world};
+use placewords::world::generate::{GenerateOptions, generate_toml};
+use placewords::world::{DoorStates, World};
+use std::path::PathBuf;
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn placewords(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run placewords")
+}
+
+/// A corridor loop whose south and north corridors are the same: three niches each at the same
+/// distances along travel. The east corridor is wider than the west one, so nothing else
+/// repeats. `extra_niche` adds a fourth niche to the north corridor only.
+fn twin_corridors(extra_niche: bool) -> World {
+    let north_extra = if extra_niche {
+        "[18.6, 11.0], [18.6, 12.5], [17.4, 12.5], [17.4, 11.0], "
+    } else {
+        ""
+    };
+    let src = format!(
+        r#"format_version = 1
+name = "twin-corridors"
+
+[robot_home]
+x_m = 1.0
+y_m = 0.0
+
+[[walls]]
+id = "outer"
+points_m = [[-1.0, -1.0], [8.0, -1.0], [8.0, -2.5], [10.0, -2.5], [10.0, -1.0], [14.0, -1.0], [14.0, -2.5], [16.0, -2.5], [16.0, -1.0], [20.0, -1.0], [20.0, -2.5], [22.0, -2.5], [22.0, -1.0], [31.6, -1.0], [31.6, 11.0], [22.0, 11.0], [22.0, 12.5], [20.0, 12.5], [20.0, 11.0], {north_extra}[16.0, 11.0], [16.0, 12.5], [14.0, 12.5], [14.0, 11.0], [10.0, 11.0], [10.0, 12.5], [8.0, 12.5], [8.0, 11.0], [-1.0, 11.0]]
+closed = true
+
+[[walls]]
+id = "inner"
+points_m = [[1.0, 1.0], [28.4, 1.0], [28.4, 9.0], [1.0, 9.0]]
+closed = true
+
+[[routes]]
+id = "lap"
+waypoints_m = [[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [0.0, 10.0]]
+"#
+    );
+    parse_world(&src, "twin-corridors").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn config(levels: usize) -> RecognizerConfig {
+    RecognizerConfig {
+        levels,
+        ..RecognizerConfig::default()
+    }
+}
+
+#[test]
+fn two_identical_corridors_are_flagged_and_a_niche_removes_the_flag() {
+    for levels in [1, 3] {
+        let twins = twin_corridors(false);
+        let closed = DoorStates::all_closed(&twins);
+        let (report, _) = ambiguity(&twins, "lap", &closed, &config(levels), 1.0).unwrap();
+        assert_eq!(report.pairs, 1, "levels {levels}: {}", report.summary());
+        // The pair is the south corridor (0-30 m along the route) and the north one (40-70 m).
+        let (a, b) = (&report.stretches[0], &report.stretches[1]);
+        assert_eq!((a.partners.clone(), b.partners.clone()), (vec![2], vec![1]));
+        let centre = |s: &placewords::authoring::AmbiguousStretch| s.from_m + s.length_m / 2.0;
+        assert!((0.0..30.0).contains(&centre(a)), "{}", report.summary());
+        assert!((40.0..70.0).contains(&centre(b)), "{}", report.summary());
+
+        let fixed = twin_corridors(true);
+        let (report, _) = ambiguity(&fixed, "lap", &closed, &config(levels), 1.0).unwrap();
+        assert!(
+            report.stretches.is_empty(),
+            "levels {levels}: {}",
+            report.summary()
+        );
+    }
+}
+
+#[test]
+fn ambiguity_cli_writes_a_picture_and_json_with_the_stretches() {
+    let dir = tempfile::tempdir().unwrap();
+    let world = dir.path().join("gen.toml");
+    let out = dir.path().join("amb.svg");
+    let gen_out = placewords(&[
+        "world",
+        "generate",
+        "--seed",
+        "7",
+        "--doors",
+        "8",
+        "-o",
+        world.to_str().unwrap(),
+    ]);
+    assert!(
+        gen_out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&gen_out.stderr)
+    );
+    let run = placewords(&[
+        "world",
+        "ambiguity",
+        world.to_str().unwrap(),
+        "--route",
+        "lap",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let stretches = json["stretches"].as_array().unwrap();
+    for s in stretches {
+        for key in ["from_m", "to_m", "length_m"] {
+            assert!(s[key].as_f64().is_some(), "{s}");
+        }
+        assert!(!s["partners"].as_array().unwrap().is_empty(), "{s}");
+    }
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let bands = doc
+        .descendants()
+        .filter(|n| n.attribute("class") == Some("band"))
+        .count();
+    assert_eq!(bands, stretches.len());
+}
+
+#[test]
+fn unknown_route_is_an_error_naming_the_routes() {
+    let out = placewords(&[
+        "world",
+        "ambiguity",
+        "worlds/loop-small.toml",
+        "--route",
+        "lapp",
+        "-o",
+        "/dev/null",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("no route 'lapp'") && err.contains("lap"),
+        "{err}"
+    );
+}
+
+#[test]
+fn density_map_uses_the_recognizer_classes_and_sees_the_hall_wider_than_a_corridor() {
+    let w = load_world(&root().join("worlds/institute-floor.toml")).unwrap();
+    let closed = DoorStates::all_closed(&w);
+    let cfg = RecognizerConfig::default();
+    let map = density_map(&w, &closed, &cfg, DEFAULT_SAMPLE_M);
+    // The entrance hall at A (6.5 m x 6.5 m) is wider than the south corridor's middle.
+    let hall = map.class_at(Vec2::new(2.5, 2.5)).expect("hall is free");
+    let corridor = map
+        .class_at(Vec2::new(20.0, 0.0))
+        .expect("corridor is free");
+    assert!(hall > corridor, "hall {hall}, corridor {corridor}");
+    // Inside a closed office nothing is coloured; its door open, it is.
+    let room_door = w.door_index("s-12").unwrap();
+    let d = &w.doors[room_door];
+    let inside = d.panel(true).b;
+    assert_eq!(map.class_at(inside), None);
+    let mut open = closed.clone();
+    open.open[room_door] = true;
+    let map_open = density_map(&w, &open, &cfg, DEFAULT_SAMPLE_M);
+    assert!(
+        map_open
+            .class_at(inside + (inside - d.hinge) * 0.5)
+            .is_some()
+    );
+    let svg = density_svg(&w, &closed, &map, "t");
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    assert!(
+        doc.descendants()
+            .any(|n| n.attribute("id") == Some("tiles"))
+    );
+}
+
+#[test]
+fn a_hundred_generated_floors_pass_the_checks() {
+    for seed in 0..100u64 {
+        let opts = GenerateOptions {
+            seed,
+            size_m: (
+                50.0 + 10.0 * (seed % 3) as f64,
+                40.0 + 10.0 * (seed % 2) as f64,
+            ),
+            doors: 2 + (seed % 3) as usize,
+            corridors: 4 + 2 * (seed % 5) as usize,
+        };
+        let text = generate_toml(&opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let w = parse_world(&text, "generated").unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        assert_eq!(w.doors.len(), opts.doors);
+        assert_eq!(w.route("lap").unwrap().waypoints.len(), opts.corridors);
+    }
+}
+
+#[test]
+fn generate_cli_is_deterministic_and_refuses_impossible_floors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.toml"), dir.path().join("b.toml"));
+    for p in [&a, &b] {
+        let out = placewords(&[
+            "world",
+            "generate",
+            "--seed",
+            "3",
+            "--size-m",
+            "50,40",
+            "-o",
+            p.to_str().unwrap(),
+        ]);
+        assert!(out.status.success());
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    let check = placewords(&["world", "check", a.to_str().unwrap()]);
+    assert!(check.status.success());
+    let bad = placewords(&[
+        "world",
+        "generate",
+        "--seed",
+        "3",
+        "--corridors",
+        "5",
+        "-o",
+        a.to_str().unwrap(),
+    ]);
+    assert_eq!(bad.status.code(), Some(2));
+}
+
+#[test]
+fn a_scenario_over_a_generated_floor_runs() {
+    let out = placewords(&[
+        "run",
+        "tests/fixtures/generated/laps.toml",
+        "--levels",
+        "1",
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("generated-laps"));
+}
+
+#[test]
+fn render_of_an_invalid_world_marks_each_problem_and_exits_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bad.svg");
+    let run = placewords(&[
+        "world",
+        "render",
+        "tests/fixtures/invalid/leg-through-wall.toml",
+        "-o",
+        out.to_str().unwrap(),
+        "--grid",
+        "--waypoints",
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("leg-through-wall.toml:28:"));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let class = |c: &str| {
+        doc.descendants()
+            .filter(|n| n.attribute("class") == Some(c))
+            .count()
+    };
+    assert_eq!(class("problem"), 1);
+    assert_eq!(class("waypoint"), 6);
+    assert!(doc.descendants().any(|n| n.attribute("id") == Some("grid")));
+    // The problem sits on the waypoint its message points at (waypoint 4 of the route).
+    let mark = doc
+        .descendants()
+        .find(|n| n.attribute("class") == Some("problem"))
+        .and_then(|g| g.first_element_child())
+        .unwrap();
+    let wp4 = doc
+        .descendants()
+        .filter(|n| n.attribute("class") == Some("waypoint"))
+        .nth(3)
+        .and_then(|g| g.first_element_child())
+        .unwrap();
+    assert_eq!(mark.attribute("cx"), wp4.attribute("cx"));
+    assert_eq!(mark.attribute("cy"), wp4.attribute("cy"));
+}
+
+#[test]
+fn render_of_a_file_that_is_not_toml_writes_no_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bad.svg");
+    let run = placewords(&[
+        "world",
+        "render",
+        "tests/fixtures/invalid/syntax-unclosed-string.toml",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.status.code(), Some(2));
+    assert!(!out.exists());
+}
