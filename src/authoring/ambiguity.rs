@@ -104,6 +104,7 @@ fn noise_free_scenario(
         world: world.clone(),
         route: route.clone(),
         seed: 0,
+        seeds: None,
         runs: vec![RunPlan {
             start_waypoint: 0,
             laps: 2,
