@@ -97,14 +97,11 @@ impl Outcome {
         match (self.actual, self.seed) {
             (Some(a), Some(seed)) => {
                 let op = if self.passed { op } else { negate(op) };
-                let of = if self.seeds == self.runs {
-                    format!("of {}", self.runs)
-                } else {
-                    format!(
-                        "of {}; {} matched nothing",
-                        self.runs,
-                        self.runs - self.seeds
-                    )
+                let n = self.runs;
+                let of = match n - self.seeds {
+                    0 if n == 1 => "over 1 seed".to_string(),
+                    0 => format!("over {n} seeds"),
+                    nothing => format!("over {n} seeds; {nothing} matched nothing"),
                 };
                 format!(
                     "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed}, {of})",
