@@ -5,11 +5,11 @@
 //! The world is `worlds/institute-floor.toml` through `scenarios/B.toml`.
 
 use criterion::{BatchSize, Criterion, criterion_group};
+use placewords::experiment::{Scenario, load_scenario};
 use placewords::geom::Pose2;
 use placewords::sim::laser::{Laser, LaserConfig, LaserPreset};
 use placewords::sim::rng::{Purpose, stream};
 use placewords::sim::runner::RunSim;
-use placewords::spec::scenario::{Scenario, load_scenario};
 use placewords::world::DoorStates;
 use placewords::world::raycast::SweepCaster;
 use std::hint::black_box;
@@ -23,16 +23,16 @@ fn scenario() -> Scenario {
 
 fn bench_scan(c: &mut Criterion) {
     let scn = scenario();
-    let world = &scn.world;
+    let world = &scn.sim.world;
     let caster = SweepCaster::for_world(world, &DoorStates::all_closed(world));
     eprintln!(
         "institute-floor: {} outline segments, {} doors, lap {:.1} m",
         caster.segment_count(),
         world.doors.len(),
-        scn.route.length_m()
+        scn.sim.route.length_m()
     );
     // Poses every 3 m along the route.
-    let legs = scn.route.legs();
+    let legs = scn.sim.route.legs();
     let mut poses = Vec::new();
     for l in &legs {
         let d = l.b - l.a;
@@ -65,7 +65,7 @@ fn bench_scan(c: &mut Criterion) {
 
 fn bench_step(c: &mut Criterion) {
     let scn = scenario();
-    let mut sim = RunSim::new(&scn, 0);
+    let mut sim = RunSim::new(&scn.sim, 0);
     sim.begin_lap(0);
     c.bench_function("sim_step_physics_and_scan_every_other", |b| {
         b.iter(|| black_box(sim.step().expect("not blocked")))
@@ -78,7 +78,7 @@ fn bench_lap(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("full_lap_institute_floor", |b| {
         b.iter_batched(
-            || RunSim::new(&scn, 0),
+            || RunSim::new(&scn.sim, 0),
             |mut sim| black_box(sim.run_lap(0).expect("not blocked").frames.len()),
             BatchSize::LargeInput,
         )

@@ -87,24 +87,17 @@ pub struct Drive {
     pub loop_m: f64,
 }
 
-/// A scenario of one run of two laps over `route` with every noise and wander off.
-fn noise_free_scenario(
-    world: &World,
-    route: &Route,
-    doors: &DoorStates,
-    cfg: &RecognizerConfig,
-) -> crate::spec::scenario::Scenario {
+/// A simulation of one run of two laps over `route` with every noise and wander off.
+fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::sim::plan::SimPlan {
+    use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
     use crate::sim::{laser, odometry, pedestrians, robot};
-    use crate::spec::scenario::{DoorChoice, DoorPlan, RunPlan, Scenario};
-    Scenario {
+    SimPlan {
         name: format!("{}-ambiguity", world.name),
-        description: None,
         path: Default::default(),
         world_path: Default::default(),
         world: world.clone(),
         route: route.clone(),
         seed: 0,
-        seeds: None,
         runs: vec![RunPlan {
             start_waypoint: 0,
             laps: 2,
@@ -128,20 +121,12 @@ fn noise_free_scenario(
             ..odometry::OdometryConfig::default()
         },
         robot: robot::RobotConfig::default(),
-        recognizer: cfg.clone(),
-        evaluation: Default::default(),
-        expect: Default::default(),
     }
 }
 
 /// Drives `route` twice without noise.
-pub fn drive(
-    world: &World,
-    route: &Route,
-    doors: &DoorStates,
-    cfg: &RecognizerConfig,
-) -> Result<Drive, AmbiguityError> {
-    let scn = noise_free_scenario(world, route, doors, cfg);
+pub fn drive(world: &World, route: &Route, doors: &DoorStates) -> Result<Drive, AmbiguityError> {
+    let scn = noise_free_plan(world, route, doors);
     let runs = crate::sim::simulate(&scn, None, &|| {})?;
     let frames: Vec<Frame> = runs
         .into_iter()
@@ -378,7 +363,7 @@ pub fn ambiguity(
                 "route ids",
             ),
         })?;
-    let drive = drive(world, route, doors, cfg)?;
+    let drive = drive(world, route, doors)?;
     let mut rec = Recognizer::new(cfg.clone())?;
     let mut matches = Vec::new();
     for f in &drive.frames {

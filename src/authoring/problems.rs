@@ -5,8 +5,9 @@
 use crate::geom::Vec2;
 use crate::report::world_render::{MarkOverlay, RenderOptions, render_world_svg};
 use crate::spec::Diagnostic;
-use crate::spec::world::{WorldLoc, WorldSpec, read_world_lenient};
+use crate::spec::world::{WorldLoc, WorldSpec};
 use crate::world::World;
+use crate::world::load::read_world_lenient;
 
 const PROBLEM_COLOR: &str = "#d62728";
 /// Most problem messages written under the picture.

@@ -62,6 +62,9 @@ pub fn print_and_write(
         let title = format!("{name}: matched pairs, {what}");
         let svg = picture::matches_svg(world, &exp.runs, rec, radius_m, &title);
         write_file(&dir.join(format!("matches-{file}.svg")), svg.as_bytes())?;
+        let title = format!("{name}: recall and precision per lap, {what}");
+        let svg = picture::lap_strip_svg(rec, &exp.report.evaluation, &title);
+        write_file(&dir.join(format!("laps-{file}.svg")), svg.as_bytes())?;
     }
     eprintln!("pictures: {}", dir.display());
     Ok(())

@@ -17,8 +17,13 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
     use anyhow::Context;
     use placewords::io::mobilesim;
     let name = args.map.display().to_string();
-    let src = std::fs::read_to_string(&args.map)
-        .with_context(|| format!("{name}: cannot read; check the path"))?;
+    let src = match placewords::spec::diag::read_text(&args.map) {
+        Ok(src) => src,
+        Err(e) => {
+            super::print_problems(&e, Default::default());
+            return Ok(ExitCode::from(2));
+        }
+    };
     let spec = match mobilesim::import_mobilesim(&src, &name) {
         Ok(s) => s,
         Err(mobilesim::MapError::NoRoute {

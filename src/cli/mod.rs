@@ -21,6 +21,8 @@ pub mod merge;
 pub mod out;
 pub mod recognize;
 pub mod run;
+pub mod scenario;
+pub mod score;
 pub mod simulate;
 pub mod sweep;
 pub mod table;
@@ -40,6 +42,9 @@ pub enum Command {
     /// Check, render, describe and import world layouts.
     #[command(subcommand)]
     World(world::WorldCommand),
+    /// Check scenario files without running them.
+    #[command(subcommand)]
+    Scenario(scenario::ScenarioCommand),
     /// Drive the simulated robot through a scenario and write CARMEN logs.
     Simulate(simulate::SimulateArgs),
     /// Simulate a scenario, recognize places at 1, 2 and 3 levels, evaluate and report.
@@ -54,11 +59,14 @@ pub enum Command {
     Sweep(sweep::SweepArgs),
     /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
     Recognize(recognize::RecognizeArgs),
+    /// Score any recognizer's matches file against the logs `simulate` wrote.
+    Score(score::ScoreArgs),
 }
 
 pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::World(c) => world::run(c),
+        Command::Scenario(c) => scenario::run(c),
         Command::Simulate(a) => simulate::run(a),
         Command::Run(a) => run::run(a),
         Command::Check(a) => check::run(a),
@@ -66,5 +74,19 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),
+        Command::Score(a) => score::run(a),
+    }
+}
+
+/// Prints a file's problems: human form on stderr, JSON lines on stdout.
+pub fn print_problems(
+    e: &placewords::spec::SpecError,
+    format: placewords::spec::diag::MessageFormat,
+) {
+    for line in e.render(format) {
+        match format {
+            placewords::spec::diag::MessageFormat::Human => eprintln!("{line}"),
+            placewords::spec::diag::MessageFormat::Json => println!("{line}"),
+        }
     }
 }

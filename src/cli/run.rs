@@ -5,7 +5,6 @@ use super::common::{LevelsArg, SeedsArg, print_and_write, write_file};
 use clap::Args;
 use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::{self, ExperimentOptions};
-use placewords::spec::scenario::Scenario;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -21,16 +20,21 @@ pub struct RunArgs {
     #[arg(long)]
     pub icp: bool,
     /// Replace every run's lap count (for a quick look).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// Write the JSON report here (schema in the README; with --seeds, every seed's report and
     /// the figures over seeds).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
-    /// Write pictures here: the true and odometry paths, and the matched pairs of each level
-    /// configuration (green correct, red wrong). One seed only.
+    /// Write pictures here: the true and odometry paths; per level configuration, the true path
+    /// coloured where revisits were recognized, wrong or missed, and recall and precision per lap.
+    /// One seed only.
     #[arg(long, value_name = "DIR", conflicts_with = "seeds")]
     pub svg: Option<PathBuf>,
+    /// Write the matched scan pairs of the last level configuration run (`--levels N`) as a
+    /// matches file for `placewords score` (docs/scoring.md). One seed only.
+    #[arg(long, value_name = "FILE", conflicts_with = "seeds")]
+    pub export_matches: Option<PathBuf>,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -60,15 +64,17 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
-    let scn = Scenario {
-        seed: args.seeds.seed.unwrap_or(scn.seed),
-        ..scn
-    };
+    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
+    if let Some(seed) = args.seeds.seed {
+        scn.sim.seed = seed;
+    }
     let exp = experiment::run_scenario(&scn, &opts)?;
+    if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
+        super::score::export(path, rec, &exp.runs)?;
+    }
     print_and_write(
         &exp,
-        &scn.world,
+        &scn.sim.world,
         scn.evaluation.tp_radius_m,
         args.report.as_deref(),
         args.svg.as_deref(),

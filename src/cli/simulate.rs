@@ -11,7 +11,7 @@ pub struct SimulateArgs {
     /// Scenario file (TOML).
     pub scenario: PathBuf,
     /// Laps per run, replacing the scenario's counts.
-    #[arg(long)]
+    #[arg(long, value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// Output folder for the logs and manifest.
     #[arg(short, long)]
@@ -26,8 +26,13 @@ pub struct SimulateArgs {
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
     use placewords::sim::logs;
-    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
-    let total: usize = scn.runs.iter().map(|r| args.laps.unwrap_or(r.laps)).sum();
+    let scn = placewords::experiment::load_scenario(&args.scenario)?;
+    let total: usize = scn
+        .sim
+        .runs
+        .iter()
+        .map(|r| args.laps.unwrap_or(r.laps))
+        .sum();
     let bar = if args.quiet || !std::io::stderr().is_terminal() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -36,21 +41,21 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
             indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} laps {elapsed}")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
-        b.set_message(format!("simulating {}", scn.name));
+        b.set_message(format!("simulating {}", scn.sim.name));
         b
     };
     let tick = || bar.inc(1);
     let started = std::time::Instant::now();
-    let logs_ = placewords::sim::simulate(&scn, args.laps, &tick)?;
+    let logs_ = placewords::sim::simulate(&scn.sim, args.laps, &tick)?;
     let simulated_s = started.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let mut files = logs::write_logs(&scn, &logs_, args.laps, &args.out)?;
+    let mut files = logs::write_logs(&scn.sim, &logs_, args.laps, &args.out)?;
     if args.svg {
         for r in &logs_ {
             let p = args.out.join(format!("run-{:03}.svg", r.run));
-            let title = format!("{}: run {}, true path and odometry", scn.name, r.run);
+            let title = format!("{}: run {}, true path and odometry", scn.sim.name, r.run);
             let svg = placewords::experiment::picture::trajectory_svg(
-                &scn.world,
+                &scn.sim.world,
                 std::slice::from_ref(r),
                 &title,
             );

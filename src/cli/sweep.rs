@@ -28,7 +28,7 @@ pub struct SweepArgs {
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
-    let scn = placewords::spec::scenario::load_scenario(&args.scenario)?;
+    let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let base = experiment::recognizer_config(&scn)?;
     let opts = ExperimentOptions {
         laps: args.laps,
@@ -38,13 +38,19 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let (runs, _) = experiment::simulate(&scn, &opts)?;
     let laps = runs.iter().map(|r| r.laps.len()).sum();
     let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
-    let report = SweepReport::new(&scn.name, scn.seed, laps, scn.evaluation.clone(), results);
+    let report = SweepReport::new(
+        &scn.sim.name,
+        scn.sim.seed,
+        laps,
+        scn.evaluation.clone(),
+        results,
+    );
     out!("{}", curves_table(&report.curves))?;
     write_file(
         &args.out.join("sweep.json"),
         placewords::report::json::to_json(&report).as_bytes(),
     )?;
-    let title = format!("{}: precision / recall (Fig. 8)", scn.name);
+    let title = format!("{}: precision / recall (Fig. 8)", scn.sim.name);
     write_file(
         &args.out.join("pr-curves.svg"),
         pr_curves_svg(&report.curves, &title).as_bytes(),

@@ -40,20 +40,20 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     let scenarios = args
         .scenarios
         .iter()
-        .map(|p| placewords::spec::scenario::load_scenario(p))
+        .map(|p| placewords::experiment::load_scenario(p))
         .collect::<Result<Vec<_>, _>>()?;
     let mut reports = Vec::new();
     for scn in &scenarios {
-        eprintln!("scenario {}", scn.name);
+        eprintln!("scenario {}", scn.sim.name);
         let exp = experiment::run_scenario(scn, &opts)?;
         write_file(
-            &args.out.join(format!("report-{}.json", scn.name)),
+            &args.out.join(format!("report-{}.json", scn.sim.name)),
             placewords::report::json::to_json(&exp.report).as_bytes(),
         )?;
         reports.push(exp.report);
     }
     let md = format!(
-        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized):\n\n{}",
+        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized) and pair recall (share of every pair that could be found):\n\n{}",
         markdown_table_i(&reports),
         thresholds_note(&reports),
         markdown_visit_recall(&reports)

@@ -83,6 +83,9 @@ pub struct CheckArgs {
     /// World files (TOML).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+    /// `human` (file:line:col: error: ...) or `json` (one object per problem, on stdout).
+    #[arg(long, value_name = "FORMAT", default_value = "human", value_parser = ["human", "json"])]
+    pub message_format: String,
 }
 
 #[derive(Debug, Args)]
@@ -133,7 +136,7 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
 fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for f in &args.files {
-        match placewords::spec::world::load_world(f) {
+        match placewords::world::load_world(f) {
             Ok(w) => outln!(
                 "{}: ok ({} walls, {} doors, {} routes)",
                 f.display(),
@@ -142,7 +145,8 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 w.routes.len()
             )?,
             Err(e) => {
-                eprintln!("{e}");
+                let format = placewords::spec::diag::MessageFormat::from_name(&args.message_format);
+                super::print_problems(&e, format.unwrap_or_default());
                 failed = true;
             }
         }
@@ -156,7 +160,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
 
 /// Loads a world; on invalid input prints every located problem and returns `None`.
 fn load(path: &std::path::Path) -> Option<World> {
-    match placewords::spec::world::load_world(path) {
+    match placewords::world::load_world(path) {
         Ok(w) => Some(w),
         Err(e) => {
             eprintln!("{e}");
@@ -195,7 +199,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
         show_waypoints: args.waypoints,
         ..RenderOptions::default()
     };
-    let world = match placewords::spec::world::parse_world(&src, &path) {
+    let world = match placewords::world::parse_world(&src, &path) {
         Ok(w) => w,
         Err(_) => {
             let (svg, diags) = placewords::authoring::problems::problems_svg(&src, &path, &base);

@@ -20,25 +20,28 @@ pub enum Metric {
     Precision,
     Recall,
     VisitRecall,
+    PairRecall,
     SecondsPerLap,
 }
 
 impl Metric {
     /// Every metric, in report order.
-    pub const ALL: [Metric; 4] = [
+    pub const ALL: [Metric; 5] = [
         Metric::Precision,
         Metric::Recall,
         Metric::VisitRecall,
+        Metric::PairRecall,
         Metric::SecondsPerLap,
     ];
 
     /// The name in test case names and tables: `precision`, `recall`, `visit_recall`,
-    /// `seconds_per_lap`.
+    /// `pair_recall`, `seconds_per_lap`.
     pub fn name(self) -> &'static str {
         match self {
             Metric::Precision => "precision",
             Metric::Recall => "recall",
             Metric::VisitRecall => "visit_recall",
+            Metric::PairRecall => "pair_recall",
             Metric::SecondsPerLap => "seconds_per_lap",
         }
     }
@@ -55,6 +58,7 @@ impl Metric {
             Metric::Precision => Some(s.precision),
             Metric::Recall => Some(s.recall),
             Metric::VisitRecall => Some(s.visit_recall),
+            Metric::PairRecall => Some(s.pair_recall),
             Metric::SecondsPerLap => Some(s.recognize_seconds_per_lap),
         }
     }
@@ -116,6 +120,8 @@ pub struct ConfigSpread {
     pub precision: Option<Spread>,
     pub recall: Option<Spread>,
     pub visit_recall: Option<Spread>,
+    #[serde(default)]
+    pub pair_recall: Option<Spread>,
     pub seconds_per_lap: Option<Spread>,
     /// Seeds at which the recognizer made no pair at all.
     pub no_match_seeds: Vec<u64>,
@@ -128,6 +134,7 @@ impl ConfigSpread {
             Metric::Precision => self.precision.as_ref(),
             Metric::Recall => self.recall.as_ref(),
             Metric::VisitRecall => self.visit_recall.as_ref(),
+            Metric::PairRecall => self.pair_recall.as_ref(),
             Metric::SecondsPerLap => self.seconds_per_lap.as_ref(),
         }
     }
@@ -182,6 +189,7 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
                 .collect();
             let (precision, recall) = (spread(Metric::Precision), spread(Metric::Recall));
             let visit_recall = spread(Metric::VisitRecall);
+            let pair_recall = spread(Metric::PairRecall);
             let seconds_per_lap = spread(Metric::SecondsPerLap);
             ConfigSpread {
                 subject,
@@ -190,6 +198,7 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
                 precision,
                 recall,
                 visit_recall,
+                pair_recall,
                 seconds_per_lap,
                 no_match_seeds,
             }

@@ -1,12 +1,13 @@
 //! The CI gate: the reports of a scenario's seeds against its `[expect]` block.
 //!
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
-//! testcase): `min_precision`, `min_recall` and `max_seconds_per_lap` of each `[[expect.levels]]`
-//! entry and of `[expect.icp]`. A bound applies to the worst seed, or with `quantile = q` to the
-//! q-quantile from the worst end (`eval::distribution`). A bound on a configuration no report
-//! holds fails ("not in the report"), and so does a precision bound when no seed matched
-//! anything ("no matches"). Exit decision ([`gate_exit_code`], the one rule the CLI uses): 2
-//! when a scenario or seed could not be run (an error), else 1 when any outcome missed, else 0.
+//! testcase): `min_precision`, `min_recall`, `min_visit_recall`, `min_pair_recall` and
+//! `max_seconds_per_lap` of each `[[expect.levels]]` entry and of `[expect.icp]`. A bound applies
+//! to the worst seed, or with `quantile = q` to the q-quantile from the worst end
+//! (`eval::distribution`). A bound on a configuration no report holds fails ("not in the
+//! report"), and so does a precision bound when no seed matched anything ("no matches"). Exit
+//! decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a scenario or seed could not
+//! be run (an error), else 1 when any outcome missed, else 0.
 
 use crate::eval::distribution::{self, Metric};
 use crate::eval::scores::Report;
@@ -19,6 +20,8 @@ use serde::{Deserialize, Serialize};
 pub enum Bound {
     MinPrecision,
     MinRecall,
+    MinVisitRecall,
+    MinPairRecall,
     MaxSecondsPerLap,
 }
 
@@ -28,6 +31,8 @@ impl Bound {
         match self {
             Bound::MinPrecision => Metric::Precision,
             Bound::MinRecall => Metric::Recall,
+            Bound::MinVisitRecall => Metric::VisitRecall,
+            Bound::MinPairRecall => Metric::PairRecall,
             Bound::MaxSecondsPerLap => Metric::SecondsPerLap,
         }
     }
@@ -75,6 +80,8 @@ impl Outcome {
         match self.bound {
             Bound::MinPrecision => ("precision", ">="),
             Bound::MinRecall => ("recall", ">="),
+            Bound::MinVisitRecall => ("visit recall", ">="),
+            Bound::MinPairRecall => ("pair recall", ">="),
             Bound::MaxSecondsPerLap => ("s/lap", "<="),
         }
     }
@@ -163,6 +170,8 @@ pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> V
         let bounds = [
             (Bound::MinPrecision, e.min_precision),
             (Bound::MinRecall, e.min_recall),
+            (Bound::MinVisitRecall, e.min_visit_recall),
+            (Bound::MinPairRecall, e.min_pair_recall),
             (Bound::MaxSecondsPerLap, e.max_seconds_per_lap),
         ];
         for (bound, limit) in bounds {
@@ -258,6 +267,8 @@ mod tests {
             levels,
             min_precision: Some(p),
             min_recall: Some(r),
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: s,
         }
     }

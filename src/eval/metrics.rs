@@ -8,14 +8,15 @@
 //!   ids the recognizer never reported as observations are not scored; they are counted in
 //!   [`Metrics::unresolved_pairs`] (always 0 for a well-behaved recognizer).
 //! - **Correct pair.** The true positions of the two observations (truth of the frames that made
-//!   them) are at most `r` apart.
+//!   them) are at most `r` apart, and their true headings agree within `heading_tolerance_deg`
+//!   (the same direction, as a revisit needs).
 //! - **Precision** = correct pairs / pairs. With no pair at all, precision is reported as 0 and
 //!   [`Metrics::no_pairs`] is set, so reports stay free of NaN.
 //! - **Per-match precision** (`match_precision`): a match is correct when strictly more than half
 //!   of its own (deduplicated) pairs are correct; `match_precision` = correct matches / matches
 //!   with at least one scored pair. Matches without pairs are ignored.
 //! - **Revisit.** Observation `o` has a revisit when an observation made before it, with at least
-//!   `min_gap_m` less odometric travel, lies within `r` of it (true positions) with a true
+//!   `min_gap_m` less true travel (the harness's, [`super::pair_recall::true_travel_m`]), lies within `r` of it (true positions) with a true
 //!   heading within `heading_tolerance_deg` of `o`'s (same direction, as the paper counts).
 //!   The radius of the revisit test follows the scoring radius, so a sensitivity radius changes
 //!   both what is correct and what could have been found.
@@ -28,6 +29,7 @@
 //! Revisits are searched with a spatial hash of cell size `r`, in creation order, so the cost is
 //! about linear in the number of observations.
 
+use super::pair_recall::heading_agrees;
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -66,6 +68,10 @@ pub struct Metrics {
     /// across door changes. Computed at `tp_radius_m` only (0 elsewhere).
     #[serde(default)]
     pub visit_recall: f64,
+    /// Pair recall: correct pairs ÷ every pair that could have been found (see
+    /// [`super::pair_recall`]). Computed at `tp_radius_m` only (0 elsewhere).
+    #[serde(default)]
+    pub pair_recall: f64,
     /// Pairs naming an observation id the recognizer never reported (not scored).
     pub unresolved_pairs: usize,
 }
@@ -96,6 +102,14 @@ pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
     let scorer = Scorer::new(&rec.observations, &rec.truth, spec);
     let (mut main, door_configs) = scorer.score(&rec.matches, spec.tp_radius_m, true);
     main.visit_recall = scorer.visit_recall(&rec.matches, spec.tp_radius_m);
+    main.pair_recall = super::pair_recall::pair_recall(
+        &rec.observations,
+        &rec.matches,
+        &rec.truth,
+        spec,
+        spec.tp_radius_m,
+    )
+    .ratio();
     let sensitivity = spec
         .sensitivity_radii_m
         .iter()
@@ -212,6 +226,7 @@ impl Scorer {
             .enumerate()
             .map(|(i, o)| (o.id, i))
             .collect();
+        let travel = super::pair_recall::true_travel_m(truth);
         let obs = observations
             .iter()
             .map(|o| {
@@ -223,7 +238,7 @@ impl Scorer {
                         x: pose.0.x,
                         y: pose.0.y,
                         theta: pose.0.theta,
-                        travel_m: o.travel_m,
+                        travel_m: travel[o.input_index],
                         config: lap_config[f.lap_slot],
                         lap: f.lap_slot,
                     })
@@ -295,6 +310,7 @@ impl Scorer {
             };
             if let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi])
                 && (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
+                && heading_agrees(q.theta, pa.theta, self.heading_tol_rad)
             {
                 matched.entry(qi).or_default().insert(pa.lap);
             }
@@ -383,7 +399,8 @@ impl Scorer {
                     }
                     continue;
                 };
-                let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2;
+                let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
+                    && heading_agrees(q.theta, pa.theta, self.heading_tol_rad);
                 if in_match.insert((p.query, p.past)) {
                     n += 1;
                     ok += correct as usize;
@@ -478,6 +495,7 @@ impl Counts {
             recall: ratio(self.recalled, self.revisits),
             recall_either_side: ratio(self.recalled_any, self.revisits),
             visit_recall: 0.0,
+            pair_recall: 0.0,
             unresolved_pairs: self.unresolved,
         }
     }

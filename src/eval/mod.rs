@@ -10,6 +10,7 @@
 pub mod distribution;
 pub mod gate;
 pub mod metrics;
+pub mod pair_recall;
 pub mod scores;
 pub mod suite;
 pub mod sweep;

@@ -10,7 +10,8 @@
 //!                 "precision": 0.93, "recall": 0.41, "match_precision": 0.95,
 //!                 "pairs": 10234, "correct_pairs": 9518, "no_pairs": false,
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
-//!                 "recall_either_side": 0.45, "recognize_seconds_per_lap": 0.8,
+//!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
+//!                 "recognize_seconds_per_lap": 0.8,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
 //!                                     "metrics": { "precision": ..., ... } } ] } ],
@@ -45,6 +46,9 @@ pub struct Scores {
     /// matching across door changes (see `eval::metrics::Metrics::visit_recall`).
     #[serde(default)]
     pub visit_recall: f64,
+    /// Correct pairs ÷ every pair that could have been found (see `eval::pair_recall`).
+    #[serde(default)]
+    pub pair_recall: f64,
     pub recognize_seconds_per_lap: f64,
     /// Scores at each sensitivity radius.
     pub sensitivity: Vec<Metrics>,
@@ -68,6 +72,7 @@ impl Scores {
             revisits: m.revisits,
             recall_either_side: m.recall_either_side,
             visit_recall: m.visit_recall,
+            pair_recall: m.pair_recall,
             recognize_seconds_per_lap,
             sensitivity: e.sensitivity.clone(),
             door_configs: e.door_configs.clone(),

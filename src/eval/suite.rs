@@ -325,6 +325,8 @@ mod tests {
                     levels: 3,
                     min_precision: Some(0.5),
                     min_recall: None,
+                    min_visit_recall: None,
+                    min_pair_recall: None,
                     max_seconds_per_lap: None,
                 }],
                 icp: None,

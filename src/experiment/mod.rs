@@ -5,6 +5,8 @@
 
 pub mod picture;
 pub mod real;
+pub mod scenario;
+pub mod score;
 pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
@@ -19,9 +21,9 @@ use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
 use crate::spec::evaluation::EvaluationSpec;
-use crate::spec::scenario::Scenario;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+pub use scenario::{Scenario, load_scenario, parse_scenario};
 use std::time::Instant;
 
 /// Why an experiment could not be carried out.
@@ -125,10 +127,15 @@ impl PlaceRecognizer for Recognizer {
 
 /// Simulates a scenario with a progress bar; returns the runs and the wall-clock seconds.
 pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
-    let laps: usize = scn.runs.iter().map(|r| opts.laps.unwrap_or(r.laps)).sum();
+    let laps: usize = scn
+        .sim
+        .runs
+        .iter()
+        .map(|r| opts.laps.unwrap_or(r.laps))
+        .sum();
     let bar = progress_bar(laps as u64, "simulating", opts.quiet);
     let t = Instant::now();
-    let runs = crate::sim::runner::simulate(scn, opts.laps, &|| bar.inc(1))?;
+    let runs = crate::sim::runner::simulate(&scn.sim, opts.laps, &|| bar.inc(1))?;
     bar.finish_and_clear();
     Ok((runs, t.elapsed().as_secs_f64()))
 }
@@ -140,7 +147,14 @@ pub fn run_scenario(
 ) -> Result<Experiment, ExperimentError> {
     let base = recognizer_config(scn)?;
     let (runs, sim_s) = simulate(scn, opts)?;
-    let mut exp = evaluate_runs(&scn.name, scn.seed, runs, &base, &scn.evaluation, opts)?;
+    let mut exp = evaluate_runs(
+        &scn.sim.name,
+        scn.sim.seed,
+        runs,
+        &base,
+        &scn.evaluation,
+        opts,
+    )?;
     let laps = exp.report.laps.max(1);
     exp.report.simulate_seconds_per_lap = sim_s / laps as f64;
     Ok(exp)

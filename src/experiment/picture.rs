@@ -1,22 +1,26 @@
-//! Pictures of an experiment: the world with the true and odometry paths, and with the matched
-//! pairs of a recognition drawn between their true positions, green when correct, red when not.
+//! Pictures of an experiment: the world with the true and odometry paths (odometry placed at the
+//! run's true start); the true path coloured where revisits were recognized, recognized wrongly
+//! and missed, with the worst clusters of wrong pairs as lines; and a strip of recall and
+//! precision per lap with the door configurations marked.
 
 use crate::eval::Recognition;
-use crate::eval::metrics::scored_pairs;
+use crate::eval::metrics::Scorer;
+use crate::eval::pair_recall::heading_agrees;
 use crate::log::RunLog;
+use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
     LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
 };
+use crate::spec::evaluation::EvaluationSpec;
 use crate::world::World;
-
-/// Most segments drawn for matched pairs; beyond it every k-th pair is drawn (a picture of
-/// 80,000 lines is neither readable nor small).
-pub const MAX_PAIR_SEGMENTS: usize = 4000;
+use std::collections::{HashMap, HashSet};
 
 const TRUE_COLOR: &str = "#1f77b4";
 const ODOM_COLOR: &str = "#ff7f0e";
 const CORRECT_COLOR: &str = "#2ca02c";
 const WRONG_COLOR: &str = "#d62728";
+const MISSED_COLOR: &str = "#222222";
+const PLAIN_COLOR: &str = "#c7c7c7";
 
 fn true_paths(runs: &[RunLog], label: &str) -> Vec<PathOverlay> {
     runs.iter()
@@ -45,25 +49,41 @@ fn plain(world: &World, title: String) -> RenderOptions {
     }
 }
 
-/// The world with each run's true path and odometry path.
+/// A run's odometry path in the world frame: the odometry frame placed so that the first
+/// odometry pose lies on the first true pose (the robot's odometry starts at (0, 0, 0) wherever
+/// it is switched on).
+pub fn odometry_in_world(run: &RunLog) -> Vec<crate::geom::Vec2> {
+    let mut frames = run.frames();
+    let Some(first) = frames.next() else {
+        return Vec::new();
+    };
+    let world_from_odom = first.truth.0.compose(&first.odom.0.inverse());
+    std::iter::once(first)
+        .chain(frames)
+        .map(|f| world_from_odom.transform_point(f.odom.0.position()))
+        .collect()
+}
+
+/// The world with each run's true path and odometry path (drawn from the run's true start).
 pub fn trajectory_svg(world: &World, runs: &[RunLog], title: &str) -> String {
     let mut opts = plain(world, title.to_string());
     opts.paths = true_paths(runs, "true path");
     opts.paths
         .extend(runs.iter().enumerate().map(|(i, r)| PathOverlay {
             label: if i == 0 {
-                "odometry".into()
+                "odometry (from the true start)".into()
             } else {
                 String::new()
             },
             color: ODOM_COLOR.into(),
-            points: r.frames().map(|f| f.odom.0.position()).collect(),
+            points: odometry_in_world(r),
             dashed: true,
         }));
     render_world_svg(world, &opts)
 }
 
-/// The world with the true path and every matched pair of `rec` between its true positions.
+/// The world with the true path coloured where revisits were recognized, recognized wrongly
+/// and missed (see [`ObsStatus`]), and the worst clusters of wrong pairs as lines.
 pub fn matches_svg(
     world: &World,
     runs: &[RunLog],
@@ -71,51 +91,276 @@ pub fn matches_svg(
     radius_m: f64,
     title: &str,
 ) -> String {
-    let pairs = scored_pairs(rec, radius_m);
-    let step = pairs.len().div_ceil(MAX_PAIR_SEGMENTS).max(1);
-    let correct = pairs.iter().filter(|p| p.correct).count();
+    let spec = EvaluationSpec {
+        tp_radius_m: radius_m,
+        ..EvaluationSpec::default()
+    };
+    let status = observation_status(rec, &spec);
     let mut opts = plain(world, title.to_string());
-    opts.paths = true_paths(runs, "true path");
-    // Wrong pairs last, so they are drawn on top.
-    let mut segs: Vec<(bool, SegmentOverlay)> = pairs
+    opts.paths = true_paths(runs, "true path, no revisit");
+    for p in &mut opts.paths {
+        p.color = PLAIN_COLOR.into();
+    }
+    let counts = |k: Kind| status.kinds.iter().filter(|x| **x == k).count();
+    for kind in [Kind::Recognized, Kind::Missed, Kind::Wrong] {
+        opts.paths
+            .extend(status.runs_of(kind).into_iter().map(|points| PathOverlay {
+                label: String::new(),
+                color: kind.color().into(),
+                points,
+                dashed: false,
+            }));
+    }
+    let clusters = worst_wrong_clusters(&status.wrong_pairs, WORST_CLUSTERS);
+    let shown: usize = clusters.iter().map(|c| c.2).sum();
+    opts.segments = clusters
         .iter()
-        .step_by(step)
-        .map(|p| {
-            (
-                p.correct,
-                SegmentOverlay {
-                    color: if p.correct {
-                        CORRECT_COLOR
-                    } else {
-                        WRONG_COLOR
-                    }
-                    .into(),
-                    a: p.query_truth.0.position(),
-                    b: p.past_truth.0.position(),
-                },
-            )
+        .map(|&(a, b, _)| SegmentOverlay {
+            color: WRONG_COLOR.into(),
+            a,
+            b,
         })
         .collect();
-    segs.sort_by_key(|(ok, _)| !*ok);
-    opts.segments = segs.into_iter().map(|(_, s)| s).collect();
-    let note = if step > 1 {
-        format!(" (every {step}th drawn)")
-    } else {
-        String::new()
+    let legend = |label: String, color: &str| LegendEntry {
+        label,
+        color: color.into(),
+        dashed: false,
     };
     opts.legend = vec![
-        LegendEntry {
-            label: format!("correct pair ({correct}){note}"),
-            color: CORRECT_COLOR.into(),
-            dashed: false,
-        },
-        LegendEntry {
-            label: format!("wrong pair ({})", pairs.len() - correct),
-            color: WRONG_COLOR.into(),
-            dashed: false,
-        },
+        legend(
+            format!(
+                "recognized, most pairs correct ({} obs.)",
+                counts(Kind::Recognized)
+            ),
+            CORRECT_COLOR,
+        ),
+        legend(
+            format!(
+                "recognized, most pairs wrong ({} obs.)",
+                counts(Kind::Wrong)
+            ),
+            WRONG_COLOR,
+        ),
+        legend(
+            format!("revisit missed ({} obs.)", counts(Kind::Missed)),
+            MISSED_COLOR,
+        ),
+        legend(
+            format!(
+                "pairs: {} correct, {} wrong; lines: worst {} wrong clusters ({shown} pairs)",
+                status.correct_pairs,
+                status.wrong_pairs.len(),
+                clusters.len()
+            ),
+            WRONG_COLOR,
+        ),
     ];
     render_world_svg(world, &opts)
+}
+
+/// Wrong-pair clusters drawn as lines in the matches picture.
+pub const WORST_CLUSTERS: usize = 8;
+/// Cell size of wrong-pair clustering, metres.
+const CLUSTER_CELL_M: f64 = 5.0;
+
+/// What happened at one observation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// No revisit and no pair.
+    Plain,
+    /// The query of pairs, at least half of them correct.
+    Recognized,
+    /// The query of pairs, most of them wrong.
+    Wrong,
+    /// A revisit with no pair at all.
+    Missed,
+}
+
+impl Kind {
+    fn color(self) -> &'static str {
+        match self {
+            Kind::Plain => PLAIN_COLOR,
+            Kind::Recognized => CORRECT_COLOR,
+            Kind::Wrong => WRONG_COLOR,
+            Kind::Missed => MISSED_COLOR,
+        }
+    }
+}
+
+/// Per observation (creation order): its kind, true position, lap slot and revisit; and the
+/// wrong pairs' true positions.
+pub struct ObsStatus {
+    pub kinds: Vec<Kind>,
+    pub positions: Vec<Option<crate::geom::Vec2>>,
+    pub lap_slots: Vec<Option<usize>>,
+    pub revisits: Vec<bool>,
+    /// Per observation: (correct pairs, pairs) it is the query of.
+    pub pair_counts: Vec<(usize, usize)>,
+    pub correct_pairs: usize,
+    pub wrong_pairs: Vec<(crate::geom::Vec2, crate::geom::Vec2)>,
+}
+
+/// Classifies every observation of `rec` (a pair is correct within `tp_radius_m` with agreeing
+/// headings, as the evaluation says).
+pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus {
+    let revisits = Scorer::new(&rec.observations, &rec.truth, spec).revisits(spec.tp_radius_m);
+    let index_of: HashMap<usize, usize> = rec
+        .observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    let pose = |i: usize| {
+        rec.truth
+            .frame(rec.observations[i].input_index)
+            .map(|f| f.pose.0)
+    };
+    let n = rec.observations.len();
+    let mut pair_counts = vec![(0usize, 0usize); n];
+    let (mut correct_pairs, mut wrong_pairs) = (0, Vec::new());
+    let mut seen = HashSet::new();
+    let tol = spec.heading_tolerance_deg.to_radians();
+    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
+        let (Some(&q), Some(&pa)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
+            continue;
+        };
+        let (Some(a), Some(b)) = (pose(q), pose(pa)) else {
+            continue;
+        };
+        if !seen.insert((q, pa)) {
+            continue;
+        }
+        let ok = a.distance(&b) <= spec.tp_radius_m && heading_agrees(a.theta, b.theta, tol);
+        pair_counts[q].1 += 1;
+        if ok {
+            pair_counts[q].0 += 1;
+            correct_pairs += 1;
+        } else {
+            wrong_pairs.push((a.position(), b.position()));
+        }
+    }
+    let kinds = (0..n)
+        .map(|i| match pair_counts[i] {
+            (c, t) if c > 0 && 2 * c >= t => Kind::Recognized,
+            (_, t) if t > 0 => Kind::Wrong,
+            _ if revisits[i] => Kind::Missed,
+            _ => Kind::Plain,
+        })
+        .collect();
+    ObsStatus {
+        kinds,
+        positions: (0..n).map(|i| pose(i).map(|p| p.position())).collect(),
+        lap_slots: rec
+            .observations
+            .iter()
+            .map(|o| rec.truth.frame(o.input_index).map(|f| f.lap_slot))
+            .collect(),
+        revisits,
+        pair_counts,
+        correct_pairs,
+        wrong_pairs,
+    }
+}
+
+impl ObsStatus {
+    /// Polylines of consecutive observations of `kind` (in the same lap, at most 1 m apart).
+    fn runs_of(&self, kind: Kind) -> Vec<Vec<crate::geom::Vec2>> {
+        let mut out: Vec<Vec<crate::geom::Vec2>> = Vec::new();
+        let mut cur: Vec<crate::geom::Vec2> = Vec::new();
+        let mut last_slot = None;
+        for i in 0..self.kinds.len() {
+            let (Some(p), true) = (self.positions[i], self.kinds[i] == kind) else {
+                if cur.len() > 1 {
+                    out.push(std::mem::take(&mut cur));
+                }
+                cur.clear();
+                continue;
+            };
+            let broken = last_slot != self.lap_slots[i]
+                || cur
+                    .last()
+                    .is_some_and(|q: &crate::geom::Vec2| (p - q).norm() > 1.0);
+            if broken && !cur.is_empty() {
+                let done = std::mem::take(&mut cur);
+                if done.len() > 1 {
+                    out.push(done);
+                }
+            }
+            last_slot = self.lap_slots[i];
+            cur.push(p);
+        }
+        if cur.len() > 1 {
+            out.push(cur);
+        }
+        out
+    }
+}
+
+/// The `k` largest clusters of wrong pairs (query cell, past cell on a 5 m grid), each as the
+/// mean query position, the mean past position and its size, largest first.
+pub fn worst_wrong_clusters(
+    wrong: &[(crate::geom::Vec2, crate::geom::Vec2)],
+    k: usize,
+) -> Vec<(crate::geom::Vec2, crate::geom::Vec2, usize)> {
+    let cell = |p: crate::geom::Vec2| {
+        (
+            (p.x / CLUSTER_CELL_M).floor() as i64,
+            (p.y / CLUSTER_CELL_M).floor() as i64,
+        )
+    };
+    type Acc = (crate::geom::Vec2, crate::geom::Vec2, usize);
+    type Cells = ((i64, i64), (i64, i64));
+    let mut groups: HashMap<Cells, Acc> = HashMap::new();
+    for &(a, b) in wrong {
+        let g = groups.entry((cell(a), cell(b))).or_insert((
+            crate::geom::Vec2::zeros(),
+            crate::geom::Vec2::zeros(),
+            0,
+        ));
+        g.0 += a;
+        g.1 += b;
+        g.2 += 1;
+    }
+    let mut list: Vec<(Cells, Acc)> = groups.into_iter().collect();
+    // Largest first; ties by cell so the picture does not depend on hash order.
+    list.sort_by(|x, y| y.1.2.cmp(&x.1.2).then(x.0.cmp(&y.0)));
+    list.into_iter()
+        .take(k)
+        .map(|(_, (a, b, n))| (a / n as f64, b / n as f64, n))
+        .collect()
+}
+
+/// Per lap (in driving order): recall of its observations with a revisit and precision of the
+/// pairs whose query lies in it, with its door configuration; as an SVG strip.
+pub fn lap_strip_svg(rec: &Recognition, spec: &EvaluationSpec, title: &str) -> String {
+    let status = observation_status(rec, spec);
+    let n = rec.truth.laps.len();
+    let mut acc = vec![(0usize, 0usize, 0usize, 0usize); n];
+    for i in 0..status.kinds.len() {
+        let Some(slot) = status.lap_slots[i] else {
+            continue;
+        };
+        let a = &mut acc[slot];
+        if status.revisits[i] {
+            a.0 += 1;
+            a.1 += (status.pair_counts[i].0 > 0) as usize;
+        }
+        a.2 += status.pair_counts[i].1;
+        a.3 += status.pair_counts[i].0;
+    }
+    let laps: Vec<LapPoint> = rec
+        .truth
+        .laps
+        .iter()
+        .zip(&acc)
+        .map(|(l, &(rv, rc, pairs, ok))| LapPoint {
+            run: l.run,
+            door_config: l.door_config.clone(),
+            recall: (rv > 0).then(|| rc as f64 / rv as f64),
+            precision: (pairs > 0).then(|| ok as f64 / pairs as f64),
+        })
+        .collect();
+    lap_strip(&laps, title)
 }
 
 /// An empty world for real logs, which come without a world file; the picture's extent follows
@@ -135,5 +380,86 @@ pub fn empty_world(runs: &[RunLog], name: &str) -> World {
         doors: Vec::new(),
         routes: Vec::new(),
         areas: Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{OdomPose, Pose2, TruePose};
+    use crate::scan::{BeamLayout, Scan};
+    use crate::sim::{Frame, LapLog};
+
+    /// A run starting at (5, 3) facing +y, driving 2 m straight; odometry starts at (0, 0, 0)
+    /// and drifts 2° to the left.
+    fn run() -> RunLog {
+        let layout = BeamLayout::centered(3, 1.0, 8.0, Pose2::IDENTITY);
+        let frames = (0..=20)
+            .map(|k| {
+                let d = 0.1 * k as f64;
+                Frame {
+                    time_s: d,
+                    odom: OdomPose(Pose2::new(d, 0.035 * d, 0.0)),
+                    truth: TruePose(Pose2::new(5.0, 3.0 + d, std::f64::consts::FRAC_PI_2)),
+                    scan: Scan {
+                        layout: layout.clone(),
+                        ranges_m: vec![8.0; 3],
+                        time_s: d,
+                    },
+                }
+            })
+            .collect();
+        RunLog {
+            run: 0,
+            laps: vec![LapLog {
+                lap: 0,
+                door_config: "all-closed".into(),
+                open_doors: vec![],
+                frames,
+            }],
+        }
+    }
+
+    /// Regression: odometry was drawn from (0, 0, 0), so in scenario A its loops lay rotated,
+    /// outside the building. The picture's first odometry point is the first true pose.
+    #[test]
+    fn odometry_is_drawn_from_the_true_start() {
+        let r = run();
+        let pts = odometry_in_world(&r);
+        assert!((pts[0] - crate::geom::Vec2::new(5.0, 3.0)).norm() < 1e-12);
+        // 2 m of odometry along its own x axis is 2 m up the true heading.
+        assert!(
+            (pts[20] - crate::geom::Vec2::new(5.0 - 0.07, 5.0)).norm() < 1e-9,
+            "{:?}",
+            pts[20]
+        );
+        let world = empty_world(std::slice::from_ref(&r), "t");
+        let svg = trajectory_svg(&world, std::slice::from_ref(&r), "t");
+        let doc = roxmltree::Document::parse(&svg).expect("valid SVG");
+        let firsts: Vec<String> = doc
+            .descendants()
+            .filter(|n| n.attribute("class") == Some("path"))
+            .map(|n| {
+                n.attribute("points")
+                    .unwrap()
+                    .split(' ')
+                    .next()
+                    .unwrap()
+                    .to_string()
+            })
+            .collect();
+        assert_eq!(firsts.len(), 2, "true path and odometry");
+        assert_eq!(firsts[0], firsts[1]);
+    }
+
+    #[test]
+    fn worst_clusters_are_largest_first() {
+        let v = crate::geom::Vec2::new;
+        let mut wrong = vec![(v(1.0, 1.0), v(30.0, 1.0)); 5];
+        wrong.extend(vec![(v(12.0, 1.0), v(40.0, 1.0)); 2]);
+        wrong.push((v(50.0, 50.0), v(0.0, 0.0)));
+        let c = worst_wrong_clusters(&wrong, 2);
+        assert_eq!(c.iter().map(|c| c.2).collect::<Vec<_>>(), [5, 2]);
+        assert_eq!(c[0].0, v(1.0, 1.0));
     }
 }

@@ -9,8 +9,8 @@
 //! (timings apart).
 
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
+use crate::experiment::scenario::{Scenario, load_scenario};
 use crate::experiment::{ExperimentOptions, progress_bar, run_scenario};
-use crate::spec::scenario::{Scenario, load_scenario};
 use crate::spec::seeds::{SeedRange, Shard};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -51,7 +51,9 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
             let scenario = load_scenario(path).map_err(|e| e.to_string());
             let (seeds, options) = match &scenario {
                 Ok(scn) => (
-                    opts.seeds.or(scn.seeds).unwrap_or(SeedRange::one(scn.seed)),
+                    opts.seeds
+                        .or(scn.seeds)
+                        .unwrap_or(SeedRange::one(scn.sim.seed)),
                     options_for(scn, opts),
                 ),
                 Err(_) => (opts.seeds.unwrap_or(SeedRange::one(0)), None),
@@ -126,10 +128,8 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
 /// Runs `scn` at `seed`, timing it.
 pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedResult {
     let t = Instant::now();
-    let scn = Scenario {
-        seed,
-        ..scn.clone()
-    };
+    let mut scn = scn.clone();
+    scn.sim.seed = seed;
     let options = ExperimentOptions {
         quiet: true,
         ..options.clone()
@@ -156,7 +156,7 @@ fn assemble(
         .iter()
         .map(|p| {
             let name = match &p.scenario {
-                Ok(s) => s.name.clone(),
+                Ok(s) => s.sim.name.clone(),
                 Err(_) => stem(&p.file),
             };
             (name, p.file.clone())

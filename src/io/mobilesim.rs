@@ -32,7 +32,7 @@ use std::collections::{HashMap, VecDeque};
 pub const WALL_THICKNESS_M: f64 = 0.05;
 
 /// Most wall segments a world may hold (the world checks' limit).
-pub const MAX_SEGMENTS: usize = 100_000;
+pub const MAX_SEGMENTS: usize = crate::spec::world::MAX_SEGMENTS;
 
 /// Largest extent of a world, corner to corner, metres (the world checks' limit).
 pub const MAX_EXTENT_M: f64 = 10_000.0;
@@ -376,6 +376,50 @@ pub fn import_mobilesim(src: &str, name: &str) -> Result<WorldSpec, MapError> {
     import_mobilesim_with(src, name, &ImportOptions::default())
 }
 
+/// How far outside the walls' bounding box the home may lie, metres.
+pub const HOME_MARGIN_M: f64 = 1.0;
+
+/// The home must lie within the walls' bounding box (plus [`HOME_MARGIN_M`]): the route is
+/// grown from it, and a far-away home makes route generation slow and the route wrong.
+fn home_inside_walls(
+    src: &str,
+    name: &str,
+    segments: &[Segment],
+    home: Vec2,
+) -> Result<(), MapError> {
+    let Some(first) = segments.first() else {
+        return Ok(());
+    };
+    let (mut lo, mut hi) = (first.a, first.a);
+    for p in segments.iter().flat_map(|s| [s.a, s.b]) {
+        lo = lo.inf(&p);
+        hi = hi.sup(&p);
+    }
+    let outside = (lo - home).sup(&(home - hi)).sup(&Vec2::zeros()).norm();
+    if outside <= HOME_MARGIN_M {
+        return Ok(());
+    }
+    let line = src
+        .lines()
+        .position(|l| l.contains("RobotHome"))
+        .map_or(1, |i| i + 1);
+    let col = src
+        .lines()
+        .nth(line - 1)
+        .and_then(|l| l.find("RobotHome"))
+        .map_or(1, |c| c + 1);
+    Err(malformed(
+        name,
+        line,
+        col,
+        format!(
+            "RobotHome ({:.2}, {:.2}) m is {outside:.1} m outside the map's walls (limit {HOME_MARGIN_M} m); \
+         put the home inside the building, in millimetres like the lines",
+            home.x, home.y
+        ),
+    ))
+}
+
 /// [`import_mobilesim`] with explicit route-generation settings.
 pub fn import_mobilesim_with(
     src: &str,
@@ -403,6 +447,7 @@ pub fn import_mobilesim_with(
             map.segments.len()
         )));
     }
+    home_inside_walls(src, name, &map.segments, Vec2::new(hx, hy))?;
     let (mut lo, mut hi) = (Vec2::new(hx, hy), Vec2::new(hx, hy));
     for s in &map.segments {
         for p in [s.a, s.b] {

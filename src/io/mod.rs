@@ -3,5 +3,6 @@
 
 pub mod atomic;
 pub mod carmen;
+pub mod matches_csv;
 pub mod mobilesim;
 pub mod real_log;

@@ -174,6 +174,8 @@ mod tests {
                 levels: 3,
                 min_precision: Some(0.95),
                 min_recall: Some(0.3),
+                min_visit_recall: None,
+                min_pair_recall: None,
                 max_seconds_per_lap: None,
             }],
             icp: None,

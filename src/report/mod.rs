@@ -2,6 +2,7 @@
 
 pub mod json;
 pub mod junit;
+pub mod lap_strip;
 pub mod plot;
 pub mod suite;
 pub mod svg;

@@ -302,6 +302,8 @@ mod tests {
                     levels: 3,
                     min_precision: None,
                     min_recall: Some(0.2),
+                    min_visit_recall: None,
+                    min_pair_recall: None,
                     max_seconds_per_lap: None,
                 }],
                 ..ExpectSpec::default()

@@ -9,15 +9,15 @@ use crate::geom::{Pose2, wrap_angle};
 use crate::io::atomic::write_atomic;
 use crate::io::carmen::{LaserRecord, LogRecord, OdomRecord, TruePosRecord, write_record};
 use crate::log::RunLog;
-use crate::spec::scenario::Scenario;
-use serde::Serialize;
+use crate::sim::plan::SimPlan;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Host name written in every record.
 pub const HOST: &str = "placewords-sim";
 
 /// The CARMEN text of one run.
-pub fn carmen_log(scn: &Scenario, run: &RunLog) -> String {
+pub fn carmen_log(scn: &SimPlan, run: &RunLog) -> String {
     let mut out = String::new();
     out.push_str(&format!(
         "# placewords simulation: scenario {}, seed {}, run {}, route {} of world {}\n",
@@ -84,7 +84,7 @@ pub fn carmen_log(scn: &Scenario, run: &RunLog) -> String {
 }
 
 /// The JSON manifest of a simulation.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Manifest {
     pub placewords_version: String,
     pub scenario: String,
@@ -96,7 +96,7 @@ pub struct Manifest {
     pub runs: Vec<ManifestRun>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ManifestRun {
     pub run: usize,
     pub file: String,
@@ -105,7 +105,7 @@ pub struct ManifestRun {
     pub laps: Vec<ManifestLap>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ManifestLap {
     pub lap: usize,
     pub door_config: String,
@@ -118,7 +118,7 @@ pub fn log_file_name(run: usize) -> String {
     format!("run-{run:03}.log")
 }
 
-pub fn manifest(scn: &Scenario, runs: &[RunLog], laps_override: Option<usize>) -> Manifest {
+pub fn manifest(scn: &SimPlan, runs: &[RunLog], laps_override: Option<usize>) -> Manifest {
     Manifest {
         placewords_version: env!("CARGO_PKG_VERSION").into(),
         scenario: scn.path.display().to_string(),
@@ -152,7 +152,7 @@ pub fn manifest(scn: &Scenario, runs: &[RunLog], laps_override: Option<usize>) -
 /// Writes `run-NNN.log` per run and `manifest.json` into `dir`, each atomically; returns the
 /// paths written.
 pub fn write_logs(
-    scn: &Scenario,
+    scn: &SimPlan,
     runs: &[RunLog],
     laps_override: Option<usize>,
     dir: &Path,

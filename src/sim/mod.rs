@@ -8,10 +8,13 @@ pub mod laser;
 pub mod logs;
 pub mod odometry;
 pub mod pedestrians;
+pub mod plan;
 pub mod rng;
 pub mod robot;
 pub mod runner;
+pub mod variation;
 
+pub use plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 pub use runner::{SimError, simulate};
 
 /// The records a simulation produces live in the neutral [`crate::log`] module (real-log readers

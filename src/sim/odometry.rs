@@ -7,12 +7,18 @@
 //! ±`wheel_radius_mismatch_ratio`/2 (right/left: a heading drift on straight lines). Then a random
 //! error, by model:
 //!
-//! - **Proportional** (default; MobileSim's "random each update"): every update's translation
-//!   `Δs` and rotation `Δθ` get independent zero-mean Gaussian errors with variances
-//!   `σ_t²·|Δs|` and `σ_r²·|Δθ|`. Errors therefore add up like a random walk in distance
-//!   travelled and angle turned: after `d` metres the translation error has standard deviation
-//!   `σ_t·√d`, so `σ_t = 0.0075` is the standard deviation after one metre (and `σ_r = 0.0075`
-//!   after one radian of turning), independent of the update rate.
+//! - **Proportional** (default), in one of two forms ([`ProportionalError`]):
+//!   - **each update** (default; MobileSim's `random_each_update`, the default odometry error
+//!     mode of the MobileSim the paper's simulated runs came from): at every update a new error
+//!     fraction is drawn uniformly in `±σ_t` (translation) and `±σ_r` (rotation), and the update's
+//!     `Δs` and `Δθ` are scaled by `(1 + e)`, as MobileSim's position model does
+//!     (`vx·dt·(1 + integration_error.x)`, a new `integration_error` each iteration). The error of
+//!     one update is proportional to its motion; over `n` updates of length `δ` the spread is
+//!     `σ_t·δ·√(n/3)` = `σ_t·√(δ·d/3)`: with 0.02 m updates, about 0.002 m after 10 m.
+//!   - **random walk** (the earlier default, kept as an option): every update's `Δs` and `Δθ`
+//!     get independent zero-mean Gaussian errors with variances `σ_t²·|Δs|` and `σ_r²·|Δθ|`, so
+//!     after `d` metres the translation error has standard deviation `σ_t·√d` (0.024 m after
+//!     10 m with `σ_t = 0.0075`), independent of the update rate.
 //! - **Thrun** (Probabilistic Robotics, table 5.6, `sample_motion_model_odometry`): the motion
 //!   is split into rot1, trans, rot2 and each part gets a Gaussian error with variance
 //!   `α1·rot1² + α2·trans²` (rotations) and `α3·trans² + α4·(rot1² + rot2²)` (translation).
@@ -37,10 +43,26 @@ pub enum OdometryModel {
     Thrun { alpha: [f64; 4] },
 }
 
-/// Odometry parameters. Default: proportional 0.0075 m/m and rad/rad, no systematic error.
+/// How the proportional model turns its ratios into errors (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ProportionalError {
+    /// MobileSim `random_each_update`: each update scaled by `1 + U(-ratio, ratio)`.
+    #[default]
+    EachUpdate,
+    /// Gaussian random walk: variance `ratio²·|Δ|` per update.
+    RandomWalk,
+}
+
+/// Odometry parameters. Default: proportional 0.0075 m/m and rad/rad drawn at each update
+/// (MobileSim), no systematic error.
+/// Thrun's α1..α4 when a file names `model = "thrun"` without giving them.
+pub const DEFAULT_THRUN_ALPHA: [f64; 4] = [0.01; 4];
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct OdometryConfig {
     pub model: OdometryModel,
+    /// Form of the proportional model's error. Default [`ProportionalError::EachUpdate`].
+    pub proportional: ProportionalError,
     /// Relative error of both wheel radii (odometric distance = true × (1 + this)). Default 0.
     pub wheel_radius_bias_ratio: f64,
     /// Right wheel radius minus left, relative to nominal. Default 0.
@@ -54,6 +76,7 @@ impl Default for OdometryConfig {
                 translation_ratio: 0.0075,
                 rotation_ratio: 0.0075,
             },
+            proportional: ProportionalError::EachUpdate,
             wheel_radius_bias_ratio: 0.0,
             wheel_radius_mismatch_ratio: 0.0,
         }
@@ -70,6 +93,32 @@ pub struct Odometry {
 
 fn gauss(rng: &mut SimRng) -> f64 {
     rng.sample::<f64, _>(StandardNormal)
+}
+
+/// The proportional model's noisy `(Δs, Δθ)` for one update's `(Δs, Δθ)`.
+fn proportional_error(
+    form: ProportionalError,
+    (ds, dth): (f64, f64),
+    (t_ratio, r_ratio): (f64, f64),
+    rng: &mut SimRng,
+) -> (f64, f64) {
+    match form {
+        ProportionalError::EachUpdate => {
+            let mut fraction = |r: f64| {
+                if r > 0.0 {
+                    rng.random_range(-r..r)
+                } else {
+                    0.0
+                }
+            };
+            let (et, er) = (fraction(t_ratio), fraction(r_ratio));
+            (ds * (1.0 + et), dth * (1.0 + er))
+        }
+        ProportionalError::RandomWalk => (
+            ds + t_ratio * ds.abs().sqrt() * gauss(rng),
+            dth + r_ratio * dth.abs().sqrt() * gauss(rng),
+        ),
+    }
 }
 
 impl Odometry {
@@ -104,8 +153,12 @@ impl Odometry {
                 translation_ratio,
                 rotation_ratio,
             } => {
-                let ds = ds + translation_ratio * ds.abs().sqrt() * gauss(rng);
-                let dth = dth + rotation_ratio * dth.abs().sqrt() * gauss(rng);
+                let (ds, dth) = proportional_error(
+                    self.config.proportional,
+                    (ds, dth),
+                    (translation_ratio, rotation_ratio),
+                    rng,
+                );
                 (ds, dth, th + dth / 2.0)
             }
             OdometryModel::Thrun {
@@ -146,6 +199,7 @@ mod tests {
         let mut rng = stream(7, 0, 0, Purpose::Odometry);
         let cfg = OdometryConfig {
             wheel_radius_bias_ratio: 0.01,
+            proportional: ProportionalError::RandomWalk,
             ..OdometryConfig::default()
         };
         let errs: Vec<f64> = (0..2000)
@@ -171,7 +225,11 @@ mod tests {
         let w = 2.0 * std::f64::consts::PI / 400.0 * axle / 2.0;
         let errs: Vec<f64> = (0..2000)
             .map(|_| {
-                let mut o = Odometry::new(OdometryConfig::default(), axle, Pose2::IDENTITY);
+                let walk = OdometryConfig {
+                    proportional: ProportionalError::RandomWalk,
+                    ..OdometryConfig::default()
+                };
+                let mut o = Odometry::new(walk, axle, Pose2::IDENTITY);
                 let mut total = 0.0;
                 for _ in 0..400 {
                     total += o.update(-w, w, &mut rng).1;
@@ -183,6 +241,30 @@ mod tests {
         let want = 0.0075 * (2.0 * std::f64::consts::PI).sqrt();
         assert!(m.abs() < 0.1 * want, "mean {m}");
         assert!((sd / want - 1.0).abs() < 0.1, "sd {sd} vs {want}");
+    }
+
+    /// MobileSim's `random_each_update`: 500 updates of 0.02 m, each scaled by 1 + U(±0.0075):
+    /// spread 0.0075 · 0.02 · √(500/3), far below the random walk's 0.0075 · √10.
+    #[test]
+    fn each_update_error_is_proportional_to_each_update() {
+        let mut rng = stream(10, 0, 0, Purpose::Odometry);
+        let errs: Vec<f64> = (0..2000)
+            .map(|_| {
+                let mut o = Odometry::new(OdometryConfig::default(), 0.357, Pose2::IDENTITY);
+                for _ in 0..500 {
+                    o.update(0.02, 0.02, &mut rng);
+                }
+                o.pose().x - 10.0
+            })
+            .collect();
+        let (m, sd) = stats(&errs);
+        let want = 0.0075 * 0.02 * (500.0f64 / 3.0).sqrt();
+        assert!(m.abs() < 0.1 * want, "mean {m}");
+        assert!((sd / want - 1.0).abs() < 0.1, "sd {sd} vs {want}");
+        // One update never errs by more than the ratio of its own motion.
+        let mut o = Odometry::new(OdometryConfig::default(), 0.357, Pose2::IDENTITY);
+        let (ds, _) = o.update(1.0, 1.0, &mut rng);
+        assert!((ds - 1.0).abs() <= 0.0075);
     }
 
     #[test]

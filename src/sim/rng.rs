@@ -32,7 +32,9 @@ pub enum Purpose {
     /// The robot's sideways wander from the route in a lap.
     PathWander = 6,
     /// `placewords world generate` (with run and lap 0).
-    WorldGenerator = 7,
+    WorldGenerator = 8,
+    /// The lap's variation plan: lanes, speeds, stops, turns on the spot.
+    LapVariation = 7,
 }
 
 /// The stream for (seed, run, lap, purpose).

@@ -3,6 +3,7 @@
 //! obstacles ahead and waits for them to clear.
 
 use crate::geom::{Pose2, Segment, Vec2, wrap_angle};
+use crate::sim::variation::{LapVariationConfig, PathShape};
 use crate::world::Route;
 
 /// Robot and controller parameters (P3-DX defaults from ARIA/MobileSim).
@@ -36,12 +37,15 @@ pub struct RobotConfig {
     /// the route shifted sideways by a smooth random function of arc length (a real robot does
     /// not retrace its path to the millimetre). Default 0 (it follows the route exactly).
     pub path_wander_m: f64,
+    /// Lanes across the corridor, speed changes, short stops and turns on the spot per lap
+    /// (see [`crate::sim::variation`]). Default: all off.
+    pub variation: LapVariationConfig,
 }
 
 impl Default for RobotConfig {
     fn default() -> Self {
         RobotConfig {
-            radius_m: 0.25,
+            radius_m: crate::world::validate::ROBOT_RADIUS_M,
             axle_track_m: 0.357,
             cruise_speed_m_s: 0.4,
             max_speed_m_s: 1.0,
@@ -54,6 +58,7 @@ impl Default for RobotConfig {
             blocked_timeout_s: 30.0,
             step_s: 0.05,
             path_wander_m: 0.0,
+            variation: LapVariationConfig::default(),
         }
     }
 }
@@ -123,13 +128,21 @@ impl RouteTracker {
         s.rem_euclid(self.length_m)
     }
 
-    /// The point at arc length `s` (any real, taken modulo the loop) and the leg's direction.
-    pub fn point_at(&self, s: f64) -> (Vec2, Vec2) {
+    /// The leg at arc length `s` (any real, taken modulo the loop) and the fraction of it done.
+    pub fn locate(&self, s: f64) -> (usize, f64) {
         let s = self.wrap(s);
         let i = match self.starts.partition_point(|&x| x <= s) {
             0 => 0,
             k => k - 1,
         };
+        let len = self.legs[i].length().max(1e-12);
+        (i, ((s - self.starts[i]) / len).clamp(0.0, 1.0))
+    }
+
+    /// The point at arc length `s` (any real, taken modulo the loop) and the leg's direction.
+    pub fn point_at(&self, s: f64) -> (Vec2, Vec2) {
+        let s = self.wrap(s);
+        let i = self.locate(s).0;
         let leg = self.legs[i];
         let len = leg.length().max(1e-12);
         let dir = (leg.b - leg.a) / len;
@@ -195,12 +208,21 @@ pub struct Wander {
 impl Wander {
     /// A wander of at most `amplitude_m`, drawn from `rng`.
     pub fn draw(amplitude_m: f64, rng: &mut crate::sim::rng::SimRng) -> Self {
+        Self::draw_with_wavelengths(amplitude_m, (8.0, 30.0), rng)
+    }
+
+    /// A wave of at most `amplitude_m` with wavelengths in `[lo, hi)` metres.
+    pub fn draw_with_wavelengths(
+        amplitude_m: f64,
+        (lo, hi): (f64, f64),
+        rng: &mut crate::sim::rng::SimRng,
+    ) -> Self {
         use rand::RngExt;
         let mut waves = [(0.0, 1.0, 0.0); 3];
         let mut total = 0.0;
         for w in &mut waves {
             let a: f64 = rng.random_range(0.2..1.0);
-            let lambda: f64 = rng.random_range(8.0..30.0);
+            let lambda: f64 = rng.random_range(lo..hi);
             let phase: f64 = rng.random_range(0.0..std::f64::consts::TAU);
             *w = (a, lambda, phase);
             total += a;
@@ -225,6 +247,9 @@ impl Wander {
     }
 }
 
+/// Turn rate when the target is more than 60° off the heading, rad/s (about 46°/s).
+pub const TURN_BACK_RAD_S: f64 = 0.8;
+
 /// The controller's state: current commanded speeds.
 #[derive(Clone, Debug, Default)]
 pub struct Controller {
@@ -240,17 +265,18 @@ impl Controller {
         cfg: &RobotConfig,
         pose: Pose2,
         tracker: &RouteTracker,
-        wander: &Wander,
+        path: &dyn PathShape,
         free_ahead_m: f64,
     ) -> (f64, f64) {
         let dt = cfg.step_s;
         let s = tracker.arc_m() + cfg.lookahead_m;
-        let (on_route, dir) = tracker.point_at(s);
-        let target = on_route + Vec2::new(-dir.y, dir.x) * wander.offset_m(s);
+        let target = path.target(tracker, s);
         let to = target - pose.position();
         let alpha = wrap_angle(to.y.atan2(to.x) - pose.theta);
-        // Speed: cruise, less when the route bends away, and less near obstacles.
-        let cruise = cfg.cruise_speed_m_s.min(cfg.max_speed_m_s);
+        // Speed: cruise (as the lap plan varies it), less when the route bends away, and less
+        // near obstacles.
+        let cruise = (cfg.cruise_speed_m_s * path.speed_factor(tracker.arc_m()))
+            .clamp(0.0, cfg.max_speed_m_s);
         let heading_factor = if alpha.abs() > 60f64.to_radians() {
             0.0
         } else {
@@ -264,9 +290,31 @@ impl Controller {
         // Turn: pure pursuit curvature at (at least) a nominal speed so the robot can line up
         // when it is slow or stopped.
         let ld = to.norm().max(1e-3);
-        let w_goal = (2.0 * v.max(0.15) * alpha.sin() / ld)
-            .clamp(-cfg.max_turn_rate_rad_s, cfg.max_turn_rate_rad_s);
+        // Facing away (after a turn on the spot): turn back at a steady rate, since the
+        // pursuit curvature vanishes as the target falls behind.
+        let w_goal = if heading_factor == 0.0 {
+            alpha.signum() * TURN_BACK_RAD_S
+        } else {
+            2.0 * v.max(0.15) * alpha.sin() / ld
+        }
+        .clamp(-cfg.max_turn_rate_rad_s, cfg.max_turn_rate_rad_s);
         let dw = cfg.turn_accel_rad_s2 * dt;
+        let w = w_goal.clamp(self.w_rad_s - dw, self.w_rad_s + dw);
+        self.v_m_s = v;
+        self.w_rad_s = w;
+        (v, w)
+    }
+}
+
+impl Controller {
+    /// Speeds while the robot holds its place: slowing to a stop, turning at `turn_rad_s`
+    /// (0 for a plain stop), within the acceleration limits.
+    pub fn hold(&mut self, cfg: &RobotConfig, turn_rad_s: f64) -> (f64, f64) {
+        let dt = cfg.step_s;
+        let dv = cfg.accel_m_s2 * dt;
+        let v = 0f64.clamp(self.v_m_s - dv, self.v_m_s + dv);
+        let dw = cfg.turn_accel_rad_s2 * dt;
+        let w_goal = turn_rad_s.clamp(-cfg.max_turn_rate_rad_s, cfg.max_turn_rate_rad_s);
         let w = w_goal.clamp(self.w_rad_s - dw, self.w_rad_s + dw);
         self.v_m_s = v;
         self.w_rad_s = w;

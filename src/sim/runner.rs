@@ -16,10 +16,12 @@ use crate::log::{Frame, LapLog, RunLog};
 use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
+use crate::sim::plan::{DoorPlan, SimPlan};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
 use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
-use crate::spec::scenario::{DoorPlan, Scenario};
+use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
 use crate::world::DoorStates;
+use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
 use crate::world::raycast::{Disc, SweepCaster};
 use rand::RngExt;
@@ -42,7 +44,7 @@ pub enum SimError {
 }
 
 /// The door states of `run`'s lap `lap`, and the configuration's name.
-pub fn door_states(scn: &Scenario, run: usize, lap: usize) -> (String, DoorStates) {
+pub fn door_states(scn: &SimPlan, run: usize, lap: usize) -> (String, DoorStates) {
     match &scn.runs[run].doors {
         DoorPlan::Fixed(c) => (c.name.clone(), c.states.clone()),
         DoorPlan::Cycle(list) => {
@@ -65,7 +67,7 @@ pub fn door_states(scn: &Scenario, run: usize, lap: usize) -> (String, DoorState
 /// Simulates every run (in parallel; results are identical whatever the thread count).
 /// `laps_override` replaces each run's lap count; `progress` is called once per finished lap.
 pub fn simulate(
-    scn: &Scenario,
+    scn: &SimPlan,
     laps_override: Option<usize>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunLog>, SimError> {
@@ -89,7 +91,7 @@ pub fn simulate(
 
 /// The state of one run: robot, odometry, laser, physics, pedestrians, time.
 pub struct RunSim<'a> {
-    scn: &'a Scenario,
+    scn: &'a SimPlan,
     run: usize,
     laser: Laser,
     odometry: Odometry,
@@ -113,15 +115,35 @@ pub struct RunSim<'a> {
     door_config: String,
     open_doors: Vec<String>,
     contact_steps: usize,
-    wander: Wander,
+    plan: LapPlan,
+    /// Walls and doors a lane keeps clear of, and the room at each waypoint.
+    lanes: (SegmentIndex, LaneRoom),
+    /// What the robot is doing instead of driving: stopped until a time, or turning on the
+    /// spot with an angle left to turn.
+    hold: Hold,
 }
+
+/// A pause in driving, from the lap plan.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Hold {
+    Drive,
+    StopUntil(f64),
+    /// Signed angle left to turn, radians.
+    Spin(f64),
+}
+
+/// Turn rate of a turn on the spot, rad/s (45°/s).
+const SPIN_RATE_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
 
 impl<'a> RunSim<'a> {
     /// A run at its start waypoint, with all doors closed until the first lap sets them.
-    pub fn new(scn: &'a Scenario, run: usize) -> Self {
+    pub fn new(scn: &'a SimPlan, run: usize) -> Self {
         let plan = &scn.runs[run];
         let tracker = RouteTracker::new(&scn.route, plan.start_waypoint);
         let truth = tracker.start_pose();
+        let obstacles = obstacles(&scn.world);
+        let clearance_m = scn.robot.radius_m + scn.robot.variation.lane_margin_m;
+        let room = LaneRoom::measure(&scn.route, &obstacles, clearance_m);
         let mut angle_rng = stream(scn.seed, run as u64, RUN_WIDE, Purpose::LaserAngles);
         let laser = Laser::new(scn.laser.clone(), &mut angle_rng);
         let physics = Physics::new(
@@ -160,7 +182,9 @@ impl<'a> RunSim<'a> {
             door_config: "all-closed".into(),
             open_doors: Vec::new(),
             contact_steps: 0,
-            wander: Wander::default(),
+            plan: LapPlan::wander_only(Wander::default()),
+            lanes: (obstacles, room),
+            hold: Hold::Drive,
         }
     }
 
@@ -184,7 +208,17 @@ impl<'a> RunSim<'a> {
         self.laser_rng = stream(scn.seed, run, lap as u64, Purpose::LaserNoise);
         self.odom_rng = stream(scn.seed, run, lap as u64, Purpose::Odometry);
         let mut wrng = stream(scn.seed, run, lap as u64, Purpose::PathWander);
-        self.wander = Wander::draw(scn.robot.path_wander_m, &mut wrng);
+        let wander = Wander::draw(scn.robot.path_wander_m, &mut wrng);
+        let mut vrng = stream(scn.seed, run, lap as u64, Purpose::LapVariation);
+        let clearance_m = scn.robot.radius_m + scn.robot.variation.lane_margin_m;
+        let lap_start_m = self.tracker.arc_m();
+        self.plan = LapPlan::draw(
+            &scn.robot.variation,
+            (&self.lanes.1, &scn.route, &self.lanes.0, clearance_m),
+            (lap_start_m, self.tracker.length_m()),
+            wander,
+            &mut vrng,
+        );
         self.lap = lap;
         self.lap_start_s = self.time_s;
         self.stall_mark = (self.tracker.progress_m(), self.time_s);
@@ -223,13 +257,7 @@ impl<'a> RunSim<'a> {
     pub fn step(&mut self) -> Result<Option<Frame>, SimError> {
         let cfg = &self.scn.robot;
         let dt = cfg.step_s;
-        let (v, w) = self.controller.command(
-            cfg,
-            self.truth,
-            &self.tracker,
-            &self.wander,
-            self.free_ahead_m,
-        );
+        let (v, w) = self.drive_command();
         let (vl, vr) = wheel_speeds(v, w, cfg.axle_track_m);
         let next = integrate(self.truth, v, w, dt);
         self.odometry.update(vl * dt, vr * dt, &mut self.odom_rng);
@@ -246,7 +274,19 @@ impl<'a> RunSim<'a> {
             self.contact_steps += 1;
         }
         self.truth = next;
+        if let Hold::Spin(left) = self.hold {
+            let turned = w * dt;
+            self.hold = if left.abs() <= turned.abs() {
+                Hold::Drive
+            } else {
+                Hold::Spin(left - turned)
+            };
+        }
         let progress = self.tracker.update(next.position());
+        if self.hold != Hold::Drive {
+            // A planned pause is not being blocked.
+            self.stall_mark.1 = self.time_s;
+        }
         if progress >= self.stall_mark.0 + 0.1 {
             self.stall_mark = (progress, self.time_s);
         } else if self.time_s - self.stall_mark.1 > cfg.blocked_timeout_s {
@@ -263,6 +303,34 @@ impl<'a> RunSim<'a> {
             return Ok(Some(self.take_scan()));
         }
         Ok(None)
+    }
+
+    /// Speeds for the next step: the lap plan's stops and turns on the spot when one is due,
+    /// otherwise the route-following controller.
+    fn drive_command(&mut self) -> (f64, f64) {
+        let cfg = &self.scn.robot;
+        let arc = self.tracker.arc_m();
+        if self.hold == Hold::Drive {
+            if let Some(d) = self.plan.take_stop(arc) {
+                self.hold = Hold::StopUntil(self.time_s + d);
+            } else if let Some(a) = self.plan.take_spin(arc) {
+                self.hold = Hold::Spin(a);
+            }
+        }
+        match self.hold {
+            Hold::StopUntil(t) if self.time_s < t => self.controller.hold(cfg, 0.0),
+            Hold::Spin(left) => self.controller.hold(cfg, left.signum() * SPIN_RATE_RAD_S),
+            _ => {
+                self.hold = Hold::Drive;
+                self.controller.command(
+                    cfg,
+                    self.truth,
+                    &self.tracker,
+                    &self.plan,
+                    self.free_ahead_m,
+                )
+            }
+        }
     }
 
     fn take_scan(&mut self) -> Frame {

@@ -14,6 +14,49 @@ pub struct Diagnostic {
     pub message: String,
 }
 
+impl Diagnostic {
+    /// A problem at `(line, col)` (1-based) of `path`.
+    pub fn error(path: &str, (line, col): (usize, usize), message: impl Into<String>) -> Self {
+        Diagnostic {
+            path: path.to_string(),
+            line,
+            col,
+            message: message.into(),
+        }
+    }
+}
+
+/// Longest piece of a file echoed in a message, characters: a 10 MB key is not printed back.
+pub const MAX_ECHO_CHARS: usize = 60;
+
+/// `text` cut to [`MAX_ECHO_CHARS`] characters, with `...` when cut.
+pub fn echo(text: &str) -> String {
+    match text.char_indices().nth(MAX_ECHO_CHARS) {
+        None => text.to_string(),
+        Some((cut, _)) => format!("{}...", &text[..cut]),
+    }
+}
+
+/// Reads a text file; invalid UTF-8 is a located problem at the first bad byte.
+pub fn read_text(path: &Path) -> Result<String, SpecError> {
+    let bytes = std::fs::read(path).map_err(|e| SpecError::io(path, e))?;
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let good = e.utf8_error().valid_up_to();
+        // The valid prefix is text, so lines and columns count as everywhere else.
+        let prefix = std::str::from_utf8(&bytes[..good]).unwrap_or("");
+        let at = line_col(prefix, good);
+        SpecError::Invalid(vec![Diagnostic::error(
+            &path.display().to_string(),
+            at,
+            format!(
+                "the file is not valid UTF-8 (byte 0x{:02x}); save it as UTF-8 text",
+                bytes[good]
+            ),
+        )])
+    })
+}
+
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
@@ -69,11 +112,179 @@ impl SpecError {
     }
 }
 
+/// How problems are printed: for people, or one JSON object per line for editors and CI (as
+/// cargo's `--message-format json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum MessageFormat {
+    /// `file:line:col: error: what is wrong; what to try`, the first [`SHOWN_PROBLEMS`], then a
+    /// count.
+    #[default]
+    Human,
+    /// `{"path":..,"line":..,"col":..,"severity":"error","message":..}`, every problem.
+    Json,
+}
+
+impl MessageFormat {
+    /// The format named `human` or `json`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "human" => Some(MessageFormat::Human),
+            "json" => Some(MessageFormat::Json),
+            _ => None,
+        }
+    }
+}
+
+/// Problems printed in human form before the rest are only counted.
+pub const SHOWN_PROBLEMS: usize = 20;
+
+impl Diagnostic {
+    /// One line in `format`.
+    pub fn render(&self, format: MessageFormat) -> String {
+        match format {
+            MessageFormat::Human => format!(
+                "{}:{}:{}: error: {}",
+                self.path, self.line, self.col, self.message
+            ),
+            MessageFormat::Json => serde_json::json!({
+                "path": self.path,
+                "line": self.line,
+                "col": self.col,
+                "severity": "error",
+                "message": self.message,
+            })
+            .to_string(),
+        }
+    }
+}
+
+impl SpecError {
+    /// Every problem as lines in `format` (human form: the first few, then a count).
+    pub fn render(&self, format: MessageFormat) -> Vec<String> {
+        let diags = match self {
+            SpecError::Invalid(d) => d.clone(),
+            SpecError::Io { path, source } => vec![Diagnostic::error(
+                &path.display().to_string(),
+                (1, 1),
+                format!("cannot read: {source}; check the path"),
+            )],
+        };
+        let shown = match format {
+            MessageFormat::Human => SHOWN_PROBLEMS.min(diags.len()),
+            MessageFormat::Json => diags.len(),
+        };
+        let mut out: Vec<String> = diags[..shown].iter().map(|d| d.render(format)).collect();
+        if shown < diags.len() {
+            out.push(format!(
+                "{} more problems not shown; fix the ones above and check again",
+                diags.len() - shown
+            ));
+        }
+        out
+    }
+}
+
 fn join(d: &[Diagnostic]) -> String {
     d.iter()
         .map(ToString::to_string)
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// Most diagnostics reported for one file.
+pub const MAX_DIAGNOSTICS: usize = 500;
+
+/// Collects located problems of one file; offsets are bytes into the source.
+pub struct Diags<'a> {
+    src: &'a str,
+    path: &'a str,
+    list: Vec<(usize, String)>,
+    overflow: usize,
+}
+
+impl<'a> Diags<'a> {
+    pub fn new(src: &'a str, path: &'a str) -> Self {
+        Diags {
+            src,
+            path,
+            list: Vec::new(),
+            overflow: 0,
+        }
+    }
+
+    /// Records a problem at byte `offset`.
+    pub fn at(&mut self, offset: usize, message: String) {
+        if self.list.len() >= MAX_DIAGNOSTICS {
+            self.overflow += 1;
+        } else {
+            self.list.push((offset, message));
+        }
+    }
+
+    /// Whether the report is full (further problems are only counted).
+    pub fn is_full(&self) -> bool {
+        self.list.len() >= MAX_DIAGNOSTICS
+    }
+
+    /// 1-based line of byte `offset`.
+    pub fn line_of(&self, offset: usize) -> usize {
+        let end = offset.min(self.src.len());
+        self.src.as_bytes()[..end]
+            .iter()
+            .filter(|b| **b == b'\n')
+            .count()
+            + 1
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The problems in file order, with 1-based lines and columns (columns count characters).
+    pub fn into_sorted(self) -> Vec<Diagnostic> {
+        let mut line_starts = vec![0usize];
+        line_starts.extend(
+            self.src
+                .bytes()
+                .enumerate()
+                .filter(|(_, b)| *b == b'\n')
+                .map(|(i, _)| i + 1),
+        );
+        let mut list = self.list;
+        list.sort_by_key(|(o, _)| *o);
+        list.dedup();
+        let mut out: Vec<Diagnostic> = list
+            .into_iter()
+            .map(|(offset, message)| {
+                let mut cut = offset.min(self.src.len());
+                while !self.src.is_char_boundary(cut) {
+                    cut -= 1;
+                }
+                let line_idx = line_starts.partition_point(|&s| s <= cut) - 1;
+                let start = line_starts[line_idx];
+                let col = self.src[start..cut].chars().count() + 1;
+                Diagnostic {
+                    path: self.path.to_string(),
+                    line: line_idx + 1,
+                    col,
+                    message,
+                }
+            })
+            .collect();
+        if self.overflow > 0 {
+            let last = out.last().map(|d| (d.line, d.col)).unwrap_or((1, 1));
+            out.push(Diagnostic {
+                path: self.path.to_string(),
+                line: last.0,
+                col: last.1,
+                message: format!(
+                    "{} more problems not shown; fix the ones above and check again",
+                    self.overflow
+                ),
+            });
+        }
+        out
+    }
 }
 
 #[cfg(test)]

@@ -1,7 +1,10 @@
 //! The `[evaluation]` and `[expect]` blocks of a scenario file: how matches are scored, and the
 //! CI gate a scenario must pass.
 
+use crate::spec::diag::Diags;
+use crate::spec::read::{Val, get, integer, number, table, table_array, unknown_keys};
 use serde::{Deserialize, Serialize};
+use toml::de::{DeTable, DeValue};
 
 /// How matches are scored against ground truth (DESIGN.md §6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -61,6 +64,12 @@ pub struct LevelExpectation {
     /// Minimum same-direction recall in [0, 1].
     #[serde(default)]
     pub min_recall: Option<f64>,
+    /// Minimum visit recall in [0, 1].
+    #[serde(default)]
+    pub min_visit_recall: Option<f64>,
+    /// Minimum pair recall in [0, 1].
+    #[serde(default)]
+    pub min_pair_recall: Option<f64>,
     /// Maximum recognition time per lap, seconds.
     #[serde(default)]
     pub max_seconds_per_lap: Option<f64>,
@@ -72,6 +81,8 @@ impl LevelExpectation {
         Expectation {
             min_precision: self.min_precision,
             min_recall: self.min_recall,
+            min_visit_recall: self.min_visit_recall,
+            min_pair_recall: self.min_pair_recall,
             max_seconds_per_lap: self.max_seconds_per_lap,
         }
     }
@@ -85,6 +96,167 @@ pub struct Expectation {
     pub min_precision: Option<f64>,
     /// Minimum same-direction recall in [0, 1].
     pub min_recall: Option<f64>,
+    /// Minimum visit recall in [0, 1].
+    pub min_visit_recall: Option<f64>,
+    /// Minimum pair recall in [0, 1].
+    pub min_pair_recall: Option<f64>,
     /// Maximum recognition time per lap, seconds.
     pub max_seconds_per_lap: Option<f64>,
+}
+
+/// Keys of `[evaluation]`.
+pub const EVALUATION_KEYS: &[&str] = &[
+    "tp_radius_m",
+    "min_gap_m",
+    "heading_tolerance_deg",
+    "sensitivity_radii_m",
+];
+/// Keys of `[expect]`.
+pub const EXPECT_KEYS: &[&str] = &["levels", "icp", "quantile"];
+/// Keys of an `[[expect.levels]]` entry.
+pub const EXPECT_LEVEL_KEYS: &[&str] = &[
+    "levels",
+    "min_precision",
+    "min_recall",
+    "max_seconds_per_lap",
+    "min_visit_recall",
+    "min_pair_recall",
+];
+/// Keys of `[expect.icp]`.
+pub const EXPECT_ICP_KEYS: &[&str] = &[
+    "min_precision",
+    "min_recall",
+    "max_seconds_per_lap",
+    "min_visit_recall",
+    "min_pair_recall",
+];
+
+/// A key, its slot, the rule it must meet and the rule in words.
+type Check<'a> = (&'a str, &'a mut f64, fn(f64) -> bool, &'a str);
+
+/// `[evaluation]` over [`EvaluationSpec::default`]; each bad value reported at its key.
+pub(crate) fn read_evaluation(top: &DeTable<'_>, d: &mut Diags) -> EvaluationSpec {
+    let mut ev = EvaluationSpec::default();
+    let Some((_, t)) = table(top, "evaluation", d) else {
+        return ev;
+    };
+    let ctx = "[evaluation]";
+    unknown_keys(t, EVALUATION_KEYS, ctx, d);
+    let checks: [Check; 3] = [
+        ("tp_radius_m", &mut ev.tp_radius_m, |x| x > 0.0, "positive"),
+        ("min_gap_m", &mut ev.min_gap_m, |x| x >= 0.0, "0 or more"),
+        (
+            "heading_tolerance_deg",
+            &mut ev.heading_tolerance_deg,
+            |x| x > 0.0,
+            "positive",
+        ),
+    ];
+    for (key, slot, ok, what) in checks {
+        let Some((_, v)) = get(t, key) else { continue };
+        match number(v, key, ctx, d) {
+            Some(x) if ok(x) => *slot = x,
+            Some(x) => d.at(
+                v.span().start,
+                format!("{key} = {x} in {ctx} must be {what}"),
+            ),
+            None => {}
+        }
+    }
+    if let Some((_, v)) = get(t, "sensitivity_radii_m") {
+        let radii = numbers(v, "sensitivity_radii_m", ctx, d);
+        ev.sensitivity_radii_m = radii.unwrap_or_default();
+    }
+    ev
+}
+
+fn numbers(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<Vec<f64>> {
+    let DeValue::Array(a) = v.get_ref() else {
+        d.at(
+            v.span().start,
+            format!("`{key}` in {ctx} must be a list of numbers; write e.g. `[0.5, 2.0]`"),
+        );
+        return None;
+    };
+    a.iter().map(|x| number(x, key, ctx, d)).collect()
+}
+
+/// `[expect]`: `[[expect.levels]]` entries and an optional `[expect.icp]`.
+pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
+    let mut ex = ExpectSpec::default();
+    let Some((_, t)) = table(top, "expect", d) else {
+        return ex;
+    };
+    unknown_keys(t, EXPECT_KEYS, "[expect]", d);
+    for (i, (_, lt)) in table_array(t, "levels", d).into_iter().enumerate() {
+        let ctx = format!("[[expect.levels]] #{}", i + 1);
+        unknown_keys(lt, EXPECT_LEVEL_KEYS, &ctx, d);
+        let levels = match get(lt, "levels") {
+            None => {
+                d.at(
+                    0,
+                    format!("missing key `levels` in {ctx}; add `levels = 1`, 2 or 3"),
+                );
+                0
+            }
+            Some((_, v)) => match integer(v, "levels", &ctx, d) {
+                Some(n @ 1..=3) => n as usize,
+                Some(n) => {
+                    d.at(v.span().start, format!("levels = {n}; use 1, 2 or 3"));
+                    0
+                }
+                None => 0,
+            },
+        };
+        let e = expectation(lt, &ctx, d);
+        ex.levels.push(LevelExpectation {
+            levels,
+            min_precision: e.min_precision,
+            min_recall: e.min_recall,
+            max_seconds_per_lap: e.max_seconds_per_lap,
+            min_visit_recall: e.min_visit_recall,
+            min_pair_recall: e.min_pair_recall,
+        });
+    }
+    if let Some((_, it)) = table(t, "icp", d) {
+        unknown_keys(it, EXPECT_ICP_KEYS, "[expect.icp]", d);
+        ex.icp = Some(expectation(it, "[expect.icp]", d));
+    }
+    if let Some((_, v)) = get(t, "quantile")
+        && let Some(q) = number(v, "quantile", "[expect]", d)
+    {
+        if (0.0..1.0).contains(&q) {
+            ex.quantile = Some(q);
+        } else {
+            d.at(
+                v.span().start,
+                format!("quantile = {q} is outside 0..1; use 0.1 for the 10th percentile"),
+            );
+        }
+    }
+    ex
+}
+
+fn expectation(t: &DeTable<'_>, ctx: &str, d: &mut Diags) -> Expectation {
+    let mut bound = |key: &str, unit: bool| -> Option<f64> {
+        let (_, v) = get(t, key)?;
+        let x = number(v, key, ctx, d)?;
+        let ok = if unit {
+            (0.0..=1.0).contains(&x)
+        } else {
+            x > 0.0
+        };
+        if !ok {
+            let range = if unit { "outside 0..1" } else { "not positive" };
+            d.at(v.span().start, format!("{key} = {x} in {ctx} is {range}"));
+        }
+        ok.then_some(x)
+    };
+    Expectation {
+        min_precision: bound("min_precision", true),
+        min_recall: bound("min_recall", true),
+        max_seconds_per_lap: bound("max_seconds_per_lap", false),
+        min_visit_recall: bound("min_visit_recall", true),
+        min_pair_recall: bound("min_pair_recall", true),
+    }
 }

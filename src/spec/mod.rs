@@ -1,12 +1,14 @@
-//! Files people write: the serde structures of world and scenario files, parsing from a string,
-//! and validation with located errors (`file:line:col: what is wrong; what to try`).
+//! Files people write: the structures of world and scenario files, reading them from a string
+//! with one reader ([`read`]), and located diagnostics (`file:line:col: error: what is wrong;
+//! what to try`). Nothing here knows the models built from the files: the world's geometric
+//! checks live in `world`, the scenario's cross-checks against its world in `experiment`.
 
 pub mod diag;
 pub mod evaluation;
+pub(crate) mod read;
 pub mod scenario;
 pub mod seeds;
 pub mod suggest;
-pub mod validate;
 pub mod world;
 
-pub use diag::{Diagnostic, SpecError};
+pub use diag::{Diagnostic, Diags, SpecError};

@@ -5,6 +5,10 @@ pub fn closest<'a, I>(word: &str, candidates: I) -> Option<&'a str>
 where
     I: IntoIterator<Item = &'a str>,
 {
+    // No typo is this long, and comparing a huge word costs time and memory.
+    if word.chars().count() > 64 {
+        return None;
+    }
     let lower = word.to_lowercase();
     candidates
         .into_iter()

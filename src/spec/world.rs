@@ -1,12 +1,14 @@
 //! The world file format (TOML, `format_version = 1`): walls, doors, routes, home pose, areas.
 //!
-//! These structs describe the file only; [`crate::world::World`] is the validated model built
+//! The reference, with every key, unit, default and limit, is `docs/world-format.md`.
+//!
+//! These structs describe the file only; `world::World` is the validated model built
 //! from them. Units are in every physical key; angles are degrees here and radians in the model.
 //!
 //! Parsing walks toml's spanned document ([`toml::de::DeTable`]) by hand rather than through
 //! serde, so that every problem of a file (unknown keys, missing keys, wrong types, bad
 //! numbers) is reported at once with the line and column of the offending value; the geometric
-//! checks then run in [`crate::spec::validate`].
+//! checks then run in `crate::world::validate`.
 //!
 //! ```toml
 //! format_version = 1
@@ -43,11 +45,12 @@
 //! max_m = [10.0, 1.5]
 //! ```
 
-use crate::spec::diag::Diagnostic;
-use crate::spec::suggest;
-use crate::spec::validate::{self, Diags};
+use crate::spec::diag::Diags;
+use crate::spec::read::{
+    boolean, ctx_of, get, id, missing, number, opt_number, parse_int, read_entries, req_number,
+    req_point, req_points, string, table_array, type_name, unknown_keys,
+};
 use serde::{Deserialize, Serialize};
-use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
 /// A whole world file.
@@ -227,348 +230,32 @@ pub struct AreaLoc {
     pub max: usize,
 }
 
-/// Parses and validates a world file's text into its file structures; `path` only names the
-/// file in messages. Every problem is reported, in file order.
-pub fn parse_world_spec(src: &str, path: &str) -> Result<WorldSpec, crate::spec::SpecError> {
-    let mut d = Diags::new(src, path);
-    let spec = read_and_validate(src, &mut d).map(|(spec, _)| spec);
-    match (spec, d.into_sorted()) {
-        (Some(spec), diags) if diags.is_empty() => Ok(spec),
-        (_, mut diags) => {
-            if diags.is_empty() {
-                // Defensive: a failed read always reports why; never return an empty error.
-                diags.push(Diagnostic {
-                    path: path.to_string(),
-                    line: 1,
-                    col: 1,
-                    message: "the file could not be read as a world; check it against worlds/loop-small.toml".into(),
-                });
-            }
-            Err(crate::spec::SpecError::Invalid(diags))
-        }
-    }
-}
+/// Most wall segments, door panels and route legs a world may hold. The simulator's time per
+/// lap grows faster than linearly with the segment count (20,000 segments take about 10 s a lap
+/// on one core), so the limit keeps a lap within seconds.
+pub const MAX_SEGMENTS: usize = 10_000;
 
-/// What could be read of a world file even when it is invalid, for pictures of what is wrong:
-/// its structures and the offsets of its values (`None` when the text is not TOML), and every
-/// problem, in file order.
-pub fn read_world_lenient(
-    src: &str,
-    path: &str,
-) -> (Option<(WorldSpec, WorldLoc)>, Vec<Diagnostic>) {
-    let mut d = Diags::new(src, path);
-    let read = read_and_validate(src, &mut d);
-    (read, d.into_sorted())
-}
-
-/// Parses and validates a world file's text; `path` only names the file in messages.
-pub fn parse_world(src: &str, path: &str) -> Result<crate::world::World, crate::spec::SpecError> {
-    parse_world_spec(src, path).map(|spec| crate::world::World::from_spec(&spec))
-}
-
-/// Reads and validates a world file.
-pub fn load_world(path: &std::path::Path) -> Result<crate::world::World, crate::spec::SpecError> {
-    let src = std::fs::read_to_string(path).map_err(|e| crate::spec::SpecError::io(path, e))?;
-    parse_world(&src, &path.display().to_string())
-}
-
-fn read_and_validate(src: &str, d: &mut Diags) -> Option<(WorldSpec, WorldLoc)> {
-    let (doc, errors) = DeTable::parse_recoverable(src);
-    if !errors.is_empty() {
-        for e in &errors {
-            let at = e.span().map(|s| s.start).unwrap_or(0);
-            let msg = e
-                .message()
-                .lines()
-                .map(str::trim)
-                .filter(|l| !l.is_empty())
-                .collect::<Vec<_>>()
-                .join(" ");
-            let msg = lowercase_first(msg.trim_end_matches('.'));
-            d.at(
-                at,
-                format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
-            );
-        }
+/// Reads a world file's text into its file structures and the offsets of its values, reporting
+/// every syntax, key and type problem to `d`. `None` when the text is not TOML (or the problem
+/// list is full); the geometric checks are the world model's (`crate::world::validate`).
+pub fn read_world(src: &str, d: &mut Diags) -> Option<(WorldSpec, WorldLoc)> {
+    let doc = crate::spec::read::parse_document(src, d)?;
+    if is_scenario(doc.get_ref()) {
+        d.at(
+            0,
+            "this is a scenario file, not a world; check it with `placewords scenario check`"
+                .into(),
+        );
         return None;
     }
     let mut loc = WorldLoc::default();
     let spec = read_top(doc.get_ref(), d, &mut loc)?;
-    validate::validate(&spec, &loc, d);
     Some((spec, loc))
 }
 
-fn lowercase_first(s: &str) -> String {
-    let mut c = s.chars();
-    match c.next() {
-        Some(f) => f.to_lowercase().chain(c).collect(),
-        None => String::new(),
-    }
-}
-
-type Val<'i> = Spanned<DeValue<'i>>;
-
-/// Looks a key up in a table: (key start, value).
-fn get<'t, 'i>(t: &'t DeTable<'i>, key: &str) -> Option<(usize, &'t Val<'i>)> {
-    t.iter()
-        .find(|(k, _)| k.get_ref().as_ref() == key)
-        .map(|(k, v)| (k.span().start, v))
-}
-
-/// Reports keys of `t` that are not in `known`.
-fn unknown_keys(t: &DeTable<'_>, known: &[&str], ctx: &str, d: &mut Diags) {
-    for (k, _) in t.iter() {
-        let name = k.get_ref().as_ref();
-        if !known.contains(&name) {
-            let hint = suggest::hint(name, known.iter().copied(), "keys here");
-            d.at(
-                k.span().start,
-                format!("unknown key `{name}` in {ctx}; {hint}"),
-            );
-        }
-    }
-}
-
-/// Whether `t` holds an unknown key that looks like a misspelling of `key` (then the
-/// unknown-key message, with its "did you mean", already says what is wrong).
-fn misspelt(t: &DeTable<'_>, key: &str, known: &[&str]) -> bool {
-    t.iter().any(|(k, _)| {
-        let name = k.get_ref().as_ref();
-        !known.contains(&name) && suggest::closest(name, known.iter().copied()) == Some(key)
-    })
-}
-
-/// Reports a missing key unless a misspelling of it is already reported.
-fn missing(t: &DeTable<'_>, key: &str, known: &[&str], at: usize, msg: String, d: &mut Diags) {
-    if !misspelt(t, key, known) {
-        d.at(at, msg);
-    }
-}
-
-fn type_name(v: &DeValue<'_>) -> &'static str {
-    match v {
-        DeValue::String(_) => "a string",
-        DeValue::Integer(_) => "an integer",
-        DeValue::Float(_) => "a number",
-        DeValue::Boolean(_) => "a boolean",
-        DeValue::Datetime(_) => "a date",
-        DeValue::Array(_) => "an array",
-        DeValue::Table(_) => "a table",
-    }
-}
-
-fn parse_int(s: &str, radix: u32) -> Option<i64> {
-    i64::from_str_radix(s, radix)
-        .ok()
-        .or_else(|| i64::from_str_radix(&s.replace('_', ""), radix).ok())
-}
-
-/// A finite number (integers accepted); reports wrong types and non-finite values.
-fn number(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<f64> {
-    let at = v.span().start;
-    let x = match v.get_ref() {
-        DeValue::Integer(i) => parse_int(i.as_str(), i.radix()).map(|n| n as f64),
-        DeValue::Float(f) => {
-            let s = f.as_str();
-            s.parse::<f64>()
-                .ok()
-                .or_else(|| s.replace('_', "").parse::<f64>().ok())
-        }
-        other => {
-            d.at(
-                at,
-                format!(
-                    "`{key}` in {ctx} must be a number, found {}; write a plain number such as `{key} = 1.0`",
-                    type_name(other)
-                ),
-            );
-            return None;
-        }
-    };
-    match x {
-        Some(x) if x.is_finite() => Some(x),
-        Some(_) => {
-            d.at(
-                at,
-                format!("`{key}` in {ctx} is not a finite number; use an ordinary number, not nan or inf"),
-            );
-            None
-        }
-        None => {
-            d.at(
-                at,
-                format!("`{key}` in {ctx} is out of range; use an ordinary number"),
-            );
-            None
-        }
-    }
-}
-
-/// A point `[x, y]` in metres.
-fn point(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<[f64; 2]> {
-    let DeValue::Array(a) = v.get_ref() else {
-        d.at(
-            v.span().start,
-            format!(
-                "`{key}` in {ctx} must be a point [x, y] in metres, found {}; write e.g. `[1.0, 2.0]`",
-                type_name(v.get_ref())
-            ),
-        );
-        return None;
-    };
-    if a.len() != 2 {
-        d.at(
-            v.span().start,
-            format!(
-                "`{key}` in {ctx} must be a point of 2 numbers [x, y], found {} value(s); write e.g. `[1.0, 2.0]`",
-                a.len()
-            ),
-        );
-        return None;
-    }
-    let x = number(&a[0], key, ctx, d);
-    let y = number(&a[1], key, ctx, d);
-    Some([x?, y?])
-}
-
-/// A list of points; each point's start offset goes to `spans`.
-fn points(
-    v: &Val<'_>,
-    key: &str,
-    ctx: &str,
-    d: &mut Diags,
-    spans: &mut Vec<usize>,
-) -> Option<Vec<[f64; 2]>> {
-    let DeValue::Array(a) = v.get_ref() else {
-        d.at(
-            v.span().start,
-            format!(
-                "`{key}` in {ctx} must be a list of points, found {}; write e.g. `[[0.0, 0.0], [4.0, 0.0]]`",
-                type_name(v.get_ref())
-            ),
-        );
-        return None;
-    };
-    let mut out = Vec::with_capacity(a.len().min(validate::MAX_SEGMENTS + 1));
-    let mut ok = true;
-    for p in a.iter() {
-        spans.push(p.span().start);
-        match point(p, key, ctx, d) {
-            Some(p) => out.push(p),
-            None => ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
-    ok.then_some(out)
-}
-
-fn string(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<String> {
-    match v.get_ref() {
-        DeValue::String(s) => Some(s.to_string()),
-        other => {
-            d.at(
-                v.span().start,
-                format!(
-                    "`{key}` in {ctx} must be a string, found {}; put it in quotes, e.g. `{key} = \"text\"`",
-                    type_name(other)
-                ),
-            );
-            None
-        }
-    }
-}
-
-fn boolean(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<bool> {
-    match v.get_ref() {
-        DeValue::Boolean(b) => Some(*b),
-        other => {
-            d.at(
-                v.span().start,
-                format!(
-                    "`{key}` in {ctx} must be true or false, found {}; write `{key} = true` or `{key} = false`",
-                    type_name(other)
-                ),
-            );
-            None
-        }
-    }
-}
-
-/// An entity id: non-empty, letters, digits, `-`, `_`, `.` (ids appear in comma lists on the
-/// command line).
-fn id(
-    t: &DeTable<'_>,
-    known: &[&str],
-    at_table: usize,
-    ctx: &str,
-    d: &mut Diags,
-) -> (Option<String>, usize) {
-    let Some((_, v)) = get(t, "id") else {
-        missing(
-            t,
-            "id",
-            known,
-            at_table,
-            format!("missing key `id` in {ctx}; add a unique `id = \"...\"`"),
-            d,
-        );
-        return (None, at_table);
-    };
-    let at = v.span().start;
-    let Some(s) = string(v, "id", ctx, d) else {
-        return (None, at);
-    };
-    if s.is_empty()
-        || !s
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
-    {
-        d.at(
-            at,
-            format!(
-                "id {s:?} in {ctx} is not a plain id; use letters, digits, `-`, `_` or `.` only (e.g. \"n-03\")"
-            ),
-        );
-        return (None, at);
-    }
-    (Some(s), at)
-}
-
-/// The array of tables under `key` (e.g. `[[doors]]`), or an error when it is something else.
-fn table_array<'t, 'i>(
-    top: &'t DeTable<'i>,
-    key: &str,
-    d: &mut Diags,
-) -> Vec<(usize, &'t DeTable<'i>)> {
-    let Some((kat, v)) = get(top, key) else {
-        return Vec::new();
-    };
-    let DeValue::Array(a) = v.get_ref() else {
-        d.at(
-            kat,
-            format!(
-                "`{key}` must be a list of tables, found {}; write each entry as a `[[{key}]]` section",
-                type_name(v.get_ref())
-            ),
-        );
-        return Vec::new();
-    };
-    let mut out = Vec::new();
-    for e in a.iter() {
-        match e.get_ref() {
-            DeValue::Table(t) => out.push((e.span().start, t)),
-            other => d.at(
-                e.span().start,
-                format!(
-                    "each entry of `{key}` must be a table, found {}; write each entry as a `[[{key}]]` section",
-                    type_name(other)
-                ),
-            ),
-        }
-    }
-    out
+/// Whether a document is a scenario (it names a world and has runs) rather than a world.
+fn is_scenario(top: &DeTable<'_>) -> bool {
+    get(top, "runs").is_some() && get(top, "world").is_some()
 }
 
 fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<WorldSpec> {
@@ -809,153 +496,6 @@ fn read_home(top: &DeTable<'_>, d: &mut Diags, l: &mut HomeLoc) -> Option<HomeSp
         y_m: y?,
         heading_deg: heading?,
     })
-}
-
-fn ctx_of(kind: &str, id: &Option<String>, i: usize) -> String {
-    match id {
-        Some(id) => format!("{kind} '{id}'"),
-        None => format!("{kind} #{}", i + 1),
-    }
-}
-
-/// Reads a required number key of an entity; stores the value's offset in `slot`.
-#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
-fn req_number(
-    t: &DeTable<'_>,
-    known: &[&str],
-    key: &str,
-    ctx: &str,
-    at_table: usize,
-    what: &str,
-    d: &mut Diags,
-    slot: &mut usize,
-) -> Option<f64> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = ...` ({what})"),
-                d,
-            );
-            *slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *slot = v.span().start;
-            number(v, key, ctx, d)
-        }
-    }
-}
-
-fn opt_number(
-    t: &DeTable<'_>,
-    key: &str,
-    ctx: &str,
-    default: f64,
-    at_table: usize,
-    d: &mut Diags,
-    slot: &mut usize,
-) -> Option<f64> {
-    match get(t, key) {
-        None => {
-            *slot = at_table;
-            Some(default)
-        }
-        Some((_, v)) => {
-            *slot = v.span().start;
-            number(v, key, ctx, d)
-        }
-    }
-}
-
-fn req_point(
-    t: &DeTable<'_>,
-    known: &[&str],
-    key: &str,
-    ctx: &str,
-    at_table: usize,
-    d: &mut Diags,
-    slot: &mut usize,
-) -> Option<[f64; 2]> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = [x, y]` (metres)"),
-                d,
-            );
-            *slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *slot = v.span().start;
-            point(v, key, ctx, d)
-        }
-    }
-}
-
-#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
-fn req_points(
-    t: &DeTable<'_>,
-    known: &[&str],
-    key: &str,
-    ctx: &str,
-    at_table: usize,
-    d: &mut Diags,
-    key_slot: &mut usize,
-    spans: &mut Vec<usize>,
-) -> Option<Vec<[f64; 2]>> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = [[x, y], ...]` (metres)"),
-                d,
-            );
-            *key_slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *key_slot = v.span().start;
-            points(v, key, ctx, d, spans)
-        }
-    }
-}
-
-/// Reads every table of an array of entries (walls, doors, ...) with `read`, keeping the
-/// locations of those that read cleanly; `ok` turns false when one does not. `None` when the
-/// problem list is full.
-fn read_entries<T, L>(
-    tables: Vec<(usize, &DeTable<'_>)>,
-    d: &mut Diags,
-    ok: &mut bool,
-    read: fn(&DeTable<'_>, usize, usize, &mut Diags, &mut L) -> Option<T>,
-    new_loc: impl Fn(usize) -> L,
-) -> Option<(Vec<T>, Vec<L>)> {
-    let (mut items, mut locs) = (Vec::new(), Vec::new());
-    for (i, (at, t)) in tables.into_iter().enumerate() {
-        let mut l = new_loc(at);
-        match read(t, at, i, d, &mut l) {
-            Some(x) => {
-                items.push(x);
-                locs.push(l);
-            }
-            None => *ok = false,
-        }
-        if d.is_full() {
-            return None;
-        }
-    }
-    Some((items, locs))
 }
 
 fn read_wall(

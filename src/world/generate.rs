@@ -332,8 +332,12 @@ pub fn generate_toml(opts: &GenerateOptions) -> Result<String, GenerateError> {
          # each (swinging into the office), niches in the courtyard wall.\n{body}",
         opts.seed, opts.size_m.0, opts.size_m.1, opts.doors, opts.corridors
     );
-    crate::spec::world::parse_world_spec(&text, "generated world")
-        .map_err(|e| GenerateError::Invalid(e.to_string()))?;
+    crate::world::load::parse_world_spec(
+        &text,
+        "generated world",
+        &crate::world::validate::WorldCheck::default(),
+    )
+    .map_err(|e| GenerateError::Invalid(e.to_string()))?;
     Ok(text)
 }
 

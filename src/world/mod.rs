@@ -5,9 +5,14 @@ pub mod cell_grid;
 pub mod generate;
 pub mod geometry;
 pub mod info;
+pub mod load;
 pub mod physics;
 pub mod raster;
 pub mod raycast;
+pub mod validate;
+
+pub use load::{load_world, load_world_for, parse_world, parse_world_for, parse_world_spec};
+pub use validate::WorldCheck;
 
 use crate::geom::{Pose2, Segment, Vec2};
 use crate::spec::world::WorldSpec;
@@ -131,7 +136,7 @@ pub struct World {
 
 impl World {
     /// Builds the model from a file's structures, converting degrees to radians. Checks nothing:
-    /// validation lives in `spec` and reports located errors before this is called.
+    /// validation lives in [`validate`] and reports located errors before this is called.
     pub fn from_spec(spec: &WorldSpec) -> World {
         let v = |p: &[f64; 2]| Vec2::new(p[0], p[1]);
         World {

@@ -279,6 +279,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             levels: 1,
             min_precision: Some(0.5),
             min_recall: Some(0.5),
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: None,
         }],
         icp: Some(Expectation {
@@ -294,6 +296,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             levels: 1,
             min_precision: Some(1.01),
             min_recall: None,
+            min_visit_recall: None,
+            min_pair_recall: None,
             max_seconds_per_lap: None,
         }],
         icp: None,
@@ -362,9 +366,8 @@ fn icp_cost_over_twenty_laps() {
 #[test]
 #[ignore]
 fn icp_cost_on_institute_floor() {
-    let world =
-        placewords::spec::world::load_world(std::path::Path::new("worlds/institute-floor.toml"))
-            .expect("the shipped world loads");
+    let world = placewords::world::load_world(std::path::Path::new("worlds/institute-floor.toml"))
+        .expect("the shipped world loads");
     let walls = world.obstacle_outline(&placewords::world::DoorStates::all_closed(&world));
     let route = world.route("lap").expect("route lap").waypoints.clone();
     let laps = 6;

@@ -379,8 +379,8 @@ fn mobilesim_maps_import_to_valid_worlds() {
         // Round trip through the world file parser.
         let back: placewords::spec::world::WorldSpec = toml::from_str(&toml_text).unwrap();
         assert_eq!(back, spec);
-        let world = placewords::spec::world::parse_world(&toml_text, file)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let world =
+            placewords::world::parse_world(&toml_text, file).unwrap_or_else(|e| panic!("{e}"));
         let walls = world.wall_segments();
         let half = world
             .walls

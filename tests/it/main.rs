@@ -7,4 +7,5 @@ mod eval;
 mod io;
 mod recognizer;
 mod sim;
+mod spec;
 mod world;

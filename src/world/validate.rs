@@ -4,18 +4,33 @@
 //! Clearances are exact f64 distances between centre lines minus half the thickness of the wall
 //! or door (thick segments treated as capsules, so slightly conservative at wall ends). Route
 //! legs are checked by the exact segment-to-segment distance between the leg (the path of the
-//! robot's centre) and each obstacle's centre line: the robot's disc (radius 0.25 m) sweeps the
+//! robot's centre) and each obstacle's centre line: the robot's disc (radius `WorldCheck::robot_radius_m`, 0.25 m by default) sweeps the
 //! leg without touching an obstacle exactly when that clearance is at least the radius. Legs are
 //! checked with all doors closed and with all doors open.
 
 use crate::geom::{Segment, Vec2, wrap_angle};
-use crate::spec::diag::Diagnostic;
+use crate::spec::diag::Diags;
 use crate::spec::world::{WorldLoc, WorldSpec};
 use crate::world::geometry::{SegmentIndex, ThickSegment};
 use std::collections::HashMap;
 
-/// Robot radius, metres (Pioneer 3-DX).
+/// Robot radius, metres (Pioneer 3-DX): the default robot a world is checked for.
 pub const ROBOT_RADIUS_M: f64 = 0.25;
+
+/// What a world is checked for: the robot that must fit its home pose and drive its routes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WorldCheck {
+    /// Radius of the robot's disc, metres. Default [`ROBOT_RADIUS_M`].
+    pub robot_radius_m: f64,
+}
+
+impl Default for WorldCheck {
+    fn default() -> Self {
+        WorldCheck {
+            robot_radius_m: ROBOT_RADIUS_M,
+        }
+    }
+}
 /// Extra clearance route waypoints keep beyond the robot radius, metres.
 pub const WAYPOINT_MARGIN_M: f64 = 0.05;
 /// How far each end of a closed door may be from a wall, metres.
@@ -26,7 +41,7 @@ pub const MAX_EXTENT_M: f64 = 10_000.0;
 /// far from overflow.
 pub const MAX_ABS_COORD_M: f64 = 1_000_000.0;
 /// Most wall segments, door panels and route legs a world may hold.
-pub const MAX_SEGMENTS: usize = 100_000;
+pub const MAX_SEGMENTS: usize = crate::spec::world::MAX_SEGMENTS;
 /// Half the width of a walking person, metres (scenario A's pedestrians are about 0.3 m across).
 pub const PEDESTRIAN_RADIUS_M: f64 = 0.15;
 /// Wall thickness must lie in (0, this), metres.
@@ -37,92 +52,6 @@ pub const DOOR_WIDTH_RANGE_M: (f64, f64) = (0.5, 3.0);
 pub const MAX_DOOR_THICKNESS_M: f64 = 0.2;
 /// Smallest swing between closed and open headings, degrees.
 pub const MIN_DOOR_SWING_DEG: f64 = 10.0;
-/// Most diagnostics reported for one file.
-pub const MAX_DIAGNOSTICS: usize = 500;
-
-/// Collects located problems of one file; offsets are bytes into the source.
-pub struct Diags<'a> {
-    src: &'a str,
-    path: &'a str,
-    list: Vec<(usize, String)>,
-    overflow: usize,
-}
-
-impl<'a> Diags<'a> {
-    pub fn new(src: &'a str, path: &'a str) -> Self {
-        Diags {
-            src,
-            path,
-            list: Vec::new(),
-            overflow: 0,
-        }
-    }
-
-    /// Records a problem at byte `offset`.
-    pub fn at(&mut self, offset: usize, message: String) {
-        if self.list.len() >= MAX_DIAGNOSTICS {
-            self.overflow += 1;
-        } else {
-            self.list.push((offset, message));
-        }
-    }
-
-    /// Whether the report is full (further problems are only counted).
-    pub fn is_full(&self) -> bool {
-        self.list.len() >= MAX_DIAGNOSTICS
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.list.is_empty()
-    }
-
-    /// The problems in file order, with 1-based lines and columns (columns count characters).
-    pub fn into_sorted(self) -> Vec<Diagnostic> {
-        let mut line_starts = vec![0usize];
-        line_starts.extend(
-            self.src
-                .bytes()
-                .enumerate()
-                .filter(|(_, b)| *b == b'\n')
-                .map(|(i, _)| i + 1),
-        );
-        let mut list = self.list;
-        list.sort_by_key(|(o, _)| *o);
-        list.dedup();
-        let mut out: Vec<Diagnostic> = list
-            .into_iter()
-            .map(|(offset, message)| {
-                let mut cut = offset.min(self.src.len());
-                while !self.src.is_char_boundary(cut) {
-                    cut -= 1;
-                }
-                let line_idx = line_starts.partition_point(|&s| s <= cut) - 1;
-                let start = line_starts[line_idx];
-                let col = self.src[start..cut].chars().count() + 1;
-                Diagnostic {
-                    path: self.path.to_string(),
-                    line: line_idx + 1,
-                    col,
-                    message,
-                }
-            })
-            .collect();
-        if self.overflow > 0 {
-            let last = out.last().map(|d| (d.line, d.col)).unwrap_or((1, 1));
-            out.push(Diagnostic {
-                path: self.path.to_string(),
-                line: last.0,
-                col: last.1,
-                message: format!(
-                    "{} more problems not shown; fix the ones above and check again",
-                    self.overflow
-                ),
-            });
-        }
-        out
-    }
-}
-
 fn v(p: &[f64; 2]) -> Vec2 {
     Vec2::new(p[0], p[1])
 }
@@ -149,7 +78,7 @@ fn duplicates<'s>(ids: impl Iterator<Item = (&'s str, usize)>, kind: &str, d: &m
     let mut seen: HashMap<&str, usize> = HashMap::new();
     for (id, at) in ids {
         if let Some(&first) = seen.get(id) {
-            let line = d.src[..first.min(d.src.len())].matches('\n').count() + 1;
+            let line = d.line_of(first);
             d.at(
                 at,
                 format!(
@@ -163,7 +92,7 @@ fn duplicates<'s>(ids: impl Iterator<Item = (&'s str, usize)>, kind: &str, d: &m
 }
 
 /// All checks after reading; see the module docs.
-pub fn validate(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Diags) {
     duplicates(
         spec.walls
             .iter()
@@ -376,7 +305,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     }
 
     if geometry_ok && !d.is_full() {
-        geometry(spec, loc, d);
+        geometry(spec, loc, check.robot_radius_m, d);
     }
 }
 
@@ -493,7 +422,7 @@ impl Obstacles {
     }
 }
 
-fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags) {
     let mut items = Vec::new();
     let mut owner = Vec::new();
     for (wi, w) in spec.walls.iter().enumerate() {
@@ -597,11 +526,11 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
         let p = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
         let s = Segment::new(p, p);
         let worst = [
-            walls.nearest(s, ROBOT_RADIUS_M).map(|(o, c)| (o, c, "")),
+            walls.nearest(s, robot_radius_m).map(|(o, c)| (o, c, "")),
             closed
-                .nearest(s, ROBOT_RADIUS_M)
+                .nearest(s, robot_radius_m)
                 .map(|(o, c)| (o, c, "closed")),
-            open.nearest(s, ROBOT_RADIUS_M).map(|(o, c)| (o, c, "open")),
+            open.nearest(s, robot_radius_m).map(|(o, c)| (o, c, "open")),
         ]
         .into_iter()
         .flatten()
@@ -610,7 +539,7 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             d.at(
                 loc.home.x,
                 format!(
-                    "robot home is {} {}; put it in free space, at least {ROBOT_RADIUS_M} m (the robot's radius) from walls and doors",
+                    "robot home is {} {}; put it in free space, at least {robot_radius_m} m (the robot's radius) from walls and doors",
                     fmt_m(c),
                     owner_name(spec, o, state)
                 ),
@@ -623,7 +552,7 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     home_inside_the_building(spec, loc, d);
 
     // Routes: waypoints keep radius + margin; legs let the disc through in both door states.
-    let need_wp = ROBOT_RADIUS_M + WAYPOINT_MARGIN_M;
+    let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
         let n = r.waypoints_m.len();
         if n < 3 {
@@ -646,7 +575,7 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
                 d.at(
                     l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
                     format!(
-                        "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {ROBOT_RADIUS_M} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
+                        "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
                         r.id,
                         k + 1,
                         fmt_m(c),
@@ -663,14 +592,14 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             let leg = Segment::new(v(&r.waypoints_m[k]), v(&r.waypoints_m[k2]));
             let at = l.waypoints.get(k).copied().unwrap_or(l.waypoints_key);
             let checks = [
-                (walls.nearest(leg, ROBOT_RADIUS_M), "", ""),
+                (walls.nearest(leg, robot_radius_m), "", ""),
                 (
-                    closed.nearest(leg, ROBOT_RADIUS_M),
+                    closed.nearest(leg, robot_radius_m),
                     "closed",
                     " with all doors closed",
                 ),
                 (
-                    open.nearest(leg, ROBOT_RADIUS_M),
+                    open.nearest(leg, robot_radius_m),
                     "open",
                     " with all doors open",
                 ),
@@ -680,7 +609,7 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
                     d.at(
                         at,
                         format!(
-                            "route '{}' leg from waypoint {} to {} is blocked{when}: it passes {} {} and the robot's disc (radius {ROBOT_RADIUS_M} m) cannot drive through; move the waypoints so the leg keeps {ROBOT_RADIUS_M} m from walls and doors",
+                            "route '{}' leg from waypoint {} to {} is blocked{when}: it passes {} {} and the robot's disc (radius {robot_radius_m} m) cannot drive through; move the waypoints so the leg keeps {robot_radius_m} m from walls and doors",
                             r.id,
                             k + 1,
                             k2 + 1,

@@ -1,0 +1,63 @@
+//! `placewords scenario check FILE...`: every problem of every scenario file (and of the worlds
+//! they name), without running anything; exit 2 on any.
+
+use clap::{Args, Subcommand};
+use placewords::spec::diag::MessageFormat;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Subcommand)]
+pub enum ScenarioCommand {
+    /// Check scenario files; every problem is printed as file:line:col on stderr (exit 2).
+    Check(CheckArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    /// Scenario files (TOML).
+    #[arg(required = true)]
+    pub files: Vec<PathBuf>,
+    /// `human` (file:line:col: error: ...) or `json` (one object per problem, on stdout).
+    #[arg(long, value_name = "FORMAT", default_value = "human", value_parser = ["human", "json"])]
+    pub message_format: String,
+}
+
+pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
+    let ScenarioCommand::Check(args) = cmd;
+    let format = MessageFormat::from_name(&args.message_format).unwrap_or_default();
+    let mut failed = false;
+    for f in &args.files {
+        match placewords::experiment::load_scenario(f) {
+            Ok(s) if format == MessageFormat::Human => {
+                println!(
+                    "{}: ok ({} runs, world {})",
+                    f.display(),
+                    s.sim.runs.len(),
+                    s.sim.world.name
+                )
+            }
+            Ok(_) => {}
+            Err(e) => {
+                failed = true;
+                super::print_problems(&e, format);
+            }
+        }
+    }
+    Ok(if failed {
+        ExitCode::from(2)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// `--laps N`: the same limit as `laps` in a file.
+pub fn laps_flag(s: &str) -> Result<usize, String> {
+    let n: i64 = match s.trim().parse::<u64>() {
+        Ok(n) => i64::try_from(n).unwrap_or(i64::MAX),
+        Err(_) => s
+            .trim()
+            .parse()
+            .map_err(|_| format!("`{s}` is not a whole number"))?,
+    };
+    placewords::spec::scenario::check_laps(n)
+}

@@ -1,0 +1,53 @@
+//! `placewords score LOGDIR --matches FILE [--report OUT.json]`: scores any recognizer's matches
+//! against the logs `placewords simulate` wrote (docs/scoring.md).
+
+use super::common::write_file;
+use anyhow::Context;
+use clap::Args;
+use placewords::experiment::score;
+use placewords::io::matches_csv;
+use placewords::spec::evaluation::EvaluationSpec;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Debug, Args)]
+pub struct ScoreArgs {
+    /// Folder `placewords simulate -o` wrote (run-NNN.log files and manifest.json).
+    pub logdir: PathBuf,
+    /// Matches file: `query_run,query_scan,matched_run,matched_scan,score` (score optional).
+    #[arg(long, value_name = "FILE")]
+    pub matches: PathBuf,
+    /// Write the JSON report here (the schema of `run`'s).
+    #[arg(long, value_name = "OUT.json")]
+    pub report: Option<PathBuf>,
+    /// Label the result as this level configuration in the table and report.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub levels: usize,
+}
+
+pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
+    let logs = score::load_logged_runs(&args.logdir)?;
+    let name = args.matches.display().to_string();
+    let text =
+        std::fs::read_to_string(&args.matches).with_context(|| format!("{name}: cannot read"))?;
+    let rows = matches_csv::parse_matches(&text, &name)?;
+    let report = score::score_rows(&logs, &rows, &name, &EvaluationSpec::default(), args.levels)?;
+    print!("{}", placewords::report::table::text_table(&report));
+    if let Some(path) = &args.report {
+        write_file(path, placewords::report::json::to_json(&report).as_bytes())?;
+        eprintln!("report: {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Writes `rec`'s matched pairs as a matches file.
+pub fn export(
+    path: &Path,
+    rec: &placewords::eval::Recognition,
+    runs: &[placewords::sim::RunLog],
+) -> anyhow::Result<()> {
+    let rows = score::export_rows(rec, &score::run_frames(runs));
+    write_file(path, matches_csv::write_matches(&rows).as_bytes())?;
+    eprintln!("matches: {} ({} pairs)", path.display(), rows.len());
+    Ok(())
+}

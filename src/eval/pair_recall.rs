@@ -1,0 +1,220 @@
+//! Pair recall and the truth-side rules every recall shares.
+//!
+//! - **True travel.** Revisit gaps are measured on the harness's truth, not on the recognizer's
+//!   odometry: [`true_travel_m`] is the distance driven along the true path up to each input
+//!   frame, counted across runs (a run boundary adds no travel, but pairs across runs are always
+//!   beyond any gap because the second run's travel starts after the first's ends).
+//! - **Heading agreement.** A pair is correct only if its two true positions are within the
+//!   radius *and* its true headings agree as its direction claims ([`heading_agrees`]; every
+//!   pair claims the same direction today: headings within `heading_tolerance_deg`).
+//! - **Pair recall** = correct pairs that could have been found ÷ every pair that could have
+//!   been found, where a pair could have been found when it joins an observation to an earlier
+//!   one, at least `min_gap_m` of true travel before it, within `tp_radius_m` and facing the
+//!   same way. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
+//!   observation per earlier lap suffices), it counts every observation of every earlier pass,
+//!   so it is the figure closest to the paper's "matches that could be obtained".
+
+use super::GroundTruth;
+use crate::geom::wrap_angle;
+use crate::recognizer::{Match, ObsId, Observation};
+use crate::spec::evaluation::EvaluationSpec;
+use std::collections::{HashMap, HashSet};
+
+/// Distance along the true path from the first frame to each frame, metres.
+pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
+    let mut out = Vec::with_capacity(truth.frames.len());
+    let mut acc = 0.0;
+    for (i, f) in truth.frames.iter().enumerate() {
+        if i > 0 {
+            let prev = &truth.frames[i - 1];
+            let same_run = truth.laps[prev.lap_slot].run == truth.laps[f.lap_slot].run;
+            if same_run {
+                acc += prev.pose.0.distance(&f.pose.0);
+            }
+        }
+        out.push(acc);
+    }
+    out
+}
+
+/// Whether two true headings agree as a same-direction pair must.
+pub fn heading_agrees(a_rad: f64, b_rad: f64, tolerance_rad: f64) -> bool {
+    wrap_angle(a_rad - b_rad).abs() <= tolerance_rad
+}
+
+/// Truth of one observation: position, heading, true travel.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    x: f64,
+    y: f64,
+    theta: f64,
+    travel_m: f64,
+}
+
+/// Counts behind [`pair_recall`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairRecall {
+    /// Pairs that could have been found.
+    pub possible: u64,
+    /// Distinct pairs of the matches among them (all correct by construction).
+    pub found: u64,
+}
+
+impl PairRecall {
+    /// found / possible, 0 when nothing was possible.
+    pub fn ratio(&self) -> f64 {
+        if self.possible == 0 {
+            0.0
+        } else {
+            self.found as f64 / self.possible as f64
+        }
+    }
+}
+
+/// Pair recall of `matches` at radius `r` (see the module docs).
+pub fn pair_recall(
+    observations: &[Observation],
+    matches: &[Match],
+    truth: &GroundTruth,
+    spec: &EvaluationSpec,
+    r: f64,
+) -> PairRecall {
+    if r <= 0.0 || !r.is_finite() {
+        return PairRecall::default();
+    }
+    let travel = true_travel_m(truth);
+    let placed: Vec<Option<Placed>> = observations
+        .iter()
+        .map(|o| {
+            let f = truth.frame(o.input_index)?;
+            Some(Placed {
+                x: f.pose.0.x,
+                y: f.pose.0.y,
+                theta: f.pose.0.theta,
+                travel_m: travel[o.input_index],
+            })
+        })
+        .collect();
+    let tol = spec.heading_tolerance_deg.to_radians();
+    let possible_pair = |q: &Placed, p: &Placed| {
+        q.travel_m - p.travel_m >= spec.min_gap_m
+            && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
+            && heading_agrees(q.theta, p.theta, tol)
+    };
+    let index_of: HashMap<ObsId, usize> = observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    let mut seen: HashSet<(usize, usize)> = HashSet::new();
+    for p in matches.iter().flat_map(|m| &m.pairs) {
+        let (Some(&qi), Some(&pi)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
+            continue;
+        };
+        if let (Some(q), Some(pa)) = (&placed[qi], &placed[pi])
+            && possible_pair(q, pa)
+        {
+            seen.insert((qi, pi));
+        }
+    }
+    PairRecall {
+        possible: count_possible(&placed, r, &possible_pair),
+        found: seen.len() as u64,
+    }
+}
+
+/// Every (observation, earlier observation) pair `ok` accepts among those within `r`, found
+/// with a spatial hash of cell `r`.
+fn count_possible(placed: &[Option<Placed>], r: f64, ok: &dyn Fn(&Placed, &Placed) -> bool) -> u64 {
+    let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
+    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+    let mut n = 0u64;
+    for (i, o) in placed.iter().enumerate() {
+        let Some(o) = o else { continue };
+        let (cx, cy) = cell(o.x, o.y);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for &j in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
+                    let p = placed[j]
+                        .as_ref()
+                        .expect("only placed observations are inserted");
+                    n += ok(o, p) as u64;
+                }
+            }
+        }
+        grid.entry((cx, cy)).or_default().push(i);
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::metrics::tests::circle;
+    use crate::recognizer::AlignedPair;
+
+    fn one_match(obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
+        Match {
+            levels: 1,
+            ngram_len: 1,
+            word_pairs: vec![],
+            pairs: pairs
+                .iter()
+                .map(|&(q, p)| AlignedPair {
+                    query: q,
+                    past: p,
+                    query_odom: obs[q].odom_pose,
+                    past_odom: obs[p].odom_pose,
+                })
+                .collect(),
+        }
+    }
+
+    /// Every possible pair found scores 1; only the nearest neighbour of one earlier lap scores
+    /// far less, although per-observation recall would be 1.
+    #[test]
+    fn pair_recall_counts_every_possible_pair() {
+        let (obs, gt) = circle(3, 40.0);
+        let spec = EvaluationSpec::default();
+        let travel = true_travel_m(&gt);
+        let pos = |i: usize| gt.frames[i].pose.0;
+        let mut all = Vec::new();
+        for q in 0..obs.len() {
+            for p in 0..q {
+                if travel[q] - travel[p] >= spec.min_gap_m && pos(q).distance(&pos(p)) <= 1.0 {
+                    all.push((q, p));
+                }
+            }
+        }
+        let full = pair_recall(&obs, &[one_match(&obs, &all)], &gt, &spec, 1.0);
+        assert_eq!(full.found, full.possible);
+        assert_eq!(full.ratio(), 1.0);
+        // One pair per observation, one lap back.
+        let nearest: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
+        let some = pair_recall(&obs, &[one_match(&obs, &nearest)], &gt, &spec, 1.0);
+        assert!(some.ratio() < 0.1, "{some:?}");
+        assert_eq!(some.found, nearest.len() as u64);
+        assert_eq!(pair_recall(&obs, &[], &gt, &spec, 1.0).ratio(), 0.0);
+    }
+
+    /// A pair facing the other way is not a revisit and is not counted as found.
+    #[test]
+    fn opposite_headings_do_not_count() {
+        let (obs, mut gt) = circle(2, 40.0);
+        for f in &mut gt.frames[400..] {
+            f.pose.0.theta += std::f64::consts::PI;
+        }
+        let spec = EvaluationSpec::default();
+        let m = one_match(&obs, &[(400, 0), (450, 50)]);
+        let pr = pair_recall(&obs, &[m], &gt, &spec, 1.0);
+        assert_eq!(pr.found, 0);
+    }
+
+    #[test]
+    fn true_travel_follows_the_true_path() {
+        let (_, gt) = circle(2, 40.0);
+        let t = true_travel_m(&gt);
+        assert_eq!(t[0], 0.0);
+        assert!((t[400] - 40.0).abs() < 0.01, "{}", t[400]);
+    }
+}

@@ -1,0 +1,692 @@
+//! A checked scenario: the file read by `spec::scenario`, checked against its world and built
+//! into the simulator's plan and the recognizer's, evaluation's and gate's settings. Every
+//! problem is reported at once, each at its value. The format (all keys, units, defaults,
+//! limits) is `docs/scenario-format.md`.
+//!
+//! ```toml
+//! format_version = 1
+//! name = "smoke"                        # optional; default: the file stem
+//! world = "../worlds/loop-small.toml"   # relative to this file
+//! route = "lap"
+//! seed = 42                             # the seed of `run` (and of `check` without `seeds`)
+//! seeds = "1..20"                       # optional: the seeds `check` runs (both ends included)
+//!
+//! [door_configs]                        # named sets of open doors
+//! south-open = ["d-south"]
+//!
+//! [[runs]]
+//! start_waypoint = 0                    # default 0
+//! laps = 2
+//! doors = "all-closed"                  # "all-closed", "all-open" or a [door_configs] name
+//! # doors_cycle = ["all-closed", "south-open"]    # lap k uses entry k mod len
+//! # doors_random = { open_probability = 0.3 }    # each door open with this probability, per lap
+//!
+//! [pedestrians]                         # optional
+//! count = 2
+//! areas = ["corridor-south"]            # world area ids, and/or:
+//! paths_m = [[[1.0, 1.0], [5.0, 1.0]]]
+//! speed_min_m_s = 0.5                   # default 0.5
+//! speed_max_m_s = 1.2                   # default 1.2
+//! radius_m = 0.2                        # default 0.2
+//!
+//! [laser]                               # preset "lms200" (default) or "lms200-mm", then overrides:
+//! preset = "lms200"                     # max_range_m, range_noise_m, angle_error_deg, rate_hz, mount_x_m
+//!
+//! [odometry]                            # model "proportional" (default) or "thrun"
+//! model = "proportional"                # translation_error_ratio, rotation_error_ratio (0.0075)
+//! # model = "thrun"                     # alpha1..alpha4
+//! # wheel_radius_bias_ratio = 0.0, wheel_radius_mismatch_ratio = 0.0
+//!
+//! [robot]                               # cruise_speed_m_s, max_speed_m_s, max_turn_rate_deg_s,
+//!                                       # accel_m_s2, turn_accel_deg_s2, radius_m, axle_track_m,
+//!                                       # lookahead_m, path_wander_m, stop_distance_m, slow_distance_m,
+//!                                       # blocked_timeout_s, step_s
+//! [recognizer]                          # any table, for the recognizer
+//! [evaluation]                          # crate::spec::evaluation::EvaluationSpec
+//! [expect]                              # crate::spec::evaluation::ExpectSpec
+//! ```
+//!
+//! At most one of `doors`, `doors_cycle`, `doors_random` per run; none means all closed.
+
+use crate::geom::Vec2;
+use crate::recognizer::RecognizerConfig;
+use crate::sim::laser::{LaserConfig, LaserPreset};
+use crate::sim::odometry::{DEFAULT_THRUN_ALPHA, OdometryConfig, OdometryModel, ProportionalError};
+use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
+use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
+use crate::sim::robot::RobotConfig;
+use crate::sim::variation::LapVariationConfig;
+use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
+use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
+use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
+use crate::spec::seeds::SeedRange;
+use crate::spec::suggest::hint;
+use crate::spec::{SpecError, scenario::read_scenario};
+use crate::world::{DoorStates, Route, World, WorldCheck};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+type S<T> = Spanned<T>;
+
+/// A checked scenario: what to simulate, and how to recognize, evaluate and gate it.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    /// The simulation: world, route, seed, runs and models (its `name` is the scenario's).
+    pub sim: SimPlan,
+    pub description: Option<String>,
+    /// The seeds `check` runs by default (`seeds = "1..20"`); `None`: only `sim.seed`.
+    pub seeds: Option<SeedRange>,
+    /// Recognizer settings: the `[recognizer]` table over the defaults.
+    pub recognizer: RecognizerConfig,
+    pub evaluation: EvaluationSpec,
+    pub expect: ExpectSpec,
+}
+
+/// Loads a world file checked for a robot (tests pass a closure that parses a string).
+pub type WorldLoader<'a> = &'a dyn Fn(&Path, &WorldCheck) -> Result<World, SpecError>;
+
+/// Reads and checks a scenario file and the world it names.
+pub fn load_scenario(path: &Path) -> Result<Scenario, SpecError> {
+    let src = read_text(path)?;
+    parse_scenario(&src, path, &crate::world::load_world_for)
+}
+
+/// Parses and checks a scenario's text. `path` names the file in messages and anchors the world
+/// path. Every problem of the file is reported, then those of its world.
+pub fn parse_scenario(
+    src: &str,
+    path: &Path,
+    load_world: WorldLoader,
+) -> Result<Scenario, SpecError> {
+    let file = path.display().to_string();
+    let mut d = Diags::new(src, &file);
+    let mut world_problems = Vec::new();
+    let built = read_scenario(src, &mut d).and_then(|spec| {
+        let models = Models::build(&spec, &mut d);
+        let world_path = resolve(path, spec.world.get_ref());
+        let check = WorldCheck {
+            robot_radius_m: models.robot.radius_m,
+        };
+        let world = load_for(
+            &spec,
+            &world_path,
+            &check,
+            load_world,
+            &mut d,
+            &mut world_problems,
+        )?;
+        let sim = plan(&spec, world, models, path, world_path, &mut d)?;
+        Some((spec, sim))
+    });
+    let mut diags = d.into_sorted();
+    diags.append(&mut world_problems);
+    match built {
+        Some((spec, sim)) if diags.is_empty() => Ok(Scenario {
+            recognizer: sim.1,
+            sim: sim.0,
+            description: spec.description,
+            seeds: spec.seeds.map(|s| s.into_inner()),
+            evaluation: spec.evaluation,
+            expect: spec.expect,
+        }),
+        _ if diags.is_empty() => Err(SpecError::Invalid(vec![Diagnostic::error(
+            &file,
+            (1, 1),
+            "the file could not be read as a scenario; check it against scenarios/smoke.toml",
+        )])),
+        _ => Err(SpecError::Invalid(diags)),
+    }
+}
+
+/// The world path, relative to the scenario's folder unless absolute.
+fn resolve(scenario: &Path, world: &str) -> PathBuf {
+    let rel = PathBuf::from(world);
+    match scenario.parent() {
+        Some(dir) if !rel.is_absolute() => dir.join(rel),
+        _ => rel,
+    }
+}
+
+/// The world, checked for this scenario's robot, so a larger robot is refused here rather than
+/// found "blocked" halfway through a run. The world's own problems go to `extra`.
+fn load_for(
+    spec: &ScenarioSpec,
+    world_path: &Path,
+    check: &WorldCheck,
+    load_world: WorldLoader,
+    d: &mut Diags,
+    extra: &mut Vec<Diagnostic>,
+) -> Option<World> {
+    let at = spec.world.span().start;
+    let shown = echo(&world_path.display().to_string());
+    match load_world(world_path, check) {
+        Ok(w) => Some(w),
+        Err(SpecError::Io { source, .. }) => {
+            d.at(at, format!(
+                "cannot read world file `{shown}`: {source}; the path is relative to the scenario file"));
+            None
+        }
+        Err(SpecError::Invalid(mut problems)) => {
+            let robot = if *check == WorldCheck::default() {
+                String::new()
+            } else {
+                format!(
+                    " for this scenario's robot (radius_m = {})",
+                    check.robot_radius_m
+                )
+            };
+            d.at(
+                at,
+                format!("world `{shown}` is invalid{robot}; fix the problems listed below"),
+            );
+            extra.append(&mut problems);
+            None
+        }
+    }
+}
+
+/// The settings that need no world: laser, odometry, robot, recognizer.
+struct Models {
+    laser: LaserConfig,
+    odometry: OdometryConfig,
+    robot: RobotConfig,
+    recognizer: RecognizerConfig,
+}
+
+impl Models {
+    fn build(spec: &ScenarioSpec, d: &mut Diags) -> Models {
+        Models {
+            laser: laser(&spec.laser, d),
+            odometry: odometry(&spec.odometry, d),
+            robot: robot(&spec.robot, d),
+            recognizer: recognizer(&spec.recognizer, d),
+        }
+    }
+}
+
+/// What a number must be.
+#[derive(Clone, Copy)]
+enum Rule {
+    Positive,
+    NonNegative,
+    Finite,
+}
+
+/// The number given for `key`, or `default` (the model's own) when absent or out of range.
+fn value(d: &mut Diags, s: &Settings, key: &str, default: f64, rule: Rule) -> f64 {
+    let Some(x) = s.get(key) else {
+        return default;
+    };
+    let v = *x.get_ref();
+    let (ok, what) = match rule {
+        Rule::Positive => (v > 0.0, "positive"),
+        Rule::NonNegative => (v >= 0.0, "non-negative"),
+        Rule::Finite => (true, "finite"),
+    };
+    if ok && v.is_finite() {
+        return v;
+    }
+    d.at(
+        x.span().start,
+        format!("{key} = {v} is out of range; use a {what} number (default {default})"),
+    );
+    default
+}
+
+/// A name out of `known`, or an error with a "did you mean".
+fn named<'a>(d: &mut Diags, name: &S<String>, known: &[&'a str], what: &str) -> Option<&'a str> {
+    let n = name.get_ref().as_str();
+    let found = known.iter().find(|k| **k == n).copied();
+    if found.is_none() {
+        let h = hint(n, known.iter().copied(), &format!("{what}s"));
+        d.at(
+            name.span().start,
+            format!("unknown {what} `{}`; {h}", echo(n)),
+        );
+    }
+    found
+}
+
+fn laser(s: &Settings, d: &mut Diags) -> LaserConfig {
+    let preset = s
+        .name
+        .as_ref()
+        .and_then(|p| named(d, p, &LaserPreset::NAMES, "laser preset"))
+        .and_then(LaserPreset::from_name)
+        .unwrap_or(LaserPreset::Lms200);
+    let mut l = LaserConfig::preset(preset);
+    l.max_range_m = value(d, s, "max_range_m", l.max_range_m, Rule::Positive);
+    l.range_noise_m = value(d, s, "range_noise_m", l.range_noise_m, Rule::NonNegative);
+    let angle_deg = l.angle_error_rad.to_degrees();
+    l.angle_error_rad = value(d, s, "angle_error_deg", angle_deg, Rule::NonNegative).to_radians();
+    l.rate_hz = value(d, s, "rate_hz", l.rate_hz, Rule::Positive);
+    l.mount_x_m = value(d, s, "mount_x_m", l.mount_x_m, Rule::Finite);
+    l
+}
+
+const ALPHA_NAMES: [&str; 4] = ["alpha1", "alpha2", "alpha3", "alpha4"];
+const RATIO_NAMES: [&str; 2] = ["translation_error_ratio", "rotation_error_ratio"];
+
+fn odometry(s: &Settings, d: &mut Diags) -> OdometryConfig {
+    let mut o = OdometryConfig::default();
+    let thrun = match &s.name {
+        Some(m) => named(d, m, &["proportional", "thrun"], "odometry model") == Some("thrun"),
+        None => false,
+    };
+    other_model_keys(s, thrun, d);
+    o.model = match (thrun, o.model) {
+        (true, _) => {
+            let mut alpha = DEFAULT_THRUN_ALPHA;
+            for (a, key) in alpha.iter_mut().zip(ALPHA_NAMES) {
+                *a = value(d, s, key, *a, Rule::NonNegative);
+            }
+            OdometryModel::Thrun { alpha }
+        }
+        (
+            false,
+            OdometryModel::Proportional {
+                translation_ratio,
+                rotation_ratio,
+            },
+        ) => OdometryModel::Proportional {
+            translation_ratio: value(d, s, RATIO_NAMES[0], translation_ratio, Rule::NonNegative),
+            rotation_ratio: value(d, s, RATIO_NAMES[1], rotation_ratio, Rule::NonNegative),
+        },
+        (false, model) => model,
+    };
+    o.proportional = proportional_error(s, d);
+    let bias = o.wheel_radius_bias_ratio;
+    o.wheel_radius_bias_ratio = value(d, s, "wheel_radius_bias_ratio", bias, Rule::Finite);
+    let mismatch = o.wheel_radius_mismatch_ratio;
+    o.wheel_radius_mismatch_ratio =
+        value(d, s, "wheel_radius_mismatch_ratio", mismatch, Rule::Finite);
+    o
+}
+
+/// `[odometry] proportional_error`: "each-update" (MobileSim, default) or "random-walk".
+fn proportional_error(s: &Settings, d: &mut Diags) -> ProportionalError {
+    let Some(w) = s.word("proportional_error") else {
+        return ProportionalError::default();
+    };
+    match named(d, w, &["each-update", "random-walk"], "proportional_error") {
+        Some("random-walk") => ProportionalError::RandomWalk,
+        _ => ProportionalError::EachUpdate,
+    }
+}
+
+/// A ratio in `[0, max]`, or an error and the default.
+fn bounded(d: &mut Diags, s: &Settings, key: &str, default: f64, max: f64) -> f64 {
+    let v = value(d, s, key, default, Rule::NonNegative);
+    match s.get(key) {
+        Some(x) if v > max => {
+            d.at(
+                x.span().start,
+                format!("{key} = {v} is above {max}; use 0-{max}"),
+            );
+            default
+        }
+        _ => v,
+    }
+}
+
+/// The lap variation keys of `[robot]` (see [`crate::sim::variation`]); off unless given.
+fn lap_variation(s: &Settings, d: &mut Diags) -> LapVariationConfig {
+    use Rule::NonNegative;
+    let v = LapVariationConfig::default();
+    LapVariationConfig {
+        lane_offset_ratio: bounded(d, s, "lane_offset_ratio", v.lane_offset_ratio, 1.0),
+        lane_margin_m: value(d, s, "lane_margin_m", v.lane_margin_m, NonNegative),
+        lap_speed_spread_ratio: bounded(
+            d,
+            s,
+            "lap_speed_spread_ratio",
+            v.lap_speed_spread_ratio,
+            0.9,
+        ),
+        speed_wave_ratio: bounded(d, s, "speed_wave_ratio", v.speed_wave_ratio, 0.9),
+        stop_spacing_m: value(d, s, "stop_spacing_m", v.stop_spacing_m, NonNegative),
+        stop_duration_s: value(d, s, "stop_duration_s", v.stop_duration_s, NonNegative),
+        spin_spacing_m: value(d, s, "spin_spacing_m", v.spin_spacing_m, NonNegative),
+        spin_angle_rad: bounded(d, s, "spin_angle_deg", v.spin_angle_rad.to_degrees(), 720.0)
+            .to_radians(),
+    }
+}
+
+fn robot(s: &Settings, d: &mut Diags) -> RobotConfig {
+    use Rule::*;
+    let mut r = RobotConfig::default();
+    r.radius_m = value(d, s, "radius_m", r.radius_m, Positive);
+    r.axle_track_m = value(d, s, "axle_track_m", r.axle_track_m, Positive);
+    r.cruise_speed_m_s = value(d, s, "cruise_speed_m_s", r.cruise_speed_m_s, Positive);
+    r.max_speed_m_s = value(d, s, "max_speed_m_s", r.max_speed_m_s, Positive);
+    let turn_deg = r.max_turn_rate_rad_s.to_degrees();
+    r.max_turn_rate_rad_s = value(d, s, "max_turn_rate_deg_s", turn_deg, Positive).to_radians();
+    r.accel_m_s2 = value(d, s, "accel_m_s2", r.accel_m_s2, Positive);
+    let turn_accel_deg = r.turn_accel_rad_s2.to_degrees();
+    r.turn_accel_rad_s2 = value(d, s, "turn_accel_deg_s2", turn_accel_deg, Positive).to_radians();
+    r.lookahead_m = value(d, s, "lookahead_m", r.lookahead_m, Positive);
+    r.stop_distance_m = value(d, s, "stop_distance_m", r.stop_distance_m, NonNegative);
+    r.slow_distance_m = value(d, s, "slow_distance_m", r.slow_distance_m, NonNegative);
+    // Their ranges were checked while reading (the limits that keep a run finite).
+    r.blocked_timeout_s = value(d, s, "blocked_timeout_s", r.blocked_timeout_s, Finite);
+    r.step_s = value(d, s, "step_s", r.step_s, Finite);
+    r.path_wander_m = value(d, s, "path_wander_m", r.path_wander_m, NonNegative);
+    r.variation = lap_variation(s, d);
+    robot_cross_checks(s, &r, d);
+    r
+}
+
+fn robot_cross_checks(s: &Settings, r: &RobotConfig, d: &mut Diags) {
+    if let Some(w) = s.get("path_wander_m").filter(|_| r.path_wander_m > 0.5) {
+        d.at(
+            w.span().start,
+            "path_wander_m above 0.5 m takes the robot off 2 m corridors; use 0.1-0.3".into(),
+        );
+    }
+    if let Some(c) = s
+        .get("cruise_speed_m_s")
+        .filter(|_| r.cruise_speed_m_s > r.max_speed_m_s)
+    {
+        d.at(
+            c.span().start,
+            format!(
+                "cruise_speed_m_s exceeds max_speed_m_s ({}); lower it",
+                r.max_speed_m_s
+            ),
+        );
+    }
+}
+
+/// The `[recognizer]` keys over [`RecognizerConfig::default`]; each problem at its key.
+fn recognizer(entries: &[(S<String>, toml::Value)], d: &mut Diags) -> RecognizerConfig {
+    let defaults = toml::Table::try_from(RecognizerConfig::default()).unwrap_or_default();
+    let known: Vec<&str> = defaults.keys().map(String::as_str).collect();
+    let mut table = defaults.clone();
+    let mut ok = true;
+    for (key, v) in entries {
+        let k = key.get_ref();
+        if !known.contains(&k.as_str()) {
+            let h = hint(k, known.iter().copied(), "keys here");
+            d.at(
+                key.span().start,
+                format!("unknown key `{}` in [recognizer]; {h}", echo(k)),
+            );
+            ok = false;
+            continue;
+        }
+        let mut one = defaults.clone();
+        one.insert(k.clone(), v.clone());
+        if let Err(e) = one.try_into::<RecognizerConfig>() {
+            let msg = e.message().trim().replace('\n', " ");
+            d.at(key.span().start, format!("[recognizer] {k}: {msg}"));
+            ok = false;
+        }
+        table.insert(k.clone(), v.clone());
+    }
+    let cfg = match table.try_into::<RecognizerConfig>() {
+        Ok(cfg) if ok => cfg,
+        _ => return RecognizerConfig::default(),
+    };
+    for p in cfg.problems() {
+        let at = entries.iter().find(|(k, _)| k.get_ref() == p.field);
+        let at = at
+            .or(entries.first())
+            .map(|(k, _)| k.span().start)
+            .unwrap_or(0);
+        d.at(at, format!("[recognizer] {}: {}", p.field, p.problem));
+    }
+    cfg
+}
+
+/// The simulation plan and recognizer settings: everything checked against the world.
+fn plan(
+    spec: &ScenarioSpec,
+    world: World,
+    models: Models,
+    path: &Path,
+    world_path: PathBuf,
+    d: &mut Diags,
+) -> Option<(SimPlan, RecognizerConfig)> {
+    let route = route(spec, &world, d);
+    let door_configs = door_configs(spec, &world, d);
+    let doors = Doors {
+        world: &world,
+        configs: &door_configs,
+    };
+    let runs: Vec<RunPlan> = spec
+        .runs
+        .iter()
+        .filter_map(|r| run(r, route.as_ref(), &doors, d))
+        .collect();
+    let pedestrians = pedestrians(spec.pedestrians.as_ref(), &world, d);
+    let name = spec.name.clone().unwrap_or_else(|| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scenario".into())
+    });
+    let sim = SimPlan {
+        name,
+        path: path.to_path_buf(),
+        world_path,
+        route: route?,
+        seed: *spec.seed.get_ref(),
+        runs,
+        door_configs,
+        pedestrians,
+        laser: models.laser,
+        odometry: models.odometry,
+        robot: models.robot,
+        world,
+    };
+    Some((sim, models.recognizer))
+}
+
+fn route(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> Option<Route> {
+    let id = spec.route.get_ref();
+    let found = world.route(id).cloned();
+    if found.is_none() {
+        let h = hint(id, world.routes.iter().map(|r| r.id.as_str()), "routes");
+        d.at(
+            spec.route.span().start,
+            format!("unknown route `{}`; {h}", echo(id)),
+        );
+    }
+    found
+}
+
+/// Door configuration names a file may not define.
+const RESERVED: [&str; 3] = ["all-closed", "all-open", "random"];
+
+fn door_configs(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> BTreeMap<String, DoorStates> {
+    let mut out = BTreeMap::new();
+    for (name, ids) in &spec.door_configs {
+        if RESERVED.contains(&name.get_ref().as_str()) {
+            d.at(
+                name.span().start,
+                format!(
+                    "door configuration name `{}` is reserved; rename it",
+                    name.get_ref()
+                ),
+            );
+        }
+        let mut st = DoorStates::all_closed(world);
+        for id in ids {
+            match world.door_index(id.get_ref()) {
+                Some(i) => st.open[i] = true,
+                None => {
+                    let h = hint(
+                        id.get_ref(),
+                        world.doors.iter().map(|x| x.id.as_str()),
+                        "doors",
+                    );
+                    d.at(
+                        id.span().start,
+                        format!("unknown door `{}`; {h}", echo(id.get_ref())),
+                    );
+                }
+            }
+        }
+        out.insert(name.get_ref().clone(), st);
+    }
+    out
+}
+
+/// What a run's door names are looked up in.
+struct Doors<'a> {
+    world: &'a World,
+    configs: &'a BTreeMap<String, DoorStates>,
+}
+
+impl Doors<'_> {
+    fn choice(&self, name: &S<String>, d: &mut Diags) -> Option<DoorChoice> {
+        let n = name.get_ref().as_str();
+        let states = match n {
+            "all-closed" => Some(DoorStates::all_closed(self.world)),
+            "all-open" => Some(DoorStates::all_open(self.world)),
+            _ => self.configs.get(n).cloned(),
+        };
+        if let Some(states) = states {
+            return Some(DoorChoice {
+                name: n.to_string(),
+                states,
+            });
+        }
+        let what = if self.world.door_index(n).is_some() {
+            format!(
+                "`{n}` is a door, not a door configuration; name a set of open doors in \
+                 [door_configs], e.g. only-{n} = [\"{n}\"], and use its name"
+            )
+        } else {
+            let names = RESERVED[..2]
+                .iter()
+                .copied()
+                .chain(self.configs.keys().map(String::as_str));
+            format!(
+                "unknown door configuration `{}`; {}",
+                echo(n),
+                hint(n, names, "configurations")
+            )
+        };
+        d.at(name.span().start, what);
+        None
+    }
+}
+
+fn run(r: &RunSpec, route: Option<&Route>, doors: &Doors, d: &mut Diags) -> Option<RunPlan> {
+    let start = r.start_waypoint.as_ref().map(|s| *s.get_ref()).unwrap_or(0);
+    if let (Some(s), Some(route)) = (&r.start_waypoint, route) {
+        let n = route.waypoints.len();
+        if start < 0 || start as usize >= n {
+            d.at(s.span().start, format!(
+                "start_waypoint {start} is not a waypoint of route `{}`; use 0 (the first) to {} \
+                 (the last); messages about the world count waypoints from 1",
+                route.id, n.saturating_sub(1)));
+        }
+    }
+    let plan = match &r.doors {
+        None => DoorPlan::Fixed(DoorChoice {
+            name: "all-closed".into(),
+            states: DoorStates::all_closed(doors.world),
+        }),
+        Some(DoorsSpec::Fixed(name)) => DoorPlan::Fixed(doors.choice(name, d)?),
+        Some(DoorsSpec::Cycle(list)) => {
+            if list.get_ref().is_empty() {
+                d.at(
+                    list.span().start,
+                    "doors_cycle is empty; list at least one configuration".into(),
+                );
+            }
+            DoorPlan::Cycle(
+                list.get_ref()
+                    .iter()
+                    .filter_map(|n| doors.choice(n, d))
+                    .collect(),
+            )
+        }
+        Some(DoorsSpec::Random(p)) => DoorPlan::Random {
+            open_probability: *p.get_ref(),
+        },
+    };
+    Some(RunPlan {
+        start_waypoint: start.max(0) as usize,
+        laps: *r.laps.get_ref(),
+        doors: plan,
+    })
+}
+
+fn pedestrians(p: Option<&PedestriansSpec>, world: &World, d: &mut Diags) -> PedestrianConfig {
+    let mut cfg = PedestrianConfig::default();
+    let Some(p) = p else {
+        return cfg;
+    };
+    cfg.count = *p.count.get_ref();
+    for a in &p.areas {
+        match world.areas.iter().find(|w| w.id == *a.get_ref()) {
+            Some(area) => cfg.sources.push(WalkSource::Area(area.clone())),
+            None => {
+                let h = hint(
+                    a.get_ref(),
+                    world.areas.iter().map(|x| x.id.as_str()),
+                    "areas",
+                );
+                d.at(
+                    a.span().start,
+                    format!("unknown area `{}`; {h}", echo(a.get_ref())),
+                );
+            }
+        }
+    }
+    for path in &p.paths_m {
+        let pts = path
+            .get_ref()
+            .iter()
+            .map(|q| Vec2::new(q[0], q[1]))
+            .collect();
+        cfg.sources.push(WalkSource::Path(pts));
+    }
+    if cfg.count > 0 && p.areas.is_empty() && p.paths_m.is_empty() {
+        d.at(
+            p.count.span().start,
+            "pedestrians need somewhere to walk; add areas = [..] or paths_m = [..]".into(),
+        );
+    }
+    walker_settings(&p.settings, &mut cfg, d);
+    cfg
+}
+
+/// Speeds and size of the people, over [`PedestrianConfig::default`].
+fn walker_settings(s: &Settings, cfg: &mut PedestrianConfig, d: &mut Diags) {
+    cfg.speed_min_m_s = value(d, s, "speed_min_m_s", cfg.speed_min_m_s, Rule::Positive);
+    cfg.speed_max_m_s = value(d, s, "speed_max_m_s", cfg.speed_max_m_s, Rule::Positive);
+    cfg.radius_m = value(d, s, "radius_m", cfg.radius_m, Rule::Positive);
+    if let Some(x) = s
+        .get("speed_max_m_s")
+        .filter(|_| cfg.speed_max_m_s < cfg.speed_min_m_s)
+    {
+        d.at(
+            x.span().start,
+            "speed_max_m_s is below speed_min_m_s; swap them".into(),
+        );
+    }
+}
+
+/// Keys of the other odometry model are a mistake, not silently ignored.
+fn other_model_keys(s: &Settings, thrun: bool, d: &mut Diags) {
+    let (other, fix) = if thrun {
+        (
+            &RATIO_NAMES[..],
+            "proportional\"; remove it or change the model",
+        )
+    } else {
+        (
+            &ALPHA_NAMES[..],
+            "thrun\"; remove it or set model = \"thrun\"",
+        )
+    };
+    for key in other {
+        if let Some(x) = s.get(key) {
+            d.at(x.span().start, format!("{key} applies to model = \"{fix}"));
+        }
+    }
+}

@@ -1,0 +1,414 @@
+//! Scoring any recognizer: the logs `placewords simulate` wrote (CARMEN logs with `TRUEPOS`, and
+//! `manifest.json`) plus a matches file ([`crate::io::matches_csv`]) from any tool give the same
+//! metrics, table and JSON report as `placewords run`.
+//!
+//! The harness holds the truth: the `TRUEPOS` of every laser line and the laps (door
+//! configurations) from the manifest. Placewords' recognizer scores *observations*, one per
+//! 0.10 m of odometric travel; a tool's matches name *scans*. To score both on the same footing,
+//! the scans are thinned the same way: a run's first scan and every scan after at least
+//! [`OBSERVATION_SPACING_M`] of odometric travel since the last one kept are the observations,
+//! and a matched scan counts as the observation at or before it in its run. The remaining
+//! differences with `run` (the recognizer's observations are interpolated between scans, so
+//! they fall on slightly different scans) are small: see the test beside `score`.
+
+use crate::eval::scores::Report;
+use crate::eval::{FrameTruth, GroundTruth, LapInfo, Recognition};
+use crate::geom::{OdomPose, Pose2, TruePose};
+use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
+use crate::io::matches_csv::{MatchRow, MatchesCsvError};
+use crate::recognizer::{AlignedPair, Match, Observation};
+use crate::sim::RunLog;
+use crate::sim::logs::Manifest;
+use crate::spec::evaluation::EvaluationSpec;
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+/// Odometric travel between two observations, metres (as the recognizer's default).
+pub const OBSERVATION_SPACING_M: f64 = 0.10;
+
+/// Why a log folder or matches file could not be scored.
+#[derive(Debug, thiserror::Error)]
+pub enum ScoreError {
+    #[error("{path}: {message}")]
+    Manifest { path: String, message: String },
+    #[error(transparent)]
+    Log(#[from] CarmenError),
+    #[error(transparent)]
+    Matches(#[from] MatchesCsvError),
+    #[error(
+        "{path}: match {row} names run {run} scan {scan}, which the logs do not hold ({what}); \
+         check the run and 0-based scan numbers against manifest.json"
+    )]
+    UnknownScan {
+        path: String,
+        row: usize,
+        run: usize,
+        scan: usize,
+        what: String,
+    },
+}
+
+/// What the harness knows about a simulated log folder.
+#[derive(Clone, Debug)]
+pub struct LoggedRuns {
+    pub scenario: String,
+    pub seed: u64,
+    pub laps: usize,
+    /// Truth of every laser line, runs in manifest order.
+    pub truth: GroundTruth,
+    /// Observations (thinned scans, see the module docs).
+    pub observations: Vec<Observation>,
+    /// Per run (manifest order): run number, index of its first scan in `truth.frames`, scans.
+    pub runs: Vec<(usize, usize, usize)>,
+    /// Global scan index → observation index (the observation at or before it).
+    obs_of_scan: Vec<usize>,
+}
+
+/// `(run number, frames)` of simulated runs, to map observations back to scans.
+pub fn run_frames(runs: &[RunLog]) -> Vec<(usize, usize)> {
+    runs.iter().map(|r| (r.run, r.frames().count())).collect()
+}
+
+/// The distinct pairs of `rec`'s matches as matches-file rows (query run/scan, matched
+/// run/scan, the match's n-gram length as score), with runs laid out as `run_frames` says.
+pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<MatchRow> {
+    let mut starts = Vec::with_capacity(run_frames.len());
+    let mut acc = 0;
+    for &(_, n) in run_frames {
+        starts.push(acc);
+        acc += n;
+    }
+    let locate = |input: usize| {
+        let k = starts.partition_point(|&s| s <= input).saturating_sub(1);
+        (run_frames[k].0, input - starts[k])
+    };
+    let input_of: HashMap<usize, usize> = rec
+        .observations
+        .iter()
+        .map(|o| (o.id, o.input_index))
+        .collect();
+    let mut seen = HashSet::new();
+    let mut rows = Vec::new();
+    for m in &rec.matches {
+        for p in &m.pairs {
+            let (Some(&q), Some(&pa)) = (input_of.get(&p.query), input_of.get(&p.past)) else {
+                continue;
+            };
+            if !seen.insert((p.query, p.past)) {
+                continue;
+            }
+            let ((qr, qs), (pr, ps)) = (locate(q), locate(pa));
+            rows.push(MatchRow {
+                query_run: qr,
+                query_scan: qs,
+                matched_run: pr,
+                matched_scan: ps,
+                score: Some(m.ngram_len as f64),
+            });
+        }
+    }
+    rows
+}
+
+/// Reads `dir/manifest.json` and every run's log in it.
+pub fn load_logged_runs(dir: &Path) -> Result<LoggedRuns, ScoreError> {
+    let mpath = dir.join("manifest.json");
+    let bad = |message: String| ScoreError::Manifest {
+        path: mpath.display().to_string(),
+        message,
+    };
+    let text = std::fs::read_to_string(&mpath).map_err(|e| {
+        bad(format!(
+            "cannot read: {e}; give the folder `placewords simulate -o` wrote"
+        ))
+    })?;
+    let manifest: Manifest = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let mut truth = GroundTruth::default();
+    let mut odom = Vec::new();
+    let mut runs = Vec::new();
+    for r in &manifest.runs {
+        let path = dir.join(&r.file);
+        let (poses, truths) = read_run(&path)?;
+        let lap_frames: usize = r.laps.iter().map(|l| l.frames).sum();
+        if poses.len() != lap_frames {
+            return Err(bad(format!(
+                "run {} lists {lap_frames} frames in its laps but {} has {} laser lines with TRUEPOS",
+                r.run,
+                path.display(),
+                poses.len()
+            )));
+        }
+        runs.push((r.run, truth.frames.len(), poses.len()));
+        let mut k = 0;
+        for l in &r.laps {
+            let slot = truth.laps.len();
+            truth.laps.push(LapInfo {
+                run: r.run,
+                lap: l.lap,
+                door_config: l.door_config.clone(),
+                open_doors: l.open_doors.clone(),
+            });
+            for (t, o) in truths[k..k + l.frames].iter().zip(&poses[k..k + l.frames]) {
+                truth.frames.push(FrameTruth {
+                    pose: TruePose(*t),
+                    odom: crate::geom::OdomPose(*o),
+                    lap_slot: slot,
+                });
+            }
+            k += l.frames;
+        }
+        odom.extend(poses);
+    }
+    let (observations, obs_of_scan) = thin(&odom, &runs);
+    Ok(LoggedRuns {
+        scenario: manifest.scenario_name,
+        seed: manifest.seed,
+        laps: truth.laps.len(),
+        truth,
+        observations,
+        runs,
+        obs_of_scan,
+    })
+}
+
+/// The odometry and truth of every laser line of one log (a laser line's truth is the
+/// `TRUEPOS` line that follows it, as `simulate` writes them).
+fn read_run(path: &Path) -> Result<(Vec<Pose2>, Vec<Pose2>), ScoreError> {
+    let readout = read_log(path, ReadOptions::default())?;
+    let (mut odom, mut truth) = (Vec::new(), Vec::new());
+    let mut pending: Option<Pose2> = None;
+    for rec in &readout.records {
+        match rec {
+            LogRecord::Laser(l) => pending = Some(l.odom),
+            LogRecord::TruePos(t) => {
+                if let Some(o) = pending.take() {
+                    odom.push(o);
+                    truth.push(t.truth);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok((odom, truth))
+}
+
+/// Observations from scans: each run's first scan, then one each `OBSERVATION_SPACING_M` of
+/// odometric travel; and for every scan, the observation at or before it.
+fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Vec<usize>) {
+    let mut obs: Vec<Observation> = Vec::new();
+    let mut of_scan = vec![0; odom.len()];
+    let mut travel = 0.0;
+    for (run_pos, &(_, start, n)) in runs.iter().enumerate() {
+        let mut since = f64::INFINITY;
+        for i in start..start + n {
+            if i > start {
+                let d = odom[i - 1].distance(&odom[i]);
+                travel += d;
+                since += d;
+            }
+            if since >= OBSERVATION_SPACING_M {
+                // Keep the remainder, so observations average one per spacing as the
+                // recognizer's (interpolated) ones do.
+                since = if since.is_finite() {
+                    since - OBSERVATION_SPACING_M
+                } else {
+                    0.0
+                };
+                obs.push(Observation {
+                    id: obs.len(),
+                    run: run_pos,
+                    input_index: i,
+                    odom_pose: OdomPose(odom[i]),
+                    travel_m: travel,
+                    psi: 0.0,
+                });
+            }
+            of_scan[i] = obs.len() - 1;
+        }
+    }
+    (obs, of_scan)
+}
+
+impl LoggedRuns {
+    /// Global scan index of `run`'s scan `scan`, if the logs hold it.
+    fn scan(&self, run: usize, scan: usize) -> Result<usize, String> {
+        let Some(&(_, start, n)) = self.runs.iter().find(|r| r.0 == run) else {
+            let have: Vec<String> = self.runs.iter().map(|r| r.0.to_string()).collect();
+            return Err(format!("runs are {}", have.join(", ")));
+        };
+        if scan < n {
+            Ok(start + scan)
+        } else {
+            Err(format!("run {run} has {n} scans"))
+        }
+    }
+
+    /// `rows` as a recognition: every row one match of one observation pair.
+    pub fn recognition(&self, rows: &[MatchRow], path: &str) -> Result<Recognition, ScoreError> {
+        let mut matches = Vec::with_capacity(rows.len());
+        for (k, r) in rows.iter().enumerate() {
+            let at = |run: usize, scan: usize| {
+                self.scan(run, scan)
+                    .map_err(|what| ScoreError::UnknownScan {
+                        path: path.to_string(),
+                        row: k + 1,
+                        run,
+                        scan,
+                        what,
+                    })
+            };
+            let q = self.obs_of_scan[at(r.query_run, r.query_scan)?];
+            let p = self.obs_of_scan[at(r.matched_run, r.matched_scan)?];
+            let (qo, po) = (&self.observations[q], &self.observations[p]);
+            matches.push(Match {
+                levels: 1,
+                ngram_len: 1,
+                word_pairs: Vec::new(),
+                pairs: vec![AlignedPair {
+                    query: qo.id,
+                    past: po.id,
+                    query_odom: qo.odom_pose,
+                    past_odom: po.odom_pose,
+                }],
+            });
+        }
+        Ok(Recognition {
+            name: "external".into(),
+            observations: self.observations.clone(),
+            matches,
+            seconds: 0.0,
+            laps: self.laps,
+            truth: self.truth.clone(),
+        })
+    }
+}
+
+/// Scores `rows` against the logs as a report with one `levels` entry labelled `levels`.
+pub fn score_rows(
+    logs: &LoggedRuns,
+    rows: &[MatchRow],
+    path: &str,
+    spec: &EvaluationSpec,
+    levels: usize,
+) -> Result<Report, ScoreError> {
+    let rec = logs.recognition(rows, path)?;
+    let mut report = Report::new(&logs.scenario, logs.seed, logs.laps, spec.clone());
+    report.add_level(levels, &[], &rec);
+    report.finish();
+    Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::{ExperimentOptions, evaluate_runs, recognizer_config};
+    use crate::io::matches_csv::{parse_matches, write_matches};
+    use crate::spec::scenario::load_scenario;
+
+    /// The smoke scenario simulated and written as `simulate` writes it.
+    fn smoke_logs() -> (
+        tempfile::TempDir,
+        Vec<RunLog>,
+        crate::spec::scenario::Scenario,
+    ) {
+        let scn = load_scenario(Path::new("scenarios/smoke.toml")).expect("smoke loads");
+        let runs = crate::sim::simulate(&scn, None, &|| {}).expect("smoke simulates");
+        let dir = tempfile::tempdir().expect("temp dir");
+        crate::sim::logs::write_logs(&scn, &runs, None, dir.path()).expect("logs written");
+        (dir, runs, scn)
+    }
+
+    /// For every observation with a revisit, its nearest earlier revisit partner, as rows; with
+    /// `shift` scans added to the matched scan (clamped to the run).
+    fn oracle_rows(logs: &LoggedRuns, spec: &EvaluationSpec, shift: usize) -> Vec<MatchRow> {
+        let travel = crate::eval::pair_recall::true_travel_m(&logs.truth);
+        let pose = |o: &Observation| logs.truth.frames[o.input_index].pose.0;
+        let locate = |i: usize| {
+            let &(run, start, n) = logs.runs.iter().rfind(|r| r.1 <= i).expect("a run");
+            (run, i - start, n)
+        };
+        let mut rows = Vec::new();
+        for (k, q) in logs.observations.iter().enumerate() {
+            let best = logs.observations[..k]
+                .iter()
+                .filter(|p| travel[q.input_index] - travel[p.input_index] >= spec.min_gap_m)
+                .filter(|p| {
+                    crate::geom::wrap_angle(pose(q).theta - pose(p).theta).abs()
+                        <= spec.heading_tolerance_deg.to_radians()
+                })
+                .map(|p| (pose(q).distance(&pose(p)), p))
+                .filter(|(d, _)| *d <= spec.tp_radius_m)
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            if let Some((_, p)) = best {
+                let (qr, qs, _) = locate(q.input_index);
+                let (pr, ps, n) = locate(p.input_index);
+                if ps + shift < n {
+                    rows.push(MatchRow {
+                        query_run: qr,
+                        query_scan: qs,
+                        matched_run: pr,
+                        matched_scan: ps + shift,
+                        score: None,
+                    });
+                }
+            }
+        }
+        rows
+    }
+
+    /// A matches file written from the truth scores 1; the same file with every matched scan
+    /// moved 5 m along the path (125 scans at 0.4 m/s and 10 Hz) scores 0. And `score` on
+    /// `run`'s own exported matches gives `run`'s figures: precision within 0.01, recall within
+    /// 0.02 (scans are thinned to observations, which fall on nearly the same scans).
+    #[test]
+    fn score_reads_logs_and_matches_files_like_run() {
+        let (dir, runs, scn) = smoke_logs();
+        let logs = load_logged_runs(dir.path()).expect("logs load");
+        let spec = EvaluationSpec::default();
+        let text = write_matches(&oracle_rows(&logs, &spec, 0));
+        let perfect = parse_matches(&text, "perfect.csv").expect("parses");
+        let r = score_rows(&logs, &perfect, "perfect.csv", &spec, 1).unwrap();
+        let s = &r.levels[0].scores;
+        assert_eq!((s.precision, s.recall), (1.0, 1.0), "{s:?}");
+        let shifted = oracle_rows(&logs, &spec, 125);
+        assert!(shifted.len() > perfect.len() / 2);
+        let r = score_rows(&logs, &shifted, "shifted.csv", &spec, 1).unwrap();
+        let s = &r.levels[0].scores;
+        assert_eq!((s.precision, s.recall), (0.0, 0.0), "{s:?}");
+
+        let opts = ExperimentOptions {
+            levels: vec![3],
+            quiet: true,
+            ..ExperimentOptions::default()
+        };
+        let base = recognizer_config(&scn).unwrap();
+        let exp = evaluate_runs("smoke", scn.seed, runs, &base, &spec, &opts).unwrap();
+        let (_, rec) = &exp.recognitions[0];
+        let rows = export_rows(rec, &run_frames(&exp.runs));
+        let scored = score_rows(&logs, &rows, "run.csv", &spec, 3).unwrap();
+        let (a, b) = (&exp.report.levels[0].scores, &scored.levels[0].scores);
+        assert!(a.pairs > 100, "smoke should match: {a:?}");
+        assert!((a.precision - b.precision).abs() <= 0.01, "{a:?} vs {b:?}");
+        assert!((a.recall - b.recall).abs() <= 0.02, "{a:?} vs {b:?}");
+    }
+
+    #[test]
+    fn unknown_scans_are_named() {
+        let (dir, _, _) = smoke_logs();
+        let logs = load_logged_runs(dir.path()).unwrap();
+        let row = MatchRow {
+            query_run: 7,
+            query_scan: 0,
+            matched_run: 0,
+            matched_scan: 0,
+            score: None,
+        };
+        let e = score_rows(&logs, &[row], "m.csv", &EvaluationSpec::default(), 1).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("m.csv: match 1 names run 7 scan 0"),
+            "{e}"
+        );
+        assert!(load_logged_runs(Path::new("/nonexistent")).is_err());
+    }
+}

@@ -1,0 +1,60 @@
+//! What the simulator is asked to do: the world and route, the seed, the runs with their door
+//! plans, and the models of the robot, its laser, its odometry and the people around it. Built
+//! (and checked) from a scenario file one layer up, in `experiment::scenario`.
+
+use crate::sim::laser::LaserConfig;
+use crate::sim::odometry::OdometryConfig;
+use crate::sim::pedestrians::PedestrianConfig;
+use crate::sim::robot::RobotConfig;
+use crate::world::{DoorStates, Route, World};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// A named set of door states.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DoorChoice {
+    /// "all-closed", "all-open" or a `[door_configs]` name.
+    pub name: String,
+    pub states: DoorStates,
+}
+
+/// How a run's doors are set each lap.
+#[derive(Clone, Debug, PartialEq)]
+pub enum DoorPlan {
+    Fixed(DoorChoice),
+    /// Lap `k` uses entry `k mod len`.
+    Cycle(Vec<DoorChoice>),
+    /// Each door open with this probability, drawn per lap.
+    Random {
+        open_probability: f64,
+    },
+}
+
+/// One run: where it starts, how many laps, how its doors are set.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunPlan {
+    /// Index into the route's waypoints (0 is the first).
+    pub start_waypoint: usize,
+    pub laps: usize,
+    pub doors: DoorPlan,
+}
+
+/// Everything a simulation needs.
+#[derive(Clone, Debug)]
+pub struct SimPlan {
+    /// The scenario's name (for log headers and manifests).
+    pub name: String,
+    /// The scenario file (as given).
+    pub path: PathBuf,
+    /// The world file, resolved against the scenario's folder.
+    pub world_path: PathBuf,
+    pub world: World,
+    pub route: Route,
+    pub seed: u64,
+    pub runs: Vec<RunPlan>,
+    pub door_configs: BTreeMap<String, DoorStates>,
+    pub pedestrians: PedestrianConfig,
+    pub laser: LaserConfig,
+    pub odometry: OdometryConfig,
+    pub robot: RobotConfig,
+}

@@ -1,0 +1,70 @@
+//! Loading a world file: read it with `spec`, check it here, build the model.
+
+use crate::spec::diag::{Diagnostic, Diags, SpecError};
+use crate::spec::world::{WorldSpec, read_world};
+use crate::world::World;
+use crate::world::validate::{self, WorldCheck};
+use std::path::Path;
+
+/// Reads and checks a world file's text into its file structures; `path` only names the file in
+/// messages. Every problem is reported, in file order.
+pub fn parse_world_spec(src: &str, path: &str, check: &WorldCheck) -> Result<WorldSpec, SpecError> {
+    let mut d = Diags::new(src, path);
+    let spec = read_world(src, &mut d).map(|(spec, loc)| {
+        validate::validate(&spec, &loc, check, &mut d);
+        spec
+    });
+    match (spec, d.into_sorted()) {
+        (Some(spec), diags) if diags.is_empty() => Ok(spec),
+        (_, mut diags) => {
+            if diags.is_empty() {
+                // Defensive: a failed read always reports why; never return an empty error.
+                diags.push(Diagnostic::error(
+                    path,
+                    (1, 1),
+                    "the file could not be read as a world; check it against worlds/loop-small.toml",
+                ));
+            }
+            Err(SpecError::Invalid(diags))
+        }
+    }
+}
+
+/// Parses and checks a world file's text for the default robot; `path` only names the file.
+pub fn parse_world(src: &str, path: &str) -> Result<World, SpecError> {
+    parse_world_for(src, path, &WorldCheck::default())
+}
+
+/// Parses and checks a world file's text for the robot in `check`.
+pub fn parse_world_for(src: &str, path: &str, check: &WorldCheck) -> Result<World, SpecError> {
+    parse_world_spec(src, path, check).map(|spec| World::from_spec(&spec))
+}
+
+/// Reads and checks a world file for the default robot.
+pub fn load_world(path: &Path) -> Result<World, SpecError> {
+    load_world_for(path, &WorldCheck::default())
+}
+
+/// Reads and checks a world file for the robot in `check`.
+pub fn load_world_for(path: &Path, check: &WorldCheck) -> Result<World, SpecError> {
+    let src = crate::spec::diag::read_text(path)?;
+    parse_world_for(&src, &path.display().to_string(), check)
+}
+
+/// What could be read of a world file even when it is invalid, for pictures of what is wrong:
+/// its structures and the offsets of its values (`None` when the text is not TOML), and every
+/// problem, in file order.
+pub fn read_world_lenient(
+    src: &str,
+    path: &str,
+) -> (
+    Option<(WorldSpec, crate::spec::world::WorldLoc)>,
+    Vec<Diagnostic>,
+) {
+    let mut d = Diags::new(src, path);
+    let read = read_world(src, &mut d);
+    if let Some((spec, loc)) = &read {
+        validate::validate(spec, loc, &WorldCheck::default(), &mut d);
+    }
+    (read, d.into_sorted())
+}

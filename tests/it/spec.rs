@@ -1,0 +1,246 @@
+//! Bad scenario files and the inputs fuzzing found: each fixture gives its located message.
+//!
+//! `tests/fixtures/invalid-scenarios/NAME.toml` and `tests/fixtures/fuzz/NAME.{toml,map}` sit
+//! beside `NAME.expected`, the exact lines `placewords scenario check` (or `world check`, or
+//! `world import` for `.map`) prints. Re-mint with `PLACEWORDS_BLESS=1` and review the diff.
+
+use placewords::spec::diag::{MessageFormat, read_text};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The lines a file's check prints; `None` when the file is accepted.
+fn problems(shown: &Path) -> Option<String> {
+    let name = shown.to_string_lossy();
+    let lines = if name.ends_with(".map") {
+        let e = match read_text(shown) {
+            Err(e) => return Some(e.render(MessageFormat::Human).join("\n")),
+            Ok(src) => placewords::io::mobilesim::import_mobilesim(&src, &name).err()?,
+        };
+        vec![e.to_string()]
+    } else if name.ends_with(".world.toml") {
+        placewords::world::load_world(shown)
+            .err()?
+            .render(MessageFormat::Human)
+    } else {
+        placewords::experiment::load_scenario(shown)
+            .err()?
+            .render(MessageFormat::Human)
+    };
+    Some(lines.join("\n"))
+}
+
+fn check_folder(folder: &str, at_least: usize) {
+    // Paths as messages show them: relative to the crate root, where cargo runs tests.
+    assert_eq!(std::env::current_dir().unwrap(), root());
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml" || x == "map"))
+        .collect();
+    files.sort();
+    assert!(
+        files.len() >= at_least,
+        "only {} fixtures in {folder}",
+        files.len()
+    );
+    let bless = std::env::var_os("PLACEWORDS_BLESS").is_some();
+    let mut failures = Vec::new();
+    for f in files {
+        let expected_path = f.with_extension("expected");
+        let expected_path = PathBuf::from(
+            expected_path
+                .to_string_lossy()
+                .replace(".world.expected", ".expected"),
+        );
+        let Some(got) = problems(&f) else {
+            failures.push(format!(
+                "{}: accepted, but it is an invalid fixture",
+                f.display()
+            ));
+            continue;
+        };
+        if bless {
+            std::fs::write(&expected_path, format!("{got}\n")).unwrap();
+            continue;
+        }
+        let expected = std::fs::read_to_string(&expected_path).unwrap_or_default();
+        if expected.trim_end() != got.trim_end() {
+            failures.push(format!(
+                "{}:\n  expected: {}\n  got:      {got}",
+                f.display(),
+                expected.trim_end()
+            ));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{}\n(re-mint with PLACEWORDS_BLESS=1 if intended)",
+        failures.join("\n")
+    );
+}
+
+#[test]
+fn invalid_scenarios_give_their_messages() {
+    check_folder("tests/fixtures/invalid-scenarios", 15);
+}
+
+#[test]
+fn fuzz_finds_give_located_messages() {
+    check_folder("tests/fixtures/fuzz", 10);
+}
+
+/// Fuzz find 8: a world of 99,000 wall segments passed the checks, then a lap never ended.
+#[test]
+fn a_world_of_99000_segments_is_refused() {
+    let base = std::fs::read_to_string(root().join("worlds/loop-small.toml")).unwrap();
+    let mut src = base + "\n[[walls]]\nid = \"zigzag\"\npoints_m = [";
+    for i in 0..99_001 {
+        src.push_str(&format!(
+            "[{}, {}],",
+            1.0 + (i % 2) as f64 * 0.01,
+            1.0 + i as f64 * 1e-4
+        ));
+    }
+    src.push_str("]\n");
+    let err = placewords::world::parse_world(&src, "big.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("wall segments") && err.contains("(limit 10000)"),
+        "{err}"
+    );
+}
+
+/// Fuzz find 15: a 10 MB key was echoed back whole.
+#[test]
+fn a_huge_key_is_cut_in_the_message() {
+    let key = "k".repeat(10_000_000);
+    let src = format!("format_version = 1\n{key} = 1\n");
+    let err = placewords::world::parse_world(&src, "huge.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("huge.toml:2:1: unknown key `kkk"),
+        "{}",
+        &err[..200.min(err.len())]
+    );
+    assert!(err.len() < 2_000, "message is {} bytes", err.len());
+}
+
+/// Fuzz find 1 (flag form): `--laps` goes through the same limit as `laps` in a file.
+#[test]
+fn the_laps_flag_has_the_files_limit() {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args([
+            "run",
+            "scenarios/smoke.toml",
+            "--laps",
+            "18446744073709551615",
+        ])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("more than 1000"), "{err}");
+}
+
+/// `world check` given a scenario says so in one line; `scenario check` reports every problem
+/// of every file, located, and exits 2.
+#[test]
+fn scenario_check_reports_every_file() {
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_placewords"))
+            .args(args)
+            .current_dir(root())
+            .output()
+            .unwrap()
+    };
+    let o = run(&["world", "check", "scenarios/smoke.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&o.stderr).lines().count(), 1);
+    let o = run(&[
+        "scenario",
+        "check",
+        "scenarios/smoke.toml",
+        "tests/fixtures/invalid-scenarios/many-problems.toml",
+        "tests/fixtures/invalid-scenarios/unknown-route.toml",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.lines().count() >= 5, "{err}");
+    assert!(err.lines().all(|l| l.contains(": error: ")), "{err}");
+    let o = run(&[
+        "scenario",
+        "check",
+        "--message-format",
+        "json",
+        "tests/fixtures/invalid-scenarios/many-problems.toml",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    for line in out.lines() {
+        let v: serde_json::Value = serde_json::from_str(line).unwrap();
+        assert!(
+            v["line"].as_u64().unwrap() >= 1 && v["severity"] == "error",
+            "{line}"
+        );
+    }
+    assert!(out.lines().count() >= 4, "{out}");
+}
+
+/// Every key the readers accept is in the format reference (as `` `key` ``): the key tables
+/// the readers check unknown keys against are the list.
+#[test]
+fn the_format_reference_names_every_key() {
+    use placewords::spec::{evaluation as ev, scenario as sc, world as wo};
+    let recognizer =
+        toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
+    let recognizer_keys: Vec<&str> = recognizer.keys().map(String::as_str).collect();
+    let docs: [(&str, Vec<&[&str]>); 2] = [
+        (
+            "docs/world-format.md",
+            vec![
+                wo::TOP_KEYS,
+                wo::HOME_KEYS,
+                wo::WALL_KEYS,
+                wo::DOOR_KEYS,
+                wo::ROUTE_KEYS,
+                wo::AREA_KEYS,
+            ],
+        ),
+        (
+            "docs/scenario-format.md",
+            vec![
+                sc::TOP_KEYS,
+                sc::RUN_KEYS,
+                sc::DOORS_RANDOM_KEYS,
+                sc::PEDESTRIAN_KEYS,
+                sc::LASER_KEYS,
+                sc::ODOMETRY_KEYS,
+                sc::ROBOT_KEYS,
+                ev::EVALUATION_KEYS,
+                ev::EXPECT_KEYS,
+                ev::EXPECT_LEVEL_KEYS,
+                ev::EXPECT_ICP_KEYS,
+                &recognizer_keys,
+            ],
+        ),
+    ];
+    let mut missing = Vec::new();
+    for (doc, tables) in docs {
+        let text = std::fs::read_to_string(root().join(doc)).unwrap();
+        for key in tables.into_iter().flatten() {
+            if !text.contains(&format!("`{key}`")) {
+                missing.push(format!("{doc}: `{key}`"));
+            }
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "keys the parser accepts but the reference lacks:\n{}",
+        missing.join("\n")
+    );
+}
