@@ -6,6 +6,7 @@
 
 pub mod ambiguity;
 pub mod density;
+pub mod generate;
 pub mod problems;
 
 pub use ambiguity::{AmbiguityReport, AmbiguousStretch, ambiguity, ambiguity_svg};

@@ -276,7 +276,7 @@ fn print_quietly(text: &str) -> anyhow::Result<()> {
 }
 
 fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
-    use placewords::world::generate::{GenerateOptions, generate_toml};
+    use placewords::authoring::generate::{GenerateOptions, generate_toml};
     let [w, h] = args.size_m[..] else {
         bail!("--size-m takes two numbers, W,H (e.g. --size-m 40,30)");
     };

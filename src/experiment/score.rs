@@ -301,20 +301,16 @@ pub fn score_rows(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiment::load_scenario;
     use crate::experiment::{ExperimentOptions, evaluate_runs, recognizer_config};
     use crate::io::matches_csv::{parse_matches, write_matches};
-    use crate::spec::scenario::load_scenario;
 
     /// The smoke scenario simulated and written as `simulate` writes it.
-    fn smoke_logs() -> (
-        tempfile::TempDir,
-        Vec<RunLog>,
-        crate::spec::scenario::Scenario,
-    ) {
+    fn smoke_logs() -> (tempfile::TempDir, Vec<RunLog>, crate::experiment::Scenario) {
         let scn = load_scenario(Path::new("scenarios/smoke.toml")).expect("smoke loads");
-        let runs = crate::sim::simulate(&scn, None, &|| {}).expect("smoke simulates");
+        let runs = crate::sim::simulate(&scn.sim, None, &|| {}).expect("smoke simulates");
         let dir = tempfile::tempdir().expect("temp dir");
-        crate::sim::logs::write_logs(&scn, &runs, None, dir.path()).expect("logs written");
+        crate::sim::logs::write_logs(&scn.sim, &runs, None, dir.path()).expect("logs written");
         (dir, runs, scn)
     }
 
@@ -382,7 +378,7 @@ mod tests {
             ..ExperimentOptions::default()
         };
         let base = recognizer_config(&scn).unwrap();
-        let exp = evaluate_runs("smoke", scn.seed, runs, &base, &spec, &opts).unwrap();
+        let exp = evaluate_runs("smoke", scn.sim.seed, runs, &base, &spec, &opts).unwrap();
         let (_, rec) = &exp.recognitions[0];
         let rows = export_rows(rec, &run_frames(&exp.runs));
         let scored = score_rows(&logs, &rows, "run.csv", &spec, 3).unwrap();

@@ -239,8 +239,8 @@ mod tests {
                     }
                 }
             }
-            for c in 0..nx * ny {
-                assert_eq!(seen[c], 1, "cell {c} from ({ci}, {cj})");
+            for (c, n) in seen.iter().enumerate().take(nx * ny) {
+                assert_eq!(*n, 1, "cell {c} from ({ci}, {cj})");
             }
         }
     }

@@ -2,7 +2,6 @@
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
 pub mod cell_grid;
-pub mod generate;
 pub mod geometry;
 pub mod info;
 pub mod load;

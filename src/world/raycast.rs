@@ -411,6 +411,8 @@ impl RelSegment {
 
 /// Intersects a segment with beams `i0..=i1`, keeping each beam's nearest hit; beams that already
 /// hit something within `dmin` are skipped.
+// Beams are indexed into three parallel arrays (dx, dy, out): an index loop reads clearest.
+#[allow(clippy::needless_range_loop)]
 fn hit_beams(s: &Sensor, g: &RelSegment, i0: usize, i1: usize, dmin: f64, out: &mut [f64]) {
     for i in i0..=i1 {
         if out[i] <= dmin {
@@ -535,6 +537,8 @@ fn cell_span(s: &Sensor, rect: [f64; 4], out: &[f64]) -> Option<BeamSpan> {
 }
 
 /// Intersects a disc with the beams it covers.
+// Beams are indexed into parallel arrays (dx, dy, out): an index loop reads clearest.
+#[allow(clippy::needless_range_loop)]
 fn sweep_disc(s: &Sensor, d: &Disc, out: &mut [f64]) {
     let (cx, cy) = (d.centre.x - s.ox, d.centre.y - s.oy);
     let c2 = cx * cx + cy * cy;
@@ -659,7 +663,7 @@ mod tests {
     fn institute_floor() -> World {
         let p =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/institute-floor.toml");
-        crate::spec::world::load_world(&p).expect("the shipped floor is valid")
+        crate::world::load_world(&p).expect("the shipped floor is valid")
     }
 
     proptest::proptest! {

@@ -2,11 +2,11 @@
 
 use placewords::authoring::ambiguity::ambiguity;
 use placewords::authoring::density::{DEFAULT_SAMPLE_M, density_map, density_svg};
+use placewords::authoring::generate::{GenerateOptions, generate_toml};
 use placewords::geom::Vec2;
 use placewords::recognizer::RecognizerConfig;
-use placewords::spec::world::{load_world, parse_world};
-use placewords::world::generate::{GenerateOptions, generate_toml};
 use placewords::world::{DoorStates, World};
+use placewords::world::{load_world, parse_world};
 use std::path::PathBuf;
 use std::process::Command;
 
