@@ -1,92 +1,108 @@
-//! `placewords check SCENARIO...`: the CI gate. Runs each scenario and compares it with its
-//! `[expect]` block; one PASS/FAIL line per expectation; exit 0 all pass, 1 any missed, 2 error.
+//! `placewords check SCENARIO...`: the CI gate. Runs each scenario over its seeds and compares
+//! the worst seed (or the `[expect]` quantile) with its `[expect]` block; one PASS/FAIL line per
+//! bound, then `N passed, M failed`; exit 0 all pass, 1 any missed, 2 error. With `--shard K/N`
+//! it runs one part of the work and writes it for `merge`.
 
-use super::common::write_file;
+use super::common::SeedsArg;
+use anyhow::Context;
 use clap::Args;
-use placewords::eval::gate;
-use placewords::experiment::{self, ExperimentOptions};
-use placewords::report::junit::{Suite, junit_xml};
-use std::path::PathBuf;
+use placewords::eval::suite::SuiteReport;
+use placewords::experiment::ExperimentOptions;
+use placewords::experiment::stress::{self, StressOptions};
+use placewords::report::{junit, suite as format};
+use placewords::spec::seeds::Shard;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
 
 #[derive(Debug, Args)]
 pub struct CheckArgs {
     /// Scenario files (TOML) with an [expect] block.
     #[arg(required = true)]
     pub scenarios: Vec<PathBuf>,
-    /// Also write a JUnit XML file (one testcase per expectation).
+    #[command(flatten)]
+    pub seeds: SeedsArg,
+    /// Run only part K of N of the (scenario × seed) work and write it with --report, for
+    /// `placewords merge`. `auto`: K from JOB_COMPLETION_INDEX (Kubernetes Indexed Job, 0-based),
+    /// N from --shard-count or PLACEWORDS_SHARD_COUNT.
+    #[arg(long, value_name = "K/N|auto")]
+    pub shard: Option<String>,
+    /// The number of parts for `--shard auto` (default: PLACEWORDS_SHARD_COUNT).
+    #[arg(long, value_name = "N")]
+    pub shard_count: Option<usize>,
+    /// Write the whole report (every seed's results, the figures, the gate) as JSON; with
+    /// --shard, the part for `merge`.
+    #[arg(long, value_name = "OUT.json")]
+    pub report: Option<PathBuf>,
+    /// Write DIR/report.json, DIR/table.md and DIR/junit.xml.
+    #[arg(long, short, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Also write a JUnit XML file (one testcase per bound).
     #[arg(long, value_name = "OUT.xml")]
     pub junit: Option<PathBuf>,
-    /// Replace the scenario's seed.
-    #[arg(long, value_name = "N")]
-    pub seed: Option<u64>,
-    /// No progress bars.
+    /// Print a JSON summary on stdout instead of the tables and lines.
+    #[arg(long)]
+    pub json: bool,
+    /// Skip a scenario without [expect] instead of failing (exit 2) on it.
+    #[arg(long)]
+    pub allow_no_expect: bool,
+    /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
 }
 
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
-    let mut suites = Vec::new();
-    let mut errors = 0;
-    for path in &args.scenarios {
-        let t = Instant::now();
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| path.display().to_string());
-        let outcome = (|| -> anyhow::Result<Vec<gate::Outcome>> {
-            let mut scn = placewords::experiment::load_scenario(path)?;
-            if let Some(seed) = args.seed {
-                scn.sim.seed = seed;
-            }
-            let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
-            levels.sort_unstable();
-            levels.dedup();
-            if levels.is_empty() && scn.expect.icp.is_none() {
-                eprintln!(
-                    "{}: no [expect] block, nothing to check; add [[expect.levels]] entries",
-                    path.display()
-                );
-                return Ok(Vec::new());
-            }
-            let opts = ExperimentOptions {
-                levels,
-                icp: scn.expect.icp.is_some(),
-                laps: None,
-                quiet: args.quiet,
-            };
-            let exp = experiment::run_scenario(&scn, &opts)?;
-            Ok(gate::check(&exp.report, &scn.expect))
-        })();
-        match outcome {
-            Ok(outcomes) => {
-                for o in &outcomes {
-                    outln!("{}", o.line())?;
-                }
-                suites.push(Suite {
-                    scenario: name,
-                    outcomes,
-                    error: None,
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
-            Err(e) => {
-                errors += 1;
-                eprintln!("error: {e:#}");
-                outln!("ERROR {name}")?;
-                suites.push(Suite {
-                    scenario: name,
-                    outcomes: Vec::new(),
-                    error: Some(format!("{e:#}")),
-                    seconds: t.elapsed().as_secs_f64(),
-                });
-            }
-        }
+    let shard = match args.shard.as_deref() {
+        None => None,
+        Some("auto") => Some(Shard::from_env(args.shard_count).map_err(anyhow::Error::msg)?),
+        Some(s) => Some(s.parse::<Shard>().map_err(anyhow::Error::msg)?),
+    };
+    if shard.is_some() && args.report.is_none() {
+        anyhow::bail!("--shard writes a part for `merge`; add --report PART.json");
     }
-    if let Some(path) = &args.junit {
-        write_file(path, junit_xml(&suites).as_bytes())?;
+    let opts = StressOptions {
+        seeds: args.seeds.range(),
+        shard,
+        gate: true,
+        allow_no_expect: args.allow_no_expect,
+        experiment: ExperimentOptions {
+            quiet: args.quiet,
+            ..ExperimentOptions::default()
+        },
+    };
+    let suite = stress::run_stress(&args.scenarios, &opts);
+    if let Some(path) = &args.report {
+        stress::write_file(path, suite.to_json().as_bytes())?;
     }
-    let outcomes = suites.iter().flat_map(|s| &s.outcomes);
-    Ok(ExitCode::from(gate::gate_exit_code(errors, outcomes)))
+    finish(
+        &suite,
+        args.out.as_deref(),
+        args.junit.as_deref(),
+        args.json,
+    )
+}
+
+/// Prints a stress run's verdict, writes the outputs asked for, and gives the exit code (a
+/// part exits 0 unless something failed to run: its seeds are not the distribution).
+pub fn finish(
+    suite: &SuiteReport,
+    out: Option<&Path>,
+    junit_path: Option<&Path>,
+    json: bool,
+) -> anyhow::Result<ExitCode> {
+    if let Some(dir) = out {
+        stress::write_dir(suite, dir).with_context(|| "writing the outputs")?;
+    }
+    if let Some(path) = junit_path {
+        let xml = junit::junit_xml(&junit::suites(suite));
+        stress::write_file(path, xml.as_bytes())?;
+    }
+    for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
+        eprintln!("error: {e}");
+    }
+    if json {
+        outln!("{}", format::summary_json(suite))?;
+    } else {
+        out!("{}", format::check_text(suite))?;
+    }
+    Ok(ExitCode::from(suite.exit_code()))
 }

@@ -69,3 +69,23 @@ pub fn print_and_write(
     eprintln!("pictures: {}", dir.display());
     Ok(())
 }
+
+/// `--seeds A..B` or `--seed N`: which seeds to run.
+#[derive(Debug, Args)]
+pub struct SeedsArg {
+    /// Run every seed from A to B (both included), e.g. 1..20. Each seed re-draws everything
+    /// random: noise, doors drawn at random, people, lap variation.
+    #[arg(long, value_name = "A..B", conflicts_with = "seed")]
+    pub seeds: Option<placewords::spec::seeds::SeedRange>,
+    /// Run this seed only (the scenario's `seed` is replaced).
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+}
+
+impl SeedsArg {
+    /// The seeds asked for, if any.
+    pub fn range(&self) -> Option<placewords::spec::seeds::SeedRange> {
+        self.seeds
+            .or(self.seed.map(placewords::spec::seeds::SeedRange::one))
+    }
+}

@@ -17,6 +17,7 @@ use std::process::ExitCode;
 pub mod check;
 pub mod common;
 pub mod import;
+pub mod merge;
 pub mod out;
 pub mod recognize;
 pub mod run;
@@ -50,6 +51,8 @@ pub enum Command {
     Run(run::RunArgs),
     /// Run scenarios and compare them with their [expect] blocks (the CI gate).
     Check(check::CheckArgs),
+    /// Join the parts of a sharded `check` into one report, table and JUnit file.
+    Merge(merge::MergeArgs),
     /// The paper's Table I for one or more scenarios, as Markdown and JSON.
     Table(table::TableArgs),
     /// The paper's Fig. 8: precision/recall over the n-gram thresholds.
@@ -67,6 +70,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Simulate(a) => simulate::run(a),
         Command::Run(a) => run::run(a),
         Command::Check(a) => check::run(a),
+        Command::Merge(a) => merge::run(a),
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),

@@ -1,7 +1,9 @@
-//! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report.
+//! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report; over
+//! a range of seeds with `--seeds A..B` (mean and worst per configuration).
 
-use super::common::{LevelsArg, print_and_write};
+use super::common::{LevelsArg, SeedsArg, print_and_write, write_file};
 use clap::Args;
+use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::{self, ExperimentOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -12,25 +14,26 @@ pub struct RunArgs {
     pub scenario: PathBuf,
     #[command(flatten)]
     pub levels: LevelsArg,
+    #[command(flatten)]
+    pub seeds: SeedsArg,
     /// Also run the ICP baseline (slow: every region is aligned with every past region).
     #[arg(long)]
     pub icp: bool,
     /// Replace every run's lap count (for a quick look).
     #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
-    /// Write the JSON report here (schema in the README).
+    /// Write the JSON report here (schema in the README; with --seeds, every seed's report and
+    /// the figures over seeds).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
     /// Write pictures here: the true and odometry paths; per level configuration, the true path
     /// coloured where revisits were recognized, wrong or missed, and recall and precision per lap.
-    #[arg(long, value_name = "DIR")]
+    /// One seed only.
+    #[arg(long, value_name = "DIR", conflicts_with = "seeds")]
     pub svg: Option<PathBuf>,
-    /// Replace the scenario's seed.
-    #[arg(long, value_name = "N")]
-    pub seed: Option<u64>,
     /// Write the matched scan pairs of the last level configuration run (`--levels N`) as a
-    /// matches file for `placewords score` (docs/scoring.md).
-    #[arg(long, value_name = "FILE")]
+    /// matches file for `placewords score` (docs/scoring.md). One seed only.
+    #[arg(long, value_name = "FILE", conflicts_with = "seeds")]
     pub export_matches: Option<PathBuf>,
     /// No progress bars.
     #[arg(long, short)]
@@ -38,16 +41,33 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
-    if let Some(seed) = args.seed {
-        scn.sim.seed = seed;
-    }
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
         laps: args.laps,
         quiet: args.quiet,
     };
+    if let Some(seeds) = args.seeds.seeds {
+        let stress_opts = StressOptions {
+            seeds: Some(seeds),
+            experiment: opts,
+            ..StressOptions::default()
+        };
+        let suite = stress::run_stress(std::slice::from_ref(&args.scenario), &stress_opts);
+        out!("{}", placewords::report::suite::text_table(&suite))?;
+        if let Some(path) = &args.report {
+            write_file(path, suite.to_json().as_bytes())?;
+            eprintln!("report: {}", path.display());
+        }
+        if let Some(e) = suite.scenarios.iter().flat_map(|s| s.errors()).next() {
+            anyhow::bail!("{e}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
+    if let Some(seed) = args.seeds.seed {
+        scn.sim.seed = seed;
+    }
     let exp = experiment::run_scenario(&scn, &opts)?;
     if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
         super::score::export(path, rec, &exp.runs)?;

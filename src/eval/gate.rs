@@ -1,13 +1,16 @@
-//! The CI gate: a report against a scenario's `[expect]` block.
+//! The CI gate: the reports of a scenario's seeds against its `[expect]` block.
 //!
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
 //! testcase): `min_precision`, `min_recall`, `min_visit_recall`, `min_pair_recall` and
-//! `max_seconds_per_lap` of each `[[expect.levels]]`
-//! entry and of `[expect.icp]`. A bound on a configuration the report does not hold fails
-//! ("not in the report"). Exit decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a
-//! scenario could not be run (an error), else 1 when any outcome missed, else 0.
+//! `max_seconds_per_lap` of each `[[expect.levels]]` entry and of `[expect.icp]`. A bound applies
+//! to the worst seed, or with `quantile = q` to the q-quantile from the worst end
+//! (`eval::distribution`). A bound on a configuration no report holds fails ("not in the
+//! report"), and so does a precision bound when no seed matched anything ("no matches"). Exit
+//! decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a scenario or seed could not
+//! be run (an error), else 1 when any outcome missed, else 0.
 
-use crate::eval::scores::{Report, Scores};
+use crate::eval::distribution::{self, Metric};
+use crate::eval::scores::Report;
 use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
@@ -22,28 +25,54 @@ pub enum Bound {
     MaxSecondsPerLap,
 }
 
-/// The result of checking one bound.
+impl Bound {
+    /// The metric the bound is on.
+    pub fn metric(self) -> Metric {
+        match self {
+            Bound::MinPrecision => Metric::Precision,
+            Bound::MinRecall => Metric::Recall,
+            Bound::MinVisitRecall => Metric::VisitRecall,
+            Bound::MinPairRecall => Metric::PairRecall,
+            Bound::MaxSecondsPerLap => Metric::SecondsPerLap,
+        }
+    }
+}
+
+/// The result of checking one bound over the seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
+    /// Scenario label (its name; with its file when two scenarios share a name).
     pub scenario: String,
     /// "levels=3" or "icp".
     pub subject: String,
     pub bound: Bound,
     /// The bound from the scenario file.
     pub limit: f64,
-    /// What the report holds; `None` when the configuration is not in the report.
+    /// The quantile the bound applies to; `None`: the worst seed.
+    pub quantile: Option<f64>,
+    /// The figure checked; `None` when there is none (see `missing`).
     pub actual: Option<f64>,
+    /// The seed whose result `actual` is.
+    pub seed: Option<u64>,
+    /// Seeds with a value for the metric.
+    pub seeds: usize,
+    /// Seeds checked (those that matched nothing included).
+    pub runs: usize,
+    /// Why there is no figure: "not in the report" or "no matches".
+    pub missing: Option<String>,
     pub passed: bool,
+    /// Seconds the configuration spent recognizing, over all seeds.
+    pub seconds: f64,
 }
 
 impl Outcome {
-    /// The testcase name: `levels=3 precision >= 0.90`.
+    /// The testcase name, the same whatever the bound: `B/levels=3/precision`.
     pub fn name(&self) -> String {
-        let (what, op) = self.what_op();
         format!(
-            "{} {what} {op} {}",
+            "{}/{}/{}",
+            self.scenario,
             self.subject,
-            fmt_limit(self.bound, self.limit)
+            self.bound.metric().name()
         )
     }
 
@@ -57,24 +86,42 @@ impl Outcome {
         }
     }
 
-    /// The line printed for people: `PASS B levels=3 precision 0.93 >= 0.90`.
+    /// "worst" or "p10" (the statistic the bound applies to).
+    pub fn statistic(&self) -> String {
+        match self.quantile {
+            None => "worst".into(),
+            Some(q) => format!("p{}", fmt_quantile(q)),
+        }
+    }
+
+    /// The line printed for people: `PASS B levels=3 precision worst 0.930 >= 0.900 (seed 7 of
+    /// 20)`.
     pub fn line(&self) -> String {
         let status = if self.passed { "PASS" } else { "FAIL" };
         let (what, op) = self.what_op();
-        let limit = fmt_limit(self.bound, self.limit);
-        match self.actual {
-            Some(a) => {
+        let limit = fmt_value(self.bound, self.limit);
+        let stat = self.statistic();
+        match (self.actual, self.seed) {
+            (Some(a), Some(seed)) => {
                 let op = if self.passed { op } else { negate(op) };
+                let n = self.runs;
+                let of = match n - self.seeds {
+                    0 if n == 1 => "over 1 seed".to_string(),
+                    0 => format!("over {n} seeds"),
+                    nothing => format!("over {n} seeds; {nothing} matched nothing"),
+                };
                 format!(
-                    "{status} {} {} {what} {} {op} {limit}",
+                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed}, {of})",
                     self.scenario,
                     self.subject,
-                    fmt_limit(self.bound, a)
+                    fmt_value(self.bound, a),
                 )
             }
-            None => format!(
-                "{status} {} {} {what} {op} {limit}: not in the report",
-                self.scenario, self.subject
+            _ => format!(
+                "{status} {} {} {what} {op} {limit}: {}",
+                self.scenario,
+                self.subject,
+                self.missing.as_deref().unwrap_or("not in the report")
             ),
         }
     }
@@ -84,71 +131,112 @@ fn negate(op: &str) -> &'static str {
     if op == ">=" { "<" } else { ">" }
 }
 
-fn fmt_limit(bound: Bound, v: f64) -> String {
+/// A bound or a measured value as printed: ratios with 3 decimals, times in seconds.
+pub fn fmt_value(bound: Bound, v: f64) -> String {
     match bound {
         Bound::MaxSecondsPerLap => format!("{v:.2}s"),
         _ => format!("{v:.3}"),
     }
 }
 
-/// Checks `report` against `expect`: one outcome per bound, in file order (levels entries,
-/// then ICP; precision, recall, time within each).
-pub fn check(report: &Report, expect: &ExpectSpec) -> Vec<Outcome> {
-    let mut out = Vec::new();
-    for e in &expect.levels {
-        let scores = report.level(e.levels).map(|l| &l.scores);
-        push_bounds(
-            &mut out,
-            &report.scenario,
-            &format!("levels={}", e.levels),
-            &e.expectation(),
-            scores,
-        );
+/// 0.1 → "10", 0.25 → "25", 0.125 → "12.5".
+fn fmt_quantile(q: f64) -> String {
+    let pct = q * 100.0;
+    if (pct - pct.round()).abs() < 1e-9 {
+        format!("{}", pct.round() as i64)
+    } else {
+        format!("{pct}")
     }
+}
+
+/// Checks one report (one seed) against `expect`.
+pub fn check(report: &Report, expect: &ExpectSpec) -> Vec<Outcome> {
+    check_seeds(&report.scenario, std::slice::from_ref(report), expect)
+}
+
+/// Checks the reports of a scenario's seeds against `expect`: one outcome per bound, in file
+/// order (levels entries, then ICP; precision, recall, time within each).
+pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> Vec<Outcome> {
+    let mut out = Vec::new();
+    let mut entries: Vec<(String, Expectation)> = expect
+        .levels
+        .iter()
+        .map(|e| (format!("levels={}", e.levels), e.expectation()))
+        .collect();
     if let Some(e) = &expect.icp {
-        let scores = report.icp.as_ref().map(|i| &i.scores);
-        push_bounds(&mut out, &report.scenario, "icp", e, scores);
+        entries.push(("icp".into(), e.clone()));
+    }
+    for (subject, e) in entries {
+        let bounds = [
+            (Bound::MinPrecision, e.min_precision),
+            (Bound::MinRecall, e.min_recall),
+            (Bound::MinVisitRecall, e.min_visit_recall),
+            (Bound::MinPairRecall, e.min_pair_recall),
+            (Bound::MaxSecondsPerLap, e.max_seconds_per_lap),
+        ];
+        for (bound, limit) in bounds {
+            let Some(limit) = limit else { continue };
+            out.push(check_bound(
+                scenario,
+                reports,
+                &subject,
+                bound,
+                limit,
+                expect.quantile,
+            ));
+        }
     }
     out
 }
 
-fn push_bounds(
-    out: &mut Vec<Outcome>,
+fn check_bound(
     scenario: &str,
+    reports: &[Report],
     subject: &str,
-    e: &Expectation,
-    scores: Option<&Scores>,
-) {
-    let bounds = [
-        (Bound::MinPrecision, e.min_precision),
-        (Bound::MinRecall, e.min_recall),
-        (Bound::MinVisitRecall, e.min_visit_recall),
-        (Bound::MinPairRecall, e.min_pair_recall),
-        (Bound::MaxSecondsPerLap, e.max_seconds_per_lap),
-    ];
-    for (bound, limit) in bounds {
-        let Some(limit) = limit else { continue };
-        let actual = scores.map(|s| match bound {
-            Bound::MinPrecision => s.precision,
-            Bound::MinRecall => s.recall,
-            Bound::MinVisitRecall => s.visit_recall,
-            Bound::MinPairRecall => s.pair_recall,
-            Bound::MaxSecondsPerLap => s.recognize_seconds_per_lap,
-        });
-        let passed = match (bound, actual) {
-            (_, None) => false,
-            (Bound::MaxSecondsPerLap, Some(a)) => a <= limit,
-            (_, Some(a)) => a >= limit,
-        };
-        out.push(Outcome {
-            scenario: scenario.to_string(),
-            subject: subject.to_string(),
-            bound,
-            limit,
-            actual,
-            passed,
-        });
+    bound: Bound,
+    limit: f64,
+    quantile: Option<f64>,
+) -> Outcome {
+    let metric = bound.metric();
+    let samples = distribution::samples(reports, subject, metric);
+    let at = distribution::quantile(&samples, quantile.unwrap_or(0.0), metric.higher_is_better());
+    let present = reports
+        .iter()
+        .any(|r| distribution::scores_of(r, subject).is_some());
+    let missing = match (at, present) {
+        (Some(_), _) => None,
+        (None, true) => Some("no matches at any seed".to_string()),
+        (None, false) => Some("not in the report".to_string()),
+    };
+    let passed = match at {
+        None => false,
+        Some((_, a)) if metric.higher_is_better() => a >= limit,
+        Some((_, a)) => a <= limit,
+    };
+    Outcome {
+        scenario: scenario.to_string(),
+        subject: subject.to_string(),
+        bound,
+        limit,
+        quantile,
+        actual: at.map(|a| a.1),
+        seed: at.map(|a| a.0),
+        seeds: samples.len(),
+        runs: reports.len(),
+        missing,
+        passed,
+        seconds: recognize_seconds(reports, subject),
     }
+}
+
+/// Seconds `subject` spent recognizing, over all `reports`.
+fn recognize_seconds(reports: &[Report], subject: &str) -> f64 {
+    reports
+        .iter()
+        .filter_map(|r| {
+            distribution::scores_of(r, subject).map(|s| s.recognize_seconds_per_lap * r.laps as f64)
+        })
+        .sum()
 }
 
 /// 0 when every outcome passed, 1 when any missed.
@@ -191,12 +279,20 @@ mod tests {
         let spec = ExpectSpec {
             levels: vec![expect(3, 0.9, 0.3, Some(2.0)), expect(1, 0.9, 0.1, None)],
             icp: None,
+            quantile: None,
         };
         let o = check(&rep, &spec);
         assert_eq!(o.len(), 5);
         assert_eq!(exit_code(&o), 0);
-        assert_eq!(o[0].line(), "PASS B levels=3 precision 0.900 >= 0.900");
-        assert_eq!(o[2].line(), "PASS B levels=3 s/lap 1.50s <= 2.00s");
+        assert_eq!(
+            o[0].line(),
+            "PASS B levels=3 precision worst 0.900 >= 0.900 (seed 7, over 1 seed)"
+        );
+        assert_eq!(o[0].name(), "B/levels=3/precision");
+        assert_eq!(
+            o[2].line(),
+            "PASS B levels=3 s/lap worst 1.50s <= 2.00s (seed 7, over 1 seed)"
+        );
     }
 
     #[test]
@@ -208,10 +304,14 @@ mod tests {
                 min_precision: Some(0.01),
                 ..Expectation::default()
             }),
+            quantile: None,
         };
         let o = check(&rep, &spec);
         assert_eq!(exit_code(&o), 1);
-        assert_eq!(o[0].line(), "FAIL C levels=2 precision 0.910 < 0.950");
+        assert_eq!(
+            o[0].line(),
+            "FAIL C levels=2 precision worst 0.910 < 0.950 (seed 7, over 1 seed)"
+        );
         assert!(o[1].passed && o[2].passed);
         assert_eq!(o[2].subject, "icp");
     }
@@ -227,6 +327,7 @@ mod tests {
                 min_recall: Some(0.0),
                 ..Expectation::default()
             }),
+            quantile: None,
         };
         let o = check(&rep, &spec);
         assert!(o.iter().all(|o| !o.passed));
@@ -243,5 +344,52 @@ mod tests {
         let rep = sample("A", [0.9; 3], [0.1; 3]);
         assert_eq!(exit_code(&check(&rep, &ExpectSpec::default())), 0);
         assert_eq!(gate_exit_code(1, &check(&rep, &ExpectSpec::default())), 2);
+    }
+
+    #[test]
+    fn bounds_apply_to_the_worst_seed_or_to_the_quantile() {
+        let reports: Vec<Report> = (1..=10)
+            .map(|seed| {
+                let mut r = sample("A", [0.9; 3], [0.5; 3]);
+                r.seed = seed;
+                r.levels[2].scores.precision = if seed == 4 { 0.6 } else { 0.9 };
+                r
+            })
+            .collect();
+        let mut spec = ExpectSpec {
+            levels: vec![expect(3, 0.8, 0.0, None)],
+            icp: None,
+            quantile: None,
+        };
+        let worst = check_seeds("A", &reports, &spec);
+        assert!(!worst[0].passed);
+        assert_eq!((worst[0].seed, worst[0].seeds), (Some(4), 10));
+        spec.quantile = Some(0.2);
+        let p20 = check_seeds("A", &reports, &spec);
+        assert!(p20[0].passed, "{}", p20[0].line());
+        assert!(
+            p20[0].line().contains("precision p20 0.900"),
+            "{}",
+            p20[0].line()
+        );
+    }
+
+    #[test]
+    fn no_matches_at_any_seed_fails_a_precision_bound_by_name() {
+        let mut rep = sample("A", [0.9; 3], [0.0; 3]);
+        rep.levels[0].scores.no_pairs = true;
+        let spec = ExpectSpec {
+            levels: vec![expect(1, 0.5, 0.0, None)],
+            icp: None,
+            quantile: None,
+        };
+        let o = check(&rep, &spec);
+        assert!(!o[0].passed);
+        assert!(
+            o[0].line().ends_with("no matches at any seed"),
+            "{}",
+            o[0].line()
+        );
+        assert!(o[1].passed, "recall 0 >= 0");
     }
 }

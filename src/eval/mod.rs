@@ -7,10 +7,12 @@
 //! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
+pub mod distribution;
 pub mod gate;
 pub mod metrics;
 pub mod pair_recall;
 pub mod scores;
+pub mod suite;
 pub mod sweep;
 
 use crate::geom::TruePose;

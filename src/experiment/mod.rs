@@ -7,6 +7,7 @@ pub mod picture;
 pub mod real;
 pub mod scenario;
 pub mod score;
+pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::scores::Report;

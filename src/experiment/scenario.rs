@@ -8,7 +8,8 @@
 //! name = "smoke"                        # optional; default: the file stem
 //! world = "../worlds/loop-small.toml"   # relative to this file
 //! route = "lap"
-//! seed = 42
+//! seed = 42                             # the seed of `run` (and of `check` without `seeds`)
+//! seeds = "1..20"                       # optional: the seeds `check` runs (both ends included)
 //!
 //! [door_configs]                        # named sets of open doors
 //! south-open = ["d-south"]
@@ -58,6 +59,7 @@ use crate::sim::variation::LapVariationConfig;
 use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
+use crate::spec::seeds::SeedRange;
 use crate::spec::suggest::hint;
 use crate::spec::{SpecError, scenario::read_scenario};
 use crate::world::{DoorStates, Route, World, WorldCheck};
@@ -73,6 +75,8 @@ pub struct Scenario {
     /// The simulation: world, route, seed, runs and models (its `name` is the scenario's).
     pub sim: SimPlan,
     pub description: Option<String>,
+    /// The seeds `check` runs by default (`seeds = "1..20"`); `None`: only `sim.seed`.
+    pub seeds: Option<SeedRange>,
     /// Recognizer settings: the `[recognizer]` table over the defaults.
     pub recognizer: RecognizerConfig,
     pub evaluation: EvaluationSpec,
@@ -122,6 +126,7 @@ pub fn parse_scenario(
             recognizer: sim.1,
             sim: sim.0,
             description: spec.description,
+            seeds: spec.seeds.map(|s| s.into_inner()),
             evaluation: spec.evaluation,
             expect: spec.expect,
         }),

@@ -1,21 +1,50 @@
-//! JUnit XML for `placewords check --junit`: one `<testsuite>` per scenario, one `<testcase>` per
-//! checked bound, `<failure>` for a missed bound, `<error>` for a scenario that could not run.
-//! The dialect is the common one Jenkins, GitLab and GitHub test reporters read.
+//! JUnit XML for `placewords check --junit` and `merge`: one `<testsuite>` per scenario, one
+//! `<testcase>` per checked bound, `<failure>` for a missed bound, `<error>` for a scenario or
+//! seed that could not run. The dialect is the common one Jenkins, GitLab and GitHub test
+//! reporters read.
+//!
+//! Test case names do not change when a bound does (`B/levels=3/precision`); the class name
+//! is the scenario file, so two scenarios of one name stay apart. Each test case carries the
+//! measured value, the bound, the statistic (worst or a quantile), the seed it came from and
+//! the command reproducing it as `<properties>`, and its `time` is the seconds its
+//! configuration spent recognizing over all seeds.
 
 pub use super::xml::escape;
-use crate::eval::gate::Outcome;
+use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::suite::{SuiteReport, reproduce_command};
+use std::fmt::Write;
 
 /// What `check` knows about one scenario.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Suite {
-    /// Scenario name (the testsuite name).
+    /// Scenario label (the testsuite name).
     pub scenario: String,
+    /// The scenario file (the class name of its test cases).
+    pub file: String,
     /// The gate's outcomes (empty when the scenario failed to run).
     pub outcomes: Vec<Outcome>,
-    /// Why the scenario could not run (exit code 2), if it could not.
+    /// Why the scenario (or some of its seeds) could not run (exit code 2), if so.
     pub error: Option<String>,
-    /// Wall-clock seconds the scenario took.
+    /// Wall-clock seconds the scenario took, over all seeds.
     pub seconds: f64,
+}
+
+/// The JUnit suites of a stress run.
+pub fn suites(report: &SuiteReport) -> Vec<Suite> {
+    report
+        .scenarios
+        .iter()
+        .map(|sc| {
+            let errors = sc.errors();
+            Suite {
+                scenario: sc.label.clone(),
+                file: sc.file.clone(),
+                outcomes: sc.outcomes.clone(),
+                error: (!errors.is_empty()).then(|| errors.join("\n")),
+                seconds: sc.seconds(),
+            }
+        })
+        .collect()
 }
 
 /// The JUnit XML document of `suites`.
@@ -27,48 +56,94 @@ pub fn junit_xml(suites: &[Suite]) -> String {
     let errors = suites.iter().filter(|s| s.error.is_some()).count();
     let time: f64 = suites.iter().map(|s| s.seconds).sum();
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    x.push_str(&format!(
+    let _ = writeln!(
+        x,
         "<testsuites name=\"placewords check\" tests=\"{tests}\" failures=\"{failures}\" \
-         errors=\"{errors}\" time=\"{time:.3}\">\n"
-    ));
+         errors=\"{errors}\" time=\"{time:.3}\">"
+    );
     for s in suites {
-        let name = escape(&s.scenario);
-        x.push_str(&format!(
-            "  <testsuite name=\"{name}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" \
-             skipped=\"0\" time=\"{:.3}\">\n",
+        let _ = writeln!(
+            x,
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" \
+             skipped=\"0\" time=\"{:.3}\">",
+            escape(&s.scenario),
             count(s),
             fails(s),
             s.error.is_some() as usize,
             s.seconds
-        ));
-        let classname = escape(&format!("placewords.{}", s.scenario));
+        );
         if let Some(err) = &s.error {
-            x.push_str(&format!(
-                "    <testcase name=\"run\" classname=\"{classname}\" time=\"{:.3}\">\n      \
-                 <error message=\"{}\" type=\"error\">{}</error>\n    </testcase>\n",
-                s.seconds,
-                escape(first_line(err)),
-                escape(err)
-            ));
+            x.push_str(&error_case(s, err));
         }
         for o in &s.outcomes {
-            let name = escape(&o.name());
-            if o.passed {
-                x.push_str(&format!(
-                    "    <testcase name=\"{name}\" classname=\"{classname}\" time=\"0\"/>\n"
-                ));
-            } else {
-                let line = escape(&o.line());
-                x.push_str(&format!(
-                    "    <testcase name=\"{name}\" classname=\"{classname}\" time=\"0\">\n      \
-                     <failure message=\"{line}\" type=\"expectation\">{line}</failure>\n    \
-                     </testcase>\n"
-                ));
-            }
+            x.push_str(&testcase(o, &s.file));
         }
         x.push_str("  </testsuite>\n");
     }
     x.push_str("</testsuites>\n");
+    x
+}
+
+/// The `<testcase>` of a scenario (or some of its seeds) that could not run.
+fn error_case(s: &Suite, err: &str) -> String {
+    format!(
+        "    <testcase name=\"{}/run\" classname=\"{}\" time=\"{:.3}\">\n      \
+         <error message=\"{}\" type=\"error\">{}</error>\n    </testcase>\n",
+        escape(&s.scenario),
+        escape(&s.file),
+        s.seconds,
+        escape(first_line(err)),
+        escape(err)
+    )
+}
+
+/// The properties of a test case: measured value, statistic, bound, seeds, seed, command.
+fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
+    let mut props = vec![
+        ("statistic", o.statistic()),
+        ("bound", fmt_value(o.bound, o.limit)),
+        ("seeds", o.seeds.to_string()),
+    ];
+    if let Some(a) = o.actual {
+        props.insert(0, ("value", fmt_value(o.bound, a)));
+    }
+    if let Some(seed) = o.seed {
+        props.push(("seed", seed.to_string()));
+        props.push(("reproduce", reproduce_command(file, seed)));
+    }
+    props
+}
+
+/// One `<testcase>` with its properties and, if missed, its failure.
+fn testcase(o: &Outcome, file: &str) -> String {
+    let mut x = format!(
+        "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"{:.3}\">\n      <properties>\n",
+        escape(&o.name()),
+        escape(file),
+        escape(file),
+        o.seconds
+    );
+    for (k, v) in properties(o, file) {
+        let _ = writeln!(
+            x,
+            "        <property name=\"{k}\" value=\"{}\"/>",
+            escape(&v)
+        );
+    }
+    x.push_str("      </properties>\n");
+    if !o.passed {
+        let mut text = o.line();
+        if let Some(seed) = o.seed {
+            let _ = write!(text, "; reproduce: {}", reproduce_command(file, seed));
+        }
+        let line = escape(&o.line());
+        let _ = writeln!(
+            x,
+            "      <failure message=\"{line}\" type=\"expectation\">{}</failure>",
+            escape(&text)
+        );
+    }
+    x.push_str("    </testcase>\n");
     x
 }
 
@@ -104,18 +179,21 @@ mod tests {
                 max_seconds_per_lap: None,
             }],
             icp: None,
+            quantile: None,
         };
         let outcomes = check(&rep, &spec);
         assert_eq!(outcomes[0].bound, Bound::MinPrecision);
         let xml = junit_xml(&[
             Suite {
                 scenario: rep.scenario.clone(),
+                file: "scenarios/B.toml".into(),
                 outcomes,
                 error: None,
                 seconds: 1.5,
             },
             Suite {
                 scenario: "broken".into(),
+                file: "x.toml".into(),
                 outcomes: vec![],
                 error: Some("scenarios/x.toml:3:1: unknown field `lapz`\n\"hint\"".into()),
                 seconds: 0.0,
@@ -141,8 +219,20 @@ mod tests {
             .expect("a failure element");
         assert_eq!(
             failure.attribute("message"),
-            Some("FAIL B<&> levels=3 precision 0.900 < 0.950")
+            Some("FAIL B<&> levels=3 precision worst 0.900 < 0.950 (seed 7, over 1 seed)")
         );
+        assert_eq!(cases[0].attribute("name"), Some("B<&>/levels=3/precision"));
+        assert!(
+            failure
+                .text()
+                .unwrap()
+                .contains("placewords run scenarios/B.toml --seed 7")
+        );
+        let value = cases[0]
+            .descendants()
+            .find(|n| n.attribute("name") == Some("value"))
+            .and_then(|n| n.attribute("value"));
+        assert_eq!(value, Some("0.900"));
         assert!(!cases[1].children().any(|n| n.has_tag_name("failure")));
         let error = suites[1]
             .descendants()

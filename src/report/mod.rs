@@ -4,6 +4,7 @@ pub mod json;
 pub mod junit;
 pub mod lap_strip;
 pub mod plot;
+pub mod suite;
 pub mod svg;
 pub mod table;
 pub mod world_render;

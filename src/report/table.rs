@@ -20,7 +20,7 @@ fn rows(report: &Report) -> Vec<(String, &Scores)> {
 }
 
 /// Left-aligned first column, right-aligned others, two spaces apart.
-fn render(header: &[&str], body: &[Vec<String>]) -> String {
+pub(crate) fn render(header: &[&str], body: &[Vec<String>]) -> String {
     let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
     for r in body {
         for (i, c) in r.iter().enumerate() {
@@ -144,7 +144,7 @@ pub fn text_table(report: &Report) -> String {
 
 fn fmt_p(s: &Scores) -> String {
     if s.no_pairs {
-        "- (no pairs)".to_string()
+        "no matches".to_string()
     } else {
         format!("{:.3}", s.precision)
     }
@@ -155,7 +155,7 @@ fn fmt_p(s: &Scores) -> String {
 pub fn markdown_table_i(reports: &[Report]) -> String {
     markdown_by_level(reports, &["P – R", "s/lap"], |s| {
         vec![
-            format!("{:.3} – {:.3}", s.precision, s.recall),
+            format!("{} – {:.3}", fmt_p(s), s.recall),
             format!("{:.2}", s.recognize_seconds_per_lap),
         ]
     })

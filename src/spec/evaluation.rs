@@ -31,12 +31,25 @@ impl Default for EvaluationSpec {
     }
 }
 
-/// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`.
+/// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`, checked over the
+/// seeds run: each bound applies to the worst seed, or with `quantile = q` to the q-quantile
+/// (nearest rank, counted from the worst seed; `quantile = 0.1` lets the worst tenth miss).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExpectSpec {
     pub levels: Vec<LevelExpectation>,
     pub icp: Option<Expectation>,
+    /// Bounds apply to this quantile of the seeds instead of the worst seed, in [0, 1).
+    /// Default: none (the worst seed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quantile: Option<f64>,
+}
+
+impl ExpectSpec {
+    /// Whether the block sets no bound at all.
+    pub fn is_empty(&self) -> bool {
+        self.levels.is_empty() && self.icp.is_none()
+    }
 }
 
 /// What one level configuration must achieve.
@@ -99,7 +112,7 @@ pub const EVALUATION_KEYS: &[&str] = &[
     "sensitivity_radii_m",
 ];
 /// Keys of `[expect]`.
-pub const EXPECT_KEYS: &[&str] = &["levels", "icp"];
+pub const EXPECT_KEYS: &[&str] = &["levels", "icp", "quantile"];
 /// Keys of an `[[expect.levels]]` entry.
 pub const EXPECT_LEVEL_KEYS: &[&str] = &[
     "levels",
@@ -208,6 +221,18 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
     if let Some((_, it)) = table(t, "icp", d) {
         unknown_keys(it, EXPECT_ICP_KEYS, "[expect.icp]", d);
         ex.icp = Some(expectation(it, "[expect.icp]", d));
+    }
+    if let Some((_, v)) = get(t, "quantile")
+        && let Some(q) = number(v, "quantile", "[expect]", d)
+    {
+        if (0.0..1.0).contains(&q) {
+            ex.quantile = Some(q);
+        } else {
+            d.at(
+                v.span().start,
+                format!("quantile = {q} is outside 0..1; use 0.1 for the 10th percentile"),
+            );
+        }
     }
     ex
 }

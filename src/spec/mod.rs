@@ -7,6 +7,7 @@ pub mod diag;
 pub mod evaluation;
 pub(crate) mod read;
 pub mod scenario;
+pub mod seeds;
 pub mod suggest;
 pub mod world;
 

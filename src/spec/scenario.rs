@@ -12,6 +12,7 @@ use crate::spec::read::{
     Val, get, integer, missing, number, parse_int, plain, points, string, strings, table,
     table_array, type_name, unknown_keys,
 };
+use crate::spec::seeds::SeedRange;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
@@ -36,6 +37,7 @@ pub const TOP_KEYS: &[&str] = &[
     "world",
     "route",
     "seed",
+    "seeds",
     "runs",
     "door_configs",
     "pedestrians",
@@ -124,6 +126,8 @@ pub struct ScenarioSpec {
     /// Route id in the world.
     pub route: S<String>,
     pub seed: S<u64>,
+    /// `seeds = "1..20"`: the seeds `check` runs (both ends included); `None`: only `seed`.
+    pub seeds: Option<S<SeedRange>>,
     pub runs: Vec<RunSpec>,
     /// `[door_configs]`: name and the door ids it opens, in file order.
     pub door_configs: Vec<(S<String>, Vec<S<String>>)>,
@@ -197,6 +201,7 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
     unknown_keys(top, TOP_KEYS, "the scenario file", d);
     // Every part is read before any is required, so one problem never hides the next.
     let head = read_head(top, d);
+    let seeds = read_seeds(top, d);
     let runs = read_runs(top, d);
     let door_configs = read_door_configs(top, d);
     let pedestrians = read_pedestrians(top, d);
@@ -214,6 +219,7 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
         world,
         route,
         seed,
+        seeds,
         runs: runs?,
         door_configs,
         pedestrians,
@@ -268,6 +274,19 @@ fn read_head(top: &DeTable<'_>, d: &mut Diags) -> Option<Head> {
         Some((_, v)) => seed(v, d),
     };
     Some((name, description, world?, route?, seed?))
+}
+
+/// `seeds = "A..B"` (both ends included) or `seeds = "N"`.
+fn read_seeds(top: &DeTable<'_>, d: &mut Diags) -> Option<S<SeedRange>> {
+    let (_, v) = get(top, "seeds")?;
+    let text = string(v, "seeds", "the scenario file", d)?;
+    match text.parse::<SeedRange>() {
+        Ok(r) => Some(Spanned::new(v.span(), r)),
+        Err(e) => {
+            d.at(v.span().start, e);
+            None
+        }
+    }
 }
 
 fn seed(v: &Val<'_>, d: &mut Diags) -> Option<S<u64>> {

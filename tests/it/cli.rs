@@ -118,7 +118,7 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
         "easy",
         "[[expect.levels]]\nlevels = 1\nmin_precision = 0.0\nmin_recall = 0.0\n",
     );
-    let o = placewords(&["check", "-q", easy.to_str().unwrap()]);
+    let o = placewords(&["check", "-q", "--seed", "42", easy.to_str().unwrap()]);
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -136,6 +136,8 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     let o = placewords(&[
         "check",
         "-q",
+        "--seed",
+        "42",
         hard.to_str().unwrap(),
         "--junit",
         junit.to_str().unwrap(),
@@ -212,6 +214,238 @@ fn sweep_writes_the_fig8_curves() {
     assert_eq!(r["curves"].as_array().unwrap().len(), 1 + 7);
     let svg = std::fs::read_to_string(dir.path().join("pr-curves.svg")).unwrap();
     assert!(svg.starts_with("<svg") || svg.starts_with("<?xml"));
+}
+
+/// `value` with every number under a key naming seconds set to 0 (timings differ run to run).
+fn without_timings(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            for (k, x) in map.iter_mut() {
+                if k.contains("seconds") {
+                    *x = serde_json::Value::Null;
+                } else {
+                    without_timings(x);
+                }
+            }
+        }
+        serde_json::Value::Array(a) => a.iter_mut().for_each(without_timings),
+        _ => {}
+    }
+}
+
+/// (suite, testcase, class, properties, failure text) of one JUnit test case.
+type Case = (
+    String,
+    String,
+    String,
+    Vec<(String, String)>,
+    Option<String>,
+);
+
+/// Every JUnit test case of the file at `path`, without times.
+fn junit_cases(path: &Path) -> Vec<Case> {
+    let xml = std::fs::read_to_string(path).unwrap();
+    let doc = roxmltree::Document::parse(&xml).expect("valid JUnit XML");
+    let attr = |n: roxmltree::Node, a: &str| n.attribute(a).unwrap_or("").to_string();
+    doc.descendants()
+        .filter(|n| n.has_tag_name("testcase"))
+        .map(|c| {
+            let suite = attr(c.parent().unwrap(), "name");
+            let props = c
+                .descendants()
+                .filter(|p| p.has_tag_name("property"))
+                .map(|p| (attr(p, "name"), attr(p, "value")))
+                .collect();
+            let failure = c
+                .children()
+                .find(|f| f.has_tag_name("failure") || f.has_tag_name("error"))
+                .map(|f| f.text().unwrap_or("").to_string());
+            (suite, attr(c, "name"), attr(c, "classname"), props, failure)
+        })
+        .collect()
+}
+
+/// `check --shard K/4` for every K, then `merge`, gives the report, table and JUnit test cases of
+/// the unsharded run (timings apart), and the same exit code; two scenarios of one name are
+/// told apart by their file everywhere.
+#[test]
+fn sharded_check_then_merge_equals_the_unsharded_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(&b).unwrap();
+    // the same name twice; one bound that always holds, one that no seed meets
+    let gate =
+        "[expect]\nlevels = [{ levels = 1, min_recall = 0.0 }, { levels = 3, min_recall = 1.0 }]\n";
+    let s1 = smoke_variant(&a, "smoke", gate);
+    let s2 = smoke_variant(&b, "smoke", gate);
+    let (s1, s2) = (s1.to_str().unwrap(), s2.to_str().unwrap());
+    let whole = dir.path().join("whole");
+    let o = placewords(&[
+        "check",
+        "-q",
+        s1,
+        s2,
+        "--seeds",
+        "1..3",
+        "-o",
+        whole.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&o.stdout).to_string();
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{stdout}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        stdout.trim_end().ends_with("2 passed, 2 failed"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("; reproduce: placewords run "), "{stdout}");
+
+    let mut parts = Vec::new();
+    for k in 1..=4 {
+        let part = dir.path().join(format!("part{k}.json"));
+        let shard = format!("{k}/4");
+        let o = placewords(&[
+            "check",
+            "-q",
+            s1,
+            s2,
+            "--seeds",
+            "1..3",
+            "--shard",
+            &shard,
+            "--report",
+            part.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        parts.push(part.to_str().unwrap().to_string());
+    }
+    let merged = dir.path().join("merged");
+    let mut args = vec!["merge", "-o", merged.to_str().unwrap()];
+    args.extend(parts.iter().rev().map(String::as_str));
+    let o = placewords(&args);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("2 passed, 2 failed"));
+
+    let cases = junit_cases(&whole.join("junit.xml"));
+    assert_eq!(cases, junit_cases(&merged.join("junit.xml")));
+    assert_eq!(cases.len(), 4);
+    assert_ne!(
+        cases[0].0, cases[2].0,
+        "twins get their file in the suite name"
+    );
+    assert!(cases[0].0.contains("a/smoke.toml"), "{:?}", cases[0]);
+    assert!(
+        cases[1].2.ends_with("a/smoke.toml"),
+        "the class is the file: {:?}",
+        cases[1]
+    );
+    assert_eq!(
+        cases[1].1,
+        format!("{}/levels=3/recall", cases[1].0),
+        "no bound in a name"
+    );
+    let props: Vec<&str> = cases[1].3.iter().map(|p| p.0.as_str()).collect();
+    assert_eq!(
+        props,
+        ["value", "statistic", "bound", "seeds", "seed", "reproduce"]
+    );
+    let failure = cases[1].4.as_deref().expect("the recall bound fails");
+    assert!(
+        failure.contains("recall worst") && failure.contains("< 1.000"),
+        "{failure}"
+    );
+    assert!(failure.contains("--seed "), "{failure}");
+
+    let mut want = report_of(&whole.join("report.json"));
+    let mut got = report_of(&merged.join("report.json"));
+    without_timings(&mut want);
+    without_timings(&mut got);
+    assert_eq!(
+        want, got,
+        "merged report.json differs from the unsharded one"
+    );
+    assert_eq!(want["scenarios"][0]["results"].as_array().unwrap().len(), 3);
+    let table = |d: &Path| {
+        std::fs::read_to_string(d.join("table.md"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.contains("seconds_per_lap"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(table(&whole), table(&merged));
+
+    let o = placewords(&[
+        "merge",
+        "-o",
+        merged.to_str().unwrap(),
+        &parts[0],
+        &parts[1],
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("part 3/4 is missing"));
+}
+
+/// A scenario without [expect] is an error in `check` unless --allow-no-expect, and `--json`
+/// gives a machine-readable verdict.
+#[test]
+fn check_without_expect_is_an_error_unless_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let bare = smoke_variant(dir.path(), "bare", "");
+    let bare = bare.to_str().unwrap();
+    let o = placewords(&["check", "-q", bare]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("no [expect] block") && err.contains("--allow-no-expect"),
+        "{err}"
+    );
+    let o = placewords(&["check", "-q", "--json", "--allow-no-expect", bare]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON on stdout");
+    assert_eq!(
+        (v["passed"].as_u64(), v["failed"].as_u64()),
+        (Some(0), Some(0))
+    );
+
+    // --shard auto: the part from a Kubernetes Indexed Job's JOB_COMPLETION_INDEX (0-based)
+    let part = dir.path().join("part.json");
+    let o = Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(["check", "-q", "--allow-no-expect", "--shard", "auto", bare])
+        .args(["--report", part.to_str().unwrap()])
+        .env("JOB_COMPLETION_INDEX", "2")
+        .env("PLACEWORDS_SHARD_COUNT", "4")
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert_eq!(
+        report_of(&part)["shard"],
+        serde_json::json!({"index": 3, "count": 4})
+    );
 }
 
 /// `placewords COMMAND | head`: the reader leaves before the output is written. Output stops

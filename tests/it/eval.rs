@@ -287,6 +287,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             min_precision: Some(0.5),
             ..Expectation::default()
         }),
+        quantile: None,
     };
     let outcomes = check(&report, &pass);
     assert_eq!(exit_code(&outcomes), 0, "{outcomes:?}");
@@ -300,11 +301,13 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             max_seconds_per_lap: None,
         }],
         icp: None,
+        quantile: None,
     };
     let outcomes = check(&report, &too_high);
     assert_eq!(exit_code(&outcomes), 1);
     let xml = junit_xml(&[Suite {
         scenario: "loop".into(),
+        file: "loop.toml".into(),
         outcomes,
         error: None,
         seconds: r.seconds,

@@ -1,0 +1,257 @@
+//! The stress run behind `check` and `run --seeds`: every scenario at every seed of its range,
+//! all (scenario × seed) work items in parallel on every core, gathered in a
+//! [`SuiteReport`]. With a [`Shard`], only that part's items run and the report is a part for
+//! `merge`.
+//!
+//! Each seed is simulated once and its runs shared by every level configuration (and ICP). A
+//! seed's results depend only on the scenario and the seed (`sim::rng`), and items are
+//! gathered in plan order, so a report is the same whatever the thread count or the sharding
+//! (timings apart).
+
+use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
+use crate::experiment::scenario::{Scenario, load_scenario};
+use crate::experiment::{ExperimentOptions, progress_bar, run_scenario};
+use crate::spec::seeds::{SeedRange, Shard};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What to run over seeds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StressOptions {
+    /// Seeds for every scenario. Default: each scenario's `seeds`, else its `seed`.
+    pub seeds: Option<SeedRange>,
+    /// Run only this part of the work. Default: all of it.
+    pub shard: Option<Shard>,
+    /// Check the `[expect]` blocks (`check`): the configurations run are those the block
+    /// names, and a scenario without one is an error. Default false (`run`).
+    pub gate: bool,
+    /// With `gate`, skip a scenario without `[expect]` instead of failing. Default false.
+    pub allow_no_expect: bool,
+    /// Without `gate`: the level configurations and whether ICP runs (`levels`, `icp`), laps
+    /// override (`laps`). `quiet` hides the progress bar.
+    pub experiment: ExperimentOptions,
+}
+
+/// A scenario as planned: loaded (or why not), its seeds and what to run.
+struct Planned {
+    file: String,
+    scenario: Result<Scenario, String>,
+    seeds: SeedRange,
+    /// `None`: nothing to run (no `[expect]`, allowed).
+    options: Option<ExperimentOptions>,
+}
+
+/// Loads and plans every scenario of `paths`.
+fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
+    paths
+        .iter()
+        .map(|path| {
+            let file = path.display().to_string();
+            let scenario = load_scenario(path).map_err(|e| e.to_string());
+            let (seeds, options) = match &scenario {
+                Ok(scn) => (
+                    opts.seeds
+                        .or(scn.seeds)
+                        .unwrap_or(SeedRange::one(scn.sim.seed)),
+                    options_for(scn, opts),
+                ),
+                Err(_) => (opts.seeds.unwrap_or(SeedRange::one(0)), None),
+            };
+            let scenario = match (scenario, &options) {
+                (Ok(_), None) if opts.gate && !opts.allow_no_expect => Err(format!(
+                    "{file}: no [expect] block, so `check` would test nothing; add \
+                     [[expect.levels]] bounds, or pass --allow-no-expect to skip it"
+                )),
+                (s, _) => s,
+            };
+            Planned {
+                file,
+                scenario,
+                seeds,
+                options,
+            }
+        })
+        .collect()
+}
+
+/// The configurations to run for `scn`: the `[expect]` block's under `gate`, else the options'.
+fn options_for(scn: &Scenario, opts: &StressOptions) -> Option<ExperimentOptions> {
+    if !opts.gate {
+        return Some(opts.experiment.clone());
+    }
+    if scn.expect.is_empty() {
+        return None;
+    }
+    let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
+    levels.sort_unstable();
+    levels.dedup();
+    Some(ExperimentOptions {
+        levels,
+        icp: scn.expect.icp.is_some(),
+        ..opts.experiment.clone()
+    })
+}
+
+/// Runs every scenario of `paths` over its seeds (or this shard's share of them).
+pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
+    let planned = plan(paths, opts);
+    let mut items: Vec<(usize, u64)> = Vec::new();
+    for (i, p) in planned.iter().enumerate() {
+        if p.scenario.is_ok() && p.options.is_some() {
+            items.extend(p.seeds.seeds().map(|seed| (i, seed)));
+        }
+    }
+    let items: Vec<(usize, u64)> = items
+        .into_iter()
+        .enumerate()
+        .filter(|(k, _)| opts.shard.is_none_or(|s| s.owns(*k)))
+        .map(|(_, item)| item)
+        .collect();
+    let bar = progress_bar(items.len() as u64, "seeds", opts.experiment.quiet);
+    let results: Vec<SeedResult> = items
+        .par_iter()
+        .map(|&(i, seed)| {
+            let p = &planned[i];
+            let (Ok(scn), Some(options)) = (&p.scenario, &p.options) else {
+                unreachable!("only runnable scenarios are planned")
+            };
+            let r = run_seed(scn, seed, options);
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    SuiteReport::new(opts.shard, opts.gate, assemble(planned, items, results))
+}
+
+/// Runs `scn` at `seed`, timing it.
+pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedResult {
+    let t = Instant::now();
+    let mut scn = scn.clone();
+    scn.sim.seed = seed;
+    let options = ExperimentOptions {
+        quiet: true,
+        ..options.clone()
+    };
+    let (report, error) = match run_scenario(&scn, &options) {
+        Ok(exp) => (Some(exp.report), None),
+        Err(e) => (None, Some(e.to_string())),
+    };
+    SeedResult {
+        seed,
+        seconds: t.elapsed().as_secs_f64(),
+        report,
+        error,
+    }
+}
+
+/// One [`ScenarioResult`] per planned scenario, holding its items' results.
+fn assemble(
+    planned: Vec<Planned>,
+    items: Vec<(usize, u64)>,
+    results: Vec<SeedResult>,
+) -> Vec<ScenarioResult> {
+    let names: Vec<(String, String)> = planned
+        .iter()
+        .map(|p| {
+            let name = match &p.scenario {
+                Ok(s) => s.sim.name.clone(),
+                Err(_) => stem(&p.file),
+            };
+            (name, p.file.clone())
+        })
+        .collect();
+    let labels = labels(&names);
+    let mut out: Vec<ScenarioResult> = planned
+        .into_iter()
+        .zip(names.into_iter().zip(labels))
+        .map(|(p, ((name, file), label))| ScenarioResult {
+            label,
+            name,
+            file,
+            seeds: p.seeds,
+            expect: p
+                .scenario
+                .as_ref()
+                .map(|s| s.expect.clone())
+                .unwrap_or_default(),
+            error: p.scenario.err(),
+            results: Vec::new(),
+            summary: Vec::new(),
+            outcomes: Vec::new(),
+        })
+        .collect();
+    for ((i, _), r) in items.into_iter().zip(results) {
+        out[i].results.push(r);
+    }
+    out
+}
+
+fn stem(file: &str) -> String {
+    std::path::Path::new(file)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| file.to_string())
+}
+
+/// Why parts could not be read and merged, or outputs written.
+#[derive(Debug, thiserror::Error)]
+pub enum StressError {
+    #[error("{path}: cannot read: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}:{line}:{col}: not a part written by `check --shard K/N --report`: {message}")]
+    Parse {
+        path: String,
+        line: usize,
+        col: usize,
+        message: String,
+    },
+    #[error(transparent)]
+    Merge(#[from] crate::eval::suite::MergeError),
+    #[error("{path}: cannot write: {source}")]
+    Write {
+        path: String,
+        source: std::io::Error,
+    },
+}
+
+/// Reads the parts at `paths` and merges them into the whole run's report.
+pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
+    let mut parts = Vec::new();
+    for path in paths {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| StressError::Read {
+            path: file.clone(),
+            source,
+        })?;
+        let part = SuiteReport::from_json(&text).map_err(|e| StressError::Parse {
+            path: file.clone(),
+            line: e.line(),
+            col: e.column(),
+            message: e.to_string(),
+        })?;
+        parts.push((file, part));
+    }
+    Ok(crate::eval::suite::merge(parts)?)
+}
+
+/// Writes `file` atomically, naming it in the error.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StressError> {
+    crate::io::atomic::write_atomic(path, bytes).map_err(|source| StressError::Write {
+        path: path.display().to_string(),
+        source,
+    })
+}
+
+/// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`.
+pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
+    use crate::report::{junit, suite as format};
+    write_file(&dir.join("report.json"), suite.to_json().as_bytes())?;
+    write_file(&dir.join("table.md"), format::markdown(suite).as_bytes())?;
+    let xml = junit::junit_xml(&junit::suites(suite));
+    write_file(&dir.join("junit.xml"), xml.as_bytes())
+}

@@ -1,0 +1,347 @@
+//! Stress runs for people and machines: the terminal table (mean and worst per level
+//! configuration, with the command that reproduces the worst seed), the Markdown `table.md`
+//! (mean, 10th percentile, worst and its seed, and the gate), and the `--json` summary.
+
+use crate::eval::distribution::{ConfigSpread, Metric, Spread};
+use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::suite::{ScenarioResult, SuiteReport};
+use serde::Serialize;
+use std::fmt::Write;
+
+/// `mean` of a spread, or "no matches" when no seed has a value.
+fn mean(s: Option<&Spread>) -> String {
+    s.map_or("no matches".into(), |s| format!("{:.3}", s.mean))
+}
+
+/// `worst (seed N)`, or "no matches".
+fn worst(s: Option<&Spread>, decimals: usize) -> String {
+    s.map_or("no matches".into(), |s| {
+        format!("{:.decimals$} (seed {})", s.worst, s.worst_seed)
+    })
+}
+
+/// Row label: `3 [6, 9, 12]` or `ICP`.
+fn label(c: &ConfigSpread) -> String {
+    match c.levels {
+        Some(n) => format!("{n} {:?}", c.thresholds),
+        None => "ICP".into(),
+    }
+}
+
+/// The header line of a scenario: label, file, seeds and how many ran.
+fn header(sc: &ScenarioResult) -> String {
+    let laps = sc
+        .results
+        .iter()
+        .find_map(|r| r.report.as_ref().map(|r| r.laps))
+        .unwrap_or(0);
+    format!(
+        "scenario {} ({})  seeds {} ({} run)  laps {laps}",
+        sc.label,
+        sc.file,
+        sc.seeds,
+        sc.results.len()
+    )
+}
+
+/// The terminal table of a stress run: per scenario and configuration, mean and worst of
+/// precision, recall and visit recall and of seconds per lap; then the seeds that matched
+/// nothing and, per worst seed, the command that reproduces it.
+pub fn text_table(suite: &SuiteReport) -> String {
+    let mut out = String::new();
+    for sc in &suite.scenarios {
+        let _ = writeln!(out, "{}", header(sc));
+        for e in sc.errors() {
+            let _ = writeln!(out, "  error: {e}");
+        }
+        if sc.summary.is_empty() {
+            out.push('\n');
+            continue;
+        }
+        let body: Vec<Vec<String>> = sc.summary.iter().map(text_row).collect();
+        out.push_str(&super::table::render(
+            &[
+                "levels [τ]",
+                "precision mean",
+                "worst",
+                "recall mean",
+                "worst",
+                "visit R mean",
+                "s/lap mean",
+                "worst",
+            ],
+            &body,
+        ));
+        out.push_str(&worst_seeds(sc));
+        out.push('\n');
+    }
+    out
+}
+
+fn text_row(c: &ConfigSpread) -> Vec<String> {
+    let time = c.get(Metric::SecondsPerLap);
+    vec![
+        label(c),
+        mean(c.get(Metric::Precision)),
+        worst(c.get(Metric::Precision), 3),
+        mean(c.get(Metric::Recall)),
+        worst(c.get(Metric::Recall), 3),
+        mean(c.get(Metric::VisitRecall)),
+        time.map_or("-".into(), |s| format!("{:.3}", s.mean)),
+        time.map_or("-".into(), |s| format!("{:.3}", s.worst)),
+    ]
+}
+
+/// Lines naming the seeds that matched nothing, and per seed that is worst at precision or
+/// recall somewhere, what it is worst at and the command that reproduces it.
+fn worst_seeds(sc: &ScenarioResult) -> String {
+    let mut out = String::new();
+    let mut seeds: Vec<(u64, Vec<String>)> = Vec::new();
+    for c in &sc.summary {
+        if !c.no_match_seeds.is_empty() {
+            let _ = writeln!(
+                out,
+                "{}: no matches at seed(s) {:?}",
+                label(c),
+                c.no_match_seeds
+            );
+        }
+        for m in [Metric::Precision, Metric::Recall] {
+            let Some(s) = c.get(m) else { continue };
+            let what = format!("{} at {}", m.name(), c.subject);
+            match seeds.iter_mut().find(|(seed, _)| *seed == s.worst_seed) {
+                Some((_, v)) => v.push(what),
+                None => seeds.push((s.worst_seed, vec![what])),
+            }
+        }
+    }
+    if sc.results.len() > 1 {
+        for (seed, what) in seeds {
+            let _ = writeln!(out, "worst {}: {}", what.join(", "), sc.reproduce(seed));
+        }
+    }
+    out
+}
+
+/// What `check` and `merge` print: the terminal table, a line per bound (with the command
+/// reproducing a missed one), and `N passed, M failed`; for a part, one line saying so.
+pub fn check_text(suite: &SuiteReport) -> String {
+    if let Some(shard) = suite.shard {
+        let seeds: usize = suite.scenarios.iter().map(|s| s.results.len()).sum();
+        return format!(
+            "shard {shard}: {seeds} seed(s) run; merge every part with `placewords merge` for the verdict\n"
+        );
+    }
+    let mut out = text_table(suite);
+    for sc in &suite.scenarios {
+        for o in &sc.outcomes {
+            match (o.passed, o.seed) {
+                (false, Some(seed)) => {
+                    let _ = writeln!(out, "{}; reproduce: {}", o.line(), sc.reproduce(seed));
+                }
+                _ => {
+                    let _ = writeln!(out, "{}", o.line());
+                }
+            }
+        }
+    }
+    let _ = writeln!(out, "{}", suite.tally().line());
+    out
+}
+
+/// `table.md`: per scenario, a table of mean, 10th percentile and worst (seed) per
+/// configuration and metric, then the gate's outcomes; the closing tally last.
+pub fn markdown(suite: &SuiteReport) -> String {
+    let mut out = String::from("# placewords stress run\n");
+    for sc in &suite.scenarios {
+        out.push_str(&md_scenario(sc));
+    }
+    if suite.gated {
+        let _ = writeln!(out, "\n{}", suite.tally().line());
+    }
+    out
+}
+
+/// One scenario's section of `table.md`.
+fn md_scenario(sc: &ScenarioResult) -> String {
+    let mut out = format!("\n## {} (`{}`), seeds {}\n\n", sc.label, sc.file, sc.seeds);
+    for e in sc.errors() {
+        let _ = writeln!(out, "- error: {}", e.replace('\n', " "));
+    }
+    if !sc.summary.is_empty() {
+        out.push_str("| levels | metric | mean | p10 | worst | worst seed |\n");
+        out.push_str("|---|---|---|---|---|---|\n");
+    }
+    for c in &sc.summary {
+        for m in Metric::ALL {
+            let cells = md_cells(c.get(m));
+            let _ = writeln!(out, "| {} | {} | {cells} |", label(c), m.name());
+        }
+    }
+    for c in sc.summary.iter().filter(|c| !c.no_match_seeds.is_empty()) {
+        let seeds = &c.no_match_seeds;
+        let _ = writeln!(out, "\n{}: no matches at seed(s) {seeds:?}", label(c));
+    }
+    if !sc.outcomes.is_empty() {
+        out.push_str("\n| test case | statistic | value | bound | seed | result |\n");
+        out.push_str("|---|---|---|---|---|---|\n");
+        for o in &sc.outcomes {
+            let _ = writeln!(out, "{}", md_outcome(o));
+        }
+    }
+    out
+}
+
+fn md_cells(s: Option<&Spread>) -> String {
+    match s {
+        Some(s) => format!(
+            "{:.3} | {:.3} | {:.3} | {}",
+            s.mean, s.p10, s.worst, s.worst_seed
+        ),
+        None => "no matches | – | – | –".into(),
+    }
+}
+
+fn md_outcome(o: &Outcome) -> String {
+    let value = o.actual.map_or_else(
+        || o.missing.clone().unwrap_or_default(),
+        |a| fmt_value(o.bound, a),
+    );
+    let seed = o.seed.map_or("–".into(), |s| s.to_string());
+    let result = if o.passed { "pass" } else { "**FAIL**" };
+    format!(
+        "| `{}` | {} | {value} | {} | {seed} | {result} |",
+        o.name(),
+        o.statistic(),
+        fmt_value(o.bound, o.limit),
+    )
+}
+
+/// One outcome in the `--json` summary.
+#[derive(Serialize)]
+struct JsonOutcome<'a> {
+    name: String,
+    file: &'a str,
+    passed: bool,
+    statistic: String,
+    value: Option<f64>,
+    bound: f64,
+    seed: Option<u64>,
+    seeds: usize,
+    reproduce: Option<String>,
+    line: String,
+}
+
+/// The `--json` summary: tally, exit code, every outcome and every error.
+pub fn summary_json(suite: &SuiteReport) -> String {
+    let t = suite.tally();
+    let outcomes: Vec<JsonOutcome> = suite
+        .scenarios
+        .iter()
+        .flat_map(|sc| {
+            sc.outcomes.iter().map(move |o| JsonOutcome {
+                name: o.name(),
+                file: &sc.file,
+                passed: o.passed,
+                statistic: o.statistic(),
+                value: o.actual,
+                bound: o.limit,
+                seed: o.seed,
+                seeds: o.seeds,
+                reproduce: o.seed.map(|s| sc.reproduce(s)),
+                line: o.line(),
+            })
+        })
+        .collect();
+    let errors: Vec<String> = suite.scenarios.iter().flat_map(|s| s.errors()).collect();
+    let v = serde_json::json!({
+        "passed": t.passed,
+        "failed": t.failed,
+        "errors": t.errors,
+        "exit_code": suite.exit_code(),
+        "shard": suite.shard.map(|s| s.to_string()),
+        "outcomes": outcomes,
+        "error_messages": errors,
+    });
+    serde_json::to_string_pretty(&v).expect("a summary always serializes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::scores::tests::sample;
+    use crate::eval::suite::SeedResult;
+    use crate::spec::evaluation::{ExpectSpec, LevelExpectation};
+    use crate::spec::seeds::SeedRange;
+
+    fn suite() -> SuiteReport {
+        let results = (1..=3)
+            .map(|seed| {
+                let mut r = sample("B", [0.9; 3], [0.5; 3]);
+                r.seed = seed;
+                r.icp = None;
+                if seed == 2 {
+                    r.levels[0].scores.no_pairs = true;
+                    r.levels[2].scores.recall = 0.1;
+                }
+                SeedResult {
+                    seed,
+                    seconds: 2.0,
+                    report: Some(r),
+                    error: None,
+                }
+            })
+            .collect();
+        let sc = ScenarioResult {
+            label: "B".into(),
+            name: "B".into(),
+            file: "scenarios/B.toml".into(),
+            seeds: SeedRange { first: 1, last: 3 },
+            expect: ExpectSpec {
+                levels: vec![LevelExpectation {
+                    levels: 3,
+                    min_precision: None,
+                    min_recall: Some(0.2),
+                    min_visit_recall: None,
+                    min_pair_recall: None,
+                    max_seconds_per_lap: None,
+                }],
+                ..ExpectSpec::default()
+            },
+            error: None,
+            results,
+            summary: vec![],
+            outcomes: vec![],
+        };
+        SuiteReport::new(None, true, vec![sc])
+    }
+
+    #[test]
+    fn the_terminal_table_shows_mean_worst_and_how_to_reproduce_it() {
+        let t = text_table(&suite());
+        assert!(t.contains("0.367") && t.contains("0.100 (seed 2)"), "{t}");
+        assert!(
+            t.contains("worst recall at levels=3: placewords run scenarios/B.toml --seed 2"),
+            "{t}"
+        );
+        assert!(t.contains("no matches at seed(s) [2]"), "{t}");
+    }
+
+    #[test]
+    fn markdown_and_json_carry_the_gate() {
+        let s = suite();
+        let md = markdown(&s);
+        assert!(
+            md.contains("| `B/levels=3/recall` | worst | 0.100 | 0.200 | 2 | **FAIL** |"),
+            "{md}"
+        );
+        assert!(md.ends_with("0 passed, 1 failed\n"), "{md}");
+        let v: serde_json::Value = serde_json::from_str(&summary_json(&s)).unwrap();
+        assert_eq!(v["failed"], 1);
+        assert_eq!(v["exit_code"], 1);
+        assert_eq!(
+            v["outcomes"][0]["reproduce"],
+            "placewords run scenarios/B.toml --seed 2"
+        );
+    }
+}
