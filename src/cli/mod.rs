@@ -78,6 +78,14 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// `--message-format`, shared by every command that checks files.
+#[derive(Debug, clap::Args)]
+pub struct MessageFormatArg {
+    /// `human` (file:line:col: error: ...) or `json` (one object per problem, on stdout).
+    #[arg(long, value_name = "FORMAT", default_value = "human", value_parser = ["human", "json"])]
+    pub message_format: String,
+}
+
 /// Prints a file's problems: human form on stderr, JSON lines on stdout.
 pub fn print_problems(
     e: &placewords::spec::SpecError,

@@ -17,14 +17,13 @@ pub struct CheckArgs {
     /// Scenario files (TOML).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// `human` (file:line:col: error: ...) or `json` (one object per problem, on stdout).
-    #[arg(long, value_name = "FORMAT", default_value = "human", value_parser = ["human", "json"])]
-    pub message_format: String,
+    #[command(flatten)]
+    pub format: super::MessageFormatArg,
 }
 
 pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
     let ScenarioCommand::Check(args) = cmd;
-    let format = MessageFormat::from_name(&args.message_format).unwrap_or_default();
+    let format = MessageFormat::from_name(&args.format.message_format).unwrap_or_default();
     let mut failed = false;
     for f in &args.files {
         match placewords::experiment::load_scenario(f) {

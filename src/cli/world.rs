@@ -83,9 +83,8 @@ pub struct CheckArgs {
     /// World files (TOML).
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
-    /// `human` (file:line:col: error: ...) or `json` (one object per problem, on stdout).
-    #[arg(long, value_name = "FORMAT", default_value = "human", value_parser = ["human", "json"])]
-    pub message_format: String,
+    #[command(flatten)]
+    pub format: super::MessageFormatArg,
 }
 
 #[derive(Debug, Args)]
@@ -145,7 +144,8 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 w.routes.len()
             )?,
             Err(e) => {
-                let format = placewords::spec::diag::MessageFormat::from_name(&args.message_format);
+                let format =
+                    placewords::spec::diag::MessageFormat::from_name(&args.format.message_format);
                 super::print_problems(&e, format.unwrap_or_default());
                 failed = true;
             }

@@ -1,5 +1,6 @@
 //! World authoring aids: the density map, the ambiguity map, the world generator.
 
+use super::common::{placewords, root};
 use placewords::authoring::ambiguity::ambiguity;
 use placewords::authoring::density::{DEFAULT_SAMPLE_M, density_map, density_svg};
 use placewords::authoring::generate::{GenerateOptions, generate_toml};
@@ -7,20 +8,6 @@ use placewords::geom::Vec2;
 use placewords::recognizer::RecognizerConfig;
 use placewords::world::{DoorStates, World};
 use placewords::world::{load_world, parse_world};
-use std::path::PathBuf;
-use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn placewords(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_placewords"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run placewords")
-}
 
 /// A corridor loop whose south and north corridors are the same: three niches each at the same
 /// distances along travel. The east corridor is wider than the west one, so nothing else

@@ -1,19 +1,8 @@
 //! The commands end to end, as CI pipelines and people call them: `run`, `check`, `recognize`.
 
+use super::common::{placewords, root};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn placewords(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_placewords"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("the placewords binary runs")
-}
 
 /// The smoke scenario with its world path made absolute and `extra` appended, in `dir`.
 fn smoke_variant(dir: &Path, name: &str, extra: &str) -> PathBuf {

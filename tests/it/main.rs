@@ -3,6 +3,7 @@
 mod architecture;
 mod authoring;
 mod cli;
+mod common;
 mod eval;
 mod io;
 mod recognizer;

@@ -1,6 +1,7 @@
 //! The simulator: laser geometry, doors, people, odometry statistics, determinism, located
 //! scenario errors, the golden digest and the `simulate` command.
 
+use super::common::root;
 use placewords::experiment::{Scenario, load_scenario, parse_scenario};
 use placewords::geom::{Pose2, Segment, Vec2};
 use placewords::sim::laser::{Laser, LaserConfig, LaserPreset};
@@ -11,11 +12,7 @@ use placewords::world::parse_world;
 use placewords::world::raycast::{Disc, SweepCaster};
 use placewords::world::{DoorStates, World};
 use proptest::prelude::*;
-use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
+use std::path::Path;
 
 /// The small loop as these tests know it (a copy, so that edits to `worlds/` do not move the
 /// geometry the assertions rely on): 20 × 8 m, corridors 2 m wide, doors `d-south` (hinge

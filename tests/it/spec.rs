@@ -4,12 +4,9 @@
 //! beside `NAME.expected`, the exact lines `placewords scenario check` (or `world check`, or
 //! `world import` for `.map`) prints. Re-mint with `PLACEWORDS_BLESS=1` and review the diff.
 
+use super::common::root;
 use placewords::spec::diag::{MessageFormat, read_text};
 use std::path::{Path, PathBuf};
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// The lines a file's check prints; `None` when the file is accepted.
 fn problems(shown: &Path) -> Option<String> {

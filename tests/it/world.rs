@@ -1,6 +1,7 @@
 //! World files: every shipped file loads, invalid fixtures give their located messages, random
 //! input never panics, the SVG render is well-formed, and the `world` commands behave.
 
+use super::common::{placewords, root};
 use placewords::report::{PathOverlay, RenderOptions, SegmentOverlay, render_world_svg};
 use placewords::spec::SpecError;
 use placewords::world::info::world_info;
@@ -8,11 +9,6 @@ use placewords::world::{DoorStates, World};
 use placewords::world::{load_world, parse_world};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
 
 /// Checks one authored file; `Err` holds every problem as text.
 type Loader = fn(&Path) -> Result<(), String>;
@@ -409,14 +405,6 @@ fn rendered_svg_parses_and_holds_every_wall_and_door() {
         assert_eq!(with_class(&doc, "route").len(), w.routes.len());
         assert!(svg.contains("a &lt;title&gt; &amp; more"));
     }
-}
-
-fn placewords(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_placewords"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run placewords")
 }
 
 #[test]
