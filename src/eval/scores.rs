@@ -12,6 +12,7 @@
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
 //!                 "recognize_seconds_per_lap": 0.8,
+//!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
 //!                                     "metrics": { "precision": ..., ... } } ] } ],
@@ -24,10 +25,11 @@
 //! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN).
 
 use super::Recognition;
-use super::metrics::{DoorConfigMetrics, Evaluation, Metrics};
+use super::metrics::{DoorConfigMetrics, Evaluation, Metrics, scored_pairs};
 use super::sweep::{PrCurve, SweepResult};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
 
 /// The scores every recognizer gets (flattened into its JSON object).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -94,6 +96,21 @@ pub struct LevelReport {
     pub thresholds: Vec<usize>,
     #[serde(flatten)]
     pub scores: Scores,
+    /// The distinct pairs this configuration found that the configuration with one level fewer
+    /// did not (`None` when that one was not run).
+    #[serde(default)]
+    pub only_here: Option<LevelGain>,
+}
+
+/// What a level configuration adds over the one with one level fewer.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelGain {
+    /// The configuration compared with (levels − 1).
+    pub than_levels: usize,
+    /// Distinct (query, past) observation pairs found here and not there.
+    pub pairs: usize,
+    /// How many of them are correct at `tp_radius_m`.
+    pub correct_pairs: usize,
 }
 
 /// The result of the ICP baseline.
@@ -159,8 +176,42 @@ impl Report {
             levels,
             thresholds: thresholds.to_vec(),
             scores,
+            only_here: None,
         });
         self.levels.last().expect("just pushed")
+    }
+
+    /// Sets each level configuration's `only_here` from the recognitions of every configuration
+    /// run, `(levels, recognition)`: the pairs it found that the one with one level fewer did not.
+    pub fn set_level_gains(&mut self, recognitions: &[(usize, Recognition)]) {
+        let radius_m = self.evaluation.tp_radius_m;
+        let pairs_of = |levels: usize| {
+            recognitions
+                .iter()
+                .find(|(l, _)| *l == levels)
+                .map(|(_, rec)| {
+                    scored_pairs(rec, radius_m)
+                        .into_iter()
+                        .map(|p| ((p.query, p.past), p.correct))
+                        .collect::<HashMap<_, _>>()
+                })
+        };
+        for lr in &mut self.levels {
+            let below = lr.levels.saturating_sub(1);
+            let (Some(here), Some(fewer)) = (pairs_of(lr.levels), pairs_of(below)) else {
+                continue;
+            };
+            let new: Vec<bool> = here
+                .iter()
+                .filter(|(k, _)| !fewer.contains_key(*k))
+                .map(|(_, &correct)| correct)
+                .collect();
+            lr.only_here = Some(LevelGain {
+                than_levels: below,
+                pairs: new.len(),
+                correct_pairs: new.iter().filter(|&&c| c).count(),
+            });
+        }
     }
 
     /// Scores `rec` (an ICP baseline run) and sets it as the report's ICP result.
@@ -235,6 +286,7 @@ pub(crate) mod tests {
                     recognize_seconds_per_lap: 0.5 * (l + 1) as f64,
                     ..Scores::default()
                 },
+                only_here: None,
             });
         }
         rep.icp = Some(IcpReport {

@@ -226,6 +226,7 @@ pub fn evaluate_runs(
         report.add_level(levels, &thresholds(&configs[recognitions.len()]), &r);
         recognitions.push((levels, r));
     }
+    report.set_level_gains(&recognitions);
     report.finish();
     Ok(Experiment {
         report,

@@ -41,16 +41,27 @@ pub struct RecognizerConfig {
     /// Number of level configurations searched: 1 = level 0 only, 2 = levels 0-1, 3 = levels 0-2,
     /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3.
     pub levels: usize,
+    /// How upper-level ("corrected") words are built: `paper` (Algorithm 2 as written: a level-l
+    /// word fuses l + 2 level-0 words whose first and last share a class) or `boundaries` (a
+    /// level-l word fuses a bump that leaves a class and comes back to it, crossing l class
+    /// boundaries at its deepest: `A B A` is level 1, `A B C B A` level 2). Default `boundaries`
+    /// (see the `words` module doc for why).
+    pub multi_level: MultiLevelRule,
     /// Minimum n-gram size (words) per level configuration: index k applies to configuration
     /// k + 1. Needs at least `levels` entries; 0 and 1 both accept every matching word pair (the
     /// paper's Fig. 8 sweeps from 0). Default [6, 9, 12, 15].
     pub min_ngram: Vec<usize>,
     /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
     pub max_alignment_offset: usize,
+    /// Largest shift from the n-gram's offset tried by `alignment = "chain"`, observations.
+    /// Default 5 (tuned on scenario A seeds 1..10: 10 left near-misses of about 1 m, 2 gave
+    /// the same as 5).
+    pub chain_alignment_offset: usize,
     /// Placements the fine alignment tries: `paper` (Eq. 2 as written: the n = min(S₁, S₂)
     /// observations from both words' starts, shifted by d ∈ (−Δmax, Δmax)) or `whole-word`
     /// (the smaller word's n observations at every placement inside the larger word, never past
-    /// its ends). Default `whole-word`.
+    /// its ends) or `chain` (inside the larger word, within ±`chain_alignment_offset` of the
+    /// offset the whole matched n-gram agrees on). Default `chain`.
     pub alignment: AlignmentMode,
     /// Verify each match before reporting it (see the fields `verify_*`). Default true.
     pub verify: bool,
@@ -91,9 +102,11 @@ impl Default for RecognizerConfig {
             size_tolerance_ratio: 0.25,
             angle_tolerance_deg: 30.0,
             levels: 3,
+            multi_level: MultiLevelRule::Boundaries,
             min_ngram: vec![6, 9, 12, 15],
             max_alignment_offset: 10,
-            alignment: AlignmentMode::WholeWord,
+            chain_alignment_offset: 5,
+            alignment: AlignmentMode::Chain,
             verify: true,
             verify_travel_ratio: 0.15,
             verify_travel_slack_m: 0.5,
@@ -112,6 +125,24 @@ pub enum AlignmentMode {
     Paper,
     /// Every placement of the smaller word inside the larger one.
     WholeWord,
+    /// Placements inside the larger word within ±Δmax of where the n-gram puts the pair: the
+    /// travel offset between the current and past sides, taken as the median over the n-gram's
+    /// word pairs of the offset between their centres. A long word of flat Ψ no longer slides
+    /// to an arbitrary place inside its partner.
+    Chain,
+}
+
+/// How upper-level words are built (`multi_level` setting); see the `words` module.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MultiLevelRule {
+    /// Algorithm 2 as written: level l fuses the l + 2 level-0 words w_{j−l−1} … w_j when
+    /// w_{j−l−1} and w_j have the same class.
+    Paper,
+    /// Level l fuses a bump of depth l: level-0 words w_i … w_j with w_i and w_j of class D, every
+    /// word between of another class, the farthest of them l classes from D, and at most 2l + 1
+    /// of them.
+    Boundaries,
 }
 
 /// One invalid setting: the field's name and what is wrong with it.

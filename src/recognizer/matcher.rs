@@ -22,13 +22,17 @@
 //!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
 //! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
-//! observations. The paper searches d ∈ (−Δmax, Δmax) from the words' starts; since matched
-//! words may differ in size by the size tolerance (25 %), we let the smaller word's window sit
-//! anywhere inside the larger word, plus ±Δmax beyond: with Δmax alone a long corridor word
-//! whose boundary moved by more than Δmax was paired up to metres off. Shifts whose whole window lies in
-//! the past word's run are preferred (near a run's start or end, those with the largest overlap);
-//! ties go to the smallest |d|. The aligned pairs whose travel differs by
-//! less than `candidate_gap_m` are dropped.
+//! observations. Where the shift may be is the `alignment` setting: `paper` searches
+//! d ∈ (−Δmax, Δmax) from the words' starts, as Eq. 2 is written; `whole-word` lets the smaller
+//! word sit anywhere inside the larger one (never past its ends), since matched words may differ
+//! in size by the size tolerance and a boundary that moved by more than Δmax paired a long word
+//! metres off; `chain` (default) searches inside the larger word but only within
+//! ±`chain_alignment_offset` of the shift the whole n-gram agrees on (the median over its word
+//! pairs of the travel offset between their centres), because a long word of flat Ψ has no
+//! minimum of its own and slid up to its size-tolerance slack (≈ 1 m) from where its neighbours
+//! put it. Shifts whose whole window lies in the past word's run are preferred (near a run's
+//! start or end, those with the largest overlap); ties go to the smallest |d|. The aligned pairs
+//! whose travel differs by less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::types::{AlignedPair, Match, Observation};
@@ -56,12 +60,15 @@ struct Params {
     angle_tol_deg: f64,
     candidate_gap_m: f64,
     max_offset: usize,
+    chain_offset: usize,
     alignment: AlignmentMode,
     verify: bool,
     verify_travel_ratio: f64,
     verify_travel_slack_m: f64,
     verify_turn_rad: f64,
     verify_max_psi_rms: f64,
+    /// Odometric travel between observations, metres.
+    spacing_m: f64,
 }
 
 /// Words, multi-level words, matching and alignment over a stream of observations.
@@ -94,15 +101,22 @@ impl WordMatcher {
                 angle_tol_deg: config.angle_tolerance_deg,
                 candidate_gap_m: config.candidate_gap_m,
                 max_offset: config.max_alignment_offset,
+                chain_offset: config.chain_alignment_offset,
                 alignment: config.alignment,
                 verify: config.verify,
                 verify_travel_ratio: config.verify_travel_ratio,
                 verify_travel_slack_m: config.verify_travel_slack_m,
                 verify_turn_rad: config.verify_turn_deg.to_radians(),
                 verify_max_psi_rms: config.verify_max_psi_rms,
+                spacing_m: config.observation_spacing_m,
             },
             rejections: VerificationCounts::default(),
-            words: WordLevels::new(config.classes, config.min_word_size, config.levels),
+            words: WordLevels::with_rule(
+                config.classes,
+                config.min_word_size,
+                config.levels,
+                config.multi_level,
+            ),
             occurrences: vec![Vec::new(); config.classes],
             memo: Vec::new(),
             lookup: Default::default(),
@@ -333,8 +347,9 @@ impl WordMatcher {
             .iter()
             .map(|&(wc, widx)| (wc, self.memo[wc as usize][widx].past))
             .collect();
+        let anchors = self.chain_anchors(&word_pairs);
         if self.params.verify
-            && let Some(reason) = self.verify(&word_pairs)
+            && let Some(reason) = self.verify(&word_pairs, &anchors)
         {
             self.rejections.add(reason);
             return None;
@@ -342,10 +357,12 @@ impl WordMatcher {
         let fresh_from = chain.len() - fresh;
         let mut pairs = Vec::new();
         let mut refs = Vec::with_capacity(fresh);
-        for (&(wc, widx), &(_, past)) in chain.iter().zip(&word_pairs).skip(fresh_from) {
+        for ((&(wc, widx), &(_, past)), &anchor) in
+            chain.iter().zip(&word_pairs).zip(&anchors).skip(fresh_from)
+        {
             self.memo[wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
-            self.align(wc, past, &mut pairs);
+            self.align(wc, past, anchor, &mut pairs);
         }
         self.rejections.accepted += 1;
         Some(Match {
@@ -359,7 +376,7 @@ impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
     /// both sides; the Ψ residual of its aligned pairs must be small.
-    fn verify(&self, word_pairs: &[(WordId, WordId)]) -> Option<Rejection> {
+    fn verify(&self, word_pairs: &[(WordId, WordId)], anchors: &[i64]) -> Option<Rejection> {
         let obs = self.words.observations();
         let start = |w: WordId| {
             let w = self.word(w);
@@ -386,8 +403,8 @@ impl WordMatcher {
             }
         }
         let (mut sum, mut count) = (0.0, 0usize);
-        for &(c, p) in word_pairs {
-            if let Some(w) = self.placement(c, p) {
+        for (&(c, p), &anchor) in word_pairs.iter().zip(anchors) {
+            if let Some(w) = self.placement(c, p, anchor) {
                 sum += w.cost * w.count() as f64;
                 count += w.count();
             }
@@ -400,8 +417,29 @@ impl WordMatcher {
         (rms > self.params.verify_max_psi_rms).then_some(Rejection::Density)
     }
 
-    /// Eq. 2: the best placement of the two words' observation windows (see the module doc).
-    fn placement(&self, c: WordId, p: WordId) -> Option<Placement> {
+    /// Per word pair of an n-gram (oldest first), the shift k (past index − current index, from
+    /// the words' starts) that puts the pair at the travel offset the whole n-gram agrees on:
+    /// the median over its word pairs of the offset between the two words' centres.
+    fn chain_anchors(&self, word_pairs: &[(WordId, WordId)]) -> Vec<i64> {
+        let centre = |w: &Word| 0.5 * (w.start_travel_m + w.end_travel_m);
+        let mut offsets: Vec<f64> = word_pairs
+            .iter()
+            .map(|&(c, p)| centre(self.word(c)) - centre(self.word(p)))
+            .collect();
+        offsets.sort_by(f64::total_cmp);
+        let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
+        word_pairs
+            .iter()
+            .map(|&(c, p)| {
+                let start_gap_m = self.word(c).start_travel_m - self.word(p).start_travel_m;
+                ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
+            })
+            .collect()
+    }
+
+    /// Eq. 2: the best placement of the two words' observation windows (see the module doc);
+    /// `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
+    fn placement(&self, c: WordId, p: WordId, anchor: i64) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
@@ -424,6 +462,14 @@ impl WordMatcher {
             AlignmentMode::Paper => (-(dmax - 1).max(0), (dmax - 1).max(0)),
             // The smaller word at every placement inside the larger one, never past its ends.
             AlignmentMode::WholeWord => (-(sc - n), sp - n),
+            // Inside the larger word, near the n-gram's shift (the nearest end when that lies
+            // outside).
+            AlignmentMode::Chain => {
+                let (lo, hi) = (-(sc - n), sp - n);
+                let a = anchor.clamp(lo, hi);
+                let w = self.params.chain_offset as i64;
+                ((a - w).max(lo), (a + w).min(hi))
+            }
         };
         // Whole windows first (Eq. 2 sums over all n observations), then the least mean squared
         // Ψ difference, then the smallest shift from the words' starts.
@@ -454,9 +500,9 @@ impl WordMatcher {
     }
 
     /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
-    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
+    fn align(&self, c: WordId, p: WordId, anchor: i64, out: &mut Vec<AlignedPair>) {
         let obs = self.words.observations();
-        let Some(w) = self.placement(c, p) else {
+        let Some(w) = self.placement(c, p, anchor) else {
             return;
         };
         let (s2, s1) = (self.word(c).first_obs as i64, self.word(p).first_obs as i64);

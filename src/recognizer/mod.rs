@@ -17,7 +17,7 @@ pub mod synth;
 pub mod types;
 pub mod words;
 
-pub use config::{AlignmentMode, ConfigProblem, RecognizerConfig, RecognizerError};
+pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
 pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, density};
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;

@@ -7,14 +7,27 @@
 //! class, S its observation count, A = angle(median→last) − angle(first→median) in degrees,
 //! wrapped to (−180, 180].
 //!
-//! When level-0 word w_j closes, for each level l ≥ 1 with w_{j−l−1}.D = w_j.D a level-l word
-//! is built from the observations of w_{j−l−1} … w_j (same run only): its class is that of
-//! w_{j−l−1}, its predecessors are those of w_{j−l−1}, and it becomes a predecessor of w_{j+1},
-//! whose predecessors are w_j and every upper-level word ending at w_j (at most one per level).
-//! This is Algorithm 2 with the upper-level words built as soon as their last word closes, not
-//! when the next one does: the words and predecessor lists are the same, they are only known one
-//! word earlier.
+//! **Upper levels** ("corrected" words for a bump such as an open door, paper §III). When level-0
+//! word w_j closes, upper-level words ending at it are built from the observations of w_i … w_j
+//! (same run only); such a word has the class of w_i, the predecessors of w_i, and becomes a
+//! predecessor of w_{j+1}, whose predecessors are w_j and every upper-level word ending at w_j
+//! (at most one per level). Words are built as soon as their last word closes, not when the next
+//! one does: the words and predecessor lists are Algorithm 2's, only known one word earlier.
+//! Which w_i is the `multi_level` setting:
+//! - `paper` (Algorithm 2 as written): for each level l ≥ 1, i = j − l − 1 when w_i.D = w_j.D.
+//! - `boundaries` (default): i is the last earlier word of w_j's class, provided every word
+//!   between differs from it; the word's level is the depth of the bump, the largest class
+//!   distance between D and a word in between (at most 2·depth + 1 words in between).
+//!
+//! Why `boundaries`: the paper's intent is an alternative word for a bump that crosses one, two
+//! or three class boundaries. Densities change smoothly, so a door that lifts Ψ across two class
+//! boundaries makes the symmetric `A B C B A`: Algorithm 2 as written files it under level 3
+//! (three replaced words) and level 2 (`A x y A`, an even number of words in between) is almost
+//! never built, so the 3-level configuration found exactly the pairs of the 2-level one. Counting
+//! the boundaries crossed puts `A B A` at level 1, `A B C B A` at level 2 and `A B C D C B A` at
+//! level 3, so each level adds the words of deeper bumps that lower levels cannot correct.
 
+use super::config::MultiLevelRule;
 use super::types::{Observation, WordRef};
 use crate::geom::wrap_angle;
 
@@ -95,6 +108,7 @@ pub struct WordLevels {
     classes: usize,
     min_word_size: usize,
     levels: usize,
+    rule: MultiLevelRule,
     observations: Vec<Observation>,
     /// Ψ of each observation, contiguous for the alignment.
     psi: Vec<f64>,
@@ -114,12 +128,23 @@ pub struct WordLevels {
 
 impl WordLevels {
     /// A builder with `classes` uniform classes, minimum word size t_o and words up to level
-    /// `levels − 1` (1..=4).
+    /// `levels − 1` (1..=4), upper levels built by the paper's Algorithm 2 as written.
     pub fn new(classes: usize, min_word_size: usize, levels: usize) -> Self {
+        Self::with_rule(classes, min_word_size, levels, MultiLevelRule::Paper)
+    }
+
+    /// Like [`WordLevels::new`], with upper levels built by `rule`.
+    pub fn with_rule(
+        classes: usize,
+        min_word_size: usize,
+        levels: usize,
+        rule: MultiLevelRule,
+    ) -> Self {
         WordLevels {
             classes: classes.clamp(1, 255),
             min_word_size: min_word_size.max(1),
             levels: levels.clamp(1, MAX_LEVELS),
+            rule,
             observations: Vec::new(),
             psi: Vec::new(),
             run_starts: vec![0],
@@ -279,25 +304,53 @@ impl WordLevels {
         let id = self.add(w, &preds);
         let mut closed = vec![id];
         let mut next_preds = vec![id];
-        for l in 1..self.levels {
-            if j < self.run_first_l0 + l + 1 {
-                break;
-            }
-            let first_id = self.by_level[0][j - l - 1];
-            let first = &self.words[first_id as usize];
-            if first.class != run.class {
-                continue;
-            }
+        let fusions = match self.rule {
+            MultiLevelRule::Paper => self.paper_fusions(j, run.class),
+            MultiLevelRule::Boundaries => self.bump_fusion(j, run.class).into_iter().collect(),
+        };
+        for (l, i) in fusions {
+            let first = &self.words[self.by_level[0][i] as usize];
             let start = first.first_obs;
             let len = run.start + run.len - start;
             let first_preds: Vec<WordId> = first.pred_ids().to_vec();
-            let w = self.make_word(l, first.class, start, len, (j - l - 1, j));
+            let w = self.make_word(l, first.class, start, len, (i, j));
             let uid = self.add(w, &first_preds);
             closed.push(uid);
             next_preds.push(uid);
         }
         self.next_preds = next_preds;
         closed
+    }
+
+    /// Algorithm 2 as written: (level l, first level-0 word j − l − 1) for each level whose first
+    /// word has the class of the closing word j.
+    fn paper_fusions(&self, j: usize, class: u8) -> Vec<(usize, usize)> {
+        (1..self.levels)
+            .take_while(|&l| j > self.run_first_l0 + l)
+            .map(|l| (l, j - l - 1))
+            .filter(|&(_, i)| self.words[self.by_level[0][i] as usize].class == class)
+            .collect()
+    }
+
+    /// The bump closed by level-0 word j: (its depth as the level, its first level-0 word), when
+    /// the last earlier word of j's class in the run is separated from j only by words of other
+    /// classes, at most 2·depth + 1 of them, and the depth is a level being built.
+    fn bump_fusion(&self, j: usize, class: u8) -> Option<(usize, usize)> {
+        let max_between = 2 * (self.levels - 1) + 1;
+        let mut depth = 0usize;
+        for i in (self.run_first_l0..j).rev() {
+            let c = self.words[self.by_level[0][i] as usize].class;
+            if c == class {
+                let between = j - i - 1;
+                let ok = depth >= 1 && depth < self.levels && between <= 2 * depth + 1;
+                return ok.then_some((depth, i));
+            }
+            if j - i > max_between {
+                return None;
+            }
+            depth = depth.max(c.abs_diff(class) as usize);
+        }
+        None
     }
 
     pub fn observations(&self) -> &[Observation] {

@@ -101,6 +101,15 @@ pub fn text_table(report: &Report) -> String {
         ],
         &body,
     ));
+    for l in &report.levels {
+        if let Some(g) = &l.only_here {
+            let _ = writeln!(
+                out,
+                "{} levels found {} pair(s) that {} level(s) did not ({} correct)",
+                l.levels, g.pairs, g.than_levels, g.correct_pairs
+            );
+        }
+    }
     for (label, s) in rows(report) {
         if s.sensitivity.is_empty() && s.door_configs.is_empty() {
             continue;

@@ -4,8 +4,8 @@
 use placewords::geom::{OdomPose, Pose2};
 use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::recognizer::{
-    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Match, Observation, Recognizer,
-    RecognizerConfig, WordLevels, WordMatcher, WordRef,
+    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Match, MultiLevelRule, Observation,
+    Recognizer, RecognizerConfig, WordLevels, WordMatcher, WordRef,
 };
 use placewords::scan::BeamLayout;
 use proptest::prelude::*;
@@ -165,7 +165,10 @@ fn fig2_words_from_a_synthetic_path() {
 /// level-1 word of that class holding all 19 observations (Algorithm 2 concatenates).
 #[test]
 fn fig4_level1_word_holds_all_observations() {
-    let cfg = config(|c| c.min_word_size = 3);
+    let cfg = config(|c| {
+        c.min_word_size = 3;
+        c.multi_level = MultiLevelRule::Paper;
+    });
     let (g, b) = (class_psi(5, 8), class_psi(2, 8));
     let obs = synth::observations(
         &[
@@ -190,6 +193,7 @@ fn fig4_full_multilevel_set_and_predecessors() {
     let cfg = config(|c| {
         c.min_word_size = 3;
         c.levels = 4;
+        c.multi_level = MultiLevelRule::Paper;
     });
     let (g, b) = (class_psi(5, 8), class_psi(2, 8));
     let obs = synth::observations(
@@ -244,12 +248,47 @@ fn fig4_full_multilevel_set_and_predecessors() {
     assert_eq!(m.words().predecessors(wr(0, 5)), vec![wr(0, 4), wr(2, 1)]);
 }
 
+/// `multi_level = "boundaries"`: a smooth door bump `A B C B A` (two class boundaries crossed)
+/// is a level-2 word, so the 3-level configuration has words the 2-level one lacks, while
+/// Algorithm 2 as written files it under level 3 (three replaced words) and builds no level-2
+/// word from it.
+#[test]
+fn a_bump_across_two_class_boundaries_is_a_level2_word() {
+    let psi = |c| class_psi(c, 8);
+    let stretches = [
+        Stretch::new(psi(3), 20, 0.0),
+        Stretch::new(psi(4), 6, 0.0),
+        Stretch::new(psi(5), 8, 0.0),
+        Stretch::new(psi(4), 6, 0.0),
+        Stretch::new(psi(3), 20, 0.0),
+    ];
+    let obs = synth::observations(&stretches, 0.1, 0, None);
+    let words_with = |rule| {
+        let cfg = config(|c| {
+            c.levels = 4;
+            c.multi_level = rule;
+        });
+        let (m, _) = run_matcher(&cfg, &obs);
+        (1..4).map(|l| summary(m.words(), l)).collect::<Vec<_>>()
+    };
+    let boundaries = words_with(MultiLevelRule::Boundaries);
+    assert_eq!(boundaries[0], vec![(4, 20)], "B C B crosses one boundary");
+    assert_eq!(boundaries[1], vec![(3, 60)], "A B C B A crosses two");
+    assert_eq!(boundaries[2], vec![]);
+    let paper = words_with(MultiLevelRule::Paper);
+    assert_eq!(paper[0], vec![(4, 20)]);
+    assert_eq!(paper[1], vec![], "no A x y A");
+    assert_eq!(paper[2], vec![(3, 60)]);
+}
+
 /// Fig. 3: an open door in the middle of a corridor splits it in three words; level 1 holds the
-/// "corrected" long word, which matches the corridor seen with the door closed.
+/// "corrected" long word, which matches the corridor seen with the door closed. (With
+/// `multi_level = "boundaries"`, the door's word is one class above the corridor's: a door two
+/// classes up makes a level-2 word, see `a_bump_across_two_class_boundaries_is_a_level2_word`.)
 #[test]
 fn door_bump_yields_the_corrected_long_word() {
     let cfg = config(|c| c.levels = 2);
-    let (corr, door, hall) = (class_psi(2, 8), class_psi(4, 8), class_psi(6, 8));
+    let (corr, door, hall) = (class_psi(2, 8), class_psi(3, 8), class_psi(6, 8));
     let open = synth::observations(
         &[
             Stretch::new(corr, 30, 0.0),
@@ -264,7 +303,7 @@ fn door_bump_yields_the_corrected_long_word() {
     let (m, _) = run_matcher(&cfg, &open);
     assert_eq!(
         summary(m.words(), 0),
-        vec![(2, 30), (4, 8), (2, 30), (6, 10)]
+        vec![(2, 30), (3, 8), (2, 30), (6, 10)]
     );
     assert_eq!(summary(m.words(), 1), vec![(2, 68)]);
 
