@@ -573,6 +573,7 @@ pub(crate) mod tests {
             levels: 1,
             ngram_len: 1,
             word_pairs: vec![],
+            direction: crate::recognizer::Direction::Same,
             pairs,
         }
     }

@@ -158,6 +158,7 @@ mod tests {
             levels: 1,
             ngram_len: 1,
             word_pairs: vec![],
+            direction: crate::recognizer::Direction::Same,
             pairs: pairs
                 .iter()
                 .map(|&(q, p)| AlignedPair {

@@ -52,6 +52,14 @@ pub struct RecognizerConfig {
     /// (the smaller word's n observations at every placement inside the larger word, never past
     /// its ends). Default `whole-word`.
     pub alignment: AlignmentMode,
+    /// Also recognize revisits driven the other way (paper §VI, future work). The past words are
+    /// read backwards: their order reversed, each angle syllable negated (class and size are
+    /// unchanged), and a chain grows through successors, so current word i+1 pairs with past
+    /// word j−1 when current i pairs with past j. The fine alignment reads the past word's Ψ
+    /// backwards. Verification is the same, with the past side's travel and turn measured
+    /// backwards (the turn between two matched past words is negated). Such matches carry
+    /// `direction = "opposite"`. Default true.
+    pub reverse: bool,
     /// Verify each match before reporting it (see the fields `verify_*`). Default true.
     pub verify: bool,
     /// Verification, travel: between two consecutive words of a matched n-gram, and from its
@@ -94,6 +102,7 @@ impl Default for RecognizerConfig {
             min_ngram: vec![6, 9, 12, 15],
             max_alignment_offset: 10,
             alignment: AlignmentMode::WholeWord,
+            reverse: true,
             verify: true,
             verify_travel_ratio: 0.15,
             verify_travel_slack_m: 0.5,

@@ -22,7 +22,7 @@ pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, densi
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;
 pub use matcher::WordMatcher;
-pub use types::{AlignedPair, Match, ObsId, Observation, WordRef};
+pub use types::{AlignedPair, Direction, Match, ObsId, Observation, WordRef};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;
