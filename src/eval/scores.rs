@@ -14,7 +14,9 @@
 //!                 "recognize_seconds_per_lap": 0.8,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
-//!                                     "metrics": { "precision": ..., ... } } ] } ],
+//!                                     "metrics": { "precision": ..., ... } } ],
+//!                 "directions": { "same": { "precision": ..., "recall": ..., ... },
+//!                                 "opposite": { ... } } } ],
 //!   "icp": { same fields as a "levels" entry without "levels" and "thresholds" } | null,
 //!   "simulate_seconds_per_lap": 0.4,
 //!   "evaluation": { "tp_radius_m": 1.0, "min_gap_m": 20.0, "heading_tolerance_deg": 45.0,
@@ -24,7 +26,7 @@
 //! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN).
 
 use super::Recognition;
-use super::metrics::{DoorConfigMetrics, Evaluation, Metrics};
+use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics};
 use super::sweep::{PrCurve, SweepResult};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
@@ -54,12 +56,25 @@ pub struct Scores {
     pub sensitivity: Vec<Metrics>,
     /// Scores per door configuration at `tp_radius_m`.
     pub door_configs: Vec<DoorConfigMetrics>,
+    /// Scores per direction at `tp_radius_m`: the matches of that direction against the
+    /// revisits of that direction (`eval::metrics`); the figures above count both.
+    #[serde(default)]
+    pub directions: DirectionMetrics,
 }
 
 impl Scores {
     /// The scores of an evaluation and the timing of its recognition.
     pub fn new(e: &Evaluation, recognize_seconds_per_lap: f64) -> Self {
-        let m = &e.main;
+        Scores {
+            sensitivity: e.sensitivity.clone(),
+            door_configs: e.door_configs.clone(),
+            directions: e.directions.clone(),
+            ..Scores::of_metrics(&e.main, recognize_seconds_per_lap)
+        }
+    }
+
+    /// The headline figures of `m` (no breakdowns).
+    fn of_metrics(m: &Metrics, recognize_seconds_per_lap: f64) -> Self {
         Scores {
             precision: m.precision,
             recall: m.recall,
@@ -74,9 +89,26 @@ impl Scores {
             visit_recall: m.visit_recall,
             pair_recall: m.pair_recall,
             recognize_seconds_per_lap,
-            sensitivity: e.sensitivity.clone(),
-            door_configs: e.door_configs.clone(),
+            sensitivity: Vec::new(),
+            door_configs: Vec::new(),
+            directions: DirectionMetrics::default(),
         }
+    }
+
+    /// The scores of one direction's matches against that direction's revisits (no
+    /// breakdowns), with the same timing.
+    pub fn of_direction(&self, d: crate::recognizer::Direction) -> Self {
+        let m = match d {
+            crate::recognizer::Direction::Same => &self.directions.same,
+            crate::recognizer::Direction::Opposite => &self.directions.opposite,
+        };
+        Scores::of_metrics(m, self.recognize_seconds_per_lap)
+    }
+
+    /// Whether there is anything to say about the opposite direction: revisits driven the
+    /// other way, or opposite matches.
+    pub fn has_opposite(&self) -> bool {
+        self.directions.opposite.revisits > 0 || self.directions.opposite.pairs > 0
     }
 
     /// Evaluates `rec` with `spec` and takes its timing.

@@ -1,6 +1,7 @@
 //! Tables from reports: a plain-text table for the terminal, and the paper's Table I in Markdown.
 
 use crate::eval::scores::{Report, Scores};
+use crate::recognizer::Direction;
 use std::fmt::Write;
 
 /// Rows of a terminal table: (label, scores).
@@ -17,6 +18,19 @@ fn rows(report: &Report) -> Vec<(String, &Scores)> {
         rows.push(("ICP".to_string(), &icp.scores));
     }
     rows
+}
+
+/// `rows` with, under each row that has opposite revisits or matches, a row per direction.
+fn rows_with_directions(report: &Report) -> Vec<(String, Scores)> {
+    let mut out = Vec::new();
+    for (label, s) in rows(report) {
+        out.push((label, s.clone()));
+        if s.has_opposite() {
+            out.push(("  same".to_string(), s.of_direction(Direction::Same)));
+            out.push(("  opposite".to_string(), s.of_direction(Direction::Opposite)));
+        }
+    }
+    out
 }
 
 /// Left-aligned first column, right-aligned others, two spaces apart.
@@ -69,12 +83,12 @@ pub fn text_table(report: &Report) -> String {
         report.evaluation.min_gap_m,
         report.evaluation.heading_tolerance_deg
     );
-    let body: Vec<Vec<String>> = rows(report)
+    let body: Vec<Vec<String>> = rows_with_directions(report)
         .into_iter()
         .map(|(label, s)| {
             vec![
                 label,
-                fmt_p(s),
+                fmt_p(&s),
                 format!("{:.3}", s.recall),
                 format!("{:.3}", s.visit_recall),
                 format!("{:.3}", s.pair_recall),
@@ -194,11 +208,11 @@ fn markdown_by_level(
     out.push_str("\n|---|");
     out.push_str(&"---|".repeat(reports.len() * columns.len()));
     out.push('\n');
-    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<&Scores>| {
+    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<Scores>| {
         let _ = write!(out, "| {label} |");
         for r in reports {
             match scores(r) {
-                Some(s) => cells(s).iter().for_each(|c| {
+                Some(s) => cells(&s).iter().for_each(|c| {
                     let _ = write!(out, " {c} |");
                 }),
                 None => out.push_str(&" – |".repeat(columns.len())),
@@ -207,10 +221,18 @@ fn markdown_by_level(
         out.push('\n');
     };
     for lv in rows {
-        line(lv.to_string(), &|r| r.level(lv).map(|l| &l.scores));
+        line(lv.to_string(), &|r| r.level(lv).map(|l| l.scores.clone()));
+        fn level(r: &Report, lv: usize) -> Option<&Scores> {
+            r.level(lv).map(|l| &l.scores)
+        }
+        if reports.iter().any(|r| level(r, lv).is_some_and(Scores::has_opposite)) {
+            for (name, d) in [("same", Direction::Same), ("opposite", Direction::Opposite)] {
+                line(format!("{lv} {name}"), &|r| level(r, lv).map(|s| s.of_direction(d)));
+            }
+        }
     }
     if reports.iter().any(|r| r.icp.is_some()) {
-        line("ICP".into(), &|r| r.icp.as_ref().map(|i| &i.scores));
+        line("ICP".into(), &|r| r.icp.as_ref().map(|i| i.scores.clone()));
     }
     out
 }
