@@ -100,6 +100,7 @@ fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::s
         seed: 0,
         runs: vec![RunPlan {
             start_waypoint: 0,
+            reverse: false,
             laps: 2,
             doors: DoorPlan::Fixed(DoorChoice {
                 name: "given".into(),
