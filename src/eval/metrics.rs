@@ -744,6 +744,7 @@ pub(crate) mod tests {
                 seconds: 0.0,
                 laps: 2,
                 truth: gt.clone(),
+                diagnostics: None,
             };
             evaluate(&rec, &EvaluationSpec::default())
         };
@@ -799,6 +800,7 @@ pub(crate) mod tests {
             seconds: 1.0,
             laps: 3,
             truth: gt,
+            diagnostics: None,
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -844,6 +846,7 @@ pub(crate) mod tests {
             seconds: 0.0,
             laps: 2,
             truth: gt,
+            diagnostics: None,
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);

@@ -280,6 +280,7 @@ impl LoggedRuns {
             seconds: 0.0,
             laps: self.laps,
             truth: self.truth.clone(),
+            diagnostics: None,
         })
     }
 }

@@ -91,6 +91,10 @@ pub struct WordMatcher {
     lookup: [Vec<(u32, u32)>; MAX_LEVELS],
     stamp: u32,
     rejections: VerificationCounts,
+    /// Per level configuration, the longest chain of matching word pairs seen (either direction).
+    longest: [u16; MAX_LEVELS],
+    /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
+    within_gap: usize,
 }
 
 impl WordMatcher {
@@ -123,6 +127,8 @@ impl WordMatcher {
             successors: Vec::new(),
             lookup: Default::default(),
             stamp: 0,
+            longest: [0; MAX_LEVELS],
+            within_gap: 0,
         })
     }
 
@@ -179,6 +185,17 @@ impl WordMatcher {
     /// Candidate n-grams accepted and rejected by verification so far.
     pub fn verification(&self) -> VerificationCounts {
         self.rejections
+    }
+
+    /// What the matcher saw so far, to say why nothing matched.
+    pub fn diagnostics(&self) -> MatchDiagnostics {
+        let levels = self.params.levels;
+        MatchDiagnostics {
+            longest_chain: self.longest[..levels].iter().map(|&l| l as usize).collect(),
+            min_ngram: self.params.min_ngram[..levels].to_vec(),
+            within_gap: self.within_gap,
+            verification: self.rejections,
+        }
     }
 
     /// Matching word pairs held in the memo (a measure of its size).
@@ -308,6 +325,9 @@ impl WordMatcher {
                     }
                 }
             }
+            for (m, &l) in self.longest.iter_mut().zip(&len) {
+                *m = (*m).max(l);
+            }
             entries.push(Entry {
                 past: p,
                 len,
@@ -391,6 +411,7 @@ impl WordMatcher {
             .fold(f64::NEG_INFINITY, f64::max);
         let first_current = self.word(word_pairs[0].0);
         if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
+            self.within_gap += 1;
             return None;
         }
         if self.params.verify
@@ -636,8 +657,8 @@ pub enum Rejection {
 }
 
 /// Counts of candidate n-grams (τ reached, candidate gap satisfied) by outcome, summed over
-/// level configurations.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+/// level configurations and directions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct VerificationCounts {
     pub accepted: usize,
     pub rejected_travel: usize,
@@ -646,6 +667,11 @@ pub struct VerificationCounts {
 }
 
 impl VerificationCounts {
+    /// Candidates verification turned down, for any reason.
+    pub fn rejected(&self) -> usize {
+        self.rejected_travel + self.rejected_turn + self.rejected_density
+    }
+
     fn add(&mut self, r: Rejection) {
         match r {
             Rejection::Travel => self.rejected_travel += 1,
@@ -653,6 +679,20 @@ impl VerificationCounts {
             Rejection::Density => self.rejected_density += 1,
         }
     }
+}
+
+/// What the matcher saw, so that a run without matches can say why.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct MatchDiagnostics {
+    /// Per level configuration (index k: k + 1 levels), the longest chain of matching word pairs
+    /// found, in word pairs.
+    pub longest_chain: Vec<usize>,
+    /// Per level configuration, its minimum n-gram size τ.
+    pub min_ngram: Vec<usize>,
+    /// Chains that reached τ but began within the candidate gap of their past side.
+    pub within_gap: usize,
+    /// Candidate n-grams by verification outcome.
+    pub verification: VerificationCounts,
 }
 
 /// Σ (a − b)², four lanes at a time.

@@ -116,6 +116,11 @@ pub fn text_table(report: &Report) -> String {
         &body,
     ));
     for (label, s) in rows(report) {
+        if let Some(why) = &s.no_pairs_reason {
+            let _ = writeln!(out, "{label}: no matches: {why}");
+        }
+    }
+    for (label, s) in rows(report) {
         if s.sensitivity.is_empty() && s.door_configs.is_empty() {
             continue;
         }

@@ -794,3 +794,30 @@ fn a_reverse_run_drives_the_waypoints_backwards() {
         "{all:?}"
     );
 }
+
+/// No silent failure: a run that yields no pair says so in words in the table ("no matches",
+/// not a precision of 0) and its report says why (here one lap: nothing is revisited, and no
+/// chain of matching words reaches τ).
+#[test]
+fn a_run_without_pairs_says_why() {
+    use placewords::experiment::{ExperimentOptions, evaluate_runs};
+    let src = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 1\n[[runs]]\nlaps = 1\n";
+    let scn = scenario(LOOP_WORLD, src).unwrap();
+    let runs = simulate(&scn.sim, None, &|| {}).unwrap();
+    let opts = ExperimentOptions {
+        levels: vec![1],
+        quiet: true,
+        ..Default::default()
+    };
+    let exp = evaluate_runs("tiny", 1, runs, &scn.recognizer, &scn.evaluation, &opts).unwrap();
+    let s = &exp.report.levels[0].scores;
+    assert_eq!(s.pairs, 0);
+    let why = s.no_pairs_reason.as_deref().unwrap_or_default();
+    assert!(why.contains("no observation has a revisit"), "{why}");
+    assert!(why.contains("longest chain of matching words is"), "{why}");
+    let json = serde_json::to_string(&exp.report).unwrap();
+    assert!(json.contains("\"no_pairs_reason\""), "{json}");
+    let table = placewords::report::table::text_table(&exp.report);
+    assert!(table.contains("no matches"), "{table}");
+    assert!(table.contains(why), "{table}");
+}
