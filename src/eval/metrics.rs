@@ -324,8 +324,7 @@ impl Scorer {
                             break;
                         }
                         let d2 = (o.x - p.x).powi(2) + (o.y - p.y).powi(2);
-                        if d2 <= r2 && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad)
-                        {
+                        if d2 <= r2 && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad) {
                             has[i] = true;
                             break 'search;
                         }

@@ -150,7 +150,9 @@ pub fn pair_recall(
         .collect();
     let mut seen: HashSet<(usize, usize)> = HashSet::new();
     let counted = matches.iter().filter(|m| facing.counts(m.direction));
-    for (p, claim) in counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction)))) {
+    for (p, claim) in
+        counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction))))
+    {
         let (Some(&qi), Some(&pi)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
             continue;
         };
@@ -231,15 +233,32 @@ mod tests {
                 }
             }
         }
-        let full = pair_recall(&obs, &[one_match(&obs, &all)], &gt, &spec, 1.0, Facing::Same);
+        let full = pair_recall(
+            &obs,
+            &[one_match(&obs, &all)],
+            &gt,
+            &spec,
+            1.0,
+            Facing::Same,
+        );
         assert_eq!(full.found, full.possible);
         assert_eq!(full.ratio(), 1.0);
         // One pair per observation, one lap back.
         let nearest: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
-        let some = pair_recall(&obs, &[one_match(&obs, &nearest)], &gt, &spec, 1.0, Facing::Same);
+        let some = pair_recall(
+            &obs,
+            &[one_match(&obs, &nearest)],
+            &gt,
+            &spec,
+            1.0,
+            Facing::Same,
+        );
         assert!(some.ratio() < 0.1, "{some:?}");
         assert_eq!(some.found, nearest.len() as u64);
-        assert_eq!(pair_recall(&obs, &[], &gt, &spec, 1.0, Facing::Same).ratio(), 0.0);
+        assert_eq!(
+            pair_recall(&obs, &[], &gt, &spec, 1.0, Facing::Same).ratio(),
+            0.0
+        );
     }
 
     /// A pair facing the other way is found only by a match claiming the opposite direction.
@@ -251,7 +270,14 @@ mod tests {
         }
         let spec = EvaluationSpec::default();
         let m = one_match(&obs, &[(400, 0), (450, 50)]);
-        let pr = pair_recall(&obs, &[m.clone()], &gt, &spec, 1.0, Facing::Either);
+        let pr = pair_recall(
+            &obs,
+            std::slice::from_ref(&m),
+            &gt,
+            &spec,
+            1.0,
+            Facing::Either,
+        );
         assert_eq!(pr.found, 0);
         // Claimed as opposite, the same pairs are found, in the opposite and top-level figures.
         let opposite = Match {
@@ -259,7 +285,14 @@ mod tests {
             ..m
         };
         for facing in [Facing::Opposite, Facing::Either] {
-            let pr = pair_recall(&obs, &[opposite.clone()], &gt, &spec, 1.0, facing);
+            let pr = pair_recall(
+                &obs,
+                std::slice::from_ref(&opposite),
+                &gt,
+                &spec,
+                1.0,
+                facing,
+            );
             assert_eq!(pr.found, 2, "{facing:?}");
         }
         let pr = pair_recall(&obs, &[opposite], &gt, &spec, 1.0, Facing::Same);

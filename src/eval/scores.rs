@@ -363,13 +363,13 @@ pub(crate) mod tests {
         d.longest_chain = vec![4, 8];
         let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
-        assert!(why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"), "{why}");
+        assert!(
+            why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
+            "{why}"
+        );
         let why = no_pairs_reason(&Metrics::default(), None, &spec).unwrap();
         assert!(why.starts_with("no observation has a revisit"), "{why}");
-        let some = Metrics {
-            pairs: 1,
-            ..none
-        };
+        let some = Metrics { pairs: 1, ..none };
         assert_eq!(no_pairs_reason(&some, Some(&d), &spec), None);
     }
 

@@ -27,7 +27,10 @@ fn rows_with_directions(report: &Report) -> Vec<(String, Scores)> {
         out.push((label, s.clone()));
         if s.has_opposite() {
             out.push(("  same".to_string(), s.of_direction(Direction::Same)));
-            out.push(("  opposite".to_string(), s.of_direction(Direction::Opposite)));
+            out.push((
+                "  opposite".to_string(),
+                s.of_direction(Direction::Opposite),
+            ));
         }
     }
     out
@@ -230,9 +233,14 @@ fn markdown_by_level(
         fn level(r: &Report, lv: usize) -> Option<&Scores> {
             r.level(lv).map(|l| &l.scores)
         }
-        if reports.iter().any(|r| level(r, lv).is_some_and(Scores::has_opposite)) {
+        if reports
+            .iter()
+            .any(|r| level(r, lv).is_some_and(Scores::has_opposite))
+        {
             for (name, d) in [("same", Direction::Same), ("opposite", Direction::Opposite)] {
-                line(format!("{lv} {name}"), &|r| level(r, lv).map(|s| s.of_direction(d)));
+                line(format!("{lv} {name}"), &|r| {
+                    level(r, lv).map(|s| s.of_direction(d))
+                });
             }
         }
     }

@@ -20,10 +20,10 @@ use crate::sim::plan::{DoorPlan, SimPlan};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
 use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
 use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
-use crate::world::{DoorStates, Route};
 use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
 use crate::world::raycast::{Disc, SweepCaster};
+use crate::world::{DoorStates, Route};
 use rand::RngExt;
 use rayon::prelude::*;
 

@@ -4,8 +4,8 @@
 use placewords::geom::{OdomPose, Pose2};
 use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::recognizer::{
-    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Direction, Match, Observation, Recognizer,
-    RecognizerConfig, WordLevels, WordMatcher, WordRef,
+    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Direction, Match, Observation,
+    Recognizer, RecognizerConfig, WordLevels, WordMatcher, WordRef,
 };
 use placewords::scan::BeamLayout;
 use proptest::prelude::*;
@@ -380,7 +380,10 @@ fn reversed_lap_matches_in_the_opposite_direction() {
     let lap = random_stretches(7, 40);
     let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
     let n = first.len();
-    let second = with_noise(synth::observations(&reversed(&lap), 0.1, 0, first.last()), 2);
+    let second = with_noise(
+        synth::observations(&reversed(&lap), 0.1, 0, first.last()),
+        2,
+    );
     let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
     let pairs: Vec<_> = matches

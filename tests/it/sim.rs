@@ -784,7 +784,10 @@ fn a_reverse_run_drives_the_waypoints_backwards() {
     let first = |f: &dyn Fn(&Pose2) -> bool| truth.iter().position(f).unwrap();
     let west_top = first(&|p| p.x < 3.0 && p.y > 6.0);
     let east = first(&|p| p.x > 17.0);
-    assert!(west_top < east, "reaches (1, 7) at frame {west_top}, x > 17 at {east}");
+    assert!(
+        west_top < east,
+        "reaches (1, 7) at frame {west_top}, x > 17 at {east}"
+    );
 
     let err = scenario(LOOP_WORLD, &format!("{head}direction = \"backwards\"\n")).unwrap_err();
     let all: Vec<String> = err.diagnostics().iter().map(|d| d.to_string()).collect();
