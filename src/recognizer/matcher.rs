@@ -444,19 +444,8 @@ impl WordMatcher {
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
     fn verify(&self, word_pairs: &[(WordId, WordId)], dir: Direction) -> Option<Rejection> {
-        let obs = self.words.observations();
-        let start = |w: WordId| {
-            let w = self.word(w);
-            (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta)
-        };
-        let past_start = |w: WordId| match dir {
-            Direction::Same => start(w),
-            Direction::Opposite => {
-                let w = self.word(w);
-                let last = obs[w.first_obs + w.size - 1].odom_pose.0.theta;
-                (-w.end_travel_m, last)
-            }
-        };
+        let start = |w: WordId| self.reading_start(w, Direction::Same);
+        let past_start = |w: WordId| self.reading_start(w, dir);
         let ok_travel = |a: f64, b: f64| {
             (a - b).abs()
                 <= self.params.verify_travel_ratio * a.abs().max(b.abs())
@@ -491,6 +480,21 @@ impl WordMatcher {
             (sum / count as f64).sqrt()
         };
         (rms > self.params.verify_max_psi_rms).then_some(Rejection::Density)
+    }
+
+    /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
+    /// first observation, or read backwards, of its last one with travel negated (so that
+    /// differences between words read backwards come out as travelled that way).
+    fn reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        let obs = self.words.observations();
+        let w = self.word(w);
+        match dir {
+            Direction::Same => (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta),
+            Direction::Opposite => (
+                -w.end_travel_m,
+                obs[w.first_obs + w.size - 1].odom_pose.0.theta,
+            ),
+        }
     }
 
     /// Eq. 2: the best placement of the two words' observation windows (see the module doc).
