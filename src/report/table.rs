@@ -336,6 +336,32 @@ mod tests {
         assert!(t.contains("0.100 (τ=5, P 0.950)"), "{t}");
     }
 
+    /// Where opposite revisits exist, the terminal table and Table I add a row per direction
+    /// under the level row; without them, neither does.
+    #[test]
+    fn rows_per_direction_where_opposite_revisits_exist() {
+        let plain = sample("A", [0.9; 3], [0.2; 3]);
+        assert!(!text_table(&plain).contains("opposite"));
+        assert!(!markdown_table_i(std::slice::from_ref(&plain)).contains("opposite"));
+        let mut both = plain.clone();
+        let s = &mut both.levels[2].scores;
+        s.directions.same.precision = 0.97;
+        s.directions.opposite.revisits = 100;
+        s.directions.opposite.pairs = 10;
+        s.directions.opposite.precision = 0.8;
+        let t = text_table(&both);
+        let opposite = t.lines().find(|l| l.starts_with("  opposite")).unwrap();
+        assert!(opposite.contains("0.800"), "{t}");
+        assert!(
+            t.lines()
+                .any(|l| l.starts_with("  same") && l.contains("0.970")),
+            "{t}"
+        );
+        let md = markdown_table_i(&[both]);
+        assert!(md.contains("| 3 same | 0.970 – "), "{md}");
+        assert!(md.contains("| 3 opposite | 0.800 – "), "{md}");
+    }
+
     #[test]
     fn text_table_lists_every_recognizer() {
         let t = text_table(&sample("B", [0.9; 3], [0.2; 3]));
