@@ -6,7 +6,7 @@
 //! types ([`Match`], [`Observation`]).
 
 use crate::geom::OdomPose;
-use crate::recognizer::{Match, Observation};
+use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use crate::scan::Scan;
 
 /// Anything that recognizes places from odometry and scans alone: the paper's recognizer, the
@@ -27,4 +27,9 @@ pub trait PlaceRecognizer {
     fn observations(&self) -> &[Observation];
     /// A short name for reports and progress bars ("levels=2 [6, 9]", "icp").
     fn name(&self) -> String;
+    /// What the recognizer saw, so a run without matches can say why; `None` when it cannot
+    /// tell.
+    fn diagnostics(&self) -> Option<MatchDiagnostics> {
+        None
+    }
 }

@@ -7,7 +7,8 @@
 //! lie more than `tp_radius_m` apart (their middle observations' true positions) is a confusion:
 //! both words' stretches of the route are ambiguous, and each is the other's partner. Stretches
 //! confused with each other along consecutive words are merged into one pair of stretches (one
-//! colour and number in the picture).
+//! colour and number in the picture). Only same-direction matches count (the route is driven one
+//! way; the recognizer's `reverse` setting is turned off here).
 
 use crate::geom::Vec2;
 use crate::recognizer::{Match, Recognizer, RecognizerConfig, Word};
@@ -100,6 +101,7 @@ fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::s
         seed: 0,
         runs: vec![RunPlan {
             start_waypoint: 0,
+            reverse: false,
             laps: 2,
             doors: DoorPlan::Fixed(DoorChoice {
                 name: "given".into(),
@@ -364,7 +366,12 @@ pub fn ambiguity(
             ),
         })?;
     let drive = drive(world, route, doors)?;
-    let mut rec = Recognizer::new(cfg.clone())?;
+    // The route is driven one way: a stretch that looks like another only when read backwards
+    // would confuse a robot driving it in reverse, which this map is not about.
+    let mut rec = Recognizer::new(RecognizerConfig {
+        reverse: false,
+        ..cfg.clone()
+    })?;
     let mut matches = Vec::new();
     for f in &drive.frames {
         matches.extend(rec.push(f.odom, &f.scan));

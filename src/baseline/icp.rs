@@ -578,6 +578,7 @@ impl IcpRecognizer {
             levels: 0,
             ngram_len: 1,
             word_pairs: Vec::new(),
+            direction: crate::recognizer::Direction::Same,
             pairs,
         }
     }

@@ -8,8 +8,9 @@
 //!   ids the recognizer never reported as observations are not scored; they are counted in
 //!   [`Metrics::unresolved_pairs`] (always 0 for a well-behaved recognizer).
 //! - **Correct pair.** The true positions of the two observations (truth of the frames that made
-//!   them) are at most `r` apart, and their true headings agree within `heading_tolerance_deg`
-//!   (the same direction, as a revisit needs).
+//!   them) are at most `r` apart, and their true headings agree as the match's direction claims:
+//!   within `heading_tolerance_deg` for a `same` match, 180° ± `heading_tolerance_deg` for an
+//!   `opposite` one.
 //! - **Precision** = correct pairs / pairs. With no pair at all, precision is reported as 0 and
 //!   [`Metrics::no_pairs`] is set, so reports stay free of NaN.
 //! - **Per-match precision** (`match_precision`): a match is correct when strictly more than half
@@ -17,7 +18,11 @@
 //!   with at least one scored pair. Matches without pairs are ignored.
 //! - **Revisit.** Observation `o` has a revisit when an observation made before it, with at least
 //!   `min_gap_m` less true travel (the harness's, [`super::pair_recall::true_travel_m`]), lies within `r` of it (true positions) with a true
-//!   heading within `heading_tolerance_deg` of `o`'s (same direction, as the paper counts).
+//!   heading within `heading_tolerance_deg` of `o`'s (a same-direction revisit, as the paper
+//!   counts) or 180° ± `heading_tolerance_deg` from it (an opposite-direction revisit). The
+//!   top-level figures count revisits of either direction and every match.
+//! - **Per direction** ([`Evaluation::directions`]): the same figures over the matches of one
+//!   direction and the revisits of that direction only.
 //!   The radius of the revisit test follows the scoring radius, so a sensitivity radius changes
 //!   both what is correct and what could have been found.
 //! - **Recall** = observations with a revisit that are the *query* side of at least one correct
@@ -29,7 +34,7 @@
 //! Revisits are searched with a spatial hash of cell size `r`, in creation order, so the cost is
 //! about linear in the number of observations.
 
-use super::pair_recall::heading_agrees;
+use super::pair_recall::Facing;
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -94,32 +99,59 @@ pub struct Evaluation {
     pub sensitivity: Vec<Metrics>,
     /// At `tp_radius_m`, per door configuration (order of first appearance in the runs).
     pub door_configs: Vec<DoorConfigMetrics>,
+    /// At `tp_radius_m`, per direction.
+    pub directions: DirectionMetrics,
+}
+
+/// Scores of the matches of one direction against the revisits of that direction.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct DirectionMetrics {
+    pub same: Metrics,
+    pub opposite: Metrics,
 }
 
 /// Scores `rec` as DESIGN.md §6 says: at `tp_radius_m`, at every sensitivity radius, and per
 /// door configuration.
 pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
     let scorer = Scorer::new(&rec.observations, &rec.truth, spec);
-    let (mut main, door_configs) = scorer.score(&rec.matches, spec.tp_radius_m, true);
-    main.visit_recall = scorer.visit_recall(&rec.matches, spec.tp_radius_m);
-    main.pair_recall = super::pair_recall::pair_recall(
-        &rec.observations,
-        &rec.matches,
-        &rec.truth,
-        spec,
-        spec.tp_radius_m,
-    )
-    .ratio();
+    let (main, door_configs) = main_metrics(&scorer, rec, spec, true);
     let sensitivity = spec
         .sensitivity_radii_m
         .iter()
         .map(|&r| scorer.score(&rec.matches, r, false).0)
         .collect();
+    let direction = |f: Facing| main_metrics(&scorer.with_facing(f), rec, spec, false).0;
     Evaluation {
         main,
         sensitivity,
         door_configs,
+        directions: DirectionMetrics {
+            same: direction(Facing::Same),
+            opposite: direction(Facing::Opposite),
+        },
     }
+}
+
+/// The figures at `tp_radius_m` as `scorer` counts them, visit and pair recall included.
+fn main_metrics(
+    scorer: &Scorer,
+    rec: &Recognition,
+    spec: &EvaluationSpec,
+    breakdown: bool,
+) -> (Metrics, Vec<DoorConfigMetrics>) {
+    let r = spec.tp_radius_m;
+    let (mut main, door_configs) = scorer.score(&rec.matches, r, breakdown);
+    main.visit_recall = scorer.visit_recall(&rec.matches, r);
+    main.pair_recall = super::pair_recall::pair_recall(
+        &rec.observations,
+        &rec.matches,
+        &rec.truth,
+        spec,
+        r,
+        scorer.facing,
+    )
+    .ratio();
+    (main, door_configs)
 }
 
 /// Scores observations and matches at one radius against `truth` (no breakdown).
@@ -192,7 +224,9 @@ struct ObsTruth {
     lap: usize,
 }
 
-/// Observations joined with their truth, reusable across radii.
+/// Observations joined with their truth, reusable across radii. It counts the revisits and
+/// matches of one facing ([`Facing::Either`] unless [`Scorer::with_facing`] says otherwise).
+#[derive(Clone)]
 pub struct Scorer {
     /// Observation id → position in `obs`.
     index_of: HashMap<ObsId, usize>,
@@ -202,6 +236,7 @@ pub struct Scorer {
     config_laps: Vec<usize>,
     min_gap_m: f64,
     heading_tol_rad: f64,
+    facing: Facing,
 }
 
 impl Scorer {
@@ -251,6 +286,16 @@ impl Scorer {
             config_laps,
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
+            facing: Facing::Either,
+        }
+    }
+
+    /// The same scorer counting only revisits facing as `facing` says and matches of that
+    /// direction.
+    pub fn with_facing(&self, facing: Facing) -> Self {
+        Scorer {
+            facing,
+            ..self.clone()
         }
     }
 
@@ -279,10 +324,7 @@ impl Scorer {
                             break;
                         }
                         let d2 = (o.x - p.x).powi(2) + (o.y - p.y).powi(2);
-                        if d2 <= r2
-                            && crate::geom::wrap_angle(o.theta - p.theta).abs()
-                                <= self.heading_tol_rad
-                        {
+                        if d2 <= r2 && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad) {
                             has[i] = true;
                             break 'search;
                         }
@@ -303,14 +345,17 @@ impl Scorer {
         let r2 = r * r;
         // Laps each query observation was correctly paired with.
         let mut matched: HashMap<usize, HashSet<usize>> = HashMap::new();
-        for p in matches.iter().flat_map(|m| &m.pairs) {
+        let counted = matches.iter().filter(|m| self.facing.counts(m.direction));
+        for (p, claim) in
+            counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction))))
+        {
             let (Some(&qi), Some(&pi)) = (self.index_of.get(&p.query), self.index_of.get(&p.past))
             else {
                 continue;
             };
             if let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi])
                 && (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                && heading_agrees(q.theta, pa.theta, self.heading_tol_rad)
+                && claim.agrees(q.theta, pa.theta, self.heading_tol_rad)
             {
                 matched.entry(qi).or_default().insert(pa.lap);
             }
@@ -331,8 +376,7 @@ impl Scorer {
                             break;
                         }
                         if (o.x - p.x).powi(2) + (o.y - p.y).powi(2) <= r2
-                            && crate::geom::wrap_angle(o.theta - p.theta).abs()
-                                <= self.heading_tol_rad
+                            && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad)
                         {
                             laps.insert(p.lap);
                         }
@@ -380,7 +424,8 @@ impl Scorer {
         let mut seen: HashSet<(ObsId, ObsId)> = HashSet::new();
         let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
         let r2 = r * r;
-        for m in matches {
+        for m in matches.iter().filter(|m| self.facing.counts(m.direction)) {
+            let claim = Facing::of(m.direction);
             in_match.clear();
             let (mut n, mut ok) = (0usize, 0usize);
             let mut match_cfg = None;
@@ -400,7 +445,7 @@ impl Scorer {
                     continue;
                 };
                 let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                    && heading_agrees(q.theta, pa.theta, self.heading_tol_rad);
+                    && claim.agrees(q.theta, pa.theta, self.heading_tol_rad);
                 if in_match.insert((p.query, p.past)) {
                     n += 1;
                     ok += correct as usize;
@@ -515,7 +560,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::eval::{FrameTruth, LapInfo};
     use crate::geom::{OdomPose, Pose2, TruePose};
-    use crate::recognizer::AlignedPair;
+    use crate::recognizer::{AlignedPair, Direction};
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -573,6 +618,7 @@ pub(crate) mod tests {
             levels: 1,
             ngram_len: 1,
             word_pairs: vec![],
+            direction: crate::recognizer::Direction::Same,
             pairs,
         }
     }
@@ -676,16 +722,49 @@ pub(crate) mod tests {
         assert_eq!((m.revisits, m.recall), (0, 0.0));
     }
 
+    /// A second lap facing the other way is an opposite-direction revisit, not a same-direction
+    /// one; its pairs are correct only in a match that claims the opposite direction, and the
+    /// top-level figures count both directions.
     #[test]
-    fn opposite_direction_is_no_revisit() {
-        let (mut obs, mut gt) = circle(2, 40.0);
+    fn opposite_revisits_and_pairs_are_scored_per_direction() {
+        let (obs, mut gt) = circle(2, 40.0);
         for f in &mut gt.frames[400..] {
             f.pose.0.theta += std::f64::consts::PI;
         }
-        obs.truncate(800);
-        let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 1.0);
-        // Only the loop closures inside each lap (last metre near the lap's own start).
-        assert_eq!(m.revisits, 20);
+        let pairs: Vec<AlignedPair> = (0..400).map(|k| pair(&obs, 400 + k, k)).collect();
+        let evaluate_as = |direction: Direction| {
+            let rec = Recognition {
+                name: "t".into(),
+                observations: obs.clone(),
+                matches: vec![Match {
+                    direction,
+                    ..one_match(pairs.clone())
+                }],
+                seconds: 0.0,
+                laps: 2,
+                truth: gt.clone(),
+                diagnostics: None,
+            };
+            evaluate(&rec, &EvaluationSpec::default())
+        };
+        let e = evaluate_as(Direction::Opposite);
+        let (same, opposite) = (&e.directions.same, &e.directions.opposite);
+        // Same direction: only the loop closures inside each lap (its last metre near its start).
+        assert_eq!(same.revisits, 20);
+        assert_eq!(opposite.revisits, 400);
+        assert_eq!(e.main.revisits, 410, "either direction, counted once");
+        assert_eq!((opposite.pairs, opposite.correct_pairs), (400, 400));
+        assert_eq!(opposite.recall, 1.0);
+        assert_eq!(opposite.visit_recall, 1.0);
+        assert!(opposite.pair_recall > 0.0 && same.pair_recall == 0.0);
+        assert_eq!(same.pairs, 0);
+        assert!(same.no_pairs);
+        assert_eq!((e.main.pairs, e.main.precision), (400, 1.0));
+        // The same pairs claimed as same-direction are wrong.
+        let e = evaluate_as(Direction::Same);
+        assert_eq!((e.main.pairs, e.main.correct_pairs), (400, 0));
+        assert_eq!(e.directions.same.precision, 0.0);
+        assert_eq!(e.directions.opposite.pairs, 0);
     }
 
     #[test]
@@ -720,6 +799,7 @@ pub(crate) mod tests {
             seconds: 1.0,
             laps: 3,
             truth: gt,
+            diagnostics: None,
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -765,6 +845,7 @@ pub(crate) mod tests {
             seconds: 0.0,
             laps: 2,
             truth: gt,
+            diagnostics: None,
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);

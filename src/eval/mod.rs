@@ -17,7 +17,7 @@ pub mod sweep;
 
 use crate::geom::TruePose;
 use crate::log::RunLog;
-use crate::recognizer::{Match, Observation};
+use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use std::time::Instant;
 
 pub use metrics::{Metrics, evaluate};
@@ -126,6 +126,8 @@ pub struct Recognition {
     pub laps: usize,
     /// Truth of every frame fed, by input index.
     pub truth: GroundTruth,
+    /// What the recognizer saw (to say why nothing matched), when it tells.
+    pub diagnostics: Option<MatchDiagnostics>,
 }
 
 impl Recognition {
@@ -180,5 +182,6 @@ pub fn recognize_runs_with_progress(
         seconds,
         laps,
         truth,
+        diagnostics: rec.diagnostics(),
     }
 }

@@ -5,18 +5,21 @@
 //!   frame, counted across runs (a run boundary adds no travel, but pairs across runs are always
 //!   beyond any gap because the second run's travel starts after the first's ends).
 //! - **Heading agreement.** A pair is correct only if its two true positions are within the
-//!   radius *and* its true headings agree as its direction claims ([`heading_agrees`]; every
-//!   pair claims the same direction today: headings within `heading_tolerance_deg`).
+//!   radius *and* its true headings agree as its match's direction claims ([`Facing::agrees`]):
+//!   within `heading_tolerance_deg` for `same`, 180° ± that for `opposite`. A revisit of one
+//!   direction is defined with the same rule; the top-level figures count revisits of either
+//!   direction ([`Facing::Either`]).
 //! - **Pair recall** = correct pairs that could have been found ÷ every pair that could have
 //!   been found, where a pair could have been found when it joins an observation to an earlier
 //!   one, at least `min_gap_m` of true travel before it, within `tp_radius_m` and facing the
-//!   same way. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
+//!   way the figure counts (same, opposite or either) and it is found when a match claiming
+//!   that pair's direction holds it. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
 //!   observation per earlier lap suffices), it counts every observation of every earlier pass,
 //!   so it is the figure closest to the paper's "matches that could be obtained".
 
 use super::GroundTruth;
 use crate::geom::wrap_angle;
-use crate::recognizer::{Match, ObsId, Observation};
+use crate::recognizer::{Direction, Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use std::collections::{HashMap, HashSet};
 
@@ -39,7 +42,44 @@ pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
 
 /// Whether two true headings agree as a same-direction pair must.
 pub fn heading_agrees(a_rad: f64, b_rad: f64, tolerance_rad: f64) -> bool {
-    wrap_angle(a_rad - b_rad).abs() <= tolerance_rad
+    Facing::Same.agrees(a_rad, b_rad, tolerance_rad)
+}
+
+/// The heading agreement a revisit or pair needs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Facing {
+    /// Headings within the tolerance.
+    Same,
+    /// Headings 180° apart within the tolerance.
+    Opposite,
+    /// Either of the two (the top-level figures).
+    Either,
+}
+
+impl Facing {
+    /// The agreement a match of direction `d` claims for its pairs.
+    pub fn of(d: Direction) -> Self {
+        match d {
+            Direction::Same => Facing::Same,
+            Direction::Opposite => Facing::Opposite,
+        }
+    }
+
+    /// Whether true headings `a_rad` and `b_rad` agree this way within `tolerance_rad`.
+    pub fn agrees(self, a_rad: f64, b_rad: f64, tolerance_rad: f64) -> bool {
+        let same = || wrap_angle(a_rad - b_rad).abs() <= tolerance_rad;
+        let opposite = || wrap_angle(a_rad - b_rad - std::f64::consts::PI).abs() <= tolerance_rad;
+        match self {
+            Facing::Same => same(),
+            Facing::Opposite => opposite(),
+            Facing::Either => same() || opposite(),
+        }
+    }
+
+    /// Whether a match of direction `d` counts in a figure of this facing.
+    pub fn counts(self, d: Direction) -> bool {
+        self == Facing::Either || self == Facing::of(d)
+    }
 }
 
 /// Truth of one observation: position, heading, true travel.
@@ -71,13 +111,15 @@ impl PairRecall {
     }
 }
 
-/// Pair recall of `matches` at radius `r` (see the module docs).
+/// Pair recall of `matches` at radius `r` over the pairs facing as `facing` says (see the
+/// module docs).
 pub fn pair_recall(
     observations: &[Observation],
     matches: &[Match],
     truth: &GroundTruth,
     spec: &EvaluationSpec,
     r: f64,
+    facing: Facing,
 ) -> PairRecall {
     if r <= 0.0 || !r.is_finite() {
         return PairRecall::default();
@@ -96,23 +138,27 @@ pub fn pair_recall(
         })
         .collect();
     let tol = spec.heading_tolerance_deg.to_radians();
-    let possible_pair = |q: &Placed, p: &Placed| {
+    let near = |q: &Placed, p: &Placed| {
         q.travel_m - p.travel_m >= spec.min_gap_m
             && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
-            && heading_agrees(q.theta, p.theta, tol)
     };
+    let possible_pair = |q: &Placed, p: &Placed| near(q, p) && facing.agrees(q.theta, p.theta, tol);
     let index_of: HashMap<ObsId, usize> = observations
         .iter()
         .enumerate()
         .map(|(i, o)| (o.id, i))
         .collect();
     let mut seen: HashSet<(usize, usize)> = HashSet::new();
-    for p in matches.iter().flat_map(|m| &m.pairs) {
+    let counted = matches.iter().filter(|m| facing.counts(m.direction));
+    for (p, claim) in
+        counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction))))
+    {
         let (Some(&qi), Some(&pi)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
             continue;
         };
         if let (Some(q), Some(pa)) = (&placed[qi], &placed[pi])
-            && possible_pair(q, pa)
+            && near(q, pa)
+            && claim.agrees(q.theta, pa.theta, tol)
         {
             seen.insert((qi, pi));
         }
@@ -158,6 +204,7 @@ mod tests {
             levels: 1,
             ngram_len: 1,
             word_pairs: vec![],
+            direction: crate::recognizer::Direction::Same,
             pairs: pairs
                 .iter()
                 .map(|&(q, p)| AlignedPair {
@@ -186,18 +233,35 @@ mod tests {
                 }
             }
         }
-        let full = pair_recall(&obs, &[one_match(&obs, &all)], &gt, &spec, 1.0);
+        let full = pair_recall(
+            &obs,
+            &[one_match(&obs, &all)],
+            &gt,
+            &spec,
+            1.0,
+            Facing::Same,
+        );
         assert_eq!(full.found, full.possible);
         assert_eq!(full.ratio(), 1.0);
         // One pair per observation, one lap back.
         let nearest: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
-        let some = pair_recall(&obs, &[one_match(&obs, &nearest)], &gt, &spec, 1.0);
+        let some = pair_recall(
+            &obs,
+            &[one_match(&obs, &nearest)],
+            &gt,
+            &spec,
+            1.0,
+            Facing::Same,
+        );
         assert!(some.ratio() < 0.1, "{some:?}");
         assert_eq!(some.found, nearest.len() as u64);
-        assert_eq!(pair_recall(&obs, &[], &gt, &spec, 1.0).ratio(), 0.0);
+        assert_eq!(
+            pair_recall(&obs, &[], &gt, &spec, 1.0, Facing::Same).ratio(),
+            0.0
+        );
     }
 
-    /// A pair facing the other way is not a revisit and is not counted as found.
+    /// A pair facing the other way is found only by a match claiming the opposite direction.
     #[test]
     fn opposite_headings_do_not_count() {
         let (obs, mut gt) = circle(2, 40.0);
@@ -206,7 +270,32 @@ mod tests {
         }
         let spec = EvaluationSpec::default();
         let m = one_match(&obs, &[(400, 0), (450, 50)]);
-        let pr = pair_recall(&obs, &[m], &gt, &spec, 1.0);
+        let pr = pair_recall(
+            &obs,
+            std::slice::from_ref(&m),
+            &gt,
+            &spec,
+            1.0,
+            Facing::Either,
+        );
+        assert_eq!(pr.found, 0);
+        // Claimed as opposite, the same pairs are found, in the opposite and top-level figures.
+        let opposite = Match {
+            direction: Direction::Opposite,
+            ..m
+        };
+        for facing in [Facing::Opposite, Facing::Either] {
+            let pr = pair_recall(
+                &obs,
+                std::slice::from_ref(&opposite),
+                &gt,
+                &spec,
+                1.0,
+                facing,
+            );
+            assert_eq!(pr.found, 2, "{facing:?}");
+        }
+        let pr = pair_recall(&obs, &[opposite], &gt, &spec, 1.0, Facing::Same);
         assert_eq!(pr.found, 0);
     }
 

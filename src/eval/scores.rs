@@ -15,18 +15,23 @@
 //!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
-//!                                     "metrics": { "precision": ..., ... } } ] } ],
+//!                                     "metrics": { "precision": ..., ... } } ],
+//!                 "directions": { "same": { "precision": ..., "recall": ..., ... },
+//!                                 "opposite": { ... } } } ],
 //!   "icp": { same fields as a "levels" entry without "levels" and "thresholds" } | null,
 //!   "simulate_seconds_per_lap": 0.4,
 //!   "evaluation": { "tp_radius_m": 1.0, "min_gap_m": 20.0, "heading_tolerance_deg": 45.0,
 //!                   "sensitivity_radii_m": [0.5, 2.0, 3.0] } }
 //! ```
 //!
-//! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN).
+//! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN); then
+//! `"no_pairs_reason"` says why when it can tell, and `"diagnostics"` (the recognizer's longest
+//! chains and verification counts, when it tells) gives the figures behind it.
 
 use super::Recognition;
-use super::metrics::{DoorConfigMetrics, Evaluation, Metrics, scored_pairs};
+use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, scored_pairs};
 use super::sweep::{PrCurve, SweepResult};
+use crate::recognizer::MatchDiagnostics;
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
@@ -56,12 +61,33 @@ pub struct Scores {
     pub sensitivity: Vec<Metrics>,
     /// Scores per door configuration at `tp_radius_m`.
     pub door_configs: Vec<DoorConfigMetrics>,
+    /// Scores per direction at `tp_radius_m`: the matches of that direction against the
+    /// revisits of that direction (`eval::metrics`); the figures above count both.
+    #[serde(default)]
+    pub directions: DirectionMetrics,
+    /// Set when there is no pair: why, as far as the evaluation and the recognizer can tell (no
+    /// observation with a revisit; no chain of matching words as long as τ; every candidate
+    /// rejected by verification, with counts per reason).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_pairs_reason: Option<String>,
+    /// What the recognizer saw (longest chains, verification counts), when it tells.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diagnostics: Option<MatchDiagnostics>,
 }
 
 impl Scores {
     /// The scores of an evaluation and the timing of its recognition.
     pub fn new(e: &Evaluation, recognize_seconds_per_lap: f64) -> Self {
-        let m = &e.main;
+        Scores {
+            sensitivity: e.sensitivity.clone(),
+            door_configs: e.door_configs.clone(),
+            directions: e.directions.clone(),
+            ..Scores::of_metrics(&e.main, recognize_seconds_per_lap)
+        }
+    }
+
+    /// The headline figures of `m` (no breakdowns).
+    fn of_metrics(m: &Metrics, recognize_seconds_per_lap: f64) -> Self {
         Scores {
             precision: m.precision,
             recall: m.recall,
@@ -76,15 +102,106 @@ impl Scores {
             visit_recall: m.visit_recall,
             pair_recall: m.pair_recall,
             recognize_seconds_per_lap,
-            sensitivity: e.sensitivity.clone(),
-            door_configs: e.door_configs.clone(),
+            sensitivity: Vec::new(),
+            door_configs: Vec::new(),
+            directions: DirectionMetrics::default(),
+            no_pairs_reason: None,
+            diagnostics: None,
         }
+    }
+
+    /// The scores of one direction's matches against that direction's revisits (no
+    /// breakdowns), with the same timing.
+    pub fn of_direction(&self, d: crate::recognizer::Direction) -> Self {
+        let m = match d {
+            crate::recognizer::Direction::Same => &self.directions.same,
+            crate::recognizer::Direction::Opposite => &self.directions.opposite,
+        };
+        Scores::of_metrics(m, self.recognize_seconds_per_lap)
+    }
+
+    /// Whether there is anything to say about the opposite direction: revisits driven the
+    /// other way, or opposite matches.
+    pub fn has_opposite(&self) -> bool {
+        self.directions.opposite.revisits > 0 || self.directions.opposite.pairs > 0
     }
 
     /// Evaluates `rec` with `spec` and takes its timing.
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
-        Scores::new(&super::evaluate(rec, spec), rec.seconds_per_lap())
+        let e = super::evaluate(rec, spec);
+        Scores {
+            no_pairs_reason: no_pairs_reason(&e.main, rec.diagnostics.as_ref(), spec),
+            diagnostics: rec.diagnostics.clone(),
+            ..Scores::new(&e, rec.seconds_per_lap())
+        }
     }
+}
+
+/// Why `m` has no pair, as far as the truth and the recognizer's `diagnostics` tell; `None` when
+/// there are pairs.
+pub fn no_pairs_reason(
+    m: &Metrics,
+    diagnostics: Option<&MatchDiagnostics>,
+    spec: &EvaluationSpec,
+) -> Option<String> {
+    if m.pairs > 0 {
+        return None;
+    }
+    let mut why = Vec::new();
+    if m.revisits == 0 {
+        why.push(format!(
+            "no observation has a revisit (an earlier pass within {} m, {} m of travel before)",
+            spec.tp_radius_m, spec.min_gap_m
+        ));
+    }
+    match diagnostics {
+        Some(d) => why.push(recognizer_reason(d)),
+        None if why.is_empty() => why.push("the recognizer does not say why".into()),
+        None => {}
+    }
+    Some(why.join("; "))
+}
+
+/// The recognizer's side of a run without pairs.
+fn recognizer_reason(d: &MatchDiagnostics) -> String {
+    let v = &d.verification;
+    if v.accepted > 0 {
+        return format!(
+            "{} matches were accepted but none kept an aligned pair beyond the candidate gap",
+            v.accepted
+        );
+    }
+    if v.rejected() > 0 {
+        return format!(
+            "every candidate was rejected by verification: {} (travel {}, turn {}, density {})",
+            v.rejected(),
+            v.rejected_travel,
+            v.rejected_turn,
+            v.rejected_density
+        );
+    }
+    let chains: Vec<String> = d
+        .longest_chain
+        .iter()
+        .zip(&d.min_ngram)
+        .enumerate()
+        .map(|(k, (l, t))| format!("{l} (τ = {t}) at {} level{}", k + 1, plural(k + 1)))
+        .collect();
+    let chains = chains.join(", ");
+    let short = d.longest_chain.iter().zip(&d.min_ngram).all(|(l, t)| l < t);
+    if short || d.within_gap == 0 {
+        format!("no word sequence long enough: the longest chain of matching words is {chains}")
+    } else {
+        format!(
+            "the {} chains that reached τ all began within the candidate gap of their past \
+             side (a repeat inside one pass); the longest chain of matching words is {chains}",
+            d.within_gap
+        )
+    }
+}
+
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
 }
 
 /// The result of one level configuration of the recognizer.
@@ -270,6 +387,42 @@ pub struct TableReport {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    /// A run without pairs says why: verification counts when every candidate was rejected,
+    /// chain lengths against τ when no chain was long enough, and missing revisits.
+    #[test]
+    fn no_pairs_reason_names_the_cause() {
+        let spec = EvaluationSpec::default();
+        let none = Metrics {
+            revisits: 10,
+            ..Metrics::default()
+        };
+        let mut d = MatchDiagnostics {
+            longest_chain: vec![7, 9],
+            min_ngram: vec![6, 9],
+            within_gap: 0,
+            verification: Default::default(),
+        };
+        d.verification.rejected_travel = 3;
+        d.verification.rejected_density = 2;
+        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        assert!(
+            why.contains("rejected by verification: 5 (travel 3, turn 0, density 2)"),
+            "{why}"
+        );
+        d.verification = Default::default();
+        d.longest_chain = vec![4, 8];
+        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
+            "{why}"
+        );
+        let why = no_pairs_reason(&Metrics::default(), None, &spec).unwrap();
+        assert!(why.starts_with("no observation has a revisit"), "{why}");
+        let some = Metrics { pairs: 1, ..none };
+        assert_eq!(no_pairs_reason(&some, Some(&d), &spec), None);
+    }
 
     pub(crate) fn sample(scenario: &str, p: [f64; 3], r: [f64; 3]) -> Report {
         let mut rep = Report::new(scenario, 7, 40, EvaluationSpec::default());

@@ -291,6 +291,7 @@ mod tests {
                 levels: p.levels,
                 ngram_len: 1,
                 word_pairs: vec![],
+                direction: crate::recognizer::Direction::Same,
                 pairs: (420..obs.len())
                     .step_by(p.levels)
                     .map(|q| crate::recognizer::AlignedPair {

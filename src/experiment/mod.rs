@@ -123,6 +123,9 @@ impl PlaceRecognizer for Recognizer {
         let c = self.config();
         format!("levels={} {:?}", c.levels, thresholds(c))
     }
+    fn diagnostics(&self) -> Option<crate::recognizer::MatchDiagnostics> {
+        Some(Recognizer::diagnostics(self))
+    }
 }
 
 /// Simulates a scenario with a progress bar; returns the runs and the wall-clock seconds.

@@ -5,7 +5,7 @@
 
 use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
-use crate::eval::pair_recall::heading_agrees;
+use crate::eval::pair_recall::Facing;
 use crate::log::RunLog;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
@@ -220,7 +220,11 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
     let (mut correct_pairs, mut wrong_pairs) = (0, Vec::new());
     let mut seen = HashSet::new();
     let tol = spec.heading_tolerance_deg.to_radians();
-    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
+    let claimed = rec.matches.iter().flat_map(|m| {
+        let claim = Facing::of(m.direction);
+        m.pairs.iter().map(move |p| (p, claim))
+    });
+    for (p, claim) in claimed {
         let (Some(&q), Some(&pa)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
             continue;
         };
@@ -230,7 +234,7 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
         if !seen.insert((q, pa)) {
             continue;
         }
-        let ok = a.distance(&b) <= spec.tp_radius_m && heading_agrees(a.theta, b.theta, tol);
+        let ok = a.distance(&b) <= spec.tp_radius_m && claim.agrees(a.theta, b.theta, tol);
         pair_counts[q].1 += 1;
         if ok {
             pair_counts[q].0 += 1;

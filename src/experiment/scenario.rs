@@ -16,6 +16,7 @@
 //!
 //! [[runs]]
 //! start_waypoint = 0                    # default 0
+//! direction = "forward"                 # default; "reverse" drives the waypoints backwards
 //! laps = 2
 //! doors = "all-closed"                  # "all-closed", "all-open" or a [door_configs] name
 //! # doors_cycle = ["all-closed", "south-open"]    # lap k uses entry k mod len
@@ -610,6 +611,7 @@ fn run(r: &RunSpec, route: Option<&Route>, doors: &Doors, d: &mut Diags) -> Opti
     };
     Some(RunPlan {
         start_waypoint: start.max(0) as usize,
+        reverse: r.reverse,
         laps: *r.laps.get_ref(),
         doors: plan,
     })

@@ -264,6 +264,7 @@ impl LoggedRuns {
                 levels: 1,
                 ngram_len: 1,
                 word_pairs: Vec::new(),
+                direction: crate::recognizer::Direction::Same,
                 pairs: vec![AlignedPair {
                     query: qo.id,
                     past: po.id,
@@ -279,6 +280,7 @@ impl LoggedRuns {
             seconds: 0.0,
             laps: self.laps,
             truth: self.truth.clone(),
+            diagnostics: None,
         })
     }
 }

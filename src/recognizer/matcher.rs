@@ -13,6 +13,15 @@
 //! holds one entry per matching pair, so the work per word is candidates × predecessors², and
 //! nothing sweeps the trajectory.
 //!
+//! **Reverse direction** (paper §VI, future work; `reverse = true`). A revisit driven the
+//! other way sees the past words in reverse order, each turned the other way: read backwards, a
+//! word keeps its class and size and its angle syllable is negated. Each current word is also
+//! matched against the past words read backwards, and chains grow through successors: (cᵢ, pⱼ)
+//! extends (cᵢ₋₁, pⱼ₊₁) where pⱼ₊₁ is a word whose predecessor is pⱼ. This is a second memo
+//! with the same search; its matches carry `Direction::Opposite`, are verified with the past
+//! side's travel and turn measured backwards, and are aligned on the past word's Ψ read
+//! backwards (so past ids decrease as query ids increase).
+//!
 //! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
 //! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
 //! least `candidate_gap_m` after p ends. Each word pair is reported at most once per configuration: the
@@ -35,7 +44,7 @@
 //! whose travel differs by less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
-use super::types::{AlignedPair, Match, Observation};
+use super::types::{AlignedPair, Direction, Match, Observation};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
 
@@ -62,6 +71,8 @@ struct Params {
     max_offset: usize,
     chain_offset: usize,
     alignment: AlignmentMode,
+    reverse: bool,
+    reverse_extra_ngram: usize,
     verify: bool,
     verify_travel_ratio: f64,
     verify_travel_slack_m: f64,
@@ -78,12 +89,20 @@ pub struct WordMatcher {
     words: WordLevels,
     /// Per class, the words of that class in creation order (so by end travel).
     occurrences: Vec<Vec<WordId>>,
-    /// Per word, an entry per matching past word, sorted by past word.
-    memo: Vec<Vec<Entry>>,
+    /// Per direction (`Same`, `Opposite`), per word, an entry per matching past word, sorted by
+    /// past word.
+    memo: [Vec<Vec<Entry>>; 2],
+    /// Per word, the words whose predecessor it is (the chain links of a past n-gram read
+    /// backwards).
+    successors: Vec<Vec<WordId>>,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
     lookup: [Vec<(u32, u32)>; MAX_LEVELS],
     stamp: u32,
     rejections: VerificationCounts,
+    /// Per level configuration, the longest chain of matching word pairs seen (either direction).
+    longest: [u16; MAX_LEVELS],
+    /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
+    within_gap: usize,
 }
 
 impl WordMatcher {
@@ -103,6 +122,8 @@ impl WordMatcher {
                 max_offset: config.max_alignment_offset,
                 chain_offset: config.chain_alignment_offset,
                 alignment: config.alignment,
+                reverse: config.reverse,
+                reverse_extra_ngram: config.reverse_extra_ngram,
                 verify: config.verify,
                 verify_travel_ratio: config.verify_travel_ratio,
                 verify_travel_slack_m: config.verify_travel_slack_m,
@@ -118,9 +139,12 @@ impl WordMatcher {
                 config.multi_level,
             ),
             occurrences: vec![Vec::new(); config.classes],
-            memo: Vec::new(),
+            memo: Default::default(),
+            successors: Vec::new(),
             lookup: Default::default(),
             stamp: 0,
+            longest: [0; MAX_LEVELS],
+            within_gap: 0,
         })
     }
 
@@ -179,21 +203,38 @@ impl WordMatcher {
         self.rejections
     }
 
+    /// What the matcher saw so far, to say why nothing matched.
+    pub fn diagnostics(&self) -> MatchDiagnostics {
+        let levels = self.params.levels;
+        MatchDiagnostics {
+            longest_chain: self.longest[..levels].iter().map(|&l| l as usize).collect(),
+            min_ngram: self.params.min_ngram[..levels].to_vec(),
+            within_gap: self.within_gap,
+            verification: self.rejections,
+        }
+    }
+
     /// Matching word pairs held in the memo (a measure of its size).
     pub fn memo_entries(&self) -> usize {
-        self.memo.iter().map(Vec::len).sum()
+        self.memo.iter().flatten().map(Vec::len).sum()
     }
 
     fn word(&self, id: WordId) -> &Word {
         self.words.word(id)
     }
 
-    fn syllables_match(&self, a: &Word, b: &Word) -> bool {
+    /// Whether current word `a` matches past word `b` read in direction `dir` (backwards, b's
+    /// angle syllable is negated; class and size do not change).
+    fn syllables_match(&self, a: &Word, b: &Word, dir: Direction) -> bool {
         let (sa, sb) = (a.size as f64, b.size as f64);
         if (sa - sb).abs() > self.params.size_ratio * sa.max(sb) + 1e-9 {
             return false;
         }
-        let mut d = (a.angle_deg - b.angle_deg).abs() % 360.0;
+        let b_angle = match dir {
+            Direction::Same => b.angle_deg,
+            Direction::Opposite => -b.angle_deg,
+        };
+        let mut d = (a.angle_deg - b_angle).abs() % 360.0;
         if d > 180.0 {
             d = 360.0 - d;
         }
@@ -203,7 +244,13 @@ impl WordMatcher {
     fn match_words(&mut self, closed: &[WordId]) -> Vec<Match> {
         let mut out = Vec::new();
         for &c in closed {
-            self.memoise(c);
+            self.link_successors(c);
+            self.memoise(c, Direction::Same);
+            if self.params.reverse {
+                self.memoise(c, Direction::Opposite);
+            } else {
+                self.memo[Direction::Opposite as usize].push(Vec::new());
+            }
             self.report(c, &mut out);
             let class = self.word(c).class as usize;
             self.occurrences[class].push(c);
@@ -211,10 +258,28 @@ impl WordMatcher {
         out
     }
 
-    /// Fills the memo of word `c`: one entry per matching past word.
-    fn memoise(&mut self, c: WordId) {
+    /// Records `c` as the successor of each of its predecessors.
+    fn link_successors(&mut self, c: WordId) {
+        self.successors.resize(c as usize + 1, Vec::new());
+        for &p in self.words.word(c).pred_ids() {
+            self.successors[p as usize].push(c);
+        }
+    }
+
+    /// The words a chain through past word `p` continues from, in direction `dir`: its
+    /// predecessors, or (read backwards) its successors.
+    fn past_links(&self, p: WordId, dir: Direction) -> &[WordId] {
+        match dir {
+            Direction::Same => self.word(p).pred_ids(),
+            Direction::Opposite => &self.successors[p as usize],
+        }
+    }
+
+    /// Fills the memo of word `c` in direction `dir`: one entry per matching past word.
+    fn memoise(&mut self, c: WordId, dir: Direction) {
         let n_words = self.words.all_words().len();
-        debug_assert_eq!(self.memo.len(), c as usize);
+        let d = dir as usize;
+        debug_assert_eq!(self.memo[d].len(), c as usize);
         let cw = self.word(c).clone();
         let limit = cw.start_travel_m - self.params.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
@@ -234,7 +299,7 @@ impl WordMatcher {
             if table.len() < n_words {
                 table.resize(n_words, (0, 0));
             }
-            for (idx, e) in self.memo[cp as usize].iter().enumerate() {
+            for (idx, e) in self.memo[d][cp as usize].iter().enumerate() {
                 table[e.past as usize] = (stamp, idx as u32);
             }
         }
@@ -243,7 +308,7 @@ impl WordMatcher {
         let mut entries = Vec::new();
         for &p in &occ[..end] {
             let pw = self.word(p);
-            if !self.syllables_match(&cw, pw) {
+            if !self.syllables_match(&cw, pw, dir) {
                 continue;
             }
             let top = cw.level.max(pw.level);
@@ -253,13 +318,13 @@ impl WordMatcher {
             for l in len.iter_mut().take(levels).skip(top) {
                 *l = 1;
             }
-            for &pp in pw.pred_ids() {
+            for &pp in self.past_links(p, dir) {
                 for (ci, &cp) in c_preds.iter().enumerate() {
                     let (s, idx) = self.lookup[ci][pp as usize];
                     if s != stamp {
                         continue;
                     }
-                    let e = &self.memo[cp as usize][idx as usize];
+                    let e = &self.memo[d][cp as usize][idx as usize];
                     for (k, (l, &el)) in len
                         .iter_mut()
                         .zip(&e.len)
@@ -276,6 +341,9 @@ impl WordMatcher {
                     }
                 }
             }
+            for (m, &l) in self.longest.iter_mut().zip(&len) {
+                *m = (*m).max(l);
+            }
             entries.push(Entry {
                 past: p,
                 len,
@@ -284,7 +352,7 @@ impl WordMatcher {
                 reported: 0,
             });
         }
-        self.memo.push(entries);
+        self.memo[d].push(entries);
     }
 
     /// The pair before (c, p) on the best chain of configuration k.
@@ -298,10 +366,12 @@ impl WordMatcher {
     }
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
-        for k in 0..self.params.levels {
-            for idx in 0..self.memo[c as usize].len() {
-                if let Some(m) = self.report_one(c, idx, k) {
-                    out.push(m);
+        for dir in [Direction::Same, Direction::Opposite] {
+            for k in 0..self.params.levels {
+                for idx in 0..self.memo[dir as usize][c as usize].len() {
+                    if let Some(m) = self.report_one(c, idx, k, dir) {
+                        out.push(m);
+                    }
                 }
             }
         }
@@ -309,9 +379,19 @@ impl WordMatcher {
 
     /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first, and
     /// how many of its newest pairs are not yet reported; `None` when the chain is shorter than τ.
-    fn tau_chain(&self, c: WordId, idx: usize, k: usize) -> Option<(Vec<(WordId, usize)>, usize)> {
-        let tau = self.params.min_ngram[k];
-        let e = self.memo[c as usize][idx];
+    fn tau_chain(
+        &self,
+        c: WordId,
+        idx: usize,
+        k: usize,
+        dir: Direction,
+    ) -> Option<(Vec<(WordId, usize)>, usize)> {
+        let memo = &self.memo[dir as usize];
+        let tau = match dir {
+            Direction::Same => self.params.min_ngram[k],
+            Direction::Opposite => self.params.min_ngram[k] + self.params.reverse_extra_ngram,
+        };
+        let e = memo[c as usize][idx];
         if (e.len[k] as usize) < tau {
             return None;
         }
@@ -320,7 +400,7 @@ impl WordMatcher {
         let (mut wc, mut we) = (c, e);
         while chain.len() < tau {
             let (pc, pidx) = self.step_back(wc, &we, k)?;
-            let pe = self.memo[pc as usize][pidx];
+            let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
             if all_fresh && pe.reported & (1 << k) == 0 {
                 fresh += 1;
@@ -332,24 +412,30 @@ impl WordMatcher {
         Some((chain, fresh))
     }
 
-    /// Reports the τ-gram of configuration k ending at memo entry `idx` of `c` if it is long
-    /// enough, satisfies the candidate gap, passes verification and has unreported pairs.
-    fn report_one(&mut self, c: WordId, idx: usize, k: usize) -> Option<Match> {
-        let (mut chain, fresh) = self.tau_chain(c, idx, k)?;
-        let e = self.memo[c as usize][idx];
-        let first_current = self.word(chain[chain.len() - 1].0);
-        let past_end = self.word(e.past).end_travel_m;
-        if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
-            return None;
-        }
+    /// Reports the τ-gram of configuration k ending at memo entry `idx` of `c` (direction
+    /// `dir`) if it is long enough, satisfies the candidate gap, passes verification and has
+    /// unreported pairs.
+    fn report_one(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Match> {
+        let d = dir as usize;
+        let (mut chain, fresh) = self.tau_chain(c, idx, k, dir)?;
         chain.reverse();
         let word_pairs: Vec<(WordId, WordId)> = chain
             .iter()
-            .map(|&(wc, widx)| (wc, self.memo[wc as usize][widx].past))
+            .map(|&(wc, widx)| (wc, self.memo[d][wc as usize][widx].past))
             .collect();
-        let anchors = self.chain_anchors(&word_pairs);
+        // The latest past word: the last one read forwards, the first one read backwards.
+        let past_end = word_pairs
+            .iter()
+            .map(|&(_, p)| self.word(p).end_travel_m)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let first_current = self.word(word_pairs[0].0);
+        if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
+            self.within_gap += 1;
+            return None;
+        }
+        let anchors = self.chain_anchors(&word_pairs, dir);
         if self.params.verify
-            && let Some(reason) = self.verify(&word_pairs, &anchors)
+            && let Some(reason) = self.verify(&word_pairs, dir, &anchors)
         {
             self.rejections.add(reason);
             return None;
@@ -360,28 +446,33 @@ impl WordMatcher {
         for ((&(wc, widx), &(_, past)), &anchor) in
             chain.iter().zip(&word_pairs).zip(&anchors).skip(fresh_from)
         {
-            self.memo[wc as usize][widx].reported |= 1 << k;
+            self.memo[d][wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
-            self.align(wc, past, anchor, &mut pairs);
+            self.aligned_pairs(wc, past, dir, anchor, &mut pairs);
         }
         self.rejections.accepted += 1;
         Some(Match {
             levels: k + 1,
-            ngram_len: e.len[k] as usize,
+            ngram_len: self.memo[d][c as usize][idx].len[k] as usize,
             word_pairs: refs,
             pairs,
+            direction: dir,
         })
     }
 
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
     /// both sides; the Ψ residual of its aligned pairs must be small.
-    fn verify(&self, word_pairs: &[(WordId, WordId)], anchors: &[i64]) -> Option<Rejection> {
-        let obs = self.words.observations();
-        let start = |w: WordId| {
-            let w = self.word(w);
-            (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta)
-        };
+    /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
+    /// runs the other way, so the past side's travel and turn between two words are negated.
+    fn verify(
+        &self,
+        word_pairs: &[(WordId, WordId)],
+        dir: Direction,
+        anchors: &[i64],
+    ) -> Option<Rejection> {
+        let start = |w: WordId| self.reading_start(w, Direction::Same);
+        let past_start = |w: WordId| self.reading_start(w, dir);
         let ok_travel = |a: f64, b: f64| {
             (a - b).abs()
                 <= self.params.verify_travel_ratio * a.abs().max(b.abs())
@@ -390,7 +481,8 @@ impl WordMatcher {
         let turn_tol = self.params.verify_turn_rad;
         let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
         for w in word_pairs.windows(2) {
-            let (c0, c1, p0, p1) = (start(w[0].0), start(w[1].0), start(w[0].1), start(w[1].1));
+            let (c0, c1) = (start(w[0].0), start(w[1].0));
+            let (p0, p1) = (past_start(w[0].1), past_start(w[1].1));
             let dc = (c1.0 - c0.0, wrap_angle(c1.1 - c0.1));
             let dp = (p1.0 - p0.0, wrap_angle(p1.1 - p0.1));
             cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
@@ -404,7 +496,7 @@ impl WordMatcher {
         }
         let (mut sum, mut count) = (0.0, 0usize);
         for (&(c, p), &anchor) in word_pairs.iter().zip(anchors) {
-            if let Some(w) = self.placement(c, p, anchor) {
+            if let Some(w) = self.placement(c, p, dir, anchor) {
                 sum += w.cost * w.count() as f64;
                 count += w.count();
             }
@@ -418,43 +510,68 @@ impl WordMatcher {
     }
 
     /// Per word pair of an n-gram (oldest first), the shift k (past index − current index, from
-    /// the words' starts) that puts the pair at the travel offset the whole n-gram agrees on:
-    /// the median over its word pairs of the offset between the two words' centres.
-    fn chain_anchors(&self, word_pairs: &[(WordId, WordId)]) -> Vec<i64> {
-        let centre = |w: &Word| 0.5 * (w.start_travel_m + w.end_travel_m);
+    /// the words' starts as read in direction `dir`) that puts the pair at the travel offset the
+    /// whole n-gram agrees on: the median over its word pairs of the offset between the two
+    /// words' centres (the past side's travel negated when read backwards).
+    fn chain_anchors(&self, word_pairs: &[(WordId, WordId)], dir: Direction) -> Vec<i64> {
+        let read_centre = |w: WordId, dir: Direction| {
+            let word = self.word(w);
+            let centre = 0.5 * (word.start_travel_m + word.end_travel_m);
+            match dir {
+                Direction::Same => centre,
+                Direction::Opposite => -centre,
+            }
+        };
         let mut offsets: Vec<f64> = word_pairs
             .iter()
-            .map(|&(c, p)| centre(self.word(c)) - centre(self.word(p)))
+            .map(|&(c, p)| read_centre(c, Direction::Same) - read_centre(p, dir))
             .collect();
         offsets.sort_by(f64::total_cmp);
         let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
         word_pairs
             .iter()
             .map(|&(c, p)| {
-                let start_gap_m = self.word(c).start_travel_m - self.word(p).start_travel_m;
+                let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
                 ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
             })
             .collect()
     }
 
-    /// Eq. 2: the best placement of the two words' observation windows (see the module doc);
-    /// `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
-    fn placement(&self, c: WordId, p: WordId, anchor: i64) -> Option<Placement> {
+    /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
+    /// first observation, or read backwards, of its last one with travel negated (so that
+    /// differences between words read backwards come out as travelled that way).
+    fn reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        let obs = self.words.observations();
+        let w = self.word(w);
+        match dir {
+            Direction::Same => (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta),
+            Direction::Opposite => (
+                -w.end_travel_m,
+                obs[w.first_obs + w.size - 1].odom_pose.0.theta,
+            ),
+        }
+    }
+
+    /// Eq. 2: the best placement of the two words' observation windows (see the module doc).
+    /// Read in direction `dir`, the past word is its Ψ backwards: offsets count from its last
+    /// observation. `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
+    fn placement(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
         let n = sc.min(sp);
-        let (s2, s1) = (cw.first_obs as i64, pw.first_obs as i64);
+        let s2 = cw.first_obs as i64;
+        let past = PastSide::of(pw, dir);
         let run = self.words.run_range(pw.run);
         let (lo, hi) = (run.start as i64, run.end as i64);
         let dmax = self.params.max_offset as i64;
-        // Offset k = past index − current index, from the words' starts: a = start in the
-        // current word, b = a + k start in the past word.
+        // Offset k = past index − current index, from the words' starts (as read): a = start in
+        // the current word, b = a + k start in the past word.
         let window = |k: i64| -> Placement {
             let a = (-k).clamp(0, sc - n);
             let b = a + k;
             // Keep the past window inside the past word's run.
-            let r = (lo - s1 - b).max(0)..(hi - s1 - b).min(n);
+            let r = past.inside(lo, hi, b, n);
             Placement { a, b, r, cost: 0.0 }
         };
         let (kmin, kmax) = match self.params.alignment {
@@ -480,9 +597,8 @@ impl WordMatcher {
             if count == 0 {
                 continue;
             }
-            let past = &psi[(s1 + w.b + w.r.start) as usize..(s1 + w.b + w.r.end) as usize];
             let cur = &psi[(s2 + w.a + w.r.start) as usize..(s2 + w.a + w.r.end) as usize];
-            w.cost = squared_error(past, cur) / count as f64;
+            w.cost = past.squared_error(psi, w.b, &w.r, cur) / count as f64;
             let better = match &best {
                 None => true,
                 Some((bw, bk)) => {
@@ -499,15 +615,25 @@ impl WordMatcher {
         best.map(|(w, _)| w)
     }
 
-    /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
-    fn align(&self, c: WordId, p: WordId, anchor: i64, out: &mut Vec<AlignedPair>) {
+    /// Eq. 2: aligned observation pairs of current word `c` and past word `p` read in direction
+    /// `dir` (the one place pairs are made; read backwards, the past id decreases as the query
+    /// id increases).
+    fn aligned_pairs(
+        &self,
+        c: WordId,
+        p: WordId,
+        dir: Direction,
+        anchor: i64,
+        out: &mut Vec<AlignedPair>,
+    ) {
         let obs = self.words.observations();
-        let Some(w) = self.placement(c, p, anchor) else {
+        let Some(w) = self.placement(c, p, dir, anchor) else {
             return;
         };
-        let (s2, s1) = (self.word(c).first_obs as i64, self.word(p).first_obs as i64);
+        let s2 = self.word(c).first_obs as i64;
+        let past = PastSide::of(self.word(p), dir);
         for i in w.r {
-            let (q, pst) = (&obs[(s2 + w.a + i) as usize], &obs[(s1 + w.b + i) as usize]);
+            let (q, pst) = (&obs[(s2 + w.a + i) as usize], &obs[past.index(w.b + i)]);
             if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
                 continue;
             }
@@ -538,6 +664,61 @@ impl Placement {
     }
 }
 
+/// The past word of an alignment as read: position j of the word read forwards is observation
+/// `first + j`; read backwards, `last − j`.
+#[derive(Clone, Copy, Debug)]
+struct PastSide {
+    /// Observation index of position 0 as read.
+    base: i64,
+    /// +1 forwards, −1 backwards.
+    step: i64,
+}
+
+impl PastSide {
+    fn of(w: &Word, dir: Direction) -> Self {
+        match dir {
+            Direction::Same => PastSide {
+                base: w.first_obs as i64,
+                step: 1,
+            },
+            Direction::Opposite => PastSide {
+                base: (w.first_obs + w.size) as i64 - 1,
+                step: -1,
+            },
+        }
+    }
+
+    /// Observation index of position `j` as read.
+    fn index(&self, j: i64) -> usize {
+        (self.base + self.step * j) as usize
+    }
+
+    /// The window positions i in 0..n whose observation `index(b + i)` lies in `lo..hi`.
+    fn inside(&self, lo: i64, hi: i64, b: i64, n: i64) -> std::ops::Range<i64> {
+        if self.step > 0 {
+            (lo - self.base - b).max(0)..(hi - self.base - b).min(n)
+        } else {
+            (self.base - b - hi + 1).max(0)..(self.base - b - lo + 1).min(n)
+        }
+    }
+
+    /// Σ (Ψ(past at b + i) − cur[i − r.start])² over i in `r`.
+    fn squared_error(&self, psi: &[f64], b: i64, r: &std::ops::Range<i64>, cur: &[f64]) -> f64 {
+        if self.step > 0 {
+            let from = (self.base + b + r.start) as usize;
+            squared_error(&psi[from..from + cur.len()], cur)
+        } else {
+            let last = self.index(b + r.start);
+            let past = &psi[last + 1 - cur.len()..=last];
+            past.iter()
+                .rev()
+                .zip(cur)
+                .map(|(x, y)| (x - y) * (x - y))
+                .sum()
+        }
+    }
+}
+
 /// Why verification turned a candidate n-gram down.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rejection {
@@ -550,8 +731,8 @@ pub enum Rejection {
 }
 
 /// Counts of candidate n-grams (τ reached, candidate gap satisfied) by outcome, summed over
-/// level configurations.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+/// level configurations and directions.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct VerificationCounts {
     pub accepted: usize,
     pub rejected_travel: usize,
@@ -560,6 +741,11 @@ pub struct VerificationCounts {
 }
 
 impl VerificationCounts {
+    /// Candidates verification turned down, for any reason.
+    pub fn rejected(&self) -> usize {
+        self.rejected_travel + self.rejected_turn + self.rejected_density
+    }
+
     fn add(&mut self, r: Rejection) {
         match r {
             Rejection::Travel => self.rejected_travel += 1,
@@ -567,6 +753,20 @@ impl VerificationCounts {
             Rejection::Density => self.rejected_density += 1,
         }
     }
+}
+
+/// What the matcher saw, so that a run without matches can say why.
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct MatchDiagnostics {
+    /// Per level configuration (index k: k + 1 levels), the longest chain of matching word pairs
+    /// found, in word pairs.
+    pub longest_chain: Vec<usize>,
+    /// Per level configuration, its minimum n-gram size τ.
+    pub min_ngram: Vec<usize>,
+    /// Chains that reached τ but began within the candidate gap of their past side.
+    pub within_gap: usize,
+    /// Candidate n-grams by verification outcome.
+    pub verification: VerificationCounts,
 }
 
 /// Σ (a − b)², four lanes at a time.

@@ -21,8 +21,8 @@ pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig,
 pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, density};
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;
-pub use matcher::WordMatcher;
-pub use types::{AlignedPair, Match, ObsId, Observation, WordRef};
+pub use matcher::{MatchDiagnostics, VerificationCounts, WordMatcher};
+pub use types::{AlignedPair, Direction, Match, ObsId, Observation, WordRef};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;
@@ -96,5 +96,10 @@ impl Recognizer {
 
     pub fn back_end(&self) -> &WordMatcher {
         &self.back
+    }
+
+    /// What the matcher saw so far, to say why nothing matched.
+    pub fn diagnostics(&self) -> MatchDiagnostics {
+        self.back.diagnostics()
     }
 }

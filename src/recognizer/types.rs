@@ -39,7 +39,21 @@ pub struct AlignedPair {
     pub past_odom: OdomPose,
 }
 
-/// A recognized revisit: an n-gram of current words matched to an n-gram of past words.
+/// Which way the past n-gram was read when it matched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Direction {
+    /// The revisit is driven the way the past pass was: past observations follow the query's
+    /// order (past id increases as query id increases).
+    #[default]
+    Same,
+    /// The revisit is driven the other way: the past n-gram was read backwards (word order
+    /// reversed, turn angles negated), so past id decreases as query id increases.
+    Opposite,
+}
+
+/// A recognized revisit: an n-gram of current words matched to an n-gram of past words, read
+/// forwards or (direction `Opposite`) backwards.
 ///
 /// Each word pair is reported once per level configuration: the first time a chain of matching
 /// word pairs reaches the configuration's minimum n-gram size τ, the match carries the τ pairs of
@@ -55,4 +69,6 @@ pub struct Match {
     pub word_pairs: Vec<(WordRef, WordRef)>,
     /// Observation pairs of those word pairs after fine alignment.
     pub pairs: Vec<AlignedPair>,
+    /// The way the past side was read: `Same`, or `Opposite` for a revisit driven the other way.
+    pub direction: Direction,
 }

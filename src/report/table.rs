@@ -1,6 +1,7 @@
 //! Tables from reports: a plain-text table for the terminal, and the paper's Table I in Markdown.
 
 use crate::eval::scores::{Report, Scores};
+use crate::recognizer::Direction;
 use std::fmt::Write;
 
 /// Rows of a terminal table: (label, scores).
@@ -17,6 +18,22 @@ fn rows(report: &Report) -> Vec<(String, &Scores)> {
         rows.push(("ICP".to_string(), &icp.scores));
     }
     rows
+}
+
+/// `rows` with, under each row that has opposite revisits or matches, a row per direction.
+fn rows_with_directions(report: &Report) -> Vec<(String, Scores)> {
+    let mut out = Vec::new();
+    for (label, s) in rows(report) {
+        out.push((label, s.clone()));
+        if s.has_opposite() {
+            out.push(("  same".to_string(), s.of_direction(Direction::Same)));
+            out.push((
+                "  opposite".to_string(),
+                s.of_direction(Direction::Opposite),
+            ));
+        }
+    }
+    out
 }
 
 /// Left-aligned first column, right-aligned others, two spaces apart.
@@ -69,12 +86,12 @@ pub fn text_table(report: &Report) -> String {
         report.evaluation.min_gap_m,
         report.evaluation.heading_tolerance_deg
     );
-    let body: Vec<Vec<String>> = rows(report)
+    let body: Vec<Vec<String>> = rows_with_directions(report)
         .into_iter()
         .map(|(label, s)| {
             vec![
                 label,
-                fmt_p(s),
+                fmt_p(&s),
                 format!("{:.3}", s.recall),
                 format!("{:.3}", s.visit_recall),
                 format!("{:.3}", s.pair_recall),
@@ -108,6 +125,11 @@ pub fn text_table(report: &Report) -> String {
                 "{} levels found {} pair(s) that {} level(s) did not ({} correct)",
                 l.levels, g.pairs, g.than_levels, g.correct_pairs
             );
+        }
+    }
+    for (label, s) in rows(report) {
+        if let Some(why) = &s.no_pairs_reason {
+            let _ = writeln!(out, "{label}: no matches: {why}");
         }
     }
     for (label, s) in rows(report) {
@@ -203,11 +225,11 @@ fn markdown_by_level(
     out.push_str("\n|---|");
     out.push_str(&"---|".repeat(reports.len() * columns.len()));
     out.push('\n');
-    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<&Scores>| {
+    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<Scores>| {
         let _ = write!(out, "| {label} |");
         for r in reports {
             match scores(r) {
-                Some(s) => cells(s).iter().for_each(|c| {
+                Some(s) => cells(&s).iter().for_each(|c| {
                     let _ = write!(out, " {c} |");
                 }),
                 None => out.push_str(&" – |".repeat(columns.len())),
@@ -216,10 +238,23 @@ fn markdown_by_level(
         out.push('\n');
     };
     for lv in rows {
-        line(lv.to_string(), &|r| r.level(lv).map(|l| &l.scores));
+        line(lv.to_string(), &|r| r.level(lv).map(|l| l.scores.clone()));
+        fn level(r: &Report, lv: usize) -> Option<&Scores> {
+            r.level(lv).map(|l| &l.scores)
+        }
+        if reports
+            .iter()
+            .any(|r| level(r, lv).is_some_and(Scores::has_opposite))
+        {
+            for (name, d) in [("same", Direction::Same), ("opposite", Direction::Opposite)] {
+                line(format!("{lv} {name}"), &|r| {
+                    level(r, lv).map(|s| s.of_direction(d))
+                });
+            }
+        }
     }
     if reports.iter().any(|r| r.icp.is_some()) {
-        line("ICP".into(), &|r| r.icp.as_ref().map(|i| &i.scores));
+        line("ICP".into(), &|r| r.icp.as_ref().map(|i| i.scores.clone()));
     }
     out
 }
@@ -308,6 +343,32 @@ mod tests {
         let t = curves_table(&c);
         assert_eq!(t.lines().count(), 4, "{t}");
         assert!(t.contains("0.100 (τ=5, P 0.950)"), "{t}");
+    }
+
+    /// Where opposite revisits exist, the terminal table and Table I add a row per direction
+    /// under the level row; without them, neither does.
+    #[test]
+    fn rows_per_direction_where_opposite_revisits_exist() {
+        let plain = sample("A", [0.9; 3], [0.2; 3]);
+        assert!(!text_table(&plain).contains("opposite"));
+        assert!(!markdown_table_i(std::slice::from_ref(&plain)).contains("opposite"));
+        let mut both = plain.clone();
+        let s = &mut both.levels[2].scores;
+        s.directions.same.precision = 0.97;
+        s.directions.opposite.revisits = 100;
+        s.directions.opposite.pairs = 10;
+        s.directions.opposite.precision = 0.8;
+        let t = text_table(&both);
+        let opposite = t.lines().find(|l| l.starts_with("  opposite")).unwrap();
+        assert!(opposite.contains("0.800"), "{t}");
+        assert!(
+            t.lines()
+                .any(|l| l.starts_with("  same") && l.contains("0.970")),
+            "{t}"
+        );
+        let md = markdown_table_i(&[both]);
+        assert!(md.contains("| 3 same | 0.970 – "), "{md}");
+        assert!(md.contains("| 3 opposite | 0.800 – "), "{md}");
     }
 
     #[test]

@@ -35,8 +35,23 @@ pub enum DoorPlan {
 pub struct RunPlan {
     /// Index into the route's waypoints (0 is the first).
     pub start_waypoint: usize,
+    /// Drive the route's waypoints in reverse order.
+    pub reverse: bool,
     pub laps: usize,
     pub doors: DoorPlan,
+}
+
+impl RunPlan {
+    /// The route as this run drives it (reversed for a reverse run) and the index of its start
+    /// waypoint in it (the same place as `start_waypoint` in the route's own order).
+    pub fn driven_route(&self, route: &Route) -> (Route, usize) {
+        if self.reverse {
+            let n = route.waypoints.len();
+            (route.reversed(), n.saturating_sub(1 + self.start_waypoint))
+        } else {
+            (route.clone(), self.start_waypoint)
+        }
+    }
 }
 
 /// Everything a simulation needs.

@@ -20,10 +20,10 @@ use crate::sim::plan::{DoorPlan, SimPlan};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
 use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
 use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
-use crate::world::DoorStates;
 use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
 use crate::world::raycast::{Disc, SweepCaster};
+use crate::world::{DoorStates, Route};
 use rand::RngExt;
 use rayon::prelude::*;
 
@@ -97,6 +97,8 @@ pub struct RunSim<'a> {
     odometry: Odometry,
     controller: Controller,
     tracker: RouteTracker,
+    /// The route as this run drives it (reversed for a reverse run).
+    route: Route,
     physics: Physics,
     caster: SweepCaster,
     pedestrians: Vec<Pedestrian>,
@@ -139,11 +141,12 @@ impl<'a> RunSim<'a> {
     /// A run at its start waypoint, with all doors closed until the first lap sets them.
     pub fn new(scn: &'a SimPlan, run: usize) -> Self {
         let plan = &scn.runs[run];
-        let tracker = RouteTracker::new(&scn.route, plan.start_waypoint);
+        let (route, start) = plan.driven_route(&scn.route);
+        let tracker = RouteTracker::new(&route, start);
         let truth = tracker.start_pose();
         let obstacles = obstacles(&scn.world);
         let clearance_m = scn.robot.radius_m + scn.robot.variation.lane_margin_m;
-        let room = LaneRoom::measure(&scn.route, &obstacles, clearance_m);
+        let room = LaneRoom::measure(&route, &obstacles, clearance_m);
         let mut angle_rng = stream(scn.seed, run as u64, RUN_WIDE, Purpose::LaserAngles);
         let laser = Laser::new(scn.laser.clone(), &mut angle_rng);
         let physics = Physics::new(
@@ -165,6 +168,7 @@ impl<'a> RunSim<'a> {
             ),
             controller: Controller::default(),
             tracker,
+            route,
             physics,
             caster: SweepCaster::for_world(&scn.world, &DoorStates::all_closed(&scn.world)),
             pedestrians: Vec::new(),
@@ -214,7 +218,7 @@ impl<'a> RunSim<'a> {
         let lap_start_m = self.tracker.arc_m();
         self.plan = LapPlan::draw(
             &scn.robot.variation,
-            (&self.lanes.1, &scn.route, &self.lanes.0, clearance_m),
+            (&self.lanes.1, &self.route, &self.lanes.0, clearance_m),
             (lap_start_m, self.tracker.length_m()),
             wander,
             &mut vrng,

@@ -51,6 +51,7 @@ pub const TOP_KEYS: &[&str] = &[
 /// Keys of a `[[runs]]` entry.
 pub const RUN_KEYS: &[&str] = &[
     "start_waypoint",
+    "direction",
     "laps",
     "doors",
     "doors_cycle",
@@ -148,6 +149,9 @@ pub struct RunSpec {
     pub at: usize,
     /// Index into the route's waypoints, 0 for the first. Default 0.
     pub start_waypoint: Option<S<i64>>,
+    /// Drive the route's waypoints in reverse order (`direction = "reverse"`). Default false
+    /// (`"forward"`).
+    pub reverse: bool,
     pub laps: S<usize>,
     /// How the doors are set; `None`: all closed.
     pub doors: Option<DoorsSpec>,
@@ -347,13 +351,36 @@ fn read_run(t: &DeTable<'_>, at: usize, i: usize, d: &mut Diags) -> Option<RunSp
     let start_waypoint = get(t, "start_waypoint").and_then(|(_, v)| {
         integer(v, "start_waypoint", &ctx, d).map(|n| Spanned::new(v.span(), n))
     });
+    let reverse = match get(t, "direction") {
+        None => Some(false),
+        Some((_, v)) => run_direction(v, &ctx, d),
+    };
     let doors = read_run_doors(t, at, &ctx, d);
     Some(RunSpec {
         at,
         start_waypoint,
+        reverse: reverse?,
         laps: laps?,
         doors: doors?,
     })
+}
+
+/// `direction = "forward" | "reverse"`: whether the run drives the route backwards.
+fn run_direction(v: &Val<'_>, ctx: &str, d: &mut Diags) -> Option<bool> {
+    match string(v, "direction", ctx, d)?.as_str() {
+        "forward" => Some(false),
+        "reverse" => Some(true),
+        other => {
+            d.at(
+                v.span().start,
+                format!(
+                    "`direction` in {ctx} is \"{other}\"; write \"forward\" (the route's \
+                     waypoint order, the default) or \"reverse\""
+                ),
+            );
+            None
+        }
+    }
 }
 
 /// A lap count within 1..=[`MAX_LAPS`]; the one rule for files and for `--laps`.

@@ -87,6 +87,14 @@ impl Route {
     pub fn length_m(&self) -> f64 {
         self.legs().iter().map(Segment::length).sum()
     }
+
+    /// The same loop driven the other way: waypoint i becomes waypoint n − 1 − i.
+    pub fn reversed(&self) -> Route {
+        Route {
+            id: self.id.clone(),
+            waypoints: self.waypoints.iter().rev().copied().collect(),
+        }
+    }
 }
 
 /// An axis-aligned rectangle where people may walk.

@@ -187,6 +187,7 @@ impl PlaceRecognizer for LapBack {
                 levels: 1,
                 ngram_len: 1,
                 word_pairs: vec![],
+                direction: placewords::recognizer::Direction::Same,
                 pairs: vec![AlignedPair {
                     query: id,
                     past: p,

@@ -4,8 +4,8 @@
 use placewords::geom::{OdomPose, Pose2};
 use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::recognizer::{
-    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Match, MultiLevelRule, Observation,
-    Recognizer, RecognizerConfig, WordLevels, WordMatcher, WordRef,
+    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Direction, Match, MultiLevelRule,
+    Observation, Recognizer, RecognizerConfig, WordLevels, WordMatcher, WordRef,
 };
 use placewords::scan::BeamLayout;
 use proptest::prelude::*;
@@ -401,6 +401,56 @@ fn repeated_sequence_matches_and_shuffled_does_not() {
         "a shuffled lap must not match: {:?}",
         matches.first().map(|m| &m.word_pairs)
     );
+}
+
+/// The lap driven backwards: stretches in reverse order, each turn negated.
+fn reversed(lap: &[Stretch]) -> Vec<Stretch> {
+    lap.iter()
+        .rev()
+        .map(|s| Stretch::new(s.psi, s.size, -s.turn_deg))
+        .collect()
+}
+
+/// A lap driven the other way is recognized in the opposite direction: the past side is read
+/// backwards, so each query is paired with the observation at the same place of the first lap
+/// (past id decreasing as query id increases); with `reverse = false` nothing matches.
+#[test]
+fn reversed_lap_matches_in_the_opposite_direction() {
+    let lap = random_stretches(7, 40);
+    let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
+    let n = first.len();
+    let second = with_noise(
+        synth::observations(&reversed(&lap), 0.1, 0, first.last()),
+        2,
+    );
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    let pairs: Vec<_> = matches
+        .iter()
+        .filter(|m| m.levels == 1)
+        .flat_map(|m| &m.pairs)
+        .collect();
+    assert!(
+        pairs.len() > n / 3,
+        "much of the reversed lap is paired: {} pairs of {n} observations",
+        pairs.len()
+    );
+    assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
+    for p in &pairs {
+        // Query k of the second lap is at the place of observation n − 1 − k of the first
+        // (stretches keep their sizes; the turn sits at the median, so a place may be one
+        // observation off).
+        let mirror = 2 * n - 1 - p.query;
+        assert!(
+            mirror.abs_diff(p.past) <= 1,
+            "query {} paired with {}, its place is {mirror}",
+            p.query,
+            p.past
+        );
+    }
+    let off = config(|c| c.reverse = false);
+    let (_, matches) = run_matcher(&off, &all);
+    assert!(matches.is_empty(), "reverse = false finds nothing");
 }
 
 #[test]
@@ -942,7 +992,7 @@ proptest! {
             let tau = cfg.min_ngram[k - 1];
             let reported: std::collections::HashSet<(u32, u32)> = matches
                 .iter()
-                .filter(|mt| mt.levels == k)
+                .filter(|mt| mt.levels == k && mt.direction == Direction::Same)
                 .flat_map(|mt| mt.word_pairs.iter().map(|&(c, p)| (id_of(c), id_of(p))))
                 .collect();
             let mut memo = std::collections::HashMap::new();

@@ -764,3 +764,63 @@ fn simulated_logs_read_back_through_the_carmen_reader() {
         }
     }
 }
+
+/// `direction = "reverse"` drives the route's waypoints in reverse order from the same start
+/// waypoint: on the loop (1,1) → (19,1) → (19,7) → (1,7), a reverse run leaves (1,1) heading
+/// north, towards (1,7), and reaches the west side before the east side. A bad value is a
+/// located error.
+#[test]
+fn a_reverse_run_drives_the_waypoints_backwards() {
+    let head = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 1\n[[runs]]\nlaps = 1\n";
+    let scn = scenario(LOOP_WORLD, &format!("{head}direction = \"reverse\"\n")).unwrap();
+    assert!(scn.sim.runs[0].reverse);
+    let runs = simulate(&scn.sim, None, &|| {}).unwrap();
+    let truth: Vec<Pose2> = runs[0].frames().map(|f| f.truth.0).collect();
+    assert!(
+        (truth[0].theta - std::f64::consts::FRAC_PI_2).abs() < 0.2,
+        "starts facing north: {:?}",
+        truth[0]
+    );
+    let first = |f: &dyn Fn(&Pose2) -> bool| truth.iter().position(f).unwrap();
+    let west_top = first(&|p| p.x < 3.0 && p.y > 6.0);
+    let east = first(&|p| p.x > 17.0);
+    assert!(
+        west_top < east,
+        "reaches (1, 7) at frame {west_top}, x > 17 at {east}"
+    );
+
+    let err = scenario(LOOP_WORLD, &format!("{head}direction = \"backwards\"\n")).unwrap_err();
+    let all: Vec<String> = err.diagnostics().iter().map(|d| d.to_string()).collect();
+    assert!(
+        all.iter()
+            .any(|m| m.starts_with("mem/test.toml:7:13:") && m.contains("\"reverse\"")),
+        "{all:?}"
+    );
+}
+
+/// No silent failure: a run that yields no pair says so in words in the table ("no matches",
+/// not a precision of 0) and its report says why (here one lap: nothing is revisited, and no
+/// chain of matching words reaches τ).
+#[test]
+fn a_run_without_pairs_says_why() {
+    use placewords::experiment::{ExperimentOptions, evaluate_runs};
+    let src = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 1\n[[runs]]\nlaps = 1\n";
+    let scn = scenario(LOOP_WORLD, src).unwrap();
+    let runs = simulate(&scn.sim, None, &|| {}).unwrap();
+    let opts = ExperimentOptions {
+        levels: vec![1],
+        quiet: true,
+        ..Default::default()
+    };
+    let exp = evaluate_runs("tiny", 1, runs, &scn.recognizer, &scn.evaluation, &opts).unwrap();
+    let s = &exp.report.levels[0].scores;
+    assert_eq!(s.pairs, 0);
+    let why = s.no_pairs_reason.as_deref().unwrap_or_default();
+    assert!(why.contains("no observation has a revisit"), "{why}");
+    assert!(why.contains("longest chain of matching words is"), "{why}");
+    let json = serde_json::to_string(&exp.report).unwrap();
+    assert!(json.contains("\"no_pairs_reason\""), "{json}");
+    let table = placewords::report::table::text_table(&exp.report);
+    assert!(table.contains("no matches"), "{table}");
+    assert!(table.contains(why), "{table}");
+}
