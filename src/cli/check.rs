@@ -59,6 +59,8 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if shard.is_some() && args.report.is_none() {
         anyhow::bail!("--shard writes a part for `merge`; add --report PART.json");
     }
+    super::common::check_outputs([args.report.as_deref(), args.junit.as_deref()])?;
+    super::common::check_output_dirs([args.out.as_deref()])?;
     let opts = StressOptions {
         seeds: args.seeds.range(),
         shard,

@@ -27,6 +27,26 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 
+/// Checks, before any work starts, that each output file can be written (exit 2 naming it).
+pub fn check_outputs<'a>(files: impl IntoIterator<Item = Option<&'a Path>>) -> anyhow::Result<()> {
+    for path in files.into_iter().flatten() {
+        placewords::io::atomic::check_writable(path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Checks, before any work starts, that files can be written into each output folder.
+pub fn check_output_dirs<'a>(
+    dirs: impl IntoIterator<Item = Option<&'a Path>>,
+) -> anyhow::Result<()> {
+    for dir in dirs.into_iter().flatten() {
+        placewords::io::atomic::check_writable_dir(dir)
+            .with_context(|| format!("{}: cannot write into this folder", dir.display()))?;
+    }
+    Ok(())
+}
+
 /// Prints the experiment's table, then writes its JSON report and pictures where asked: the
 /// true and odometry paths, and the matched pairs of each level configuration (and ICP).
 pub fn print_and_write(

@@ -113,6 +113,8 @@ pub fn noise_model(s: &str) -> anyhow::Result<Option<OdometryConfig>> {
 }
 
 pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_outputs([args.report.as_deref()])?;
+    super::common::check_output_dirs([args.svg.as_deref()])?;
     let noise = noise_model(&args.odometry_noise)?;
     for (flag, v) in [
         ("--tp-radius-m", args.tp_radius_m),

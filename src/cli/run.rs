@@ -41,6 +41,8 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_outputs([args.report.as_deref(), args.export_matches.as_deref()])?;
+    super::common::check_output_dirs([args.svg.as_deref()])?;
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,

@@ -28,6 +28,7 @@ pub struct SweepArgs {
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_output_dirs([Some(args.out.as_path())])?;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let base = experiment::recognizer_config(&scn)?;
     let opts = ExperimentOptions {

@@ -30,6 +30,7 @@ pub struct TableArgs {
 }
 
 pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_output_dirs([Some(args.out.as_path())])?;
     let opts = ExperimentOptions {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,

@@ -3,6 +3,7 @@
 //! truth, and gathered in one [`Report`]. The commands `run`, `check`, `table`, `sweep` and
 //! `recognize` are thin layers over this module.
 
+pub mod output;
 pub mod picture;
 pub mod real;
 pub mod scenario;
@@ -35,6 +36,10 @@ pub enum ExperimentError {
     Sim(#[from] SimError),
     #[error("{0}")]
     Recognizer(String),
+    #[error(transparent)]
+    Output(#[from] crate::io::atomic::StageError),
+    #[error("{0}")]
+    Write(#[from] std::io::Error),
 }
 
 /// What to run.
