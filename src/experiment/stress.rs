@@ -203,13 +203,8 @@ pub enum StressError {
         path: String,
         source: std::io::Error,
     },
-    #[error("{path}:{line}:{col}: not a part written by `check --shard K/N --report`: {message}")]
-    Parse {
-        path: String,
-        line: usize,
-        col: usize,
-        message: String,
-    },
+    #[error("{0}")]
+    Parse(crate::spec::diag::Diagnostic),
     #[error(transparent)]
     Merge(#[from] crate::eval::suite::MergeError),
     #[error("{path}: cannot write: {source}")]
@@ -228,11 +223,12 @@ pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
             path: file.clone(),
             source,
         })?;
-        let part = SuiteReport::from_json(&text).map_err(|e| StressError::Parse {
-            path: file.clone(),
-            line: e.line(),
-            col: e.column(),
-            message: e.to_string(),
+        let part = SuiteReport::from_json(&text).map_err(|e| {
+            StressError::Parse(crate::spec::diag::Diagnostic::error(
+                &file,
+                (e.line(), e.column()),
+                format!("not a part written by `check --shard K/N --report`: {e}"),
+            ))
         })?;
         parts.push((file, part));
     }
