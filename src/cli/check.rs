@@ -67,7 +67,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         gate: true,
         allow_no_expect: args.allow_no_expect,
         experiment: ExperimentOptions {
-            quiet: args.quiet,
+            progress: super::progress::bar(args.quiet),
             ..ExperimentOptions::default()
         },
     };

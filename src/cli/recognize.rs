@@ -119,7 +119,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         levels: args.levels.levels(),
         icp: args.icp,
         laps: None,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     let exp = experiment::evaluate_runs(&name, args.seed, vec![run], &base, &evaluation, &opts)?;
     let world = picture::empty_world(&exp.runs, &name);

@@ -47,7 +47,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         levels: args.levels.levels(),
         icp: args.icp,
         laps: args.laps,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     if let Some(seeds) = args.seeds.seeds {
         let stress_opts = StressOptions {

@@ -2,7 +2,6 @@
 //! manifest, all written atomically.
 
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -32,26 +31,14 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|r| args.laps.unwrap_or(r.laps))
         .sum();
-    let bar = if args.quiet || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let b = indicatif::ProgressBar::new(total as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} laps {elapsed}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b.set_message(format!("simulating {}", scn.sim.name));
-        b
-    };
     let started = std::time::Instant::now();
     let files = placewords::experiment::output::simulate_to_folder(
         &scn,
         args.laps,
         &args.out,
         args.svg,
-        &|| bar.inc(1),
+        &super::progress::bar(args.quiet),
     )?;
-    bar.finish_and_clear();
     if !args.quiet {
         eprintln!(
             "simulated {total} laps and wrote {} files in {:.2} s",

@@ -35,7 +35,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,
         laps: args.laps,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     // Load every scenario first, so a broken file is reported before minutes of simulation.
     let scenarios = args

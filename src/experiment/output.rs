@@ -32,16 +32,20 @@ pub fn is_simulation_folder(dir: &Path) -> bool {
 /// Simulates `scn` (laps per run replaced by `laps`) and writes folder `out`: `run-NNN.log` per
 /// run, `manifest.json` and, with `svg`, `run-NNN.svg`. `out` is checked before the simulation
 /// starts: it must be new, empty or an earlier simulation folder (which is replaced). Returns the
-/// files written, under `out`; `progress` is called once per lap simulated.
+/// files written, under `out`; progress is told once per lap simulated.
 pub fn simulate_to_folder(
     scn: &Scenario,
     laps: Option<usize>,
     out: &Path,
     svg: bool,
-    progress: &(dyn Fn() + Sync),
+    progress: &super::ProgressSink,
 ) -> Result<Vec<PathBuf>, ExperimentError> {
     let stage = StagedDir::begin(out, &is_simulation_folder)?;
-    let runs = crate::sim::simulate(&scn.sim, laps, progress)?;
+    let total: usize = scn.sim.runs.iter().map(|r| laps.unwrap_or(r.laps)).sum();
+    progress.start("simulating", total as u64);
+    let runs = crate::sim::simulate(&scn.sim, laps, &|| progress.step());
+    progress.done();
+    let runs = runs?;
     let mut files = logs::write_logs(&scn.sim, &runs, laps, stage.path())?;
     if svg {
         for r in &runs {

@@ -374,7 +374,6 @@ mod tests {
 
         let opts = ExperimentOptions {
             levels: vec![3],
-            quiet: true,
             ..ExperimentOptions::default()
         };
         let base = recognizer_config(&scn).unwrap();
