@@ -15,10 +15,13 @@ pub enum Progress<'a> {
     Done,
 }
 
+/// The callback behind a [`ProgressSink`].
+type Callback = Arc<dyn Fn(Progress<'_>) + Send + Sync>;
+
 /// Where [`Progress`] goes: a callback shared by the threads of a stage, or nowhere (the
 /// default).
 #[derive(Clone, Default)]
-pub struct ProgressSink(Option<Arc<dyn Fn(Progress<'_>) + Send + Sync>>);
+pub struct ProgressSink(Option<Callback>);
 
 impl ProgressSink {
     /// Sends every event to `f`.

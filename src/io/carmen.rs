@@ -241,7 +241,7 @@ fn read_lines<R: BufRead>(
             Ok(0) => break,
             Ok(n) if n as u64 == MAX_LINE_BYTES && bytes.last() != Some(&b'\n') => {
                 return Err(CarmenError::Malformed(Diagnostic::error(
-                    &name,
+                    name,
                     (line_no + 1, 1),
                     format!(
                         "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
@@ -283,11 +283,11 @@ fn read_lines<R: BufRead>(
                     out.skipped_lines += 1;
                     if out.first_skipped.is_none() {
                         out.first_skipped =
-                            Some(Diagnostic::error(&name, (line_no, col), message).to_string());
+                            Some(Diagnostic::error(name, (line_no, col), message).to_string());
                     }
                 } else {
                     return Err(CarmenError::Malformed(Diagnostic::error(
-                        &name,
+                        name,
                         (line_no, col),
                         message,
                     )));
