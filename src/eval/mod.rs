@@ -7,7 +7,7 @@
 //! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
-pub mod distribution;
+pub(crate) mod distribution;
 pub mod gate;
 pub mod metrics;
 pub mod pair_recall;

@@ -5,9 +5,9 @@
 
 pub mod output;
 pub mod picture;
-pub mod progress;
+pub(crate) mod progress;
 pub mod real;
-pub mod scenario;
+pub(crate) mod scenario;
 pub mod score;
 pub mod stress;
 

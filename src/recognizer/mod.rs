@@ -8,14 +8,16 @@
 //!
 //! [`Recognizer`] composes the two.
 
-pub mod config;
-pub mod density;
-pub mod frontend;
-pub mod grid;
-pub mod matcher;
+pub(crate) mod config;
+pub(crate) mod density;
+pub(crate) mod frontend;
+pub(crate) mod grid;
+pub(crate) mod matcher;
+/// Synthetic inputs for tests and benchmarks; not part of the API.
+#[doc(hidden)]
 pub mod synth;
-pub mod types;
-pub mod words;
+pub(crate) mod types;
+pub(crate) mod words;
 
 pub use config::{AlignmentMode, ConfigProblem, RecognizerConfig, RecognizerError};
 pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, density};

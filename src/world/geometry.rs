@@ -62,10 +62,6 @@ impl SegmentIndex {
         SegmentIndex { items, bvh }
     }
 
-    pub fn items(&self) -> &[ThickSegment] {
-        &self.items
-    }
-
     /// Indices of items whose box comes within `margin` of the box of `s`.
     pub fn candidates(&self, s: Segment, margin: f64) -> Vec<usize> {
         if self.items.is_empty() {

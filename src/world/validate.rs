@@ -20,7 +20,7 @@ pub const ROBOT_RADIUS_M: f64 = 0.25;
 /// What a world is checked for: the robot that must fit its home pose and drive its routes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WorldCheck {
-    /// Radius of the robot's disc, metres. Default [`ROBOT_RADIUS_M`].
+    /// Radius of the robot's disc, metres. Default `ROBOT_RADIUS_M` (0.25 m).
     pub robot_radius_m: f64,
 }
 
