@@ -117,9 +117,62 @@ impl Segment {
     }
 }
 
+/// Cross product z of two planar vectors.
+fn cross(a: Vec2, b: Vec2) -> f64 {
+    a.x * b.y - a.y * b.x
+}
+
+/// Whether the closed segments `s` and `t` share a point.
+pub fn segments_intersect(s: Segment, t: Segment) -> bool {
+    let d1 = cross(t.b - t.a, s.a - t.a);
+    let d2 = cross(t.b - t.a, s.b - t.a);
+    let d3 = cross(s.b - s.a, t.a - s.a);
+    let d4 = cross(s.b - s.a, t.b - s.a);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    // Touching or collinear cases: an endpoint lies on the other segment.
+    const EPS: f64 = 1e-12;
+    t.distance_to_point(s.a) <= EPS
+        || t.distance_to_point(s.b) <= EPS
+        || s.distance_to_point(t.a) <= EPS
+        || s.distance_to_point(t.b) <= EPS
+}
+
+/// Exact shortest distance between two closed segments (0 when they cross).
+pub fn segment_distance(s: Segment, t: Segment) -> f64 {
+    if segments_intersect(s, t) {
+        return 0.0;
+    }
+    t.distance_to_point(s.a)
+        .min(t.distance_to_point(s.b))
+        .min(s.distance_to_point(t.a))
+        .min(s.distance_to_point(t.b))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn seg(ax: f64, ay: f64, bx: f64, by: f64) -> Segment {
+        Segment::new(Vec2::new(ax, ay), Vec2::new(bx, by))
+    }
+
+    #[test]
+    fn crossing_segments_have_zero_distance() {
+        assert_eq!(
+            segment_distance(seg(0.0, 0.0, 2.0, 2.0), seg(0.0, 2.0, 2.0, 0.0)),
+            0.0
+        );
+    }
+
+    #[test]
+    fn parallel_segments_measure_their_gap() {
+        let d = segment_distance(seg(0.0, 0.0, 2.0, 0.0), seg(0.5, 1.5, 1.5, 1.5));
+        assert!((d - 1.5).abs() < 1e-12);
+    }
 
     #[test]
     fn wrap_angle_stays_in_half_open_interval() {

@@ -59,13 +59,15 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if shard.is_some() && args.report.is_none() {
         anyhow::bail!("--shard writes a part for `merge`; add --report PART.json");
     }
+    super::common::check_outputs([args.report.as_deref(), args.junit.as_deref()])?;
+    super::common::check_output_dirs([args.out.as_deref()])?;
     let opts = StressOptions {
         seeds: args.seeds.range(),
         shard,
         gate: true,
         allow_no_expect: args.allow_no_expect,
         experiment: ExperimentOptions {
-            quiet: args.quiet,
+            progress: super::progress::bar(args.quiet),
             ..ExperimentOptions::default()
         },
     };

@@ -27,6 +27,26 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
         .with_context(|| format!("{}: cannot write", path.display()))
 }
 
+/// Checks, before any work starts, that each output file can be written (exit 2 naming it).
+pub fn check_outputs<'a>(files: impl IntoIterator<Item = Option<&'a Path>>) -> anyhow::Result<()> {
+    for path in files.into_iter().flatten() {
+        placewords::io::atomic::check_writable(path)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
+}
+
+/// Checks, before any work starts, that files can be written into each output folder.
+pub fn check_output_dirs<'a>(
+    dirs: impl IntoIterator<Item = Option<&'a Path>>,
+) -> anyhow::Result<()> {
+    for dir in dirs.into_iter().flatten() {
+        placewords::io::atomic::check_writable_dir(dir)
+            .with_context(|| format!("{}: cannot write into this folder", dir.display()))?;
+    }
+    Ok(())
+}
+
 /// Prints the experiment's table, then writes its JSON report and pictures where asked: the
 /// true and odometry paths, and the matched pairs of each level configuration (and ICP).
 pub fn print_and_write(
@@ -36,7 +56,6 @@ pub fn print_and_write(
     report: Option<&Path>,
     svg_dir: Option<&Path>,
 ) -> anyhow::Result<()> {
-    use placewords::experiment::picture;
     out!("{}", placewords::report::table::text_table(&exp.report))?;
     if let Some(path) = report {
         write_file(
@@ -45,28 +64,10 @@ pub fn print_and_write(
         )?;
         eprintln!("report: {}", path.display());
     }
-    let Some(dir) = svg_dir else { return Ok(()) };
-    let name = &exp.report.scenario;
-    let paths = picture::trajectory_svg(world, &exp.runs, &format!("{name}: paths"));
-    write_file(&dir.join("trajectory.svg"), paths.as_bytes())?;
-    let recognitions = exp
-        .recognitions
-        .iter()
-        .map(|(levels, rec)| (format!("{levels} level(s)"), format!("levels{levels}"), rec))
-        .chain(
-            exp.icp
-                .iter()
-                .map(|rec| ("ICP".to_string(), "icp".to_string(), rec)),
-        );
-    for (what, file, rec) in recognitions {
-        let title = format!("{name}: matched pairs, {what}");
-        let svg = picture::matches_svg(world, &exp.runs, rec, radius_m, &title);
-        write_file(&dir.join(format!("matches-{file}.svg")), svg.as_bytes())?;
-        let title = format!("{name}: recall and precision per lap, {what}");
-        let svg = picture::lap_strip_svg(rec, &exp.report.evaluation, &title);
-        write_file(&dir.join(format!("laps-{file}.svg")), svg.as_bytes())?;
+    if let Some(dir) = svg_dir {
+        placewords::experiment::picture::write_pictures(exp, world, radius_m, dir)?;
+        eprintln!("pictures: {}", dir.display());
     }
-    eprintln!("pictures: {}", dir.display());
     Ok(())
 }
 

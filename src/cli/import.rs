@@ -21,7 +21,7 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
         Ok(src) => src,
         Err(e) => {
             super::print_problems(&e, Default::default());
-            return Ok(ExitCode::from(2));
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
     };
     let spec = match mobilesim::import_mobilesim(&src, &name) {
@@ -41,11 +41,11 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
                 "{}: written with walls and home but no route; add the [[routes]] block there",
                 args.out.display()
             );
-            return Ok(ExitCode::from(2));
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
         Err(e) => {
             eprintln!("{e}");
-            return Ok(ExitCode::from(2));
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
     };
     let text = mobilesim::world_to_toml(&spec, &name).context("cannot serialise the world")?;

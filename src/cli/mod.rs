@@ -19,6 +19,7 @@ pub mod common;
 pub mod import;
 pub mod merge;
 pub mod out;
+pub mod progress;
 pub mod recognize;
 pub mod run;
 pub mod scenario;

@@ -7,7 +7,6 @@ use clap::{Args, ValueEnum};
 use placewords::experiment::{self, ExperimentOptions, picture};
 use placewords::io::real_log::TruthSource;
 use placewords::recognizer::RecognizerConfig;
-use placewords::sim::odometry::{OdometryConfig, OdometryModel};
 use placewords::spec::evaluation::EvaluationSpec;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,8 +26,9 @@ pub struct RecognizeArgs {
     /// Where the ground truth comes from.
     #[arg(long, value_enum, default_value = "corrected")]
     pub truth: TruthArg,
-    /// Odometry derived from the corrected increments: `none`, `proportional` (0.0075 m/m and
-    /// rad/rad), `proportional:T,R`, or `thrun:A1,A2,A3,A4`.
+    /// Odometry derived from the corrected increments through the simulator's odometry model:
+    /// `none`, `proportional` (0.0075 m/m and rad/rad, random-walk form), `proportional:T,R`,
+    /// or `thrun:A1,A2,A3,A4`.
     #[arg(long, value_name = "MODEL", default_value = "proportional")]
     pub odometry_noise: String,
     /// Seed of the odometry noise stream.
@@ -65,55 +65,11 @@ pub struct RecognizeArgs {
     pub quiet: bool,
 }
 
-/// Parses `--odometry-noise`.
-pub fn noise_model(s: &str) -> anyhow::Result<Option<OdometryConfig>> {
-    let (name, params) = s.split_once(':').unwrap_or((s, ""));
-    let nums = || -> anyhow::Result<Vec<f64>> {
-        params
-            .split(',')
-            .map(|p| {
-                p.trim()
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|v| v.is_finite() && *v >= 0.0)
-                    .ok_or_else(|| {
-                        anyhow::anyhow!("--odometry-noise {s}: `{p}` is not a non-negative number")
-                    })
-            })
-            .collect()
-    };
-    let model = match (name, params.is_empty()) {
-        ("none", true) => return Ok(None),
-        ("proportional", true) => OdometryConfig::default().model,
-        ("proportional", false) => match nums()?[..] {
-            [t, r] => OdometryModel::Proportional {
-                translation_ratio: t,
-                rotation_ratio: r,
-            },
-            _ => bail!(
-                "--odometry-noise {s}: proportional takes two numbers, e.g. proportional:0.0075,0.0075"
-            ),
-        },
-        ("thrun", false) => match nums()?[..] {
-            [a, b, c, d] => OdometryModel::Thrun {
-                alpha: [a, b, c, d],
-            },
-            _ => bail!(
-                "--odometry-noise {s}: thrun takes four numbers, e.g. thrun:0.01,0.01,0.01,0.01"
-            ),
-        },
-        _ => bail!(
-            "--odometry-noise {s}: unknown model; use none, proportional, proportional:T,R or thrun:A1,A2,A3,A4"
-        ),
-    };
-    Ok(Some(OdometryConfig {
-        model,
-        ..OdometryConfig::default()
-    }))
-}
-
 pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
-    let noise = noise_model(&args.odometry_noise)?;
+    super::common::check_outputs([args.report.as_deref()])?;
+    super::common::check_output_dirs([args.svg.as_deref()])?;
+    let noise = experiment::real::parse_noise_model(&args.odometry_noise)
+        .map_err(|e| anyhow::anyhow!("--odometry-noise {}: {e}", args.odometry_noise))?;
     for (flag, v) in [
         ("--tp-radius-m", args.tp_radius_m),
         ("--min-gap-m", args.min_gap_m),
@@ -163,7 +119,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         levels: args.levels.levels(),
         icp: args.icp,
         laps: None,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     let exp = experiment::evaluate_runs(&name, args.seed, vec![run], &base, &evaluation, &opts)?;
     let world = picture::empty_world(&exp.runs, &name);

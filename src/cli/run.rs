@@ -41,11 +41,13 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_outputs([args.report.as_deref(), args.export_matches.as_deref()])?;
+    super::common::check_output_dirs([args.svg.as_deref()])?;
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
         laps: args.laps,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     if let Some(seeds) = args.seeds.seeds {
         let stress_opts = StressOptions {

@@ -43,7 +43,7 @@ pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(if failed {
-        ExitCode::from(2)
+        ExitCode::from(placewords::eval::gate::EXIT_ERROR)
     } else {
         ExitCode::SUCCESS
     })

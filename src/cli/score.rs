@@ -26,6 +26,7 @@ pub struct ScoreArgs {
 }
 
 pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_outputs([args.report.as_deref()])?;
     let logs = score::load_logged_runs(&args.logdir)?;
     let name = args.matches.display().to_string();
     let text =

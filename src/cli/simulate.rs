@@ -2,7 +2,6 @@
 //! manifest, all written atomically.
 
 use clap::Args;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -25,7 +24,6 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
-    use placewords::sim::logs;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let total: usize = scn
         .sim
@@ -33,42 +31,19 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|r| args.laps.unwrap_or(r.laps))
         .sum();
-    let bar = if args.quiet || !std::io::stderr().is_terminal() {
-        indicatif::ProgressBar::hidden()
-    } else {
-        let b = indicatif::ProgressBar::new(total as u64);
-        b.set_style(
-            indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} laps {elapsed}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        b.set_message(format!("simulating {}", scn.sim.name));
-        b
-    };
-    let tick = || bar.inc(1);
     let started = std::time::Instant::now();
-    let logs_ = placewords::sim::simulate(&scn.sim, args.laps, &tick)?;
-    let simulated_s = started.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-    let mut files = logs::write_logs(&scn.sim, &logs_, args.laps, &args.out)?;
-    if args.svg {
-        for r in &logs_ {
-            let p = args.out.join(format!("run-{:03}.svg", r.run));
-            let title = format!("{}: run {}, true path and odometry", scn.sim.name, r.run);
-            let svg = placewords::experiment::picture::trajectory_svg(
-                &scn.sim.world,
-                std::slice::from_ref(r),
-                &title,
-            );
-            placewords::io::atomic::write_atomic(&p, svg.as_bytes())
-                .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", p.display()))?;
-            files.push(p);
-        }
-    }
+    let files = placewords::experiment::output::simulate_to_folder(
+        &scn,
+        args.laps,
+        &args.out,
+        args.svg,
+        &super::progress::bar(args.quiet),
+    )?;
     if !args.quiet {
         eprintln!(
-            "simulated {total} laps in {simulated_s:.2} s; wrote {} files in {:.2} s",
+            "simulated {total} laps and wrote {} files in {:.2} s",
             files.len(),
-            started.elapsed().as_secs_f64() - simulated_s
+            started.elapsed().as_secs_f64()
         );
         for f in &files {
             eprintln!("wrote {}", f.display());

@@ -28,16 +28,17 @@ pub struct SweepArgs {
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_output_dirs([Some(args.out.as_path())])?;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let base = experiment::recognizer_config(&scn)?;
     let opts = ExperimentOptions {
         laps: args.laps,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
         ..ExperimentOptions::default()
     };
     let (runs, _) = experiment::simulate(&scn, &opts)?;
     let laps = runs.iter().map(|r| r.laps.len()).sum();
-    let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), args.quiet)?;
+    let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), &opts.progress)?;
     let report = SweepReport::new(
         &scn.sim.name,
         scn.sim.seed,

@@ -30,11 +30,12 @@ pub struct TableArgs {
 }
 
 pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_output_dirs([Some(args.out.as_path())])?;
     let opts = ExperimentOptions {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,
         laps: args.laps,
-        quiet: args.quiet,
+        progress: super::progress::bar(args.quiet),
     };
     // Load every scenario first, so a broken file is reported before minutes of simulation.
     let scenarios = args

@@ -152,7 +152,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
         }
     }
     Ok(if failed {
-        ExitCode::from(2)
+        ExitCode::from(placewords::eval::gate::EXIT_ERROR)
     } else {
         ExitCode::SUCCESS
     })
@@ -211,7 +211,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
                     args.output.display()
                 );
             }
-            return Ok(ExitCode::from(2));
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
     };
     let doors = door_states(&world, &args.open, args.all_open)?;
@@ -224,7 +224,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
 
 fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
     let Some(world) = load(&args.file) else {
-        return Ok(ExitCode::from(2));
+        return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
     let info = placewords::world::info::world_info(&world);
     if args.json {
@@ -237,7 +237,7 @@ fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
 
 fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
     let Some(world) = load(&args.file) else {
-        return Ok(ExitCode::from(2));
+        return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
     let doors = door_states(&world, &args.open, false)?;
     let svg = placewords::authoring::density::density_picture(&world, &doors);
@@ -248,7 +248,7 @@ fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
 
 fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
     let Some(world) = load(&args.file) else {
-        return Ok(ExitCode::from(2));
+        return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
     let doors = door_states(&world, &args.open, false)?;
     let levels = args.levels.map(usize::from);

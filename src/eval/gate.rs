@@ -239,6 +239,13 @@ fn recognize_seconds(reports: &[Report], subject: &str) -> f64 {
         .sum()
 }
 
+/// Exit code: every expectation met.
+pub const EXIT_PASS: u8 = 0;
+/// Exit code: an expectation missed.
+pub const EXIT_MISSED: u8 = 1;
+/// Exit code: an error (bad input, a run that could not be carried out, an unwritable output).
+pub const EXIT_ERROR: u8 = 2;
+
 /// 0 when every outcome passed, 1 when any missed.
 pub fn exit_code(outcomes: &[Outcome]) -> i32 {
     i32::from(gate_exit_code(0, outcomes))
@@ -248,11 +255,11 @@ pub fn exit_code(outcomes: &[Outcome]) -> i32 {
 /// missed, else 0.
 pub fn gate_exit_code<'a>(errors: usize, outcomes: impl IntoIterator<Item = &'a Outcome>) -> u8 {
     if errors > 0 {
-        2
+        EXIT_ERROR
     } else if outcomes.into_iter().all(|o| o.passed) {
-        0
+        EXIT_PASS
     } else {
-        1
+        EXIT_MISSED
     }
 }
 

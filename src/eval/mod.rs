@@ -7,7 +7,7 @@
 //! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
-pub mod distribution;
+pub(crate) mod distribution;
 pub mod gate;
 pub mod metrics;
 pub mod pair_recall;
@@ -15,7 +15,7 @@ pub mod scores;
 pub mod suite;
 pub mod sweep;
 
-use crate::geom::TruePose;
+use crate::geom::{OdomPose, TruePose};
 use crate::log::RunLog;
 use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use std::time::Instant;
@@ -63,21 +63,32 @@ impl GroundTruth {
         let mut gt = GroundTruth::default();
         for run in runs {
             for lap in &run.laps {
-                let slot = gt.laps.len();
-                gt.laps.push(LapInfo {
+                let info = LapInfo {
                     run: run.run,
                     lap: lap.lap,
                     door_config: lap.door_config.clone(),
                     open_doors: lap.open_doors.clone(),
-                });
-                gt.frames.extend(lap.frames.iter().map(|f| FrameTruth {
-                    pose: f.truth,
-                    odom: f.odom,
-                    lap_slot: slot,
-                }));
+                };
+                gt.push_lap(info, lap.frames.iter().map(|f| (f.truth, f.odom)));
             }
         }
         gt
+    }
+
+    /// Appends one lap: its description and the true and odometry pose of each of its frames.
+    pub fn push_lap(
+        &mut self,
+        info: LapInfo,
+        frames: impl IntoIterator<Item = (TruePose, OdomPose)>,
+    ) {
+        let slot = self.laps.len();
+        self.laps.push(info);
+        self.frames
+            .extend(frames.into_iter().map(|(pose, odom)| FrameTruth {
+                pose,
+                odom,
+                lap_slot: slot,
+            }));
     }
 
     /// Truth of input frame `input_index`, if it exists.

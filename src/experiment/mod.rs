@@ -3,9 +3,11 @@
 //! truth, and gathered in one [`Report`]. The commands `run`, `check`, `table`, `sweep` and
 //! `recognize` are thin layers over this module.
 
+pub mod output;
 pub mod picture;
+pub(crate) mod progress;
 pub mod real;
-pub mod scenario;
+pub(crate) mod scenario;
 pub mod score;
 pub mod stress;
 
@@ -21,7 +23,7 @@ use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
 use crate::spec::evaluation::EvaluationSpec;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+pub use progress::{Progress, ProgressSink};
 use rayon::prelude::*;
 pub use scenario::{Scenario, load_scenario, parse_scenario};
 use std::time::Instant;
@@ -35,6 +37,10 @@ pub enum ExperimentError {
     Sim(#[from] SimError),
     #[error("{0}")]
     Recognizer(String),
+    #[error(transparent)]
+    Output(#[from] crate::io::atomic::StageError),
+    #[error("{0}")]
+    Write(#[from] std::io::Error),
 }
 
 /// What to run.
@@ -46,8 +52,8 @@ pub struct ExperimentOptions {
     pub icp: bool,
     /// Replace every run's lap count. Default: the scenario's.
     pub laps: Option<usize>,
-    /// Hide progress bars. Default false (they hide themselves when stderr is not a terminal).
-    pub quiet: bool,
+    /// Where progress goes. Default: nowhere.
+    pub progress: ProgressSink,
 }
 
 impl Default for ExperimentOptions {
@@ -56,7 +62,7 @@ impl Default for ExperimentOptions {
             levels: vec![1, 2, 3],
             icp: false,
             laps: None,
-            quiet: false,
+            progress: ProgressSink::none(),
         }
     }
 }
@@ -68,23 +74,6 @@ pub struct Experiment {
     /// One recognition per level configuration, in the order of `ExperimentOptions::levels`.
     pub recognitions: Vec<(usize, Recognition)>,
     pub icp: Option<Recognition>,
-}
-
-/// A progress bar on stderr, hidden under `quiet` or when stderr is not a terminal.
-pub fn progress_bar(len: u64, message: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{msg:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> "),
-    );
-    bar.set_message(message.to_string());
-    bar
 }
 
 /// The recognizer settings of a scenario (checked when the scenario was loaded).
@@ -128,7 +117,7 @@ impl PlaceRecognizer for Recognizer {
     }
 }
 
-/// Simulates a scenario with a progress bar; returns the runs and the wall-clock seconds.
+/// Simulates a scenario, telling its progress per lap; returns the runs and the wall-clock seconds.
 pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
     let laps: usize = scn
         .sim
@@ -136,10 +125,11 @@ pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>
         .iter()
         .map(|r| opts.laps.unwrap_or(r.laps))
         .sum();
-    let bar = progress_bar(laps as u64, "simulating", opts.quiet);
+    opts.progress.start("simulating", laps as u64);
     let t = Instant::now();
-    let runs = crate::sim::runner::simulate(&scn.sim, opts.laps, &|| bar.inc(1))?;
-    bar.finish_and_clear();
+    let runs = crate::sim::runner::simulate(&scn.sim, opts.laps, &|| opts.progress.step());
+    opts.progress.done();
+    let runs = runs?;
     Ok((runs, t.elapsed().as_secs_f64()))
 }
 
@@ -188,12 +178,12 @@ pub fn evaluate_runs(
         configs.push(cfg);
     }
     let jobs = configs.len() + usize::from(opts.icp);
-    let bar = progress_bar((jobs * laps) as u64, "recognizing", opts.quiet);
+    opts.progress.start("recognizing", (jobs * laps) as u64);
     // Each task is single-threaded and timed on its own; the tasks share the cores.
-    let mut results: Vec<(Option<usize>, Recognition)> = (0..jobs)
+    let results: Result<Vec<(Option<usize>, Recognition)>, _> = (0..jobs)
         .into_par_iter()
         .map(|j| {
-            let mut on_lap = |_: usize| bar.inc(1);
+            let mut on_lap = |_: usize| opts.progress.step();
             if j < configs.len() {
                 let cfg = &configs[j];
                 let mut rec = Recognizer::new(cfg.clone())
@@ -213,8 +203,9 @@ pub fn evaluate_runs(
                 ))
             }
         })
-        .collect::<Result<_, ExperimentError>>()?;
-    bar.finish_and_clear();
+        .collect::<Result<_, ExperimentError>>();
+    opts.progress.done();
+    let mut results = results?;
     let mut report = Report::new(name, seed, laps, evaluation.clone());
     let icp = match results.last() {
         Some((None, _)) => results.pop().map(|(_, r)| r),
@@ -296,7 +287,7 @@ pub fn sweep(
     base: &RecognizerConfig,
     evaluation: &EvaluationSpec,
     grid: &[GridPoint],
-    quiet: bool,
+    progress: &ProgressSink,
 ) -> Result<Vec<SweepResult>, ExperimentError> {
     let (observations, _) = observe(runs, base)?;
     let truth = GroundTruth::from_runs(runs);
@@ -304,15 +295,15 @@ pub fn sweep(
     for p in grid {
         back_end_matches(&[], base, p)?;
     }
-    let bar = progress_bar(grid.len() as u64, "sweeping", quiet);
+    progress.start("sweeping", grid.len() as u64);
     let results = sweep_matches(
         grid,
         &observations,
         &truth,
         evaluation,
         |p| back_end_matches(&observations, base, p).unwrap_or_default(),
-        &|| bar.inc(1),
+        &|| progress.step(),
     );
-    bar.finish_and_clear();
+    progress.done();
     Ok(results)
 }

@@ -14,6 +14,7 @@ use crate::report::world_render::{
 use crate::spec::evaluation::EvaluationSpec;
 use crate::world::World;
 use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
 
 const TRUE_COLOR: &str = "#1f77b4";
 const ODOM_COLOR: &str = "#ff7f0e";
@@ -385,6 +386,44 @@ pub fn empty_world(runs: &[RunLog], name: &str) -> World {
         routes: Vec::new(),
         areas: Vec::new(),
     }
+}
+
+/// Writes an experiment's pictures into `dir`: `trajectory.svg` (true and odometry paths) and,
+/// per level configuration (and ICP), `matches-X.svg` (the true path coloured by what was
+/// recognized) and `laps-X.svg` (recall and precision per lap). Returns the files written.
+pub fn write_pictures(
+    exp: &super::Experiment,
+    world: &World,
+    radius_m: f64,
+    dir: &Path,
+) -> std::io::Result<Vec<PathBuf>> {
+    let name = &exp.report.scenario;
+    let mut pictures = vec![(
+        "trajectory.svg".to_string(),
+        trajectory_svg(world, &exp.runs, &format!("{name}: paths")),
+    )];
+    let recognitions = exp
+        .recognitions
+        .iter()
+        .map(|(levels, rec)| (format!("{levels} level(s)"), format!("levels{levels}"), rec))
+        .chain(exp.icp.iter().map(|rec| ("ICP".into(), "icp".into(), rec)));
+    for (what, file, rec) in recognitions {
+        let title = format!("{name}: matched pairs, {what}");
+        let svg = matches_svg(world, &exp.runs, rec, radius_m, &title);
+        pictures.push((format!("matches-{file}.svg"), svg));
+        let title = format!("{name}: recall and precision per lap, {what}");
+        let svg = lap_strip_svg(rec, &exp.report.evaluation, &title);
+        pictures.push((format!("laps-{file}.svg"), svg));
+    }
+    let mut written = Vec::new();
+    for (file, svg) in pictures {
+        let path = dir.join(file);
+        crate::io::atomic::write_atomic(&path, svg.as_bytes()).map_err(|e| {
+            std::io::Error::new(e.kind(), format!("{}: cannot write: {e}", path.display()))
+        })?;
+        written.push(path);
+    }
+    Ok(written)
 }
 
 #[cfg(test)]

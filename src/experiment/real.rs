@@ -1,57 +1,97 @@
 //! Real robot logs as experiments. "Corrected" CARMEN logs carry no raw odometry, so odometry is
-//! derived from the corrected increments, each perturbed by the simulator's odometry model
-//! ([`perturb_increment`]) from a seeded stream; the corrected pose stays the truth.
+//! derived from the corrected increments, each read as the wheel travel that drives it and passed
+//! through the simulator's odometry model ([`crate::sim::odometry::Odometry`], one update per
+//! increment) from a seeded stream; the corrected pose stays the truth.
 
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
 use crate::io::real_log::{RealLogError, TruthSource, load_run};
 use crate::log::RunLog;
-use crate::sim::odometry::{OdometryConfig, OdometryModel};
+use crate::sim::odometry::{
+    Odometry, OdometryConfig, OdometryModel, ProportionalError, noisy_motion,
+};
 use crate::sim::rng::{Purpose, SimRng, stream};
-use rand_distr::{Distribution, StandardNormal};
 use std::path::Path;
 
-/// Perturbs one odometry increment (robot frame) with `cfg`'s model:
-/// - proportional: translation `Δs` and rotation `Δθ` get independent Gaussian errors of
-///   variance `σ_t²·|Δs|` and `σ_r²·|Δθ|` (as the simulator, per update);
-/// - Thrun: the increment is split into rot1, trans, rot2, each perturbed with α1..α4;
-///
-/// then the systematic wheel-radius bias scales the translation.
+/// Axle track the wheel travels of a real increment are expressed with, metres (the simulated
+/// robot's default; only a wheel-radius mismatch depends on it).
+const AXLE_TRACK_M: f64 = 0.357;
+
+/// Perturbs one odometry increment (robot frame) with the simulator's odometry model: the
+/// increment's signed travel `Δs` and turn `Δθ` are read as the wheel travels of one update,
+/// which get the model's systematic ([`Odometry::measured_motion`]) and random
+/// ([`noisy_motion`]) errors. The noisy travel keeps the increment's own direction of travel,
+/// turned by the update's heading error (a real increment may move sideways, which a
+/// differential drive integrated at its midpoint heading would lose).
 pub fn perturb_increment(cfg: &OdometryConfig, inc: Pose2, rng: &mut SimRng) -> Pose2 {
-    let mut g = || -> f64 { StandardNormal.sample(rng) };
-    let trans = inc.x.hypot(inc.y);
-    let scale = 1.0 + cfg.wheel_radius_bias_ratio;
-    match &cfg.model {
-        OdometryModel::Proportional {
-            translation_ratio,
-            rotation_ratio,
-        } => {
-            let s = trans + g() * translation_ratio * trans.sqrt();
-            let dtheta = inc.theta + g() * rotation_ratio * inc.theta.abs().sqrt();
-            let dir = if trans > 1e-12 {
-                inc.y.atan2(inc.x)
-            } else {
-                0.0
-            };
-            let s = s * scale;
-            Pose2::new(s * dir.cos(), s * dir.sin(), wrap_angle(dtheta))
+    let ds = inc.x.hypot(inc.y).copysign(inc.x);
+    let turn_m = inc.theta * AXLE_TRACK_M / 2.0;
+    let odometry = Odometry::new(cfg.clone(), AXLE_TRACK_M, Pose2::IDENTITY);
+    let measured = odometry.measured_motion(ds - turn_m, ds + turn_m);
+    let (ds_noisy, dth_noisy, heading) = noisy_motion(cfg, measured, rng);
+    let travel_dir = if ds.abs() > 1e-12 {
+        (inc.y * ds.signum()).atan2(inc.x * ds.signum())
+    } else {
+        0.0
+    };
+    let dir = travel_dir + heading - inc.theta / 2.0;
+    Pose2::new(
+        ds_noisy * dir.cos(),
+        ds_noisy * dir.sin(),
+        wrap_angle(dth_noisy),
+    )
+}
+
+/// Parses an odometry noise model for real logs: `none` (the corrected increments exactly),
+/// `proportional` (0.0075 m/m and rad/rad), `proportional:T,R` (both in the random-walk form:
+/// spread `T·√d` after `d` metres, per increment) or `thrun:A1,A2,A3,A4`.
+pub fn parse_noise_model(s: &str) -> Result<Option<OdometryConfig>, String> {
+    let (name, params) = s.split_once(':').unwrap_or((s, ""));
+    let nums = |want: usize, example: &str| -> Result<Vec<f64>, String> {
+        let v = params
+            .split(',')
+            .map(|p| {
+                p.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite() && *v >= 0.0)
+                    .ok_or_else(|| format!("`{p}` is not a non-negative number"))
+            })
+            .collect::<Result<Vec<f64>, String>>()?;
+        if v.len() == want {
+            Ok(v)
+        } else {
+            Err(format!("{name} takes {want} numbers, e.g. {example}"))
         }
-        OdometryModel::Thrun { alpha } => {
-            let rot1 = if trans > 1e-6 {
-                inc.y.atan2(inc.x)
-            } else {
-                0.0
-            };
-            let rot2 = wrap_angle(inc.theta - rot1);
-            let sd = |v: f64| v.max(0.0).sqrt();
-            let r1 = rot1 + g() * sd(alpha[0] * rot1 * rot1 + alpha[1] * trans * trans);
-            let t =
-                trans + g() * sd(alpha[2] * trans * trans + alpha[3] * (rot1 * rot1 + rot2 * rot2));
-            let r2 = rot2 + g() * sd(alpha[0] * rot2 * rot2 + alpha[1] * trans * trans);
-            let t = t * scale;
-            Pose2::new(t * r1.cos(), t * r1.sin(), wrap_angle(r1 + r2))
+    };
+    let model = match (name, params.is_empty()) {
+        ("none", true) => return Ok(None),
+        ("proportional", true) => OdometryConfig::default().model,
+        ("proportional", false) => {
+            let v = nums(2, "proportional:0.0075,0.0075")?;
+            OdometryModel::Proportional {
+                translation_ratio: v[0],
+                rotation_ratio: v[1],
+            }
         }
-    }
+        ("thrun", false) => {
+            let v = nums(4, "thrun:0.01,0.01,0.01,0.01")?;
+            OdometryModel::Thrun {
+                alpha: [v[0], v[1], v[2], v[3]],
+            }
+        }
+        _ => {
+            return Err(
+                "unknown model; use none, proportional, proportional:T,R or thrun:A1,A2,A3,A4"
+                    .into(),
+            );
+        }
+    };
+    Ok(Some(OdometryConfig {
+        model,
+        proportional: ProportionalError::RandomWalk,
+        ..OdometryConfig::default()
+    }))
 }
 
 /// Reads a log and turns it into one run, with odometry derived by `noise` (or exactly the
@@ -92,20 +132,61 @@ mod tests {
     use super::*;
 
     #[test]
-    fn proportional_noise_has_the_configured_spread() {
-        let cfg = OdometryConfig::default();
+    fn random_walk_noise_has_the_configured_spread() {
+        let cfg = OdometryConfig {
+            proportional: ProportionalError::RandomWalk,
+            ..OdometryConfig::default()
+        };
         let mut rng = stream(1, 0, 0, Purpose::Odometry);
         let n = 20_000;
         let inc = Pose2::new(1.0, 0.0, 1.0);
         let (mut sx, mut sxx) = (0.0, 0.0);
         for _ in 0..n {
             let p = perturb_increment(&cfg, inc, &mut rng);
-            sx += p.x - 1.0;
-            sxx += (p.x - 1.0).powi(2);
+            let travel = p.x.hypot(p.y);
+            sx += travel - 1.0;
+            sxx += (travel - 1.0).powi(2);
         }
         let mean = sx / n as f64;
         let sd = (sxx / n as f64 - mean * mean).sqrt();
         assert!(mean.abs() < 0.0005, "mean error {mean}");
         assert!((sd - 0.0075).abs() < 0.00075, "spread {sd}");
+    }
+
+    /// Without errors the simulator's model gives back the increment, sideways motion and
+    /// driving backwards included.
+    #[test]
+    fn a_noise_free_model_keeps_the_increment() {
+        let cfg = parse_noise_model("proportional:0,0").unwrap().unwrap();
+        let mut rng = stream(1, 0, 0, Purpose::Odometry);
+        for inc in [
+            Pose2::new(0.5, 0.1, 0.3),
+            Pose2::new(-0.4, 0.05, -0.2),
+            Pose2::new(0.0, 0.0, 0.7),
+        ] {
+            let p = perturb_increment(&cfg, inc, &mut rng);
+            let err = (p.x - inc.x).abs() + (p.y - inc.y).abs() + (p.theta - inc.theta).abs();
+            assert!(err < 1e-12, "{inc:?} became {p:?}");
+        }
+    }
+
+    #[test]
+    fn the_noise_grammar_names_its_mistakes() {
+        assert_eq!(parse_noise_model("none"), Ok(None));
+        assert!(
+            parse_noise_model("thrun:1,2")
+                .unwrap_err()
+                .contains("takes 4 numbers")
+        );
+        assert!(
+            parse_noise_model("proportional:x,1")
+                .unwrap_err()
+                .contains("`x`")
+        );
+        assert!(
+            parse_noise_model("gauss")
+                .unwrap_err()
+                .contains("unknown model")
+        );
     }
 }

@@ -12,7 +12,7 @@
 //! they fall on slightly different scans) are small: see the test beside `score`.
 
 use crate::eval::scores::Report;
-use crate::eval::{FrameTruth, GroundTruth, LapInfo, Recognition};
+use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
 use crate::io::matches_csv::{MatchRow, MatchesCsvError};
@@ -141,20 +141,17 @@ pub fn load_logged_runs(dir: &Path) -> Result<LoggedRuns, ScoreError> {
         runs.push((r.run, truth.frames.len(), poses.len()));
         let mut k = 0;
         for l in &r.laps {
-            let slot = truth.laps.len();
-            truth.laps.push(LapInfo {
+            let info = LapInfo {
                 run: r.run,
                 lap: l.lap,
                 door_config: l.door_config.clone(),
                 open_doors: l.open_doors.clone(),
-            });
-            for (t, o) in truths[k..k + l.frames].iter().zip(&poses[k..k + l.frames]) {
-                truth.frames.push(FrameTruth {
-                    pose: TruePose(*t),
-                    odom: crate::geom::OdomPose(*o),
-                    lap_slot: slot,
-                });
-            }
+            };
+            let frames = truths[k..k + l.frames].iter().zip(&poses[k..k + l.frames]);
+            truth.push_lap(
+                info,
+                frames.map(|(t, o)| (TruePose(*t), crate::geom::OdomPose(*o))),
+            );
             k += l.frames;
         }
         odom.extend(poses);
@@ -376,7 +373,6 @@ mod tests {
 
         let opts = ExperimentOptions {
             levels: vec![3],
-            quiet: true,
             ..ExperimentOptions::default()
         };
         let base = recognizer_config(&scn).unwrap();

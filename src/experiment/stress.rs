@@ -10,7 +10,7 @@
 
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
-use crate::experiment::{ExperimentOptions, progress_bar, run_scenario};
+use crate::experiment::{ExperimentOptions, ProgressSink, run_scenario};
 use crate::spec::seeds::{SeedRange, Shard};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -29,7 +29,7 @@ pub struct StressOptions {
     /// With `gate`, skip a scenario without `[expect]` instead of failing. Default false.
     pub allow_no_expect: bool,
     /// Without `gate`: the level configurations and whether ICP runs (`levels`, `icp`), laps
-    /// override (`laps`). `quiet` hides the progress bar.
+    /// override (`laps`); progress goes to `progress` (one step per seed).
     pub experiment: ExperimentOptions,
 }
 
@@ -108,7 +108,8 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
         .filter(|(k, _)| opts.shard.is_none_or(|s| s.owns(*k)))
         .map(|(_, item)| item)
         .collect();
-    let bar = progress_bar(items.len() as u64, "seeds", opts.experiment.quiet);
+    let progress = &opts.experiment.progress;
+    progress.start("seeds", items.len() as u64);
     let results: Vec<SeedResult> = items
         .par_iter()
         .map(|&(i, seed)| {
@@ -117,11 +118,11 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
                 unreachable!("only runnable scenarios are planned")
             };
             let r = run_seed(scn, seed, options);
-            bar.inc(1);
+            progress.step();
             r
         })
         .collect();
-    bar.finish_and_clear();
+    progress.done();
     SuiteReport::new(opts.shard, opts.gate, assemble(planned, items, results))
 }
 
@@ -131,7 +132,7 @@ pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedR
     let mut scn = scn.clone();
     scn.sim.seed = seed;
     let options = ExperimentOptions {
-        quiet: true,
+        progress: ProgressSink::none(),
         ..options.clone()
     };
     let (report, error) = match run_scenario(&scn, &options) {
@@ -203,13 +204,8 @@ pub enum StressError {
         path: String,
         source: std::io::Error,
     },
-    #[error("{path}:{line}:{col}: not a part written by `check --shard K/N --report`: {message}")]
-    Parse {
-        path: String,
-        line: usize,
-        col: usize,
-        message: String,
-    },
+    #[error("{0}")]
+    Parse(crate::spec::diag::Diagnostic),
     #[error(transparent)]
     Merge(#[from] crate::eval::suite::MergeError),
     #[error("{path}: cannot write: {source}")]
@@ -228,11 +224,12 @@ pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
             path: file.clone(),
             source,
         })?;
-        let part = SuiteReport::from_json(&text).map_err(|e| StressError::Parse {
-            path: file.clone(),
-            line: e.line(),
-            col: e.column(),
-            message: e.to_string(),
+        let part = SuiteReport::from_json(&text).map_err(|e| {
+            StressError::Parse(crate::spec::diag::Diagnostic::error(
+                &file,
+                (e.line(), e.column()),
+                format!("not a part written by `check --shard K/N --report`: {e}"),
+            ))
         })?;
         parts.push((file, part));
     }

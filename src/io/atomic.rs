@@ -1,19 +1,71 @@
 //! Atomic output: write to a temporary file beside the target, then rename, so an interrupted
-//! run never leaves a half-written file.
+//! run never leaves a half-written file under a final name; output folders are staged the same
+//! way ([`StagedDir`]), so a folder holds one complete run or is left as it was.
+//!
+//! Temporary names are `.NAME.tmpPID` (hidden, beside `NAME`; PID the writing process). Every
+//! error path removes them. A process killed outright (`kill -9`, a file-size limit) cannot, so
+//! the next write of `NAME` in that folder removes the `.NAME.tmpPID` of any process that no
+//! longer runs (on systems with `/proc`; elsewhere they stay, hidden, and nothing reads them).
 
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// `.NAME.tmpPID` beside `path`, for this process.
+fn temp_path(path: &Path) -> PathBuf {
+    path.with_file_name(format!(".{}.tmp{}", file_name(path), std::process::id()))
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "out".into())
+}
+
+/// Whether process `pid` may still be running: `false` only when `/proc` says it is gone.
+fn may_be_running(pid: u32) -> bool {
+    pid == std::process::id()
+        || !Path::new("/proc/self").exists()
+        || Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// Removes the `.NAME.tmpPID` files and folders a killed process left beside `path`.
+pub fn remove_stale_temps(path: &Path) {
+    let prefix = format!(".{}.tmp", file_name(path));
+    let dir = match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(d) => d.to_path_buf(),
+        None => PathBuf::from("."),
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let digits = |p: &str| {
+            p.split(|c: char| !c.is_ascii_digit())
+                .next()
+                .map(str::to_owned)
+        };
+        let pid = name.strip_prefix(&prefix).and_then(digits);
+        let pid = pid.and_then(|p| p.parse::<u32>().ok());
+        if pid.is_some_and(|pid| !may_be_running(pid)) {
+            let p = e.path();
+            let _ = std::fs::remove_dir_all(&p).or_else(|_| std::fs::remove_file(&p));
+        }
+    }
+}
+
+fn create_parent(path: &Path) -> std::io::Result<()> {
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(parent) => std::fs::create_dir_all(parent),
+        None => Ok(()),
+    }
+}
 
 /// Writes `bytes` to `path` atomically, creating parent folders.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)?;
-    }
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp = path.with_file_name(format!(".{file_name}.tmp{}", std::process::id()));
+    create_parent(path)?;
+    remove_stale_temps(path);
+    let tmp = temp_path(path);
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -24,4 +76,118 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Checks, before any work, that a file can be written at `path`: creates its parent folders
+/// and a temporary file beside it (removed again). An existing folder at `path` is an error.
+pub fn check_writable(path: &Path) -> std::io::Result<()> {
+    if path.is_dir() {
+        return Err(std::io::Error::other("it is a folder; give a file name"));
+    }
+    create_parent(path)?;
+    let tmp = temp_path(path);
+    std::fs::File::create(&tmp)?;
+    std::fs::remove_file(&tmp)
+}
+
+/// Checks, before any work, that files can be written into folder `dir` (created if missing).
+pub fn check_writable_dir(dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    check_writable(&dir.join(".placewords-probe"))
+}
+
+/// An output folder written in full beside its final place (`.DIR.tmpPID`), then renamed onto
+/// it by [`StagedDir::commit`]; dropped without a commit, the staging folder is removed.
+#[derive(Debug)]
+pub struct StagedDir {
+    target: PathBuf,
+    staging: PathBuf,
+    committed: bool,
+}
+
+/// Why an output folder cannot be staged.
+#[derive(Debug, thiserror::Error)]
+pub enum StageError {
+    #[error(
+        "{0}: the folder holds other files than an earlier output of this command; \
+         choose an empty or new folder"
+    )]
+    Foreign(String),
+    #[error("{path}: cannot write: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+}
+
+impl StagedDir {
+    /// Stages output for `dir`. An existing `dir` must be empty or, by `replaceable`, an earlier
+    /// output of the same kind (it is then replaced whole on commit); otherwise an error, before
+    /// anything is written.
+    pub fn begin(dir: &Path, replaceable: &dyn Fn(&Path) -> bool) -> Result<StagedDir, StageError> {
+        let io = |path: &Path, source| StageError::Io {
+            path: path.display().to_string(),
+            source,
+        };
+        if dir.exists() {
+            let empty = std::fs::read_dir(dir)
+                .map_err(|e| io(dir, e))?
+                .next()
+                .is_none();
+            if !empty && !replaceable(dir) {
+                return Err(StageError::Foreign(dir.display().to_string()));
+            }
+        }
+        create_parent(dir).map_err(|e| io(dir, e))?;
+        remove_stale_temps(dir);
+        let staging = temp_path(dir);
+        let _ = std::fs::remove_dir_all(&staging);
+        std::fs::create_dir(&staging).map_err(|e| io(dir, e))?;
+        Ok(StagedDir {
+            target: dir.to_path_buf(),
+            staging,
+            committed: false,
+        })
+    }
+
+    /// The folder to write into now.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// The final folder.
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// Moves the staged folder onto the target: an old target is first moved aside (to
+    /// `.DIR.tmpPID-old`) and removed after, so the target is never a mix of two runs.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let old = self
+            .staging
+            .with_file_name(format!("{}-old", file_name(&self.staging)));
+        let moved_aside = self.target.exists();
+        if moved_aside {
+            std::fs::rename(&self.target, &old)?;
+        }
+        if let Err(e) = std::fs::rename(&self.staging, &self.target) {
+            if moved_aside {
+                let _ = std::fs::rename(&old, &self.target);
+            }
+            return Err(e);
+        }
+        self.committed = true;
+        if moved_aside {
+            let _ = std::fs::remove_dir_all(&old);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = std::fs::remove_dir_all(&self.staging);
+        }
+    }
 }

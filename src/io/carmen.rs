@@ -10,6 +10,7 @@
 //! Angles in radians, distances in metres.
 
 use crate::geom::Pose2;
+use crate::spec::diag::Diagnostic;
 use std::fmt::Write as _;
 
 /// A laser message (FLASER, RLASER or ROBOTLASER1 after reading).
@@ -174,13 +175,8 @@ pub enum CarmenError {
         source: std::io::Error,
     },
     /// A line that is not a valid message of its type.
-    #[error("{path}:{line}:{col}: {message}")]
-    Malformed {
-        path: String,
-        line: usize,
-        col: usize,
-        message: String,
-    },
+    #[error("{0}")]
+    Malformed(Diagnostic),
     /// The gzip stream ended early or is corrupt.
     #[error(
         "{path}: the gzip stream is truncated or corrupt after line {line} ({source}); \
@@ -244,15 +240,14 @@ fn read_lines<R: BufRead>(
         match (&mut r).take(MAX_LINE_BYTES).read_until(b'\n', &mut bytes) {
             Ok(0) => break,
             Ok(n) if n as u64 == MAX_LINE_BYTES && bytes.last() != Some(&b'\n') => {
-                return Err(CarmenError::Malformed {
-                    path: name.to_string(),
-                    line: line_no + 1,
-                    col: 1,
-                    message: format!(
+                return Err(CarmenError::Malformed(Diagnostic::error(
+                    name,
+                    (line_no + 1, 1),
+                    format!(
                         "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
                         MAX_LINE_BYTES >> 20
                     ),
-                });
+                )));
             }
             Ok(_) => {}
             Err(source) => {
@@ -287,15 +282,15 @@ fn read_lines<R: BufRead>(
                 if opts.lenient {
                     out.skipped_lines += 1;
                     if out.first_skipped.is_none() {
-                        out.first_skipped = Some(format!("{name}:{line_no}:{col}: {message}"));
+                        out.first_skipped =
+                            Some(Diagnostic::error(name, (line_no, col), message).to_string());
                     }
                 } else {
-                    return Err(CarmenError::Malformed {
-                        path: name.to_string(),
-                        line: line_no,
-                        col,
+                    return Err(CarmenError::Malformed(Diagnostic::error(
+                        name,
+                        (line_no, col),
                         message,
-                    });
+                    )));
                 }
             }
         }

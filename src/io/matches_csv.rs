@@ -16,6 +16,8 @@
 //! Blank lines and lines starting with `#` are ignored. A bad line is an error naming
 //! `file:line:col`. Five columns of numbers do not need a CSV crate.
 
+use crate::spec::diag::Diagnostic;
+
 /// One matched pair of scans.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MatchRow {
@@ -31,13 +33,8 @@ pub const HEADER: &str = "query_run,query_scan,matched_run,matched_scan,score";
 
 /// Why a matches file could not be read.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}:{line}:{col}: {message}")]
-pub struct MatchesCsvError {
-    pub path: String,
-    pub line: usize,
-    pub col: usize,
-    pub message: String,
-}
+#[error("{0}")]
+pub struct MatchesCsvError(pub Diagnostic);
 
 /// The text of a matches file holding `rows`.
 pub fn write_matches(rows: &[MatchRow]) -> String {
@@ -56,11 +53,8 @@ pub fn write_matches(rows: &[MatchRow]) -> String {
 
 /// Parses a matches file; `path` names it in errors.
 pub fn parse_matches(src: &str, path: &str) -> Result<Vec<MatchRow>, MatchesCsvError> {
-    let err = |line: usize, col: usize, message: String| MatchesCsvError {
-        path: path.to_string(),
-        line,
-        col,
-        message,
+    let err = |line: usize, col: usize, message: String| {
+        MatchesCsvError(Diagnostic::error(path, (line, col), message))
     };
     let mut rows = Vec::new();
     let mut header_seen = false;

@@ -24,7 +24,8 @@
 //! With no loop, an out-and-back route along the longest skeleton branch from the home is used;
 //! failing that, the import fails and explains how to add a `[[routes]]` block by hand.
 
-use crate::geom::{Segment, Vec2};
+use crate::geom::{Segment, Vec2, segment_distance};
+use crate::spec::diag::Diagnostic;
 use crate::spec::world::{HomeSpec, RouteSpec, WallSpec, WorldSpec};
 use std::collections::{HashMap, VecDeque};
 
@@ -68,13 +69,8 @@ impl Default for ImportOptions {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum MapError {
     /// A line that does not parse.
-    #[error("{path}:{line}:{col}: {message}")]
-    Malformed {
-        path: String,
-        line: usize,
-        col: usize,
-        message: String,
-    },
+    #[error("{0}")]
+    Malformed(Diagnostic),
     /// The map parsed but no drivable route could be generated.
     ///
     /// `partial` holds the world without a route when walls and home were imported; a caller
@@ -119,12 +115,7 @@ fn numbers<const N: usize>(
 }
 
 fn malformed(path: &str, line: usize, col: usize, message: impl Into<String>) -> MapError {
-    MapError::Malformed {
-        path: path.to_string(),
-        line,
-        col,
-        message: message.into(),
-    }
+    MapError::Malformed(Diagnostic::error(path, (line, col), message))
 }
 
 /// Tokens with 1-based character columns.
@@ -314,30 +305,6 @@ pub fn chain_segments(segments: &[Segment]) -> Vec<(Vec<Vec2>, bool)> {
     out
 }
 
-/// Exact shortest distance between two segments.
-pub fn segment_distance(s: &Segment, t: &Segment) -> f64 {
-    if segments_intersect(s, t) {
-        return 0.0;
-    }
-    s.distance_to_point(t.a)
-        .min(s.distance_to_point(t.b))
-        .min(t.distance_to_point(s.a))
-        .min(t.distance_to_point(s.b))
-}
-
-fn cross(o: Vec2, a: Vec2, b: Vec2) -> f64 {
-    (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x)
-}
-
-fn segments_intersect(s: &Segment, t: &Segment) -> bool {
-    let d1 = cross(t.a, t.b, s.a);
-    let d2 = cross(t.a, t.b, s.b);
-    let d3 = cross(s.a, s.b, t.a);
-    let d4 = cross(s.a, s.b, t.b);
-    ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-}
-
 /// Distance from a point to the nearest wall surface (centre-line distance − thickness/2).
 pub fn point_clearance(walls: &[Segment], thickness_m: f64, p: Vec2) -> f64 {
     walls
@@ -351,7 +318,7 @@ pub fn point_clearance(walls: &[Segment], thickness_m: f64, p: Vec2) -> f64 {
 pub fn leg_clearance(walls: &[Segment], thickness_m: f64, leg: &Segment) -> f64 {
     walls
         .iter()
-        .map(|w| segment_distance(w, leg))
+        .map(|w| segment_distance(*w, *leg))
         .fold(f64::INFINITY, f64::min)
         - thickness_m / 2.0
 }
@@ -367,7 +334,7 @@ fn leg_clear(walls: &[Segment], thickness_m: f64, leg: &Segment, clearance_m: f6
             || a.x > hi.x + r
             || b.y < lo.y - r
             || a.y > hi.y + r
-            || segment_distance(w, leg) - thickness_m / 2.0 >= clearance_m
+            || segment_distance(*w, *leg) - thickness_m / 2.0 >= clearance_m
     })
 }
 
@@ -990,14 +957,5 @@ mod tests {
         let src = "2D-Map\nCairn: RobotHome 0 0 0\nLINES\n0 0 20000000 0\n";
         let e = import_mobilesim(src, "big.map").unwrap_err();
         assert!(e.to_string().contains("millimetres"), "{e}");
-    }
-
-    #[test]
-    fn segment_distance_is_exact() {
-        let s = Segment::new(Vec2::new(0.0, 0.0), Vec2::new(2.0, 0.0));
-        let t = Segment::new(Vec2::new(1.0, 1.0), Vec2::new(1.0, 3.0));
-        assert!((segment_distance(&s, &t) - 1.0).abs() < 1e-12);
-        let x = Segment::new(Vec2::new(1.0, -1.0), Vec2::new(1.0, 1.0));
-        assert_eq!(segment_distance(&s, &x), 0.0);
     }
 }

@@ -177,7 +177,7 @@ impl DensityKernel {
     }
 
     /// Free cells reached from the cell at index `base` of a row-major array of cell values
-    /// (see [`CELL_UNKNOWN`], [`CELL_OCCUPIED_FROM`]); indices are `(base + delta) & mask`
+    /// (see `CELL_UNKNOWN`, `CELL_OCCUPIED_FROM`); indices are `(base + delta) & mask`
     /// (`usize::MAX` for a plain array, side² − 1 for a power-of-two torus). The numerator of Ψ;
     /// every grid the recognizer or the oracle test uses goes through here.
     pub fn count_free_at(

@@ -8,14 +8,16 @@
 //!
 //! [`Recognizer`] composes the two.
 
-pub mod config;
-pub mod density;
-pub mod frontend;
-pub mod grid;
-pub mod matcher;
+pub(crate) mod config;
+pub(crate) mod density;
+pub(crate) mod frontend;
+pub(crate) mod grid;
+pub(crate) mod matcher;
+/// Synthetic inputs for tests and benchmarks; not part of the API.
+#[doc(hidden)]
 pub mod synth;
-pub mod types;
-pub mod words;
+pub(crate) mod types;
+pub(crate) mod words;
 
 pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
 pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, density};
@@ -48,6 +50,58 @@ impl Recognizer {
     }
 
     /// Integrates one scan taken at `odom`; returns the matches that became known with it.
+    ///
+    /// A robot drives the same 40 m corridor twice (two runs), with openings on both sides at
+    /// irregular places; on the second pass the recognizer matches places of the first, and
+    /// every aligned pair joins two observations at the same place of the corridor:
+    ///
+    /// ```
+    /// use placewords::geom::{OdomPose, Pose2};
+    /// use placewords::recognizer::{Recognizer, RecognizerConfig};
+    /// use placewords::scan::{BeamLayout, Scan};
+    ///
+    /// // Corridor walls y = ±1 m from x = 0 to 40 m, with openings [from, to] on each side.
+    /// let openings = [(3.0, 4.0), (7.5, 8.2), (13.0, 15.5), (21.0, 21.8), (29.0, 31.0)];
+    /// let other = [(5.0, 6.5), (11.0, 11.6), (18.0, 20.0), (25.5, 26.0), (34.0, 36.5)];
+    /// let wall_at = |x: f64, gaps: &[(f64, f64)]| !gaps.iter().any(|&(a, b)| x >= a && x <= b);
+    /// let layout = BeamLayout::centered(181, std::f64::consts::PI, 30.0, Pose2::IDENTITY);
+    /// // Range along angle `a` from (x, 0): the first wall y = ±1 the beam meets, if any.
+    /// let range = |x: f64, a: f64| -> f64 {
+    ///     let (dx, dy) = (a.cos(), a.sin());
+    ///     if dy.abs() < 1e-9 {
+    ///         return layout.max_range_m;
+    ///     }
+    ///     let t = 1.0 / dy.abs();
+    ///     let hit_x = x + dx * t;
+    ///     let gaps: &[(f64, f64)] = if dy > 0.0 { &openings } else { &other };
+    ///     if (0.0..=40.0).contains(&hit_x) && wall_at(hit_x, gaps) {
+    ///         t.min(layout.max_range_m)
+    ///     } else {
+    ///         layout.max_range_m
+    ///     }
+    /// };
+    /// let mut rec = Recognizer::new(RecognizerConfig::default()).unwrap();
+    /// let mut matches = Vec::new();
+    /// for run in 0..2 {
+    ///     matches.extend(rec.start_run());
+    ///     for step in 0..=380 {
+    ///         let x = 1.0 + 0.1 * step as f64;
+    ///         let ranges_m = (0..layout.count).map(|i| range(x, layout.beam_angle_rad(i))).collect();
+    ///         let scan = Scan { layout: layout.clone(), ranges_m, time_s: step as f64 };
+    ///         matches.extend(rec.push(OdomPose(Pose2::new(x, 0.0, 0.0)), &scan));
+    ///     }
+    ///     matches.extend(rec.finish());
+    /// }
+    /// // One observation per 0.10 m of travel, on both runs.
+    /// assert!(rec.observations().len() >= 2 * 370, "{}", rec.observations().len());
+    /// // The second pass recognizes the first, at the right places.
+    /// assert!(!matches.is_empty());
+    /// for pair in matches.iter().flat_map(|m| &m.pairs) {
+    ///     let (q, p) = (&rec.observations()[pair.query], &rec.observations()[pair.past]);
+    ///     assert_eq!((q.run, p.run), (1, 0));
+    ///     assert!((q.odom_pose.0.x - p.odom_pose.0.x).abs() < 1.0);
+    /// }
+    /// ```
     pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
         let observations = self.front.push(odom, scan);
         let mut out = Vec::new();

@@ -93,7 +93,7 @@ fn error_case(s: &Suite, err: &str) -> String {
         escape(&s.file),
         s.seconds,
         escape(first_line(err)),
-        escape(err)
+        escape(rest_lines(err))
     )
 }
 
@@ -149,6 +149,12 @@ fn testcase(o: &Outcome, file: &str) -> String {
 
 fn first_line(s: &str) -> &str {
     s.lines().next().unwrap_or("")
+}
+
+/// The lines after the first (the `message` attribute holds the first; the text adds the rest,
+/// so a one-line error is not said twice).
+fn rest_lines(s: &str) -> &str {
+    s.split_once('\n').map_or("", |(_, rest)| rest)
 }
 
 #[cfg(test)]
@@ -243,5 +249,7 @@ mod tests {
             Some("scenarios/x.toml:3:1: unknown field `lapz`")
         );
         assert!(error.text().unwrap().contains("\"hint\""));
+        // The located line is the message; the text does not say it again.
+        assert!(!error.text().unwrap().contains("unknown field"));
     }
 }

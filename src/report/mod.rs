@@ -2,12 +2,12 @@
 
 pub mod json;
 pub mod junit;
-pub mod lap_strip;
+pub(crate) mod lap_strip;
 pub mod plot;
 pub mod suite;
-pub mod svg;
+pub(crate) mod svg;
 pub mod table;
-pub mod world_render;
-pub mod xml;
+pub(crate) mod world_render;
+pub(crate) mod xml;
 
 pub use world_render::{LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg};

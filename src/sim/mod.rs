@@ -7,12 +7,12 @@
 pub mod laser;
 pub mod logs;
 pub mod odometry;
-pub mod pedestrians;
-pub mod plan;
+pub(crate) mod pedestrians;
+pub(crate) mod plan;
 pub mod rng;
-pub mod robot;
+pub(crate) mod robot;
 pub mod runner;
-pub mod variation;
+pub(crate) mod variation;
 
 pub use plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 pub use runner::{SimError, simulate};

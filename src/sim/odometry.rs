@@ -146,37 +146,48 @@ impl Odometry {
 
     /// One update from the true wheel travels over a step; returns the noisy (Δs, Δθ) used.
     pub fn update(&mut self, left_m: f64, right_m: f64, rng: &mut SimRng) -> (f64, f64) {
-        let (ds, dth) = self.measured_motion(left_m, right_m);
+        let motion = self.measured_motion(left_m, right_m);
+        let (ds, dth, heading) = noisy_motion(&self.config, motion, rng);
         let th = self.pose.theta;
-        let (ds, dth, heading) = match self.config.model {
-            OdometryModel::Proportional {
-                translation_ratio,
-                rotation_ratio,
-            } => {
-                let (ds, dth) = proportional_error(
-                    self.config.proportional,
-                    (ds, dth),
-                    (translation_ratio, rotation_ratio),
-                    rng,
-                );
-                (ds, dth, th + dth / 2.0)
-            }
-            OdometryModel::Thrun {
-                alpha: [a1, a2, a3, a4],
-            } => {
-                let (rot1, trans, rot2) = (dth / 2.0, ds, dth / 2.0);
-                let n1 = (a1 * rot1 * rot1 + a2 * trans * trans).sqrt() * gauss(rng);
-                let nt =
-                    (a3 * trans * trans + a4 * (rot1 * rot1 + rot2 * rot2)).sqrt() * gauss(rng);
-                let n2 = (a1 * rot2 * rot2 + a2 * trans * trans).sqrt() * gauss(rng);
-                let (rot1, trans, rot2) = (rot1 - n1, trans - nt, rot2 - n2);
-                (trans, rot1 + rot2, th + rot1)
-            }
-        };
-        self.pose.x += ds * heading.cos();
-        self.pose.y += ds * heading.sin();
+        self.pose.x += ds * (th + heading).cos();
+        self.pose.y += ds * (th + heading).sin();
         self.pose.theta = wrap_angle(th + dth);
         (ds, dth)
+    }
+}
+
+/// The random error of one update: the encoders' `(Δs, Δθ)` (systematic errors applied) become
+/// the noisy `(Δs, Δθ, heading)`, `heading` the direction `Δs` is travelled in, relative to the
+/// heading at the start of the update (`Δθ/2` at the midpoint, or Thrun's noisy rot1). The
+/// simulator integrates it ([`Odometry::update`]); real logs add it to their increments.
+pub fn noisy_motion(
+    config: &OdometryConfig,
+    (ds, dth): (f64, f64),
+    rng: &mut SimRng,
+) -> (f64, f64, f64) {
+    match config.model {
+        OdometryModel::Proportional {
+            translation_ratio,
+            rotation_ratio,
+        } => {
+            let (ds, dth) = proportional_error(
+                config.proportional,
+                (ds, dth),
+                (translation_ratio, rotation_ratio),
+                rng,
+            );
+            (ds, dth, dth / 2.0)
+        }
+        OdometryModel::Thrun {
+            alpha: [a1, a2, a3, a4],
+        } => {
+            let (rot1, trans, rot2) = (dth / 2.0, ds, dth / 2.0);
+            let n1 = (a1 * rot1 * rot1 + a2 * trans * trans).sqrt() * gauss(rng);
+            let nt = (a3 * trans * trans + a4 * (rot1 * rot1 + rot2 * rot2)).sqrt() * gauss(rng);
+            let n2 = (a1 * rot2 * rot2 + a2 * trans * trans).sqrt() * gauss(rng);
+            let (rot1, trans, rot2) = (rot1 - n1, trans - nt, rot2 - n2);
+            (trans, rot1 + rot2, rot1)
+        }
     }
 }
 

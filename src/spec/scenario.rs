@@ -1,6 +1,6 @@
 //! The scenario file format (TOML, `format_version = 1`): the structures of the file as
 //! written, each value with its span so later checks can point at it, read with the one reader
-//! ([`crate::spec::read`]). The checks against the world and the models built from these live
+//! (`crate::spec::read`). The checks against the world and the models built from these live
 //! one layer up, in `experiment::scenario`.
 //!
 //! The reference, with every key, its unit, default and limits, is `docs/scenario-format.md`;

@@ -260,164 +260,22 @@ fn is_scenario(top: &DeTable<'_>) -> bool {
 
 fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<WorldSpec> {
     unknown_keys(top, TOP_KEYS, "the world file", d);
-    let mut ok = true;
-
-    let format_version = match get(top, "format_version") {
-        None => {
-            missing(
-                top,
-                "format_version",
-                TOP_KEYS,
-                0,
-                "missing key `format_version`; add `format_version = 1` as the first line".into(),
-                d,
-            );
-            ok = false;
-            0
-        }
-        Some((_, v)) => match v.get_ref() {
-            DeValue::Integer(i) if parse_int(i.as_str(), i.radix()) == Some(1) => 1,
-            DeValue::Integer(i) => {
-                d.at(
-                    v.span().start,
-                    format!(
-                        "unsupported format_version {}; this placewords reads `format_version = 1`",
-                        i.as_str()
-                    ),
-                );
-                ok = false;
-                0
-            }
-            other => {
-                d.at(
-                    v.span().start,
-                    format!(
-                        "`format_version` must be the integer 1, found {}; write `format_version = 1`",
-                        type_name(other)
-                    ),
-                );
-                ok = false;
-                0
-            }
-        },
-    };
-
-    let name = match get(top, "name") {
-        None => {
-            missing(
-                top,
-                "name",
-                TOP_KEYS,
-                0,
-                "missing key `name`; add `name = \"my-floor\"` near the top".into(),
-                d,
-            );
-            None
-        }
-        Some((_, v)) => match string(v, "name", "the world file", d) {
-            Some(s) if s.trim().is_empty() => {
-                d.at(
-                    v.span().start,
-                    "`name` is empty; give the world a short name".into(),
-                );
-                None
-            }
-            other => other,
-        },
-    };
-    ok &= name.is_some();
-
-    let description = match get(top, "description") {
-        None => None,
-        Some((_, v)) => {
-            let s = string(v, "description", "the world file", d);
-            ok &= s.is_some();
-            s
-        }
-    };
-
+    let format_version = read_format_version(top, d);
+    let name = read_name(top, d);
+    let description =
+        get(top, "description").map(|(_, v)| string(v, "description", "the world file", d));
     let robot_home = read_home(top, d, &mut loc.home);
-    let robot_home_ok = robot_home.is_some();
-    ok &= robot_home_ok;
-
-    if let Some((kat, _)) = get(top, "walls") {
-        loc.walls_key = kat;
-    }
-    let wall_tables = table_array(top, "walls", d);
-    let door_tables = table_array(top, "doors", d);
-    let route_tables = table_array(top, "routes", d);
-    let area_tables = table_array(top, "areas", d);
-    if let Some((kat, v)) = get(top, "walls")
-        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
-    {
-        d.at(
-            kat,
-            "`walls` is empty; add at least one `[[walls]]` section with `id` and `points_m`"
-                .into(),
-        );
-        ok = false;
-    }
-    if let Some((kat, v)) = get(top, "routes")
-        && matches!(v.get_ref(), DeValue::Array(a) if a.is_empty())
-    {
-        d.at(
-            kat,
-            "`routes` is empty; add a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)"
-                .into(),
-        );
-        ok = false;
-    }
-    if get(top, "walls").is_none() {
-        missing(
-            top,
-            "walls",
-            TOP_KEYS,
-            0,
-            "the world has no walls; add at least one `[[walls]]` section with `id` and `points_m`"
-                .into(),
-            d,
-        );
-        ok = false;
-    }
-    if get(top, "routes").is_none() {
-        missing(
-            top,
-            "routes",
-            TOP_KEYS,
-            0,
-            "the world has no routes; add a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)"
-                .into(),
-            d,
-        );
-        ok = false;
-    }
-
-    let (walls, wall_locs) = read_entries(wall_tables, d, &mut ok, read_wall, |table| WallLoc {
-        table,
-        ..Default::default()
-    })?;
-    let (doors, door_locs) = read_entries(door_tables, d, &mut ok, read_door, |table| DoorLoc {
-        table,
-        ..Default::default()
-    })?;
-    let (routes, route_locs) =
-        read_entries(route_tables, d, &mut ok, read_route, |table| RouteLoc {
-            table,
-            ..Default::default()
-        })?;
-    let (areas, area_locs) = read_entries(area_tables, d, &mut ok, read_area, |table| AreaLoc {
-        table,
-        ..Default::default()
-    })?;
-    loc.walls.extend(wall_locs);
-    loc.doors.extend(door_locs);
-    loc.routes.extend(route_locs);
-    loc.areas.extend(area_locs);
-
-    let spec = WorldSpec {
-        format_version,
+    let mut ok = format_version.is_some()
+        && name.is_some()
+        && description.as_ref().is_none_or(Option::is_some)
+        && robot_home.is_some();
+    let (walls, doors, routes, areas) = read_sections(top, d, loc, &mut ok)?;
+    loc.home.valid = robot_home.is_some();
+    loc.all_read = ok;
+    Some(WorldSpec {
+        format_version: format_version.unwrap_or(0),
         name: name.unwrap_or_default(),
-        description,
+        description: description.flatten(),
         robot_home: robot_home.unwrap_or(HomeSpec {
             x_m: 0.0,
             y_m: 0.0,
@@ -427,10 +285,129 @@ fn read_top(top: &DeTable<'_>, d: &mut Diags, loc: &mut WorldLoc) -> Option<Worl
         doors,
         routes,
         areas,
+    })
+}
+
+/// `format_version`: `Some(1)`, or `None` with the problem reported.
+fn read_format_version(top: &DeTable<'_>, d: &mut Diags) -> Option<i64> {
+    let Some((_, v)) = get(top, "format_version") else {
+        missing(
+            top,
+            "format_version",
+            TOP_KEYS,
+            0,
+            "missing key `format_version`; add `format_version = 1` as the first line".into(),
+            d,
+        );
+        return None;
     };
-    loc.home.valid = robot_home_ok;
-    loc.all_read = ok;
-    Some(spec)
+    let message = match v.get_ref() {
+        DeValue::Integer(i) if parse_int(i.as_str(), i.radix()) == Some(1) => return Some(1),
+        DeValue::Integer(i) => format!(
+            "unsupported format_version {}; this placewords reads `format_version = 1`",
+            i.as_str()
+        ),
+        other => format!(
+            "`format_version` must be the integer 1, found {}; write `format_version = 1`",
+            type_name(other)
+        ),
+    };
+    d.at(v.span().start, message);
+    None
+}
+
+/// `name`: a non-empty string, or `None` with the problem reported.
+fn read_name(top: &DeTable<'_>, d: &mut Diags) -> Option<String> {
+    let Some((_, v)) = get(top, "name") else {
+        missing(
+            top,
+            "name",
+            TOP_KEYS,
+            0,
+            "missing key `name`; add `name = \"my-floor\"` near the top".into(),
+            d,
+        );
+        return None;
+    };
+    match string(v, "name", "the world file", d) {
+        Some(s) if s.trim().is_empty() => {
+            d.at(
+                v.span().start,
+                "`name` is empty; give the world a short name".into(),
+            );
+            None
+        }
+        other => other,
+    }
+}
+
+/// The entity sections as read: walls, doors, routes, areas.
+type Sections = (Vec<WallSpec>, Vec<DoorSpec>, Vec<RouteSpec>, Vec<AreaSpec>);
+
+/// The `[[walls]]`, `[[doors]]`, `[[routes]]` and `[[areas]]` sections and their locations;
+/// `ok` is cleared on any problem (walls and routes are required).
+fn read_sections(
+    top: &DeTable<'_>,
+    d: &mut Diags,
+    loc: &mut WorldLoc,
+    ok: &mut bool,
+) -> Option<Sections> {
+    if let Some((kat, _)) = get(top, "walls") {
+        loc.walls_key = kat;
+    }
+    let wall_tables = table_array(top, "walls", d);
+    let door_tables = table_array(top, "doors", d);
+    let route_tables = table_array(top, "routes", d);
+    let area_tables = table_array(top, "areas", d);
+    *ok &= required_section(
+        top,
+        "walls",
+        "at least one `[[walls]]` section with `id` and `points_m`",
+        d,
+    );
+    *ok &= required_section(
+        top,
+        "routes",
+        "a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)",
+        d,
+    );
+    let (walls, wall_locs) = read_entries(wall_tables, d, ok, read_wall, |table| WallLoc {
+        table,
+        ..Default::default()
+    })?;
+    let (doors, door_locs) = read_entries(door_tables, d, ok, read_door, |table| DoorLoc {
+        table,
+        ..Default::default()
+    })?;
+    let (routes, route_locs) = read_entries(route_tables, d, ok, read_route, |table| RouteLoc {
+        table,
+        ..Default::default()
+    })?;
+    let (areas, area_locs) = read_entries(area_tables, d, ok, read_area, |table| AreaLoc {
+        table,
+        ..Default::default()
+    })?;
+    loc.walls.extend(wall_locs);
+    loc.doors.extend(door_locs);
+    loc.routes.extend(route_locs);
+    loc.areas.extend(area_locs);
+    Some((walls, doors, routes, areas))
+}
+
+/// Whether section `key` is present and not empty; reports it with `add` (what to add) if not.
+fn required_section(top: &DeTable<'_>, key: &str, add: &str, d: &mut Diags) -> bool {
+    match get(top, key) {
+        Some((kat, v)) if matches!(v.get_ref(), DeValue::Array(a) if a.is_empty()) => {
+            d.at(kat, format!("`{key}` is empty; add {add}"));
+            false
+        }
+        Some(_) => true,
+        None => {
+            let message = format!("the world has no {key}; add {add}");
+            missing(top, key, TOP_KEYS, 0, message, d);
+            false
+        }
+    }
 }
 
 fn read_home(top: &DeTable<'_>, d: &mut Diags, l: &mut HomeLoc) -> Option<HomeSpec> {

@@ -1,14 +1,14 @@
 //! The validated world model: walls, doors and their states, routes, home, walking areas, and the
 //! obstacle geometry the laser and the physics see. The only module that touches parry/rapier.
 
-pub mod cell_grid;
-pub mod geometry;
+pub(crate) mod cell_grid;
+pub(crate) mod geometry;
 pub mod info;
-pub mod load;
-pub mod physics;
-pub mod raster;
+pub(crate) mod load;
+pub(crate) mod physics;
+pub(crate) mod raster;
 pub mod raycast;
-pub mod validate;
+pub(crate) mod validate;
 
 pub use load::{load_world, load_world_for, parse_world, parse_world_for, parse_world_spec};
 pub use validate::WorldCheck;
@@ -143,7 +143,7 @@ pub struct World {
 
 impl World {
     /// Builds the model from a file's structures, converting degrees to radians. Checks nothing:
-    /// validation lives in [`validate`] and reports located errors before this is called.
+    /// validation lives in `validate` and reports located errors before this is called.
     pub fn from_spec(spec: &WorldSpec) -> World {
         let v = |p: &[f64; 2]| Vec2::new(p[0], p[1]);
         World {

@@ -137,6 +137,7 @@ impl Physics {
     }
 
     /// The robot body's pose (f32 precision).
+    #[cfg(test)]
     pub fn robot_pose(&self) -> Pose2 {
         let p = self.world.bodies[self.robot].position();
         Pose2::new(
@@ -147,6 +148,7 @@ impl Physics {
     }
 
     /// Pedestrian `i`'s centre (f32 precision).
+    #[cfg(test)]
     pub fn pedestrian_centre(&self, i: usize) -> Vec2 {
         let t = self.world.bodies[self.pedestrians[i]].translation();
         Vec2::new(t.x as f64, t.y as f64)

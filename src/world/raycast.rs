@@ -7,7 +7,7 @@
 //! skipped before any angle is computed. Discs (people) are handled the same way, analytically.
 //! Everything is f64 and each hit is an exact ray/segment intersection.
 //!
-//! The segments are bucketed in a uniform grid ([`CellGrid`]); cells are visited in square rings
+//! The segments are bucketed in a uniform grid (`CellGrid`); cells are visited in square rings
 //! around the sensor, and a whole cell is skipped when it is behind the scanner, beyond the
 //! maximum range, or every beam it spans already hit something nearer than the cell. Far cells
 //! that span few beams try only those beams on their segments. Each range is the least of the

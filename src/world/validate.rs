@@ -20,7 +20,7 @@ pub const ROBOT_RADIUS_M: f64 = 0.25;
 /// What a world is checked for: the robot that must fit its home pose and drive its routes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WorldCheck {
-    /// Radius of the robot's disc, metres. Default [`ROBOT_RADIUS_M`].
+    /// Radius of the robot's disc, metres. Default `ROBOT_RADIUS_M` (0.25 m).
     pub robot_radius_m: f64,
 }
 
@@ -93,6 +93,22 @@ fn duplicates<'s>(ids: impl Iterator<Item = (&'s str, usize)>, kind: &str, d: &m
 
 /// All checks after reading; see the module docs.
 pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Diags) {
+    duplicate_ids(spec, loc, d);
+    // Size limits first, before anything proportional to the geometry is built.
+    if !segment_count_ok(spec, loc, d) || !extent_ok(spec, loc, d) {
+        return;
+    }
+    // Numbers and shapes of single entities.
+    let walls_ok = walls_ok(spec, loc, d);
+    let doors_ok = doors_ok(spec, loc, d);
+    routes_and_areas(spec, loc, d);
+    if loc.all_read && walls_ok && doors_ok && !d.is_full() {
+        geometry(spec, loc, check.robot_radius_m, d);
+    }
+}
+
+/// Ids used twice among walls, doors, routes or areas.
+fn duplicate_ids(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     duplicates(
         spec.walls
             .iter()
@@ -125,10 +141,10 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
         "area",
         d,
     );
+}
 
-    let mut geometry_ok = loc.all_read;
-
-    // Size limits first, before anything proportional to the geometry is built.
+/// Whether the world holds at most [`MAX_SEGMENTS`] wall segments, door panels and route legs.
+fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
     let segments: usize = spec
         .walls
         .iter()
@@ -150,13 +166,15 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                 "the world has {segments} wall segments, door panels and route legs (limit {MAX_SEGMENTS}); simplify the walls or split the world into smaller ones"
             ),
         );
-        return;
+        return false;
     }
-    if !extent_ok(spec, loc, d) {
-        return;
-    }
+    true
+}
 
-    // Numbers and shapes of single entities.
+/// Wall thicknesses, point counts and repeated points; `false` when the geometry cannot be
+/// checked.
+fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
+    let mut ok = true;
     for (w, l) in spec.walls.iter().zip(&loc.walls) {
         if !(w.thickness_m > 0.0 && w.thickness_m < MAX_WALL_THICKNESS_M) {
             d.at(
@@ -166,7 +184,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                     w.id, w.thickness_m
                 ),
             );
-            geometry_ok = false;
+            ok = false;
         }
         let n = w.points_m.len();
         if n < 2 || (w.closed && n < 3) {
@@ -179,7 +197,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                     if w.closed { " closed" } else { "" }
                 ),
             );
-            geometry_ok = false;
+            ok = false;
             continue;
         }
         let m = if w.closed { n } else { n - 1 };
@@ -199,6 +217,12 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
             }
         }
     }
+    ok
+}
+
+/// Door widths, thicknesses, headings and swings; `false` when the geometry cannot be checked.
+fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
+    let mut ok = true;
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
         let (lo, hi) = DOOR_WIDTH_RANGE_M;
         if !(door.width_m >= lo && door.width_m <= hi) {
@@ -209,7 +233,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                     door.id, door.width_m
                 ),
             );
-            geometry_ok = false;
+            ok = false;
         }
         if !(door.thickness_m > 0.0 && door.thickness_m <= MAX_DOOR_THICKNESS_M) {
             d.at(
@@ -219,7 +243,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                     door.id, door.thickness_m
                 ),
             );
-            geometry_ok = false;
+            ok = false;
         }
         for (h, at, key) in [
             (
@@ -237,7 +261,7 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                         door.id
                     ),
                 );
-                geometry_ok = false;
+                ok = false;
             }
         }
         let swing = wrap_angle((door.open_heading_deg - door.closed_heading_deg).to_radians())
@@ -251,9 +275,14 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
                     door.id
                 ),
             );
-            geometry_ok = false;
+            ok = false;
         }
     }
+    ok
+}
+
+/// Route waypoints, area corners and the home heading.
+fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
         let n = r.waypoints_m.len();
         if n < 3 {
@@ -302,10 +331,6 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
             loc.home.heading,
             "robot home heading_deg is outside -360..360; give the heading in degrees".into(),
         );
-    }
-
-    if geometry_ok && !d.is_full() {
-        geometry(spec, loc, check.robot_radius_m, d);
     }
 }
 
@@ -423,6 +448,21 @@ impl Obstacles {
 }
 
 fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags) {
+    let walls = wall_obstacles(spec);
+    let closed = door_obstacles(spec, false);
+    let open = door_obstacles(spec, true);
+    let all = [(&walls, ""), (&closed, "closed"), (&open, "open")];
+    doors_span_their_gaps(spec, loc, &walls, d);
+    home_in_free_space(spec, loc, &all, robot_radius_m, d);
+    doors_fit_their_gaps(spec, loc, &walls, d);
+    walls_do_not_overlap(spec, loc, d);
+    home_inside_the_building(spec, loc, d);
+    routes_are_drivable(spec, loc, &all, robot_radius_m, d);
+    areas_are_walkable(spec, loc, &walls, d);
+}
+
+/// Every wall segment of positive length, as a thick segment owned by its wall.
+fn wall_obstacles(spec: &WorldSpec) -> Obstacles {
     let mut items = Vec::new();
     let mut owner = Vec::new();
     for (wi, w) in spec.walls.iter().enumerate() {
@@ -439,28 +479,42 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
             }
         }
     }
-    let walls = Obstacles {
+    Obstacles {
         index: SegmentIndex::new(items),
         owner,
-    };
-    let doors_in = |open: bool| -> Obstacles {
-        let items = spec
-            .doors
-            .iter()
-            .map(|door| ThickSegment {
-                seg: door_panel(door, open),
-                half_thickness_m: door.thickness_m / 2.0,
-            })
-            .collect();
-        Obstacles {
-            index: SegmentIndex::new(items),
-            owner: (0..spec.doors.len()).map(Owner::Door).collect(),
-        }
-    };
-    let closed = doors_in(false);
-    let open = doors_in(true);
+    }
+}
 
-    // Doors: closed they fill a wall gap; open they do not cut through a wall.
+/// Every door panel, closed or `open`.
+fn door_obstacles(spec: &WorldSpec, open: bool) -> Obstacles {
+    let items = spec
+        .doors
+        .iter()
+        .map(|door| ThickSegment {
+            seg: door_panel(door, open),
+            half_thickness_m: door.thickness_m / 2.0,
+        })
+        .collect();
+    Obstacles {
+        index: SegmentIndex::new(items),
+        owner: (0..spec.doors.len()).map(Owner::Door).collect(),
+    }
+}
+
+/// The nearest obstacle within `limit` of `s` among `all` (walls, closed and open doors), with
+/// its clearance and door state.
+fn nearest_of<'a>(
+    all: &[(&Obstacles, &'a str); 3],
+    s: Segment,
+    limit: f64,
+) -> Option<(Owner, f64, &'a str)> {
+    all.iter()
+        .filter_map(|(o, state)| o.nearest(s, limit).map(|(w, c)| (w, c, *state)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Doors: closed they fill a wall gap; open they do not cut through a wall.
+fn doors_span_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
         let panel = door_panel(door, false);
         let point = |p: Vec2| Segment::new(p, p);
@@ -520,21 +574,20 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
             );
         }
     }
+}
 
-    // Home pose: in free space.
+/// Home pose: in free space, the robot's radius from walls and doors.
+fn home_in_free_space(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    all: &[(&Obstacles, &str); 3],
+    robot_radius_m: f64,
+    d: &mut Diags,
+) {
     if loc.home.valid {
         let p = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
         let s = Segment::new(p, p);
-        let worst = [
-            walls.nearest(s, robot_radius_m).map(|(o, c)| (o, c, "")),
-            closed
-                .nearest(s, robot_radius_m)
-                .map(|(o, c)| (o, c, "closed")),
-            open.nearest(s, robot_radius_m).map(|(o, c)| (o, c, "open")),
-        ]
-        .into_iter()
-        .flatten()
-        .min_by(|a, b| a.1.total_cmp(&b.1));
+        let worst = nearest_of(all, s, robot_radius_m);
         if let Some((o, c, state)) = worst {
             d.at(
                 loc.home.x,
@@ -546,12 +599,17 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
             );
         }
     }
+}
 
-    doors_fit_their_gaps(spec, loc, &walls, d);
-    walls_do_not_overlap(spec, loc, d);
-    home_inside_the_building(spec, loc, d);
-
-    // Routes: waypoints keep radius + margin; legs let the disc through in both door states.
+/// Routes: waypoints keep radius + margin; legs let the disc through in both door states.
+fn routes_are_drivable(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    all: &[(&Obstacles, &str); 3],
+    robot_radius_m: f64,
+    d: &mut Diags,
+) {
+    let [(walls, _), (closed, _), (open, _)] = *all;
     let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
         let n = r.waypoints_m.len();
@@ -562,14 +620,7 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
         for (k, p) in r.waypoints_m.iter().enumerate() {
             let p = v(p);
             let s = Segment::new(p, p);
-            let worst = [
-                walls.nearest(s, need_wp).map(|(o, c)| (o, c, "")),
-                closed.nearest(s, need_wp).map(|(o, c)| (o, c, "closed")),
-                open.nearest(s, need_wp).map(|(o, c)| (o, c, "open")),
-            ]
-            .into_iter()
-            .flatten()
-            .min_by(|a, b| a.1.total_cmp(&b.1));
+            let worst = nearest_of(all, s, need_wp);
             if let Some((o, c, state)) = worst {
                 bad[k] = true;
                 d.at(
@@ -621,8 +672,10 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
             }
         }
     }
+}
 
-    // Walking areas: people walk along the centre line of the longer side.
+/// Walking areas: people walk along the centre line of the longer side.
+fn areas_are_walkable(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
     for (a, l) in spec.areas.iter().zip(&loc.areas) {
         let (lo, hi) = (v(&a.min_m), v(&a.max_m));
         if !(lo.x < hi.x && lo.y < hi.y) {

@@ -7,6 +7,7 @@ use placewords::io::carmen::{
 };
 use placewords::io::mobilesim::{import_mobilesim, world_to_toml};
 use placewords::io::real_log::{TruthSource, log_to_run, noise_free};
+use placewords::spec::diag::Diagnostic;
 use proptest::prelude::*;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -141,11 +142,11 @@ fn corrupted_line_gives_a_located_error_and_lenient_counts() {
     assert!(
         matches!(
             e,
-            CarmenError::Malformed {
+            CarmenError::Malformed(Diagnostic {
                 line: 4,
                 col: 16,
                 ..
-            }
+            })
         ),
         "{msg}"
     );

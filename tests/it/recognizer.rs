@@ -1036,7 +1036,8 @@ fn thinned_real_log_still_matches() {
     }
     use placewords::experiment::{self, ExperimentOptions, real};
     use placewords::io::real_log::TruthSource;
-    let noise = placewords::sim::odometry::OdometryConfig::default();
+    // `recognize`'s default noise.
+    let noise = real::parse_noise_model("proportional").unwrap().unwrap();
     let (mut run, _) =
         real::load_real_run(log, false, TruthSource::Corrected, Some(&noise), 1).unwrap();
     real::keep_every_nth_scan(&mut run, 2);
@@ -1044,7 +1045,7 @@ fn thinned_real_log_still_matches() {
         levels: vec![3],
         icp: false,
         laps: None,
-        quiet: true,
+        ..ExperimentOptions::default()
     };
     let spec = placewords::spec::evaluation::EvaluationSpec::default();
     let exp = experiment::evaluate_runs(
