@@ -809,7 +809,6 @@ fn a_run_without_pairs_says_why() {
     let runs = simulate(&scn.sim, None, &|| {}).unwrap();
     let opts = ExperimentOptions {
         levels: vec![1],
-        quiet: true,
         ..Default::default()
     };
     let exp = evaluate_runs("tiny", 1, runs, &scn.recognizer, &scn.evaluation, &opts).unwrap();
