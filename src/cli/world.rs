@@ -135,18 +135,29 @@ pub fn run(cmd: WorldCommand) -> anyhow::Result<ExitCode> {
 fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for f in &args.files {
-        match placewords::world::load_world(f) {
-            Ok(w) => outln!(
-                "{}: ok ({} walls, {} doors, {} routes)",
-                f.display(),
-                w.walls.len(),
-                w.doors.len(),
-                w.routes.len()
-            )?,
+        let format = placewords::spec::diag::MessageFormat::from_name(&args.format.message_format)
+            .unwrap_or_default();
+        match placewords::world::check_world(f) {
+            Ok((w, warnings)) => {
+                for line in
+                    placewords::spec::diag::SpecError::Invalid(warnings.clone()).render(format)
+                {
+                    eprintln!("{line}");
+                }
+                outln!(
+                    "{}: ok ({} walls, {} doors, {} routes{})",
+                    f.display(),
+                    w.walls.len(),
+                    w.doors.len(),
+                    w.routes.len(),
+                    match warnings.len() {
+                        0 => String::new(),
+                        n => format!(", {n} warning(s)"),
+                    }
+                )?
+            }
             Err(e) => {
-                let format =
-                    placewords::spec::diag::MessageFormat::from_name(&args.format.message_format);
-                super::print_problems(&e, format.unwrap_or_default());
+                super::print_problems(&e, format);
                 failed = true;
             }
         }

@@ -581,7 +581,7 @@ fn run(r: &RunSpec, route: Option<&Route>, doors: &Doors, d: &mut Diags) -> Opti
         if start < 0 || start as usize >= n {
             d.at(s.span().start, format!(
                 "start_waypoint {start} is not a waypoint of route `{}`; use 0 (the first) to {} \
-                 (the last); messages about the world count waypoints from 1",
+                 (the last); waypoints are counted from 0 everywhere",
                 route.id, n.saturating_sub(1)));
         }
     }

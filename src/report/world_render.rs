@@ -108,7 +108,7 @@ pub struct RenderOptions {
     pub swatches: Vec<Swatch>,
     /// A coordinate grid with labelled metres under the world. Default false.
     pub show_grid: bool,
-    /// Number each route waypoint (from 1, as messages count them). Default false.
+    /// Number each route waypoint (from 0, as `waypoints_m` and `start_waypoint` index them and messages count them). Default false.
     pub show_waypoints: bool,
     /// Lines of text under the legend (e.g. the numbered problems). Default none.
     pub notes: Vec<String>,
@@ -817,7 +817,7 @@ fn waypoint_marks(svg: &mut Svg, f: &Frame, world: &World) {
                 .enumerate()
                 .map(move |(k, p)| MarkOverlay {
                     at: *p,
-                    text: format!("{}", k + 1),
+                    text: format!("{k}"),
                     color: color.to_string(),
                     class: "waypoint".into(),
                 })

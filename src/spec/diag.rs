@@ -4,6 +4,26 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+/// Whether a problem stops the file from being used.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    /// The file is refused (exit 2).
+    #[default]
+    Error,
+    /// The file is used, but probably not as its author meant.
+    Warning,
+}
+
+impl Severity {
+    /// `error` or `warning`, as printed.
+    pub fn name(self) -> &'static str {
+        match self {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        }
+    }
+}
+
 /// One problem found in a file, with its 1-based line and column.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
@@ -12,6 +32,7 @@ pub struct Diagnostic {
     pub col: usize,
     /// `what is wrong; what to try`, lowercase.
     pub message: String,
+    pub severity: Severity,
 }
 
 impl Diagnostic {
@@ -22,6 +43,7 @@ impl Diagnostic {
             line,
             col,
             message: message.into(),
+            severity: Severity::Error,
         }
     }
 }
@@ -59,9 +81,13 @@ pub fn read_text(path: &Path) -> Result<String, SpecError> {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let tag = match self.severity {
+            Severity::Error => "",
+            Severity::Warning => "warning: ",
+        };
         write!(
             f,
-            "{}:{}:{}: {}",
+            "{}:{}:{}: {tag}{}",
             self.path, self.line, self.col, self.message
         )
     }
@@ -120,7 +146,7 @@ pub enum MessageFormat {
     /// count.
     #[default]
     Human,
-    /// `{"path":..,"line":..,"col":..,"severity":"error","message":..}`, every problem.
+    /// `{"path":..,"line":..,"col":..,"severity":"error"|"warning","message":..}`, every problem.
     Json,
 }
 
@@ -143,14 +169,18 @@ impl Diagnostic {
     pub fn render(&self, format: MessageFormat) -> String {
         match format {
             MessageFormat::Human => format!(
-                "{}:{}:{}: error: {}",
-                self.path, self.line, self.col, self.message
+                "{}:{}:{}: {}: {}",
+                self.path,
+                self.line,
+                self.col,
+                self.severity.name(),
+                self.message
             ),
             MessageFormat::Json => serde_json::json!({
                 "path": self.path,
                 "line": self.line,
                 "col": self.col,
-                "severity": "error",
+                "severity": self.severity.name(),
                 "message": self.message,
             })
             .to_string(),
@@ -198,7 +228,7 @@ pub const MAX_DIAGNOSTICS: usize = 500;
 pub struct Diags<'a> {
     src: &'a str,
     path: &'a str,
-    list: Vec<(usize, String)>,
+    list: Vec<(usize, String, Severity)>,
     overflow: usize,
 }
 
@@ -214,11 +244,25 @@ impl<'a> Diags<'a> {
 
     /// Records a problem at byte `offset`.
     pub fn at(&mut self, offset: usize, message: String) {
+        self.push(offset, message, Severity::Error);
+    }
+
+    /// Records a warning at byte `offset`: the file stays usable.
+    pub fn warn(&mut self, offset: usize, message: String) {
+        self.push(offset, message, Severity::Warning);
+    }
+
+    fn push(&mut self, offset: usize, message: String, severity: Severity) {
         if self.list.len() >= MAX_DIAGNOSTICS {
             self.overflow += 1;
         } else {
-            self.list.push((offset, message));
+            self.list.push((offset, message, severity));
         }
+    }
+
+    /// Whether any error (not a warning) was recorded.
+    pub fn has_errors(&self) -> bool {
+        self.overflow > 0 || self.list.iter().any(|(_, _, s)| *s == Severity::Error)
     }
 
     /// Whether the report is full (further problems are only counted).
@@ -251,11 +295,11 @@ impl<'a> Diags<'a> {
                 .map(|(i, _)| i + 1),
         );
         let mut list = self.list;
-        list.sort_by_key(|(o, _)| *o);
+        list.sort_by_key(|(o, _, _)| *o);
         list.dedup();
         let mut out: Vec<Diagnostic> = list
             .into_iter()
-            .map(|(offset, message)| {
+            .map(|(offset, message, severity)| {
                 let mut cut = offset.min(self.src.len());
                 while !self.src.is_char_boundary(cut) {
                     cut -= 1;
@@ -268,6 +312,7 @@ impl<'a> Diags<'a> {
                     line: line_idx + 1,
                     col,
                     message,
+                    severity,
                 }
             })
             .collect();
@@ -281,6 +326,7 @@ impl<'a> Diags<'a> {
                     "{} more problems not shown; fix the ones above and check again",
                     self.overflow
                 ),
+                severity: Severity::Error,
             });
         }
         out

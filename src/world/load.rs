@@ -9,13 +9,23 @@ use std::path::Path;
 /// Reads and checks a world file's text into its file structures; `path` only names the file in
 /// messages. Every problem is reported, in file order.
 pub fn parse_world_spec(src: &str, path: &str, check: &WorldCheck) -> Result<WorldSpec, SpecError> {
+    parse_world_spec_warned(src, path, check).map(|(spec, _)| spec)
+}
+
+/// Like [`parse_world_spec`], with the warnings of a world that has no error.
+pub fn parse_world_spec_warned(
+    src: &str,
+    path: &str,
+    check: &WorldCheck,
+) -> Result<(WorldSpec, Vec<Diagnostic>), SpecError> {
     let mut d = Diags::new(src, path);
     let spec = read_world(src, &mut d).map(|(spec, loc)| {
         validate::validate(&spec, &loc, check, &mut d);
         spec
     });
+    let has_errors = d.has_errors();
     match (spec, d.into_sorted()) {
-        (Some(spec), diags) if diags.is_empty() => Ok(spec),
+        (Some(spec), warnings) if !has_errors => Ok((spec, warnings)),
         (_, mut diags) => {
             if diags.is_empty() {
                 // Defensive: a failed read always reports why; never return an empty error.
@@ -43,6 +53,14 @@ pub fn parse_world_for(src: &str, path: &str, check: &WorldCheck) -> Result<Worl
 /// Reads and checks a world file for the default robot.
 pub fn load_world(path: &Path) -> Result<World, SpecError> {
     load_world_for(path, &WorldCheck::default())
+}
+
+/// Reads and checks a world file for the default robot; also returns its warnings (problems
+/// that leave the world usable), for `world check`.
+pub fn check_world(path: &Path) -> Result<(World, Vec<Diagnostic>), SpecError> {
+    let src = crate::spec::diag::read_text(path)?;
+    parse_world_spec_warned(&src, &path.display().to_string(), &WorldCheck::default())
+        .map(|(spec, warnings)| (World::from_spec(&spec), warnings))
 }
 
 /// Reads and checks a world file for the robot in `check`.

@@ -10,7 +10,9 @@ pub(crate) mod raster;
 pub mod raycast;
 pub(crate) mod validate;
 
-pub use load::{load_world, load_world_for, parse_world, parse_world_for, parse_world_spec};
+pub use load::{
+    check_world, load_world, load_world_for, parse_world, parse_world_for, parse_world_spec,
+};
 pub use validate::WorldCheck;
 
 use crate::geom::{Pose2, Segment, Vec2};

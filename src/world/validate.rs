@@ -210,8 +210,8 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
                     format!(
                         "wall '{}' has a zero-length segment (point {} repeats point {}); remove the repeated point",
                         w.id,
-                        (j + 1) % n + 1,
-                        j + 1
+                        (j + 1) % n,
+                        j
                     ),
                 );
             }
@@ -303,8 +303,8 @@ fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
                     format!(
                         "route '{}' waypoint {} repeats waypoint {} (a zero-length leg); remove it{}",
                         r.id,
-                        k + 1,
-                        j + 1,
+                        k,
+                        j,
                         if k == 0 {
                             " (the route closes by itself: do not repeat the first waypoint at the end)"
                         } else {
@@ -628,7 +628,7 @@ fn routes_are_drivable(
                     format!(
                         "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
                         r.id,
-                        k + 1,
+                        k,
                         fmt_m(c),
                         owner_name(spec, o, state)
                     ),
@@ -655,15 +655,39 @@ fn routes_are_drivable(
                     " with all doors open",
                 ),
             ];
+            let mut blocked = false;
             for (hit, state, when) in checks {
                 if let Some((o, c)) = hit {
+                    blocked = true;
                     d.at(
                         at,
                         format!(
                             "route '{}' leg from waypoint {} to {} is blocked{when}: it passes {} {} and the robot's disc (radius {robot_radius_m} m) cannot drive through; move the waypoints so the leg keeps {robot_radius_m} m from walls and doors",
                             r.id,
-                            k + 1,
-                            k2 + 1,
+                            k,
+                            k2,
+                            fmt_m(c),
+                            owner_name(spec, o, state)
+                        ),
+                    );
+                }
+            }
+            if !blocked {
+                let tight = [(&walls, ""), (&closed, "closed"), (&open, "open")]
+                    .into_iter()
+                    .filter_map(|(obs, state)| {
+                        obs.nearest(leg, robot_radius_m + WAYPOINT_MARGIN_M)
+                            .map(|(o, c)| (o, c, state))
+                    })
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                if let Some((o, c, state)) = tight {
+                    d.warn(
+                        at,
+                        format!(
+                            "route '{}' leg from waypoint {} to {} passes {} {}: the robot's disc (radius {robot_radius_m} m) clears it by less than {WAYPOINT_MARGIN_M} m, so lap variation has no room there and a noisy robot may touch it; move the waypoints away from it",
+                            r.id,
+                            k,
+                            k2,
                             fmt_m(c),
                             owner_name(spec, o, state)
                         ),
@@ -812,8 +836,8 @@ fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
                 format!(
                     "wall '{}' (points {} to {}) overlaps {other} for {len:.2} m, from [{:.2}, {:.2}] to [{:.2}, {:.2}]; draw each wall once: remove the duplicate or shorten one of them",
                     w.id,
-                    j + 1,
-                    (j + 1) % w.points_m.len() + 1,
+                    j,
+                    (j + 1) % w.points_m.len(),
                     from.x,
                     from.y,
                     to.x,

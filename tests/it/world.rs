@@ -623,3 +623,31 @@ fn shipped_worlds_are_closed_and_every_door_opens_onto_a_room() {
         }
     }
 }
+
+/// A leg that clears a wall by less than the margin is usable, so `world check` passes (exit 0)
+/// but says where and why as `file:line:col: warning: …`, in human and JSON form; the shipped
+/// worlds give no warning.
+#[test]
+fn world_check_warns_about_a_tight_leg_and_still_passes() {
+    let f = root().join("tests/fixtures/warnings/tight-leg.toml");
+    let f = f.to_str().unwrap();
+    let out = placewords(&["world", "check", f]);
+    assert_eq!(out.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("tight-leg.toml:32:16: warning: route 'lap' leg from waypoint 0 to 1 passes"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 warning(s)"));
+    let out = placewords(&["world", "check", "--message-format", "json", f]);
+    let line = String::from_utf8_lossy(&out.stderr);
+    let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+    assert_eq!(v["severity"], "warning");
+    assert_eq!(v["line"], 32);
+    for w in ["institute-floor", "loop-small", "two-loops"] {
+        let p = root().join(format!("worlds/{w}.toml"));
+        let out = placewords(&["world", "check", p.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(0));
+        assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    }
+}
