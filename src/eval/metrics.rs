@@ -162,14 +162,14 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
     };
     let mut seen = HashSet::new();
     let mut out = Vec::new();
-    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
-        if !seen.insert((p.query, p.past)) {
+    for (query, past) in rec.matches.iter().flat_map(Match::pairs) {
+        if !seen.insert((query, past)) {
             continue;
         }
-        if let (Some(q), Some(pa)) = (truth_of(p.query), truth_of(p.past)) {
+        if let (Some(q), Some(pa)) = (truth_of(query), truth_of(past)) {
             out.push(ScoredPair {
-                query: p.query,
-                past: p.past,
+                query,
+                past,
                 query_truth: q,
                 past_truth: pa,
                 correct: q.0.distance(&pa.0) <= radius_m,
@@ -303,8 +303,8 @@ impl Scorer {
         let r2 = r * r;
         // Laps each query observation was correctly paired with.
         let mut matched: HashMap<usize, HashSet<usize>> = HashMap::new();
-        for p in matches.iter().flat_map(|m| &m.pairs) {
-            let (Some(&qi), Some(&pi)) = (self.index_of.get(&p.query), self.index_of.get(&p.past))
+        for (query, past) in matches.iter().flat_map(Match::pairs) {
+            let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
             else {
                 continue;
             };
@@ -384,29 +384,28 @@ impl Scorer {
             in_match.clear();
             let (mut n, mut ok) = (0usize, 0usize);
             let mut match_cfg = None;
-            for p in &m.pairs {
-                let (Some(&qi), Some(&pi)) =
-                    (self.index_of.get(&p.query), self.index_of.get(&p.past))
+            for (query, past) in m.pairs() {
+                let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
                 else {
-                    if seen.insert((p.query, p.past)) {
+                    if seen.insert((query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
                 let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi]) else {
-                    if seen.insert((p.query, p.past)) {
+                    if seen.insert((query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
                 let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
                     && heading_agrees(q.theta, pa.theta, self.heading_tol_rad);
-                if in_match.insert((p.query, p.past)) {
+                if in_match.insert((query, past)) {
                     n += 1;
                     ok += correct as usize;
                     match_cfg.get_or_insert(q.config);
                 }
-                if seen.insert((p.query, p.past)) {
+                if seen.insert((query, past)) {
                     total.pairs += 1;
                     total.correct += correct as usize;
                     if breakdown {
@@ -515,7 +514,8 @@ pub(crate) mod tests {
     use super::*;
     use crate::eval::{FrameTruth, LapInfo};
     use crate::geom::{OdomPose, Pose2, TruePose};
-    use crate::recognizer::AlignedPair;
+    /// An aligned pair (query, past).
+    type AlignedPair = (ObsId, ObsId);
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -559,22 +559,12 @@ pub(crate) mod tests {
         (obs, gt)
     }
 
-    fn pair(obs: &[Observation], q: usize, p: usize) -> AlignedPair {
-        AlignedPair {
-            query: q,
-            past: p,
-            query_odom: obs[q].odom_pose,
-            past_odom: obs[p].odom_pose,
-        }
+    fn pair(_obs: &[Observation], q: usize, p: usize) -> AlignedPair {
+        (q, p)
     }
 
     fn one_match(pairs: Vec<AlignedPair>) -> Match {
-        Match {
-            levels: 1,
-            ngram_len: 1,
-            word_pairs: vec![],
-            pairs,
-        }
+        Match::from_pairs(1, 1, vec![], pairs)
     }
 
     /// The oracle: for every observation, its nearest earlier neighbour that makes a revisit.
@@ -720,6 +710,7 @@ pub(crate) mod tests {
             seconds: 1.0,
             laps: 3,
             truth: gt,
+            lap_seconds: Vec::new(),
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -765,6 +756,7 @@ pub(crate) mod tests {
             seconds: 0.0,
             laps: 2,
             truth: gt,
+            lap_seconds: Vec::new(),
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);
@@ -775,7 +767,7 @@ pub(crate) mod tests {
     fn unknown_ids_are_not_scored() {
         let (obs, gt) = circle(2, 40.0);
         let mut p = pair(&obs, 400, 0);
-        p.query = 99_999;
+        p.0 = 99_999;
         let m = score(
             &obs,
             &[one_match(vec![p])],

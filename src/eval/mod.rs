@@ -16,7 +16,7 @@ pub mod suite;
 pub mod sweep;
 
 use crate::geom::TruePose;
-use crate::log::RunLog;
+use crate::log::{LapLog, RunLog};
 use crate::recognizer::{Match, Observation};
 use std::time::Instant;
 
@@ -63,21 +63,26 @@ impl GroundTruth {
         let mut gt = GroundTruth::default();
         for run in runs {
             for lap in &run.laps {
-                let slot = gt.laps.len();
-                gt.laps.push(LapInfo {
-                    run: run.run,
-                    lap: lap.lap,
-                    door_config: lap.door_config.clone(),
-                    open_doors: lap.open_doors.clone(),
-                });
-                gt.frames.extend(lap.frames.iter().map(|f| FrameTruth {
-                    pose: f.truth,
-                    odom: f.odom,
-                    lap_slot: slot,
-                }));
+                gt.add_lap(run.run, lap);
             }
         }
         gt
+    }
+
+    /// Appends the truth of one lap of run `run` (laps in the order they are fed).
+    pub fn add_lap(&mut self, run: usize, lap: &LapLog) {
+        let slot = self.laps.len();
+        self.laps.push(LapInfo {
+            run,
+            lap: lap.lap,
+            door_config: lap.door_config.clone(),
+            open_doors: lap.open_doors.clone(),
+        });
+        self.frames.extend(lap.frames.iter().map(|f| FrameTruth {
+            pose: f.truth,
+            odom: f.odom,
+            lap_slot: slot,
+        }));
     }
 
     /// Truth of input frame `input_index`, if it exists.
@@ -126,6 +131,9 @@ pub struct Recognition {
     pub laps: usize,
     /// Truth of every frame fed, by input index.
     pub truth: GroundTruth,
+    /// Wall-clock seconds the recognizer spent on each lap's frames, in the order fed (empty
+    /// when not recorded).
+    pub lap_seconds: Vec<f64>,
 }
 
 impl Recognition {
@@ -152,33 +160,67 @@ pub fn recognize_runs_with_progress(
     runs: &[RunLog],
     on_lap: &mut dyn FnMut(usize),
 ) -> Recognition {
-    let truth = GroundTruth::from_runs(runs);
-    let mut matches = Vec::new();
-    let mut seconds = 0.0;
-    let mut laps = 0;
+    let mut recording = Recording::default();
     for run in runs {
-        let t = Instant::now();
-        matches.extend(rec.start_run());
-        seconds += t.elapsed().as_secs_f64();
+        recording.start_run(rec);
         for lap in &run.laps {
-            let t = Instant::now();
-            for frame in &lap.frames {
-                matches.extend(rec.push(frame.odom, &frame.scan));
-            }
-            seconds += t.elapsed().as_secs_f64();
-            laps += 1;
-            on_lap(laps);
+            recording.lap(rec, run.run, lap);
+            on_lap(recording.laps);
         }
     }
-    let t = Instant::now();
-    matches.extend(rec.finish());
-    seconds += t.elapsed().as_secs_f64();
-    Recognition {
-        name: rec.name(),
-        observations: rec.observations().to_vec(),
-        matches,
-        seconds,
-        laps,
-        truth,
+    recording.finish(rec)
+}
+
+/// A recognition in progress, fed lap by lap (so a caller need not hold every lap's scans):
+/// the truth of the laps fed, the matches so far and the recognizer's time, in total and per lap.
+#[derive(Debug, Default)]
+pub struct Recording {
+    truth: GroundTruth,
+    matches: Vec<Match>,
+    seconds: f64,
+    laps: usize,
+    lap_seconds: Vec<f64>,
+}
+
+impl Recording {
+    /// Starts a run (call before each run's first lap, the first run included).
+    pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer) {
+        let t = Instant::now();
+        self.matches.extend(rec.start_run());
+        self.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
+    pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
+        self.truth.add_lap(run, lap);
+        let t = Instant::now();
+        for frame in &lap.frames {
+            self.matches.extend(rec.push(frame.odom, &frame.scan));
+        }
+        let s = t.elapsed().as_secs_f64();
+        self.seconds += s;
+        self.lap_seconds.push(s);
+        self.laps += 1;
+    }
+
+    /// Laps fed so far.
+    pub fn laps(&self) -> usize {
+        self.laps
+    }
+
+    /// Ends the input and hands over the recognition.
+    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer) -> Recognition {
+        let t = Instant::now();
+        self.matches.extend(rec.finish());
+        self.seconds += t.elapsed().as_secs_f64();
+        Recognition {
+            name: rec.name(),
+            observations: rec.observations().to_vec(),
+            matches: self.matches,
+            seconds: self.seconds,
+            laps: self.laps,
+            truth: self.truth,
+            lap_seconds: self.lap_seconds,
+        }
     }
 }

@@ -107,8 +107,8 @@ pub fn pair_recall(
         .map(|(i, o)| (o.id, i))
         .collect();
     let mut seen: HashSet<(usize, usize)> = HashSet::new();
-    for p in matches.iter().flat_map(|m| &m.pairs) {
-        let (Some(&qi), Some(&pi)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
+    for (query, past) in matches.iter().flat_map(Match::pairs) {
+        let (Some(&qi), Some(&pi)) = (index_of.get(&query), index_of.get(&past)) else {
             continue;
         };
         if let (Some(q), Some(pa)) = (&placed[qi], &placed[pi])
@@ -151,23 +151,9 @@ fn count_possible(placed: &[Option<Placed>], r: f64, ok: &dyn Fn(&Placed, &Place
 mod tests {
     use super::*;
     use crate::eval::metrics::tests::circle;
-    use crate::recognizer::AlignedPair;
 
-    fn one_match(obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
-        Match {
-            levels: 1,
-            ngram_len: 1,
-            word_pairs: vec![],
-            pairs: pairs
-                .iter()
-                .map(|&(q, p)| AlignedPair {
-                    query: q,
-                    past: p,
-                    query_odom: obs[q].odom_pose,
-                    past_odom: obs[p].odom_pose,
-                })
-                .collect(),
-        }
+    fn one_match(_obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
+        Match::from_pairs(1, 1, vec![], pairs.iter().copied())
     }
 
     /// Every possible pair found scores 1; only the nearest neighbour of one earlier lap scores

@@ -11,7 +11,7 @@
 //!                 "pairs": 10234, "correct_pairs": 9518, "no_pairs": false,
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
-//!                 "recognize_seconds_per_lap": 0.8,
+//!                 "recognize_seconds_per_lap": 0.8, "recognize_seconds_by_lap": [0.7, 0.8, ...],
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
 //!                                     "metrics": { "precision": ..., ... } } ] } ],
@@ -94,6 +94,10 @@ pub struct LevelReport {
     pub thresholds: Vec<usize>,
     #[serde(flatten)]
     pub scores: Scores,
+    /// The recognizer's wall-clock seconds on each lap's frames, in the order fed (how per-lap
+    /// work grows with history); empty when not recorded.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub recognize_seconds_by_lap: Vec<f64>,
 }
 
 /// The result of the ICP baseline.
@@ -159,6 +163,7 @@ impl Report {
             levels,
             thresholds: thresholds.to_vec(),
             scores,
+            recognize_seconds_by_lap: rec.lap_seconds.clone(),
         });
         self.levels.last().expect("just pushed")
     }
@@ -235,6 +240,7 @@ pub(crate) mod tests {
                     recognize_seconds_per_lap: 0.5 * (l + 1) as f64,
                     ..Scores::default()
                 },
+                recognize_seconds_by_lap: Vec::new(),
             });
         }
         rep.icp = Some(IcpReport {

@@ -7,6 +7,7 @@ use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
 use crate::eval::pair_recall::heading_agrees;
 use crate::log::RunLog;
+use crate::recognizer::Match;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
     LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
@@ -220,8 +221,8 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
     let (mut correct_pairs, mut wrong_pairs) = (0, Vec::new());
     let mut seen = HashSet::new();
     let tol = spec.heading_tolerance_deg.to_radians();
-    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
-        let (Some(&q), Some(&pa)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
+    for (query, past) in rec.matches.iter().flat_map(Match::pairs) {
+        let (Some(&q), Some(&pa)) = (index_of.get(&query), index_of.get(&past)) else {
             continue;
         };
         let (Some(a), Some(b)) = (pose(q), pose(pa)) else {

@@ -7,7 +7,9 @@
 //! the predecessor lists, mixing levels freely).
 //!
 //! When a word c closes, its candidates are the words of its class (a per-class occurrence list)
-//! that end at least `candidate_gap_m` of travel before c begins and match it. For each candidate p the
+//! that end at least `candidate_gap_m` of travel before c begins and match it; with
+//! `max_candidates` = k > 0 only the k most recent of them (the bound on work per lap, see
+//! `index.rs`: a place is matched to its k most recent look-alikes, not to every earlier one). For each candidate p the
 //! longest chain ending at (c, p) is 1 + the best memoised chain of a pair (c', p') with c' a
 //! predecessor of c and p' one of p, computed for every level configuration at once; the memo
 //! holds one entry per matching pair, so the work per word is candidates × predecessors², and
@@ -31,7 +33,8 @@
 //! less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
-use super::types::{AlignedPair, Match, Observation};
+use super::index::recent_candidates;
+use super::types::{AlignedRun, Match, Observation, push_pair};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
 
@@ -55,6 +58,7 @@ struct Params {
     size_ratio: f64,
     angle_tol_deg: f64,
     candidate_gap_m: f64,
+    max_candidates: usize,
     max_offset: usize,
     alignment: AlignmentMode,
     verify: bool,
@@ -93,6 +97,7 @@ impl WordMatcher {
                 size_ratio: config.size_tolerance_ratio,
                 angle_tol_deg: config.angle_tolerance_deg,
                 candidate_gap_m: config.candidate_gap_m,
+                max_candidates: config.max_candidates,
                 max_offset: config.max_alignment_offset,
                 alignment: config.alignment,
                 verify: config.verify,
@@ -227,11 +232,11 @@ impl WordMatcher {
 
         let levels = self.params.levels;
         let mut entries = Vec::new();
-        for &p in &occ[..end] {
+        let candidates = recent_candidates(&occ[..end], self.params.max_candidates, |p| {
+            self.syllables_match(&cw, self.word(p))
+        });
+        for p in candidates {
             let pw = self.word(p);
-            if !self.syllables_match(&cw, pw) {
-                continue;
-            }
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
             let mut back_slot = 0u8;
@@ -352,7 +357,7 @@ impl WordMatcher {
             levels: k + 1,
             ngram_len: e.len[k] as usize,
             word_pairs: refs,
-            pairs,
+            runs: pairs,
         })
     }
 
@@ -454,7 +459,7 @@ impl WordMatcher {
     }
 
     /// Eq. 2: aligned observation pairs of current word `c` and past word `p`.
-    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedPair>) {
+    fn align(&self, c: WordId, p: WordId, out: &mut Vec<AlignedRun>) {
         let obs = self.words.observations();
         let Some(w) = self.placement(c, p) else {
             return;
@@ -465,12 +470,7 @@ impl WordMatcher {
             if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
                 continue;
             }
-            out.push(AlignedPair {
-                query: q.id,
-                past: pst.id,
-                query_odom: q.odom_pose,
-                past_odom: pst.odom_pose,
-            });
+            push_pair(out, q.id, pst.id, 1);
         }
     }
 }

@@ -12,6 +12,7 @@ pub mod config;
 pub mod density;
 pub mod frontend;
 pub mod grid;
+mod index;
 pub mod matcher;
 pub mod synth;
 pub mod types;
@@ -22,7 +23,7 @@ pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, densi
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;
 pub use matcher::WordMatcher;
-pub use types::{AlignedPair, Match, ObsId, Observation, WordRef};
+pub use types::{AlignedRun, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;

@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod eval;
 mod io;
+mod longterm;
 mod recognizer;
 mod sim;
 mod spec;
