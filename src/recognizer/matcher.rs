@@ -77,6 +77,8 @@ pub struct WordMatcher {
     occurrences: Vec<Vec<WordId>>,
     /// Per word, an entry per matching past word, sorted by past word.
     memo: Vec<Vec<Entry>>,
+    /// Words before this one belong to finished runs; their memo has been freed.
+    memo_forgotten: usize,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
     lookup: [Vec<(u32, u32)>; MAX_LEVELS],
     stamp: u32,
@@ -110,6 +112,7 @@ impl WordMatcher {
             words: WordLevels::new(config.classes, config.min_word_size, config.levels),
             occurrences: vec![Vec::new(); config.classes],
             memo: Vec::new(),
+            memo_forgotten: 0,
             lookup: Default::default(),
             stamp: 0,
         })
@@ -137,6 +140,7 @@ impl WordMatcher {
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
             out = self.match_words(&closed);
+            self.forget_finished_runs();
         }
         let closed = self.words.push(obs);
         out.extend(self.match_words(&closed));
@@ -147,7 +151,19 @@ impl WordMatcher {
     /// while the current run has no observation.
     pub fn start_run(&mut self) -> Vec<Match> {
         let closed = self.words.start_run();
-        self.match_words(&closed)
+        let out = self.match_words(&closed);
+        self.forget_finished_runs();
+        out
+    }
+
+    /// Frees the memo of every word made so far, once their runs are over: a memo is read only
+    /// through the predecessors of a closing word, and predecessors never cross a run, so these
+    /// entries are never read again (the memo then holds one run's words, not the history's).
+    fn forget_finished_runs(&mut self) {
+        for m in &mut self.memo[self.memo_forgotten..] {
+            *m = Vec::new();
+        }
+        self.memo_forgotten = self.memo.len();
     }
 
     /// Closes the current run's open word and matches it, without starting a new run (call at
