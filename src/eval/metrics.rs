@@ -30,6 +30,7 @@
 //! about linear in the number of observations.
 
 use super::pair_recall::heading_agrees;
+use super::pair_set::{PairSet, pack};
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -163,7 +164,7 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
     let mut seen = HashSet::new();
     let mut out = Vec::new();
     for (query, past) in rec.matches.iter().flat_map(Match::pairs) {
-        if !seen.insert((query, past)) {
+        if !seen.insert(pack(query, past)) {
             continue;
         }
         if let (Some(q), Some(pa)) = (truth_of(query), truth_of(past)) {
@@ -301,20 +302,16 @@ impl Scorer {
             return 0.0;
         }
         let r2 = r * r;
-        // Laps each query observation was correctly paired with.
-        let mut matched: HashMap<usize, HashSet<usize>> = HashMap::new();
-        for (query, past) in matches.iter().flat_map(Match::pairs) {
-            let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
-            else {
-                continue;
-            };
-            if let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi])
-                && (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                && heading_agrees(q.theta, pa.theta, self.heading_tol_rad)
-            {
-                matched.entry(qi).or_default().insert(pa.lap);
-            }
-        }
+        // (query observation, lap) for each lap a query observation was correctly paired with.
+        let matched = PairSet::from_pairs(matches.iter().flat_map(Match::pairs).filter_map(
+            |(query, past)| {
+                let (&qi, &pi) = (self.index_of.get(&query)?, self.index_of.get(&past)?);
+                let (q, pa) = (self.obs[qi]?, self.obs[pi]?);
+                ((q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
+                    && heading_agrees(q.theta, pa.theta, self.heading_tol_rad))
+                .then_some((qi, pa.lap))
+            },
+        ));
         let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
         let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
         let (mut visits, mut found) = (0usize, 0usize);
@@ -340,9 +337,7 @@ impl Scorer {
                 }
             }
             visits += laps.len();
-            if let Some(m) = matched.get(&i) {
-                found += laps.iter().filter(|l| m.contains(l)).count();
-            }
+            found += laps.iter().filter(|&&l| matched.contains(i, l)).count();
             grid.entry((cx, cy)).or_default().push(i);
         }
         ratio(found, visits)
@@ -377,7 +372,8 @@ impl Scorer {
         let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
         let mut recalled_query = vec![false; self.obs.len()];
         let mut recalled_any = vec![false; self.obs.len()];
-        let mut seen: HashSet<(ObsId, ObsId)> = HashSet::new();
+        // Packed (query, past) ids (super::pair_set::pack): half the memory of id tuples.
+        let mut seen: HashSet<u64> = HashSet::new();
         let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
         let r2 = r * r;
         for m in matches {
@@ -387,13 +383,13 @@ impl Scorer {
             for (query, past) in m.pairs() {
                 let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
                 else {
-                    if seen.insert((query, past)) {
+                    if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
                 let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi]) else {
-                    if seen.insert((query, past)) {
+                    if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
@@ -405,7 +401,7 @@ impl Scorer {
                     ok += correct as usize;
                     match_cfg.get_or_insert(q.config);
                 }
-                if seen.insert((query, past)) {
+                if seen.insert(pack(query, past)) {
                     total.pairs += 1;
                     total.correct += correct as usize;
                     if breakdown {

@@ -11,6 +11,7 @@ pub mod distribution;
 pub mod gate;
 pub mod metrics;
 pub mod pair_recall;
+pub mod pair_set;
 pub mod scores;
 pub mod suite;
 pub mod sweep;

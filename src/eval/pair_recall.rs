@@ -15,10 +15,11 @@
 //!   so it is the figure closest to the paper's "matches that could be obtained".
 
 use super::GroundTruth;
+use super::pair_set::PairSet;
 use crate::geom::wrap_angle;
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 /// Distance along the true path from the first frame to each frame, metres.
 pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
@@ -106,17 +107,13 @@ pub fn pair_recall(
         .enumerate()
         .map(|(i, o)| (o.id, i))
         .collect();
-    let mut seen: HashSet<(usize, usize)> = HashSet::new();
-    for (query, past) in matches.iter().flat_map(Match::pairs) {
-        let (Some(&qi), Some(&pi)) = (index_of.get(&query), index_of.get(&past)) else {
-            continue;
-        };
-        if let (Some(q), Some(pa)) = (&placed[qi], &placed[pi])
-            && possible_pair(q, pa)
-        {
-            seen.insert((qi, pi));
-        }
-    }
+    let seen = PairSet::from_pairs(matches.iter().flat_map(Match::pairs).filter_map(
+        |(query, past)| {
+            let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
+            let (q, pa) = (placed[qi].as_ref()?, placed[pi].as_ref()?);
+            possible_pair(q, pa).then_some((qi, pi))
+        },
+    ));
     PairRecall {
         possible: count_possible(&placed, r, &possible_pair),
         found: seen.len() as u64,

@@ -369,6 +369,7 @@ impl WordMatcher {
             self.align(wc, past, &mut pairs);
         }
         self.rejections.accepted += 1;
+        pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
         Some(Match {
             levels: k + 1,
             ngram_len: e.len[k] as usize,
