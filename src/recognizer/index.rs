@@ -45,7 +45,7 @@ mod tests {
     #[test]
     fn keeps_the_most_recent_matching_words_in_order() {
         let occ: Vec<WordId> = (0..10).collect();
-        let even = |p: WordId| p % 2 == 0;
+        let even = |p: WordId| p.is_multiple_of(2);
         assert_eq!(recent_candidates(&occ, 0, even), vec![0, 2, 4, 6, 8]);
         assert_eq!(recent_candidates(&occ, 2, even), vec![6, 8]);
         assert_eq!(recent_candidates(&occ, 9, even), vec![0, 2, 4, 6, 8]);
