@@ -132,8 +132,9 @@ pub struct Recognition {
     pub laps: usize,
     /// Truth of every frame fed, by input index.
     pub truth: GroundTruth,
-    /// Wall-clock seconds the recognizer spent on each lap's frames, in the order fed (empty
-    /// when not recorded).
+    /// Seconds the recognizer spent on each lap's frames, in the order fed: CPU time of the
+    /// thread that fed them (so a loaded machine does not blur how the work grows with history),
+    /// wall clock where the thread's CPU time cannot be read; empty when not recorded.
     pub lap_seconds: Vec<f64>,
 }
 
@@ -172,6 +173,13 @@ pub fn recognize_runs_with_progress(
     recording.finish(rec)
 }
 
+/// CPU time of the calling thread, seconds (Linux: /proc/thread-self/schedstat; `None` elsewhere).
+fn thread_cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns / 1e9)
+}
+
 /// A recognition in progress, fed lap by lap (so a caller need not hold every lap's scans):
 /// the truth of the laps fed, the matches so far and the recognizer's time, in total and per lap.
 #[derive(Debug, Default)]
@@ -194,13 +202,16 @@ impl Recording {
     /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
     pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
         self.truth.add_lap(run, lap);
-        let t = Instant::now();
+        let (t, cpu) = (Instant::now(), thread_cpu_s());
         for frame in &lap.frames {
             self.matches.extend(rec.push(frame.odom, &frame.scan));
         }
         let s = t.elapsed().as_secs_f64();
         self.seconds += s;
-        self.lap_seconds.push(s);
+        self.lap_seconds.push(match (cpu, thread_cpu_s()) {
+            (Some(a), Some(b)) => b - a,
+            _ => s,
+        });
         self.laps += 1;
     }
 

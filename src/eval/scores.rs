@@ -94,8 +94,9 @@ pub struct LevelReport {
     pub thresholds: Vec<usize>,
     #[serde(flatten)]
     pub scores: Scores,
-    /// The recognizer's wall-clock seconds on each lap's frames, in the order fed (how per-lap
-    /// work grows with history); empty when not recorded.
+    /// The recognizer's seconds on each lap's frames, in the order fed (how per-lap work grows
+    /// with history): thread CPU time where readable (see `Recognition::lap_seconds`); empty
+    /// when not recorded.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub recognize_seconds_by_lap: Vec<f64>,
 }
