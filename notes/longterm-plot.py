@@ -52,7 +52,7 @@ def main():
         '<text x="450" y="20" text-anchor="middle" font-size="14">'
         "long-term: 1000 laps of loop-small, 3 levels</text>",
     ]
-    parts += axes(70, 50, 340, 230, xmax, ymax_t, "lap", "recognizer ms per lap (mean of 10 laps)",
+    parts += axes(70, 50, 340, 230, xmax, ymax_t, "lap", "recognizer thread CPU ms per lap (mean of 10 laps)",
                   lambda v: f"{v:.0f}")
     parts.append(polyline([(x, y * ms) for x, y in smooth], 70, 50, 340, 230, xmax, ymax_t, "#1f77b4"))
     parts += axes(520, 50, 340, 230, xmax, ymax_m, "laps run", "peak resident memory, MB (1 GB line)",
