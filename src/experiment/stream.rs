@@ -12,11 +12,11 @@ use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::{PlaceRecognizer, Recognition, Recording};
 use crate::log::LapLog;
 use crate::recognizer::{Recognizer, RecognizerConfig};
-use crate::sim::SimError;
 use crate::sim::runner::RunSim;
+use crate::sim::{SimError, SimPlan};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
-use std::sync::mpsc::{Receiver, sync_channel};
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Instant;
 
 use super::{Experiment, Scenario, recognizer_config};
@@ -40,21 +40,7 @@ pub fn run_scenario_streamed(
     let bar = progress_bar(total as u64, "laps", opts.quiet);
     let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
     let sim_s = std::thread::scope(|s| {
-        let producer = s.spawn(move || -> Result<f64, SimError> {
-            let mut seconds = 0.0;
-            for run in 0..plan.runs.len() {
-                let mut sim = RunSim::new(plan, run);
-                for lap in 0..laps_of(run) {
-                    let t = Instant::now();
-                    let log = sim.run_lap(lap)?;
-                    seconds += t.elapsed().as_secs_f64();
-                    if tx.send((run, log)).is_err() {
-                        return Ok(seconds);
-                    }
-                }
-            }
-            Ok(seconds)
-        });
+        let producer = s.spawn(move || simulate_laps(plan, &laps_of, &tx));
         feed(&mut jobs, rx, &bar);
         producer
             .join()
@@ -76,6 +62,29 @@ pub fn run_scenario_streamed(
     );
     exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
     Ok(exp)
+}
+
+/// Simulates every lap of every run in order, sending each as it is made (blocks while
+/// [`LAPS_AHEAD`] laps wait); returns the seconds spent simulating. Stops early when the
+/// receiver is gone.
+fn simulate_laps(
+    plan: &SimPlan,
+    laps_of: &dyn Fn(usize) -> usize,
+    tx: &SyncSender<(usize, LapLog)>,
+) -> Result<f64, SimError> {
+    let mut seconds = 0.0;
+    for run in 0..plan.runs.len() {
+        let mut sim = RunSim::new(plan, run);
+        for lap in 0..laps_of(run) {
+            let t = Instant::now();
+            let log = sim.run_lap(lap)?;
+            seconds += t.elapsed().as_secs_f64();
+            if tx.send((run, log)).is_err() {
+                return Ok(seconds);
+            }
+        }
+    }
+    Ok(seconds)
 }
 
 /// One job per level configuration, in order, then ICP's if asked.
