@@ -137,7 +137,7 @@ fn matching(c: &mut Criterion) {
                         let mut pairs = 0;
                         for o in &next {
                             for mt in m.push_observation(o) {
-                                pairs += mt.pairs.len();
+                                pairs += mt.pair_count();
                             }
                         }
                         (m, pairs)
@@ -185,7 +185,7 @@ fn whole_recognizer(c: &mut Criterion) {
             let pairs: usize = next
                 .iter()
                 .flat_map(|(o, s)| r.push(*o, s))
-                .map(|m| m.pairs.len())
+                .map(|m| m.pair_count())
                 .sum();
             let c2 = thread_cpu_ns().unwrap_or(c1);
             eprintln!(
@@ -200,7 +200,7 @@ fn whole_recognizer(c: &mut Criterion) {
                     let mut pairs = 0;
                     for (o, s) in next {
                         for mt in r.push(*o, s) {
-                            pairs += mt.pairs.len();
+                            pairs += mt.pair_count();
                         }
                     }
                     (r, pairs)

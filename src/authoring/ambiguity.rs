@@ -207,13 +207,12 @@ fn wrong_pair(
     };
     let (cr, pr) = (c.obs_range(), p.obs_range());
     let (mut wrong, mut all) = (0, 0);
-    for a in m
-        .pairs
-        .iter()
-        .filter(|a| cr.contains(&a.query) && pr.contains(&a.past))
+    for (q, pa) in m
+        .pairs()
+        .filter(|(q, pa)| cr.contains(q) && pr.contains(pa))
     {
         all += 1;
-        wrong += usize::from((at(a.query) - at(a.past)).norm() > radius_m);
+        wrong += usize::from((at(q) - at(pa)).norm() > radius_m);
     }
     (all > 0).then_some(2 * wrong > all)
 }

@@ -33,7 +33,7 @@
 
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::PlaceRecognizer;
-use crate::recognizer::{AlignedPair, Match, Observation};
+use crate::recognizer::{Match, Observation};
 use crate::scan::Scan;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -565,22 +565,10 @@ impl IcpRecognizer {
                     .enumerate()
                     .map(|(k, p)| (k, (p[0] - m[0]).powi(2) + (p[1] - m[1]).powi(2)))
                     .fold((0, f64::INFINITY), |b, c| if c.1 < b.1 { c } else { b });
-                let p = past.obs[k];
-                AlignedPair {
-                    query: q,
-                    past: p,
-                    query_odom: self.observations[q].odom_pose,
-                    past_odom: self.observations[p].odom_pose,
-                }
+                (q, past.obs[k])
             })
-            .collect();
-        Match {
-            levels: 0,
-            ngram_len: 1,
-            word_pairs: Vec::new(),
-            direction: crate::recognizer::Direction::Same,
-            pairs,
-        }
+            .collect::<Vec<_>>();
+        Match::from_pairs(0, 1, Vec::new(), pairs)
     }
 }
 

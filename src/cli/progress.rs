@@ -20,12 +20,12 @@ pub fn bar(quiet: bool) -> ProgressSink {
                 );
                 bar.set_style(
                     indicatif::ProgressStyle::with_template(
-                        "{msg:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})",
+                        "{prefix:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta}) {msg}",
                     )
                     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
                     .progress_chars("=> "),
                 );
-                bar.set_message(stage.to_string());
+                bar.set_prefix(stage.to_string());
                 if let Some(old) = current.replace(bar) {
                     old.finish_and_clear();
                 }
@@ -33,6 +33,11 @@ pub fn bar(quiet: bool) -> ProgressSink {
             Progress::Step => {
                 if let Some(bar) = current.as_ref() {
                     bar.inc(1);
+                }
+            }
+            Progress::Status(text) => {
+                if let Some(bar) = current.as_ref() {
+                    bar.set_message(text.to_string());
                 }
             }
             Progress::Done => {

@@ -70,7 +70,12 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     if let Some(seed) = args.seeds.seed {
         scn.sim.seed = seed;
     }
-    let exp = experiment::run_scenario(&scn, &opts)?;
+    // Without pictures or exported matches nothing needs the scans afterwards: stream the laps.
+    let exp = if args.svg.is_none() && args.export_matches.is_none() {
+        experiment::run_scenario_streamed(&scn, &opts)?
+    } else {
+        experiment::run_scenario(&scn, &opts)?
+    };
     if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
         super::score::export(path, rec, &exp.runs)?;
     }

@@ -35,6 +35,7 @@
 //! about linear in the number of observations.
 
 use super::pair_recall::Facing;
+use super::pair_set::{PairSet, pack};
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -181,27 +182,17 @@ pub struct ScoredPair {
 /// Every distinct `(query, past)` pair of `rec`'s matches (first occurrence order) with its true
 /// poses and whether it is correct at `radius_m`. Pairs without truth are left out.
 pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
-    let index_of: HashMap<ObsId, usize> = rec
-        .observations
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.id, i))
-        .collect();
-    let truth_of = |id: ObsId| {
-        index_of
-            .get(&id)
-            .and_then(|&i| rec.truth.observation_pose(&rec.observations[i]))
-    };
+    let truth_of = truth_lookup(rec);
     let mut seen = HashSet::new();
     let mut out = Vec::new();
-    for p in rec.matches.iter().flat_map(|m| &m.pairs) {
-        if !seen.insert((p.query, p.past)) {
+    for (query, past) in rec.matches.iter().flat_map(Match::pairs) {
+        if !seen.insert(pack(query, past)) {
             continue;
         }
-        if let (Some(q), Some(pa)) = (truth_of(p.query), truth_of(p.past)) {
+        if let (Some(q), Some(pa)) = (truth_of(query), truth_of(past)) {
             out.push(ScoredPair {
-                query: p.query,
-                past: p.past,
+                query,
+                past,
                 query_truth: q,
                 past_truth: pa,
                 correct: q.0.distance(&pa.0) <= radius_m,
@@ -209,6 +200,38 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
         }
     }
     out
+}
+
+/// The distinct pairs of `rec`'s matches that `except` does not hold, as [`scored_pairs`] counts
+/// them (pairs without truth left out): `(pairs, correct at radius_m)`. Held as a packed set,
+/// so a long run's millions of pairs cost 8 bytes each.
+pub fn pairs_not_in(rec: &Recognition, except: &PairSet, radius_m: f64) -> (usize, usize) {
+    let truth_of = truth_lookup(rec);
+    let here = PairSet::from_pairs(rec.matches.iter().flat_map(Match::pairs));
+    let (mut pairs, mut correct) = (0, 0);
+    for (query, past) in here.iter().filter(|&(q, p)| !except.contains(q, p)) {
+        if let (Some(q), Some(pa)) = (truth_of(query), truth_of(past)) {
+            pairs += 1;
+            correct += usize::from(q.0.distance(&pa.0) <= radius_m);
+        }
+    }
+    (pairs, correct)
+}
+
+/// The true pose of an observation of `rec` by id (`None` for an id it does not hold or a
+/// frame without truth).
+fn truth_lookup(rec: &Recognition) -> impl Fn(ObsId) -> Option<crate::geom::TruePose> + '_ {
+    let index_of: HashMap<ObsId, usize> = rec
+        .observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    move |id| {
+        index_of
+            .get(&id)
+            .and_then(|&i| rec.truth.observation_pose(&rec.observations[i]))
+    }
 }
 
 /// Truth-side facts about one observation.
@@ -343,23 +366,19 @@ impl Scorer {
             return 0.0;
         }
         let r2 = r * r;
-        // Laps each query observation was correctly paired with.
-        let mut matched: HashMap<usize, HashSet<usize>> = HashMap::new();
+        // (query observation, lap) for each lap a query observation was correctly paired with.
         let counted = matches.iter().filter(|m| self.facing.counts(m.direction));
-        for (p, claim) in
-            counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction))))
-        {
-            let (Some(&qi), Some(&pi)) = (self.index_of.get(&p.query), self.index_of.get(&p.past))
-            else {
-                continue;
-            };
-            if let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi])
-                && (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                && claim.agrees(q.theta, pa.theta, self.heading_tol_rad)
-            {
-                matched.entry(qi).or_default().insert(pa.lap);
-            }
-        }
+        let matched = PairSet::from_pairs(
+            counted
+                .flat_map(|m| m.pairs().map(move |p| (p, Facing::of(m.direction))))
+                .filter_map(|((query, past), claim)| {
+                    let (&qi, &pi) = (self.index_of.get(&query)?, self.index_of.get(&past)?);
+                    let (q, pa) = (self.obs[qi]?, self.obs[pi]?);
+                    ((q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
+                        && claim.agrees(q.theta, pa.theta, self.heading_tol_rad))
+                    .then_some((qi, pa.lap))
+                }),
+        );
         let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
         let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
         let (mut visits, mut found) = (0usize, 0usize);
@@ -384,9 +403,7 @@ impl Scorer {
                 }
             }
             visits += laps.len();
-            if let Some(m) = matched.get(&i) {
-                found += laps.iter().filter(|l| m.contains(l)).count();
-            }
+            found += laps.iter().filter(|&&l| matched.contains(i, l)).count();
             grid.entry((cx, cy)).or_default().push(i);
         }
         ratio(found, visits)
@@ -421,7 +438,8 @@ impl Scorer {
         let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
         let mut recalled_query = vec![false; self.obs.len()];
         let mut recalled_any = vec![false; self.obs.len()];
-        let mut seen: HashSet<(ObsId, ObsId)> = HashSet::new();
+        // Packed (query, past) ids (super::pair_set::pack): half the memory of id tuples.
+        let mut seen: HashSet<u64> = HashSet::new();
         let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
         let r2 = r * r;
         for m in matches.iter().filter(|m| self.facing.counts(m.direction)) {
@@ -429,29 +447,28 @@ impl Scorer {
             in_match.clear();
             let (mut n, mut ok) = (0usize, 0usize);
             let mut match_cfg = None;
-            for p in &m.pairs {
-                let (Some(&qi), Some(&pi)) =
-                    (self.index_of.get(&p.query), self.index_of.get(&p.past))
+            for (query, past) in m.pairs() {
+                let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
                 else {
-                    if seen.insert((p.query, p.past)) {
+                    if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
                 let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi]) else {
-                    if seen.insert((p.query, p.past)) {
+                    if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
                 let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
                     && claim.agrees(q.theta, pa.theta, self.heading_tol_rad);
-                if in_match.insert((p.query, p.past)) {
+                if in_match.insert((query, past)) {
                     n += 1;
                     ok += correct as usize;
                     match_cfg.get_or_insert(q.config);
                 }
-                if seen.insert((p.query, p.past)) {
+                if seen.insert(pack(query, past)) {
                     total.pairs += 1;
                     total.correct += correct as usize;
                     if breakdown {
@@ -560,7 +577,9 @@ pub(crate) mod tests {
     use super::*;
     use crate::eval::{FrameTruth, LapInfo};
     use crate::geom::{OdomPose, Pose2, TruePose};
-    use crate::recognizer::{AlignedPair, Direction};
+    use crate::recognizer::Direction;
+    /// An aligned pair (query, past).
+    type AlignedPair = (ObsId, ObsId);
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -604,23 +623,12 @@ pub(crate) mod tests {
         (obs, gt)
     }
 
-    fn pair(obs: &[Observation], q: usize, p: usize) -> AlignedPair {
-        AlignedPair {
-            query: q,
-            past: p,
-            query_odom: obs[q].odom_pose,
-            past_odom: obs[p].odom_pose,
-        }
+    fn pair(_obs: &[Observation], q: usize, p: usize) -> AlignedPair {
+        (q, p)
     }
 
     fn one_match(pairs: Vec<AlignedPair>) -> Match {
-        Match {
-            levels: 1,
-            ngram_len: 1,
-            word_pairs: vec![],
-            direction: crate::recognizer::Direction::Same,
-            pairs,
-        }
+        Match::from_pairs(1, 1, vec![], pairs)
     }
 
     /// The oracle: for every observation, its nearest earlier neighbour that makes a revisit.
@@ -744,6 +752,7 @@ pub(crate) mod tests {
                 laps: 2,
                 truth: gt.clone(),
                 diagnostics: None,
+                lap_seconds: Vec::new(),
             };
             evaluate(&rec, &EvaluationSpec::default())
         };
@@ -800,6 +809,7 @@ pub(crate) mod tests {
             laps: 3,
             truth: gt,
             diagnostics: None,
+            lap_seconds: Vec::new(),
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -846,6 +856,7 @@ pub(crate) mod tests {
             laps: 2,
             truth: gt,
             diagnostics: None,
+            lap_seconds: Vec::new(),
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);
@@ -856,7 +867,7 @@ pub(crate) mod tests {
     fn unknown_ids_are_not_scored() {
         let (obs, gt) = circle(2, 40.0);
         let mut p = pair(&obs, 400, 0);
-        p.query = 99_999;
+        p.0 = 99_999;
         let m = score(
             &obs,
             &[one_match(vec![p])],

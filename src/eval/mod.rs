@@ -11,12 +11,13 @@ pub(crate) mod distribution;
 pub mod gate;
 pub mod metrics;
 pub mod pair_recall;
+pub mod pair_set;
 pub mod scores;
 pub mod suite;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};
-use crate::log::RunLog;
+use crate::log::{LapLog, RunLog};
 use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use std::time::Instant;
 
@@ -63,13 +64,7 @@ impl GroundTruth {
         let mut gt = GroundTruth::default();
         for run in runs {
             for lap in &run.laps {
-                let info = LapInfo {
-                    run: run.run,
-                    lap: lap.lap,
-                    door_config: lap.door_config.clone(),
-                    open_doors: lap.open_doors.clone(),
-                };
-                gt.push_lap(info, lap.frames.iter().map(|f| (f.truth, f.odom)));
+                gt.add_lap(run.run, lap);
             }
         }
         gt
@@ -89,6 +84,17 @@ impl GroundTruth {
                 odom,
                 lap_slot: slot,
             }));
+    }
+
+    /// Appends the truth of one lap of run `run` (laps in the order they are fed).
+    pub fn add_lap(&mut self, run: usize, lap: &LapLog) {
+        let info = LapInfo {
+            run,
+            lap: lap.lap,
+            door_config: lap.door_config.clone(),
+            open_doors: lap.open_doors.clone(),
+        };
+        self.push_lap(info, lap.frames.iter().map(|f| (f.truth, f.odom)));
     }
 
     /// Truth of input frame `input_index`, if it exists.
@@ -139,6 +145,10 @@ pub struct Recognition {
     pub truth: GroundTruth,
     /// What the recognizer saw (to say why nothing matched), when it tells.
     pub diagnostics: Option<MatchDiagnostics>,
+    /// Seconds the recognizer spent on each lap's frames, in the order fed: CPU time of the
+    /// thread that fed them (so a loaded machine does not blur how the work grows with history),
+    /// wall clock where the thread's CPU time cannot be read; empty when not recorded.
+    pub lap_seconds: Vec<f64>,
 }
 
 impl Recognition {
@@ -165,34 +175,78 @@ pub fn recognize_runs_with_progress(
     runs: &[RunLog],
     on_lap: &mut dyn FnMut(usize),
 ) -> Recognition {
-    let truth = GroundTruth::from_runs(runs);
-    let mut matches = Vec::new();
-    let mut seconds = 0.0;
-    let mut laps = 0;
+    let mut recording = Recording::default();
     for run in runs {
-        let t = Instant::now();
-        matches.extend(rec.start_run());
-        seconds += t.elapsed().as_secs_f64();
+        recording.start_run(rec);
         for lap in &run.laps {
-            let t = Instant::now();
-            for frame in &lap.frames {
-                matches.extend(rec.push(frame.odom, &frame.scan));
-            }
-            seconds += t.elapsed().as_secs_f64();
-            laps += 1;
-            on_lap(laps);
+            recording.lap(rec, run.run, lap);
+            on_lap(recording.laps);
         }
     }
-    let t = Instant::now();
-    matches.extend(rec.finish());
-    seconds += t.elapsed().as_secs_f64();
-    Recognition {
-        name: rec.name(),
-        observations: rec.observations().to_vec(),
-        matches,
-        seconds,
-        laps,
-        truth,
-        diagnostics: rec.diagnostics(),
+    recording.finish(rec)
+}
+
+/// CPU time of the calling thread, seconds (Linux: /proc/thread-self/schedstat; `None` elsewhere).
+fn thread_cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns / 1e9)
+}
+
+/// A recognition in progress, fed lap by lap (so a caller need not hold every lap's scans):
+/// the truth of the laps fed, the matches so far and the recognizer's time, in total and per lap.
+#[derive(Debug, Default)]
+pub struct Recording {
+    truth: GroundTruth,
+    matches: Vec<Match>,
+    seconds: f64,
+    laps: usize,
+    lap_seconds: Vec<f64>,
+}
+
+impl Recording {
+    /// Starts a run (call before each run's first lap, the first run included).
+    pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer) {
+        let t = Instant::now();
+        self.matches.extend(rec.start_run());
+        self.seconds += t.elapsed().as_secs_f64();
+    }
+
+    /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
+    pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
+        self.truth.add_lap(run, lap);
+        let (t, cpu) = (Instant::now(), thread_cpu_s());
+        for frame in &lap.frames {
+            self.matches.extend(rec.push(frame.odom, &frame.scan));
+        }
+        let s = t.elapsed().as_secs_f64();
+        self.seconds += s;
+        self.lap_seconds.push(match (cpu, thread_cpu_s()) {
+            (Some(a), Some(b)) => b - a,
+            _ => s,
+        });
+        self.laps += 1;
+    }
+
+    /// Laps fed so far.
+    pub fn laps(&self) -> usize {
+        self.laps
+    }
+
+    /// Ends the input and hands over the recognition.
+    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer) -> Recognition {
+        let t = Instant::now();
+        self.matches.extend(rec.finish());
+        self.seconds += t.elapsed().as_secs_f64();
+        Recognition {
+            name: rec.name(),
+            observations: rec.observations().to_vec(),
+            matches: self.matches,
+            seconds: self.seconds,
+            laps: self.laps,
+            truth: self.truth,
+            diagnostics: rec.diagnostics(),
+            lap_seconds: self.lap_seconds,
+        }
     }
 }

@@ -18,10 +18,11 @@
 //!   so it is the figure closest to the paper's "matches that could be obtained".
 
 use super::GroundTruth;
+use super::pair_set::PairSet;
 use crate::geom::wrap_angle;
 use crate::recognizer::{Direction, Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 /// Distance along the true path from the first frame to each frame, metres.
 pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
@@ -148,21 +149,16 @@ pub fn pair_recall(
         .enumerate()
         .map(|(i, o)| (o.id, i))
         .collect();
-    let mut seen: HashSet<(usize, usize)> = HashSet::new();
     let counted = matches.iter().filter(|m| facing.counts(m.direction));
-    for (p, claim) in
-        counted.flat_map(|m| m.pairs.iter().map(move |p| (p, Facing::of(m.direction))))
-    {
-        let (Some(&qi), Some(&pi)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
-            continue;
-        };
-        if let (Some(q), Some(pa)) = (&placed[qi], &placed[pi])
-            && near(q, pa)
-            && claim.agrees(q.theta, pa.theta, tol)
-        {
-            seen.insert((qi, pi));
-        }
-    }
+    let seen = PairSet::from_pairs(
+        counted
+            .flat_map(|m| m.pairs().map(move |p| (p, Facing::of(m.direction))))
+            .filter_map(|((query, past), claim)| {
+                let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
+                let (q, pa) = (placed[qi].as_ref()?, placed[pi].as_ref()?);
+                (near(q, pa) && claim.agrees(q.theta, pa.theta, tol)).then_some((qi, pi))
+            }),
+    );
     PairRecall {
         possible: count_possible(&placed, r, &possible_pair),
         found: seen.len() as u64,
@@ -197,24 +193,9 @@ fn count_possible(placed: &[Option<Placed>], r: f64, ok: &dyn Fn(&Placed, &Place
 mod tests {
     use super::*;
     use crate::eval::metrics::tests::circle;
-    use crate::recognizer::AlignedPair;
 
-    fn one_match(obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
-        Match {
-            levels: 1,
-            ngram_len: 1,
-            word_pairs: vec![],
-            direction: crate::recognizer::Direction::Same,
-            pairs: pairs
-                .iter()
-                .map(|&(q, p)| AlignedPair {
-                    query: q,
-                    past: p,
-                    query_odom: obs[q].odom_pose,
-                    past_odom: obs[p].odom_pose,
-                })
-                .collect(),
-        }
+    fn one_match(_obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
+        Match::from_pairs(1, 1, vec![], pairs.iter().copied())
     }
 
     /// Every possible pair found scores 1; only the nearest neighbour of one earlier lap scores

@@ -11,7 +11,7 @@
 //!                 "pairs": 10234, "correct_pairs": 9518, "no_pairs": false,
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
-//!                 "recognize_seconds_per_lap": 0.8,
+//!                 "recognize_seconds_per_lap": 0.8, "recognize_seconds_by_lap": [0.7, 0.8, ...],
 //!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
 //!                 "door_configs": [ { "door_config": "all-closed", "laps": 20,
@@ -29,12 +29,12 @@
 //! chains and verification counts, when it tells) gives the figures behind it.
 
 use super::Recognition;
-use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, scored_pairs};
+use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
+use super::pair_set::PairSet;
 use super::sweep::{PrCurve, SweepResult};
-use crate::recognizer::MatchDiagnostics;
+use crate::recognizer::{Match, MatchDiagnostics};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 
 /// The scores every recognizer gets (flattened into its JSON object).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -213,6 +213,11 @@ pub struct LevelReport {
     pub thresholds: Vec<usize>,
     #[serde(flatten)]
     pub scores: Scores,
+    /// The recognizer's seconds on each lap's frames, in the order fed (how per-lap work grows
+    /// with history): thread CPU time where readable (see `Recognition::lap_seconds`); empty
+    /// when not recorded.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub recognize_seconds_by_lap: Vec<f64>,
     /// The distinct pairs this configuration found that the configuration with one level fewer
     /// did not (`None` when that one was not run).
     #[serde(default)]
@@ -293,6 +298,7 @@ impl Report {
             levels,
             thresholds: thresholds.to_vec(),
             scores,
+            recognize_seconds_by_lap: rec.lap_seconds.clone(),
             only_here: None,
         });
         self.levels.last().expect("just pushed")
@@ -302,31 +308,25 @@ impl Report {
     /// run, `(levels, recognition)`: the pairs it found that the one with one level fewer did not.
     pub fn set_level_gains(&mut self, recognitions: &[(usize, Recognition)]) {
         let radius_m = self.evaluation.tp_radius_m;
-        let pairs_of = |levels: usize| {
+        let rec_of = |levels: usize| {
             recognitions
                 .iter()
                 .find(|(l, _)| *l == levels)
-                .map(|(_, rec)| {
-                    scored_pairs(rec, radius_m)
-                        .into_iter()
-                        .map(|p| ((p.query, p.past), p.correct))
-                        .collect::<HashMap<_, _>>()
-                })
+                .map(|(_, rec)| rec)
         };
         for lr in &mut self.levels {
             let below = lr.levels.saturating_sub(1);
-            let (Some(here), Some(fewer)) = (pairs_of(lr.levels), pairs_of(below)) else {
+            let (Some(here), Some(fewer)) = (rec_of(lr.levels), rec_of(below)) else {
                 continue;
             };
-            let new: Vec<bool> = here
-                .iter()
-                .filter(|(k, _)| !fewer.contains_key(*k))
-                .map(|(_, &correct)| correct)
-                .collect();
+            // Packed sets, not a map of every pair: a long run holds millions. A pair without
+            // truth there has none here either (same observations), so it is left out of both.
+            let fewer = PairSet::from_pairs(fewer.matches.iter().flat_map(Match::pairs));
+            let (pairs, correct_pairs) = pairs_not_in(here, &fewer, radius_m);
             lr.only_here = Some(LevelGain {
                 than_levels: below,
-                pairs: new.len(),
-                correct_pairs: new.iter().filter(|&&c| c).count(),
+                pairs,
+                correct_pairs,
             });
         }
     }
@@ -439,6 +439,7 @@ pub(crate) mod tests {
                     recognize_seconds_per_lap: 0.5 * (l + 1) as f64,
                     ..Scores::default()
                 },
+                recognize_seconds_by_lap: Vec::new(),
                 only_here: None,
             });
         }

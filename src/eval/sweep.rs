@@ -287,21 +287,14 @@ mod tests {
             // A fake back-end: pairs each observation with one a lap back, shifted by the
             // last threshold, so precision falls as the threshold grows.
             let shift = *p.thresholds.last().unwrap();
-            vec![Match {
-                levels: p.levels,
-                ngram_len: 1,
-                word_pairs: vec![],
-                direction: crate::recognizer::Direction::Same,
-                pairs: (420..obs.len())
+            vec![Match::from_pairs(
+                p.levels,
+                1,
+                vec![],
+                (420..obs.len())
                     .step_by(p.levels)
-                    .map(|q| crate::recognizer::AlignedPair {
-                        query: q,
-                        past: q - 400 - shift,
-                        query_odom: obs[q].odom_pose,
-                        past_odom: obs[q - 400 - shift].odom_pose,
-                    })
-                    .collect(),
-            }]
+                    .map(|q| (q, q - 400 - shift)),
+            )]
         };
         let spec = EvaluationSpec::default();
         let run = |threads| {

@@ -9,6 +9,7 @@ pub(crate) mod progress;
 pub mod real;
 pub(crate) mod scenario;
 pub mod score;
+pub(crate) mod stream;
 pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
@@ -27,6 +28,7 @@ pub use progress::{Progress, ProgressSink};
 use rayon::prelude::*;
 pub use scenario::{Scenario, load_scenario, parse_scenario};
 use std::time::Instant;
+pub use stream::run_scenario_streamed;
 
 /// Why an experiment could not be carried out.
 #[derive(Debug, thiserror::Error)]
@@ -164,19 +166,7 @@ pub fn evaluate_runs(
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
     let laps: usize = runs.iter().map(|r| r.laps.len()).sum();
-    let mut configs = Vec::new();
-    for &levels in &opts.levels {
-        let cfg = config_for_levels(base, levels);
-        let problems = cfg.problems();
-        if !problems.is_empty() {
-            let text: Vec<String> = problems.iter().map(ToString::to_string).collect();
-            return Err(ExperimentError::Recognizer(format!(
-                "recognizer with {levels} levels: {}",
-                text.join("; ")
-            )));
-        }
-        configs.push(cfg);
-    }
+    let configs = level_configs(base, &opts.levels)?;
     let jobs = configs.len() + usize::from(opts.icp);
     opts.progress.start("recognizing", (jobs * laps) as u64);
     // Each task is single-threaded and timed on its own; the tasks share the cores.
@@ -205,7 +195,43 @@ pub fn evaluate_runs(
         })
         .collect::<Result<_, ExperimentError>>();
     opts.progress.done();
-    let mut results = results?;
+    Ok(assemble(
+        name, seed, laps, evaluation, &configs, results?, runs,
+    ))
+}
+
+/// The recognizer settings of each level configuration in `levels`, checked.
+fn level_configs(
+    base: &RecognizerConfig,
+    levels: &[usize],
+) -> Result<Vec<RecognizerConfig>, ExperimentError> {
+    let mut configs = Vec::new();
+    for &levels in levels {
+        let cfg = config_for_levels(base, levels);
+        let problems = cfg.problems();
+        if !problems.is_empty() {
+            let text: Vec<String> = problems.iter().map(ToString::to_string).collect();
+            return Err(ExperimentError::Recognizer(format!(
+                "recognizer with {levels} levels: {}",
+                text.join("; ")
+            )));
+        }
+        configs.push(cfg);
+    }
+    Ok(configs)
+}
+
+/// Scores the recognitions (one per entry of `configs`, in order, then ICP's with `None`) into
+/// an experiment.
+fn assemble(
+    name: &str,
+    seed: u64,
+    laps: usize,
+    evaluation: &EvaluationSpec,
+    configs: &[RecognizerConfig],
+    mut results: Vec<(Option<usize>, Recognition)>,
+    runs: Vec<RunLog>,
+) -> Experiment {
     let mut report = Report::new(name, seed, laps, evaluation.clone());
     let icp = match results.last() {
         Some((None, _)) => results.pop().map(|(_, r)| r),
@@ -222,12 +248,12 @@ pub fn evaluate_runs(
     }
     report.set_level_gains(&recognitions);
     report.finish();
-    Ok(Experiment {
+    Experiment {
         report,
         runs,
         recognitions,
         icp,
-    })
+    }
 }
 
 /// The observations of `runs` under `cfg`'s front end, computed once (for sweeps), with the

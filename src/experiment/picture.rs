@@ -223,10 +223,10 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
     let tol = spec.heading_tolerance_deg.to_radians();
     let claimed = rec.matches.iter().flat_map(|m| {
         let claim = Facing::of(m.direction);
-        m.pairs.iter().map(move |p| (p, claim))
+        m.pairs().map(move |p| (p, claim))
     });
-    for (p, claim) in claimed {
-        let (Some(&q), Some(&pa)) = (index_of.get(&p.query), index_of.get(&p.past)) else {
+    for ((query, past), claim) in claimed {
+        let (Some(&q), Some(&pa)) = (index_of.get(&query), index_of.get(&past)) else {
             continue;
         };
         let (Some(a), Some(b)) = (pose(q), pose(pa)) else {

@@ -11,6 +11,9 @@ pub enum Progress<'a> {
     Start { stage: &'a str, steps: u64 },
     /// One step of the current stage is done (from any thread).
     Step,
+    /// How the current stage goes, in a few words to show beside its count (e.g. `run`'s laps
+    /// per second and memory).
+    Status(&'a str),
     /// The current stage is over.
     Done,
 }
@@ -49,6 +52,11 @@ impl ProgressSink {
     /// Sends `Step`.
     pub fn step(&self) {
         self.send(Progress::Step);
+    }
+
+    /// Sends `Status`.
+    pub fn status(&self, text: &str) {
+        self.send(Progress::Status(text));
     }
 
     /// Sends `Done`.

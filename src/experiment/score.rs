@@ -16,7 +16,7 @@ use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
 use crate::io::matches_csv::{MatchRow, MatchesCsvError};
-use crate::recognizer::{AlignedPair, Match, Observation};
+use crate::recognizer::{Match, Observation};
 use crate::sim::RunLog;
 use crate::sim::logs::Manifest;
 use crate::spec::evaluation::EvaluationSpec;
@@ -90,11 +90,11 @@ pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<Matc
     let mut seen = HashSet::new();
     let mut rows = Vec::new();
     for m in &rec.matches {
-        for p in &m.pairs {
-            let (Some(&q), Some(&pa)) = (input_of.get(&p.query), input_of.get(&p.past)) else {
+        for (query, past) in m.pairs() {
+            let (Some(&q), Some(&pa)) = (input_of.get(&query), input_of.get(&past)) else {
                 continue;
             };
-            if !seen.insert((p.query, p.past)) {
+            if !seen.insert((query, past)) {
                 continue;
             }
             let ((qr, qs), (pr, ps)) = (locate(q), locate(pa));
@@ -257,18 +257,7 @@ impl LoggedRuns {
             let q = self.obs_of_scan[at(r.query_run, r.query_scan)?];
             let p = self.obs_of_scan[at(r.matched_run, r.matched_scan)?];
             let (qo, po) = (&self.observations[q], &self.observations[p]);
-            matches.push(Match {
-                levels: 1,
-                ngram_len: 1,
-                word_pairs: Vec::new(),
-                direction: crate::recognizer::Direction::Same,
-                pairs: vec![AlignedPair {
-                    query: qo.id,
-                    past: po.id,
-                    query_odom: qo.odom_pose,
-                    past_odom: po.odom_pose,
-                }],
-            });
+            matches.push(Match::from_pairs(1, 1, Vec::new(), [(qo.id, po.id)]));
         }
         Ok(Recognition {
             name: "external".into(),
@@ -278,6 +267,7 @@ impl LoggedRuns {
             laps: self.laps,
             truth: self.truth.clone(),
             diagnostics: None,
+            lap_seconds: Vec::new(),
         })
     }
 }

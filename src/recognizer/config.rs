@@ -99,6 +99,11 @@ pub struct RecognizerConfig {
     /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
     /// though both default to 20). Default 20.0.
     pub candidate_gap_m: f64,
+    /// Most recent candidates a closing word is matched against: the last k earlier words of its
+    /// class that match it and end beyond the candidate gap; 0 = every one (the paper). A bound
+    /// keeps the work and the output per lap flat as the history grows (a long-term run), at the
+    /// cost of pairing each place with its k most recent look-alikes only. Default 0.
+    pub max_candidates: usize,
 }
 
 impl Default for RecognizerConfig {
@@ -129,6 +134,7 @@ impl Default for RecognizerConfig {
             verify_turn_deg: 30.0,
             verify_max_psi_rms: 0.04,
             candidate_gap_m: 20.0,
+            max_candidates: 0,
         }
     }
 }

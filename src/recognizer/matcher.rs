@@ -7,7 +7,9 @@
 //! the predecessor lists, mixing levels freely).
 //!
 //! When a word c closes, its candidates are the words of its class (a per-class occurrence list)
-//! that end at least `candidate_gap_m` of travel before c begins and match it. For each candidate p the
+//! that end at least `candidate_gap_m` of travel before c begins and match it; with
+//! `max_candidates` = k > 0 only the k most recent of them in each direction (the bound on work per lap, see
+//! `index.rs`: a place is matched to its k most recent look-alikes, not to every earlier one). For each candidate p the
 //! longest chain ending at (c, p) is 1 + the best memoised chain of a pair (c', p') with c' a
 //! predecessor of c and p' one of p, computed for every level configuration at once; the memo
 //! holds one entry per matching pair, so the work per word is candidates × predecessors², and
@@ -44,7 +46,8 @@
 //! whose travel differs by less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
-use super::types::{AlignedPair, Direction, Match, Observation};
+use super::index::recent_candidates;
+use super::types::{AlignedRun, Direction, Match, Observation, push_pair};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
 
@@ -68,6 +71,7 @@ struct Params {
     size_ratio: f64,
     angle_tol_deg: f64,
     candidate_gap_m: f64,
+    max_candidates: usize,
     max_offset: usize,
     chain_offset: usize,
     alignment: AlignmentMode,
@@ -95,6 +99,9 @@ pub struct WordMatcher {
     /// Per word, the words whose predecessor it is (the chain links of a past n-gram read
     /// backwards).
     successors: Vec<Vec<WordId>>,
+    /// Words before this one belong to finished runs; their memo (both directions) has been
+    /// freed.
+    memo_forgotten: usize,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
     lookup: [Vec<(u32, u32)>; MAX_LEVELS],
     stamp: u32,
@@ -119,6 +126,7 @@ impl WordMatcher {
                 size_ratio: config.size_tolerance_ratio,
                 angle_tol_deg: config.angle_tolerance_deg,
                 candidate_gap_m: config.candidate_gap_m,
+                max_candidates: config.max_candidates,
                 max_offset: config.max_alignment_offset,
                 chain_offset: config.chain_alignment_offset,
                 alignment: config.alignment,
@@ -141,6 +149,7 @@ impl WordMatcher {
             occurrences: vec![Vec::new(); config.classes],
             memo: Default::default(),
             successors: Vec::new(),
+            memo_forgotten: 0,
             lookup: Default::default(),
             stamp: 0,
             longest: [0; MAX_LEVELS],
@@ -170,6 +179,7 @@ impl WordMatcher {
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
             out = self.match_words(&closed);
+            self.forget_finished_runs();
         }
         let closed = self.words.push(obs);
         out.extend(self.match_words(&closed));
@@ -180,7 +190,23 @@ impl WordMatcher {
     /// while the current run has no observation.
     pub fn start_run(&mut self) -> Vec<Match> {
         let closed = self.words.start_run();
-        self.match_words(&closed)
+        let out = self.match_words(&closed);
+        self.forget_finished_runs();
+        out
+    }
+
+    /// Frees the memo (both directions) of every word made so far, once their runs are over: a
+    /// memo is read only through the predecessors of a closing word (read backwards, the past
+    /// side walks successors, but the memo is still that of the current word's predecessors),
+    /// and predecessors never cross a run, so these entries are never read again (the memo then
+    /// holds one run's words, not the history's).
+    fn forget_finished_runs(&mut self) {
+        for memo in &mut self.memo {
+            for m in &mut memo[self.memo_forgotten..] {
+                *m = Vec::new();
+            }
+        }
+        self.memo_forgotten = self.memo[0].len();
     }
 
     /// Closes the current run's open word and matches it, without starting a new run (call at
@@ -306,11 +332,11 @@ impl WordMatcher {
 
         let levels = self.params.levels;
         let mut entries = Vec::new();
-        for &p in &occ[..end] {
+        let candidates = recent_candidates(&occ[..end], self.params.max_candidates, |p| {
+            self.syllables_match(&cw, self.word(p), dir)
+        });
+        for p in candidates {
             let pw = self.word(p);
-            if !self.syllables_match(&cw, pw, dir) {
-                continue;
-            }
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
             let mut back_slot = 0u8;
@@ -451,11 +477,12 @@ impl WordMatcher {
             self.aligned_pairs(wc, past, dir, anchor, &mut pairs);
         }
         self.rejections.accepted += 1;
+        pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
         Some(Match {
             levels: k + 1,
             ngram_len: self.memo[d][c as usize][idx].len[k] as usize,
             word_pairs: refs,
-            pairs,
+            runs: pairs,
             direction: dir,
         })
     }
@@ -624,7 +651,7 @@ impl WordMatcher {
         p: WordId,
         dir: Direction,
         anchor: i64,
-        out: &mut Vec<AlignedPair>,
+        out: &mut Vec<AlignedRun>,
     ) {
         let obs = self.words.observations();
         let Some(w) = self.placement(c, p, dir, anchor) else {
@@ -637,12 +664,7 @@ impl WordMatcher {
             if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
                 continue;
             }
-            out.push(AlignedPair {
-                query: q.id,
-                past: pst.id,
-                query_odom: q.odom_pose,
-                past_odom: pst.odom_pose,
-            });
+            push_pair(out, q.id, pst.id, past.step as i8);
         }
     }
 }

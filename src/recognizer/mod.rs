@@ -12,6 +12,7 @@ pub(crate) mod config;
 pub(crate) mod density;
 pub(crate) mod frontend;
 pub(crate) mod grid;
+mod index;
 pub(crate) mod matcher;
 /// Synthetic inputs for tests and benchmarks; not part of the API.
 #[doc(hidden)]
@@ -24,7 +25,7 @@ pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, densi
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;
 pub use matcher::{MatchDiagnostics, VerificationCounts, WordMatcher};
-pub use types::{AlignedPair, Direction, Match, ObsId, Observation, WordRef};
+pub use types::{AlignedRun, Direction, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;
@@ -96,8 +97,8 @@ impl Recognizer {
     /// assert!(rec.observations().len() >= 2 * 370, "{}", rec.observations().len());
     /// // The second pass recognizes the first, at the right places.
     /// assert!(!matches.is_empty());
-    /// for pair in matches.iter().flat_map(|m| &m.pairs) {
-    ///     let (q, p) = (&rec.observations()[pair.query], &rec.observations()[pair.past]);
+    /// for (query, past) in matches.iter().flat_map(|m| m.pairs()) {
+    ///     let (q, p) = (&rec.observations()[query], &rec.observations()[past]);
     ///     assert_eq!((q.run, p.run), (1, 0));
     ///     assert!((q.odom_pose.0.x - p.odom_pose.0.x).abs() < 1.0);
     /// }

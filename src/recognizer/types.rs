@@ -30,13 +30,58 @@ pub struct WordRef {
     pub index: usize,
 }
 
-/// Two observations the fine alignment put together: `query` is the newer one.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct AlignedPair {
-    pub query: ObsId,
-    pub past: ObsId,
-    pub query_odom: OdomPose,
-    pub past_odom: OdomPose,
+/// Consecutive observation pairs the fine alignment put together, as one range: pair `i`
+/// (`i < len`) is query `query_start + i` with past `past_start + i·past_step`. `query` is the
+/// newer side. `past_step` is +1 when both sides run the same way (−1 for a place driven in the
+/// opposite direction). A word pair's alignment is a few runs, so a match costs a few words of
+/// memory however long its words are; odometry of a pair is looked up by id in the observations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct AlignedRun {
+    pub query_start: ObsId,
+    pub past_start: ObsId,
+    pub len: u32,
+    pub past_step: i8,
+}
+
+impl AlignedRun {
+    /// The pairs `(query, past)` of the run, in order of query.
+    pub fn pairs(&self) -> impl Iterator<Item = (ObsId, ObsId)> + '_ {
+        let (q, p, step) = (
+            self.query_start,
+            self.past_start as i64,
+            self.past_step as i64,
+        );
+        (0..self.len as usize).map(move |i| (q + i, (p + step * i as i64) as ObsId))
+    }
+
+    /// Appends pair `(query, past)` when it continues the run (same step), returning whether it
+    /// did.
+    pub fn extend(&mut self, query: ObsId, past: ObsId) -> bool {
+        let next_past = self.past_start as i64 + self.past_step as i64 * self.len as i64;
+        if query == self.query_start + self.len as usize && past as i64 == next_past {
+            self.len += 1;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+/// Appends pair `(query, past)` to `runs`, extending the last run with `past_step` when the pair
+/// continues it and starting a new run otherwise.
+pub fn push_pair(runs: &mut Vec<AlignedRun>, query: ObsId, past: ObsId, past_step: i8) {
+    if let Some(last) = runs.last_mut()
+        && last.past_step == past_step
+        && last.extend(query, past)
+    {
+        return;
+    }
+    runs.push(AlignedRun {
+        query_start: query,
+        past_start: past,
+        len: 1,
+        past_step,
+    });
 }
 
 /// Which way the past n-gram was read when it matched.
@@ -67,8 +112,42 @@ pub struct Match {
     pub ngram_len: usize,
     /// The word pairs (current, past) this match newly covers, oldest first.
     pub word_pairs: Vec<(WordRef, WordRef)>,
-    /// Observation pairs of those word pairs after fine alignment.
-    pub pairs: Vec<AlignedPair>,
+    /// Observation pairs of those word pairs after fine alignment, as ranges (see
+    /// [`Match::pairs`]).
+    pub runs: Vec<AlignedRun>,
     /// The way the past side was read: `Same`, or `Opposite` for a revisit driven the other way.
     pub direction: Direction,
+}
+
+impl Match {
+    /// The aligned observation pairs `(query, past)`, in the order the alignment made them.
+    pub fn pairs(&self) -> impl Iterator<Item = (ObsId, ObsId)> + '_ {
+        self.runs.iter().flat_map(AlignedRun::pairs)
+    }
+
+    /// How many aligned observation pairs the match holds.
+    pub fn pair_count(&self) -> usize {
+        self.runs.iter().map(|r| r.len as usize).sum()
+    }
+
+    /// A match of the given pairs `(query, past)`, merged into runs of step +1 where they are
+    /// consecutive, direction `Same` (for recognizers that produce pairs one by one).
+    pub fn from_pairs(
+        levels: usize,
+        ngram_len: usize,
+        word_pairs: Vec<(WordRef, WordRef)>,
+        pairs: impl IntoIterator<Item = (ObsId, ObsId)>,
+    ) -> Match {
+        let mut runs = Vec::new();
+        for (q, p) in pairs {
+            push_pair(&mut runs, q, p, 1);
+        }
+        Match {
+            levels,
+            ngram_len,
+            word_pairs,
+            runs,
+            direction: Direction::Same,
+        }
+    }
 }

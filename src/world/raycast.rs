@@ -130,6 +130,17 @@ fn inside_slab(s: &Segment, half: f64, p: Vec2) -> bool {
     cross < half
 }
 
+/// Offsets to probe whether segment `a`–`b` is hidden inside solids: a step along it (its ends
+/// pulled in by 1 µm) and a step across it (1 µm to either side). A segment whose whole length,
+/// 1 µm to each side, lies in one solid per side (solids are convex slabs, so both probed ends in
+/// one slab cover everything between) can only be reached from inside a solid, and is dropped:
+/// the end caps where wall pieces of a polyline or abutting walls meet.
+fn hidden_probe(a: Vec2, b: Vec2) -> (Vec2, Vec2) {
+    let d = b - a;
+    let unit = d / d.norm();
+    (unit * 1e-6, Vec2::new(-unit.y, unit.x) * 1e-6)
+}
+
 /// Segments whose bounding box comes this close to the sensor test every beam they cover,
 /// metres; farther ones skip beams that already hit something nearer than their bounding box.
 const NEAR_M: f64 = 3.0;
@@ -198,7 +209,8 @@ impl SweepCaster {
     /// [`World::obstacle_outline`]). Each outline segment that is a face of a thick wall or door
     /// (solid on one side, free on the other, tested 1 mm either side of its midpoint) is culled
     /// when the sensor is on its solid side: a ray from outside a solid meets a front face first,
-    /// so the ranges are unchanged and about half the segments are skipped.
+    /// so the ranges are unchanged and about half the segments are skipped. Segments hidden inside
+    /// solids on both sides (see `hidden_probe`) are dropped.
     pub fn for_world(world: &World, doors: &DoorStates) -> Self {
         let mut c = Self::new(&world.obstacle_outline(doors));
         let mut solids: Vec<(Segment, f64)> = Vec::new();
@@ -233,7 +245,33 @@ impl SweepCaster {
                 _ => 0,
             };
         }
+        let hidden: Vec<bool> = c
+            .segs
+            .iter()
+            .map(|g| {
+                let covered = |p: Vec2, q: Vec2| {
+                    near.items_at(p.x, p.y).iter().any(|&k| {
+                        let (s, h) = &solids[k as usize];
+                        inside_slab(s, *h, p) && inside_slab(s, *h, q)
+                    })
+                };
+                let (a, b) = (Vec2::new(g[0], g[1]), Vec2::new(g[2], g[3]));
+                let (u, n) = hidden_probe(a, b);
+                covered(a + u + n, b - u + n) && covered(a + u - n, b - u - n)
+            })
+            .collect();
+        c.drop_segments(&hidden);
         c
+    }
+
+    /// Removes the segments marked in `drop` and rebuckets the rest.
+    fn drop_segments(&mut self, drop: &[bool]) {
+        let keep = |k: &usize| !drop[*k];
+        let idx: Vec<usize> = (0..self.segs.len()).filter(keep).collect();
+        self.segs = idx.iter().map(|&k| self.segs[k]).collect();
+        self.faces = idx.iter().map(|&k| self.faces[k]).collect();
+        let padded: Vec<PaddedSegment> = self.segs.iter().map(|s| (*s, 0.0)).collect();
+        self.grid = CellGrid::new(&padded);
     }
 
     pub fn segment_count(&self) -> usize {

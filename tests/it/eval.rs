@@ -7,7 +7,7 @@ use placewords::eval::scores::Report;
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
 use placewords::log::{Frame, LapLog, RunLog};
-use placewords::recognizer::{AlignedPair, Match, Observation};
+use placewords::recognizer::{Match, Observation};
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
 use placewords::spec::evaluation::{EvaluationSpec, ExpectSpec, Expectation, LevelExpectation};
@@ -183,18 +183,7 @@ impl PlaceRecognizer for LapBack {
         });
         if id >= self.per_lap {
             let p = id - self.per_lap;
-            vec![Match {
-                levels: 1,
-                ngram_len: 1,
-                word_pairs: vec![],
-                direction: placewords::recognizer::Direction::Same,
-                pairs: vec![AlignedPair {
-                    query: id,
-                    past: p,
-                    query_odom: odom,
-                    past_odom: self.obs[p].odom_pose,
-                }],
-            }]
+            vec![Match::from_pairs(1, 1, vec![], [(id, p)])]
         } else {
             vec![]
         }

@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod eval;
 mod io;
+mod longterm;
 mod outputs;
 mod recognizer;
 mod sim;

@@ -357,16 +357,16 @@ fn repeated_sequence_matches_and_shuffled_does_not() {
     let (_, matches) = run_matcher(&cfg, &all);
     let one_level: Vec<&Match> = matches.iter().filter(|m| m.levels == 1).collect();
     assert!(!one_level.is_empty(), "the repeated lap is recognized");
-    let pairs: Vec<_> = one_level.iter().flat_map(|m| &m.pairs).collect();
+    let pairs: Vec<_> = one_level.iter().flat_map(|m| m.pairs()).collect();
     assert!(
         pairs.len() > lap_len / 2,
         "most of lap 2 is paired: {} pairs",
         pairs.len()
     );
-    for p in &pairs {
+    for &(query, past) in &pairs {
         assert_eq!(
-            p.query - lap_len,
-            p.past,
+            query - lap_len,
+            past,
             "aligned pairs put the same place together"
         );
     }
@@ -428,7 +428,7 @@ fn reversed_lap_matches_in_the_opposite_direction() {
     let pairs: Vec<_> = matches
         .iter()
         .filter(|m| m.levels == 1)
-        .flat_map(|m| &m.pairs)
+        .flat_map(Match::pairs)
         .collect();
     assert!(
         pairs.len() > n / 3,
@@ -436,16 +436,21 @@ fn reversed_lap_matches_in_the_opposite_direction() {
         pairs.len()
     );
     assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
-    for p in &pairs {
+    // Held as ranges read backwards: every run steps the past id down.
+    assert!(
+        matches
+            .iter()
+            .flat_map(|m| &m.runs)
+            .all(|r| r.past_step == -1)
+    );
+    for &(query, past) in &pairs {
         // Query k of the second lap is at the place of observation n − 1 − k of the first
         // (stretches keep their sizes; the turn sits at the median, so a place may be one
         // observation off).
-        let mirror = 2 * n - 1 - p.query;
+        let mirror = 2 * n - 1 - query;
         assert!(
-            mirror.abs_diff(p.past) <= 1,
-            "query {} paired with {}, its place is {mirror}",
-            p.query,
-            p.past
+            mirror.abs_diff(past) <= 1,
+            "query {query} paired with {past}, its place is {mirror}"
         );
     }
     let off = config(|c| c.reverse = false);
@@ -534,8 +539,8 @@ fn alignment_recovers_a_shift() {
     let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&cfg, &all);
     assert!(!matches.is_empty());
-    for p in matches.iter().flat_map(|m| &m.pairs) {
-        assert_eq!(p.query - n, p.past);
+    for (query, past) in matches.iter().flat_map(Match::pairs) {
+        assert_eq!(query - n, past);
     }
 }
 
@@ -764,12 +769,12 @@ fn whole_recognizer_recognizes_a_second_lap() {
     matches.extend(rec.finish());
     let obs = rec.observations();
     let lap_obs = obs.len() / 2;
-    let pairs: Vec<_> = matches.iter().flat_map(|m| &m.pairs).collect();
+    let pairs: Vec<_> = matches.iter().flat_map(Match::pairs).collect();
     let correct = pairs
         .iter()
-        .filter(|p| p.query_odom.0.distance(&p.past_odom.0) <= 1.0)
+        .filter(|&&(q, p)| obs[q].odom_pose.0.distance(&obs[p].odom_pose.0) <= 1.0)
         .count();
-    let queries: std::collections::BTreeSet<usize> = pairs.iter().map(|p| p.query).collect();
+    let queries: std::collections::BTreeSet<usize> = pairs.iter().map(|p| p.0).collect();
     eprintln!(
         "loop floor: {} observations, {} words, {} matches, {} pairs, {} correct, {} query observations",
         obs.len(),
@@ -883,8 +888,8 @@ proptest! {
         let (m, matches) = run_matcher(&cfg, &obs);
         let travel = |id: usize| obs[id].travel_m;
         for mt in &matches {
-            for p in &mt.pairs {
-                prop_assert!(travel(p.query) - travel(p.past) >= gap - 1e-9);
+            for (query, past) in mt.pairs() {
+                prop_assert!(travel(query) - travel(past) >= gap - 1e-9);
             }
             for (c, p) in &mt.word_pairs {
                 let (c, p) = (m.words().get(*c).unwrap(), m.words().get(*p).unwrap());

@@ -1,0 +1,155 @@
+//! A scenario run lap by lap: each lap is simulated on one thread and fed to every recognizer
+//! on another as soon as it is made, then dropped. Memory holds at most a few laps of scans
+//! (not every run's), plus the truth of every frame and the recognizers' own state, so a run of
+//! a thousand laps fits where holding its scans would not.
+//!
+//! The report is the one [`super::run_scenario`] gives: the simulator draws each lap from its
+//! run's seeded streams whatever else runs, and each recognizer sees the same frames in the same
+//! order. Only `Experiment::runs` is left empty (so no pictures, no exported matches).
+
+use super::{ExperimentError, ExperimentOptions, ProgressSink, assemble, level_configs};
+use crate::baseline::icp::{IcpConfig, IcpRecognizer};
+use crate::eval::{PlaceRecognizer, Recognition, Recording};
+use crate::log::LapLog;
+use crate::recognizer::{Recognizer, RecognizerConfig};
+use crate::sim::runner::RunSim;
+use crate::sim::{SimError, SimPlan};
+use rayon::prelude::*;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::time::Instant;
+
+use super::{Experiment, Scenario, recognizer_config};
+
+/// Laps simulated ahead of the recognizers at most (each holds one lap of scans).
+const LAPS_AHEAD: usize = 2;
+
+/// A recognizer with its recording; `levels` is `None` for ICP.
+type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
+
+/// Simulates `scn` and evaluates it lap by lap (see the module doc).
+pub fn run_scenario_streamed(
+    scn: &Scenario,
+    opts: &ExperimentOptions,
+) -> Result<Experiment, ExperimentError> {
+    let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
+    let mut jobs = jobs(scn, &configs, opts.icp)?;
+    let plan = &scn.sim;
+    let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
+    let total: usize = (0..plan.runs.len()).map(laps_of).sum();
+    opts.progress.start("laps", total as u64);
+    let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
+    let sim_s = std::thread::scope(|s| {
+        let producer = s.spawn(move || simulate_laps(plan, &laps_of, &tx));
+        feed(&mut jobs, rx, &opts.progress);
+        producer
+            .join()
+            .expect("the simulation thread does not panic")
+    });
+    opts.progress.done();
+    let sim_s = sim_s?;
+    let results: Vec<(Option<usize>, Recognition)> = jobs
+        .into_iter()
+        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
+        .collect();
+    let mut exp = assemble(
+        &plan.name,
+        plan.seed,
+        total,
+        &scn.evaluation,
+        &configs,
+        results,
+        Vec::new(),
+    );
+    exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
+    Ok(exp)
+}
+
+/// Simulates every lap of every run in order, sending each as it is made (blocks while
+/// [`LAPS_AHEAD`] laps wait); returns the seconds spent simulating. Stops early when the
+/// receiver is gone.
+fn simulate_laps(
+    plan: &SimPlan,
+    laps_of: &dyn Fn(usize) -> usize,
+    tx: &SyncSender<(usize, LapLog)>,
+) -> Result<f64, SimError> {
+    let mut seconds = 0.0;
+    for run in 0..plan.runs.len() {
+        let mut sim = RunSim::new(plan, run);
+        for lap in 0..laps_of(run) {
+            let t = Instant::now();
+            let log = sim.run_lap(lap)?;
+            seconds += t.elapsed().as_secs_f64();
+            if tx.send((run, log)).is_err() {
+                return Ok(seconds);
+            }
+        }
+    }
+    Ok(seconds)
+}
+
+/// One job per level configuration, in order, then ICP's if asked.
+fn jobs(
+    scn: &Scenario,
+    configs: &[RecognizerConfig],
+    icp: bool,
+) -> Result<Vec<Job>, ExperimentError> {
+    let mut jobs: Vec<Job> = Vec::new();
+    for cfg in configs {
+        let rec =
+            Recognizer::new(cfg.clone()).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+        jobs.push((Some(cfg.levels), Box::new(rec), Recording::default()));
+    }
+    if icp {
+        let icp = IcpRecognizer::new(IcpConfig {
+            min_gap_m: scn.evaluation.min_gap_m,
+            ..IcpConfig::default()
+        });
+        jobs.push((None, Box::new(icp), Recording::default()));
+    }
+    Ok(jobs)
+}
+
+/// Feeds each lap from `rx` to every job (the jobs in parallel), starting a run at each new
+/// run index; tells `progress` a step per lap and a status of laps per second and memory.
+fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink) {
+    let start = Instant::now();
+    let mut current = None;
+    for (run, lap) in rx {
+        let new_run = current != Some(run);
+        current = Some(run);
+        jobs.par_iter_mut().for_each(|(_, rec, recording)| {
+            if new_run {
+                recording.start_run(rec.as_mut());
+            }
+            recording.lap(rec.as_mut(), run, &lap);
+        });
+        progress.step();
+        let done = jobs.first().map_or(0, |j| j.2.laps());
+        progress.status(&progress_message(done, start.elapsed().as_secs_f64()));
+    }
+}
+
+/// "12.3 laps/s, 456 MB (peak 789 MB)": the rate so far and the process's resident memory.
+fn progress_message(laps: usize, seconds: f64) -> String {
+    let rate = laps as f64 / seconds.max(1e-9);
+    match resident_memory_mb() {
+        Some((now, peak)) => format!("{rate:.1} laps/s, {now:.0} MB (peak {peak:.0} MB)"),
+        None => format!("{rate:.1} laps/s"),
+    }
+}
+
+/// The process's resident memory now and at its peak, MB (`VmRSS` and `VmHWM` of
+/// /proc/self/status; `None` where that file does not exist).
+pub fn resident_memory_mb() -> Option<(f64, f64)> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb = |key: &str| -> Option<f64> {
+        let line = status.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..]
+            .trim()
+            .trim_end_matches("kB")
+            .trim()
+            .parse()
+            .ok()
+    };
+    Some((kb("VmRSS:")? / 1024.0, kb("VmHWM:")? / 1024.0))
+}
