@@ -6,7 +6,7 @@
 //! types ([`Match`], [`Observation`]).
 
 use crate::geom::OdomPose;
-use crate::recognizer::{Match, MatchDiagnostics, Observation};
+use crate::recognizer::{FrameId, Match, MatchDiagnostics, Observation};
 use crate::scan::Scan;
 
 /// Anything that recognizes places from odometry and scans alone: the paper's recognizer, the
@@ -16,8 +16,10 @@ pub trait PlaceRecognizer {
     /// the first frame of every run, the first one included. Returns the matches that closing
     /// the previous run produced (its last word is only complete once the run ends).
     fn start_run(&mut self) -> Vec<Match>;
-    /// Feeds one odometry pose and its scan; returns the matches found because of it.
-    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match>;
+    /// Feeds one odometry pose and its scan, tagged by the harness with `frame_id` (which the
+    /// observations it makes must carry back, `Observation::frame_id`); returns the matches
+    /// found because of it.
+    fn push(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match>;
     /// Called after the last frame: returns the matches that closing the last run produced.
     fn finish(&mut self) -> Vec<Match> {
         Vec::new()

@@ -154,7 +154,7 @@ pub fn drive(world: &World, route: &Route, doors: &DoorStates) -> Result<Drive, 
 /// A word's stretch of the route (start, end, metres along it) and its middle true position.
 fn word_place(rec: &Recognizer, drive: &Drive, w: &Word) -> (f64, f64, Vec2) {
     let obs = rec.observations();
-    let frame = |i: usize| obs[i].input_index.min(drive.frames.len() - 1);
+    let frame = |i: usize| obs[i].frame_id.min(drive.frames.len() - 1);
     let r = w.obs_range();
     let (first, last) = (frame(r.start), frame(r.end - 1));
     let mid = frame(r.start + w.size / 2);
@@ -202,7 +202,7 @@ fn wrong_pair(
 ) -> Option<bool> {
     let obs = rec.observations();
     let at = |i: usize| {
-        let f = obs[i].input_index.min(drive.frames.len() - 1);
+        let f = obs[i].frame_id.min(drive.frames.len() - 1);
         drive.frames[f].truth.0.position()
     };
     let (cr, pr) = (c.obs_range(), p.obs_range());

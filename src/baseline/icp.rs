@@ -33,7 +33,7 @@
 
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::PlaceRecognizer;
-use crate::recognizer::{Match, Observation};
+use crate::recognizer::{FrameId, Match, Observation};
 use crate::scan::Scan;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -385,7 +385,6 @@ pub struct IcpRecognizer {
     /// Occupied cells of the local grid, odometry frame.
     cells: HashSet<(i64, i64)>,
     run: Option<usize>,
-    input_index: usize,
     travel_m: f64,
     last_pose: Option<Pose2>,
     /// Travel at which the next observation is due (`None`: at the next frame).
@@ -414,7 +413,6 @@ impl IcpRecognizer {
             regions: Vec::new(),
             cells: HashSet::new(),
             run: None,
-            input_index: 0,
             travel_m: 0.0,
             last_pose: None,
             next_obs_travel_m: None,
@@ -582,12 +580,10 @@ impl PlaceRecognizer for IcpRecognizer {
         Vec::new()
     }
 
-    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+    fn push(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match> {
         if self.run.is_none() {
             self.start_run();
         }
-        let input_index = self.input_index;
-        self.input_index += 1;
         let pose = odom.0;
         if let Some(last) = self.last_pose {
             self.travel_m += last.distance(&pose);
@@ -611,7 +607,7 @@ impl PlaceRecognizer for IcpRecognizer {
         self.observations.push(Observation {
             id,
             run: self.run.unwrap_or(0),
-            input_index,
+            frame_id,
             odom_pose: odom,
             travel_m: self.travel_m,
             psi: 0.0,

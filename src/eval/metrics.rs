@@ -289,17 +289,14 @@ impl Scorer {
             .iter()
             .map(|o| {
                 let pose = truth.observation_pose(o);
-                truth
-                    .frame(o.input_index)
-                    .zip(pose)
-                    .map(|(f, pose)| ObsTruth {
-                        x: pose.0.x,
-                        y: pose.0.y,
-                        theta: pose.0.theta,
-                        travel_m: travel[o.input_index],
-                        config: lap_config[f.lap_slot],
-                        lap: f.lap_slot,
-                    })
+                truth.frame(o.frame_id).zip(pose).map(|(f, pose)| ObsTruth {
+                    x: pose.0.x,
+                    y: pose.0.y,
+                    theta: pose.0.theta,
+                    travel_m: travel[o.frame_id],
+                    config: lap_config[f.lap_slot],
+                    lap: f.lap_slot,
+                })
             })
             .collect();
         Scorer {
@@ -613,7 +610,7 @@ pub(crate) mod tests {
                 obs.push(Observation {
                     id: i,
                     run: 0,
-                    input_index: i,
+                    frame_id: i,
                     odom_pose: OdomPose(pose),
                     travel_m: i as f64 * 0.1,
                     psi: 0.5,
@@ -633,7 +630,7 @@ pub(crate) mod tests {
 
     /// The oracle: for every observation, its nearest earlier neighbour that makes a revisit.
     fn oracle(obs: &[Observation], gt: &GroundTruth, spec: &EvaluationSpec) -> Vec<AlignedPair> {
-        let pos = |i: usize| gt.frames[obs[i].input_index].pose.0;
+        let pos = |i: usize| gt.frames[obs[i].frame_id].pose.0;
         let mut pairs = Vec::new();
         for q in 0..obs.len() {
             let best = (0..q)

@@ -51,7 +51,7 @@ pub struct FrameTruth {
 }
 
 /// Ground truth of every frame fed to a recognizer, indexed by the global input index
-/// (`Observation::input_index`). Built beside the recognizer; never handed to it.
+/// (`Observation::frame_id`). Built beside the recognizer; never handed to it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct GroundTruth {
     pub frames: Vec<FrameTruth>,
@@ -97,23 +97,23 @@ impl GroundTruth {
         self.push_lap(info, lap.frames.iter().map(|f| (f.truth, f.odom)));
     }
 
-    /// Truth of input frame `input_index`, if it exists.
-    pub fn frame(&self, input_index: usize) -> Option<&FrameTruth> {
-        self.frames.get(input_index)
+    /// Truth of input frame `frame_id`, if it exists.
+    pub fn frame(&self, frame_id: usize) -> Option<&FrameTruth> {
+        self.frames.get(frame_id)
     }
 
     /// True pose of an observation: its frame's truth moved by the observation's odometric offset
     /// from the frame (observations interpolated back along a long step between scans lie up to
     /// a few metres before the frame that made them).
     pub fn observation_pose(&self, obs: &crate::recognizer::Observation) -> Option<TruePose> {
-        let f = self.frame(obs.input_index)?;
+        let f = self.frame(obs.frame_id)?;
         let offset = f.odom.0.between(&obs.odom_pose.0);
         Some(TruePose(f.pose.0.compose(&offset)))
     }
 
-    /// The lap of input frame `input_index`.
-    pub fn lap_of(&self, input_index: usize) -> Option<&LapInfo> {
-        self.frame(input_index).map(|f| &self.laps[f.lap_slot])
+    /// The lap of input frame `frame_id`.
+    pub fn lap_of(&self, frame_id: usize) -> Option<&LapInfo> {
+        self.frame(frame_id).map(|f| &self.laps[f.lap_slot])
     }
 
     /// Names of the door configurations in order of first appearance.
@@ -214,10 +214,13 @@ impl Recording {
 
     /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
     pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
+        // Frames are tagged with their index in the truth, which the recognizer hands back.
+        let first_id = self.truth.frames.len();
         self.truth.add_lap(run, lap);
         let (t, cpu) = (Instant::now(), thread_cpu_s());
-        for frame in &lap.frames {
-            self.matches.extend(rec.push(frame.odom, &frame.scan));
+        for (i, frame) in lap.frames.iter().enumerate() {
+            self.matches
+                .extend(rec.push(first_id + i, frame.odom, &frame.scan));
         }
         let s = t.elapsed().as_secs_f64();
         self.seconds += s;

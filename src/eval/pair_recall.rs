@@ -129,12 +129,12 @@ pub fn pair_recall(
     let placed: Vec<Option<Placed>> = observations
         .iter()
         .map(|o| {
-            let f = truth.frame(o.input_index)?;
+            let f = truth.frame(o.frame_id)?;
             Some(Placed {
                 x: f.pose.0.x,
                 y: f.pose.0.y,
                 theta: f.pose.0.theta,
-                travel_m: travel[o.input_index],
+                travel_m: travel[o.frame_id],
             })
         })
         .collect();

@@ -18,7 +18,7 @@ use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs_with_progress};
 use crate::geom::OdomPose;
 use crate::recognizer::{
-    DensityFrontEnd, Match, Observation, Recognizer, RecognizerConfig, WordMatcher,
+    DensityFrontEnd, FrameId, Match, Observation, Recognizer, RecognizerConfig, WordMatcher,
 };
 use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
@@ -101,8 +101,8 @@ impl PlaceRecognizer for Recognizer {
     fn start_run(&mut self) -> Vec<Match> {
         Recognizer::start_run(self)
     }
-    fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
-        Recognizer::push(self, odom, scan)
+    fn push(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+        Recognizer::push_frame(self, frame_id, odom, scan)
     }
     fn finish(&mut self) -> Vec<Match> {
         Recognizer::finish(self)

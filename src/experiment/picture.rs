@@ -213,7 +213,7 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
         .collect();
     let pose = |i: usize| {
         rec.truth
-            .frame(rec.observations[i].input_index)
+            .frame(rec.observations[i].frame_id)
             .map(|f| f.pose.0)
     };
     let n = rec.observations.len();
@@ -258,7 +258,7 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus
         lap_slots: rec
             .observations
             .iter()
-            .map(|o| rec.truth.frame(o.input_index).map(|f| f.lap_slot))
+            .map(|o| rec.truth.frame(o.frame_id).map(|f| f.lap_slot))
             .collect(),
         revisits,
         pair_counts,

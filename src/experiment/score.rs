@@ -85,7 +85,7 @@ pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<Matc
     let input_of: HashMap<usize, usize> = rec
         .observations
         .iter()
-        .map(|o| (o.id, o.input_index))
+        .map(|o| (o.id, o.frame_id))
         .collect();
     let mut seen = HashSet::new();
     let mut rows = Vec::new();
@@ -214,7 +214,7 @@ fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Ve
                 obs.push(Observation {
                     id: obs.len(),
                     run: run_pos,
-                    input_index: i,
+                    frame_id: i,
                     odom_pose: OdomPose(odom[i]),
                     travel_m: travel,
                     psi: 0.0,
@@ -307,7 +307,7 @@ mod tests {
     /// `shift` scans added to the matched scan (clamped to the run).
     fn oracle_rows(logs: &LoggedRuns, spec: &EvaluationSpec, shift: usize) -> Vec<MatchRow> {
         let travel = crate::eval::pair_recall::true_travel_m(&logs.truth);
-        let pose = |o: &Observation| logs.truth.frames[o.input_index].pose.0;
+        let pose = |o: &Observation| logs.truth.frames[o.frame_id].pose.0;
         let locate = |i: usize| {
             let &(run, start, n) = logs.runs.iter().rfind(|r| r.1 <= i).expect("a run");
             (run, i - start, n)
@@ -316,7 +316,7 @@ mod tests {
         for (k, q) in logs.observations.iter().enumerate() {
             let best = logs.observations[..k]
                 .iter()
-                .filter(|p| travel[q.input_index] - travel[p.input_index] >= spec.min_gap_m)
+                .filter(|p| travel[q.frame_id] - travel[p.frame_id] >= spec.min_gap_m)
                 .filter(|p| {
                     crate::geom::wrap_angle(pose(q).theta - pose(p).theta).abs()
                         <= spec.heading_tolerance_deg.to_radians()
@@ -325,8 +325,8 @@ mod tests {
                 .filter(|(d, _)| *d <= spec.tp_radius_m)
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             if let Some((_, p)) = best {
-                let (qr, qs, _) = locate(q.input_index);
-                let (pr, ps, n) = locate(p.input_index);
+                let (qr, qs, _) = locate(q.frame_id);
+                let (pr, ps, n) = locate(p.frame_id);
                 if ps + shift < n {
                     rows.push(MatchRow {
                         query_run: qr,

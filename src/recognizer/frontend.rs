@@ -17,7 +17,7 @@
 use super::config::{RecognizerConfig, RecognizerError};
 use super::density::{DensityKernel, RayDeltas};
 use super::grid::LocalGrid;
-use super::types::Observation;
+use super::types::{FrameId, Observation};
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
@@ -70,7 +70,17 @@ impl DensityFrontEnd {
     /// one; after a step longer than the spacing (sparse logs), one per spacing passed, at poses
     /// interpolated along the step (steps longer than `max_interpolation_m` give one).
     pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Observation> {
-        let input_index = self.inputs;
+        self.push_frame(self.inputs, odom, scan)
+    }
+
+    /// Like [`push`](Self::push), with the frame's id given by the caller: the observations it
+    /// makes carry `frame_id`.
+    pub fn push_frame(
+        &mut self,
+        frame_id: FrameId,
+        odom: OdomPose,
+        scan: &Scan,
+    ) -> Vec<Observation> {
         self.inputs += 1;
         let previous = self.last_odom.map(|last| (last, self.travel_m));
         if let Some(last) = self.last_odom {
@@ -124,7 +134,7 @@ impl DensityFrontEnd {
                 let obs = Observation {
                     id: self.next_id,
                     run: self.run,
-                    input_index,
+                    frame_id,
                     odom_pose: pose,
                     travel_m,
                     psi,

@@ -25,7 +25,7 @@ pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, densi
 pub use frontend::DensityFrontEnd;
 pub use grid::LocalGrid;
 pub use matcher::{MatchDiagnostics, VerificationCounts, WordMatcher};
-pub use types::{AlignedRun, Direction, Match, ObsId, Observation, WordRef, push_pair};
+pub use types::{AlignedRun, Direction, FrameId, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;
@@ -105,8 +105,20 @@ impl Recognizer {
     /// ```
     pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
         let observations = self.front.push(odom, scan);
+        self.match_observations(&observations)
+    }
+
+    /// Like [`push`](Self::push), with the frame's id given by the caller: every observation
+    /// the scan makes carries `frame_id` (`Observation::frame_id`), so a harness that tags its
+    /// frames can score matches against truth it keeps to itself.
+    pub fn push_frame(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+        let observations = self.front.push_frame(frame_id, odom, scan);
+        self.match_observations(&observations)
+    }
+
+    fn match_observations(&mut self, observations: &[Observation]) -> Vec<Match> {
         let mut out = Vec::new();
-        for obs in &observations {
+        for obs in observations {
             out.extend(self.back.push_observation(obs));
         }
         out

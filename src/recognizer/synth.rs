@@ -67,7 +67,7 @@ pub fn observations(
     after: Option<&Observation>,
 ) -> Vec<Observation> {
     let (mut pose, mut travel, mut id, mut input) = match after {
-        Some(o) => (o.odom_pose.0, o.travel_m, o.id + 1, o.input_index + 1),
+        Some(o) => (o.odom_pose.0, o.travel_m, o.id + 1, o.frame_id + 1),
         None => (Pose2::IDENTITY, 0.0, 0, 0),
     };
     let mut out = Vec::new();
@@ -86,7 +86,7 @@ pub fn observations(
             out.push(Observation {
                 id,
                 run,
-                input_index: input,
+                frame_id: input,
                 odom_pose: OdomPose(pose),
                 travel_m: travel,
                 psi: s.psi,

@@ -1,11 +1,14 @@
 //! What the recognizer hands out: observations and matches. Evaluation scores these against
-//! truth it holds itself, by `Observation::input_index`.
+//! truth it holds itself, by `Observation::frame_id`.
 
 use crate::geom::OdomPose;
 use serde::Serialize;
 
 /// Index of an observation in the order the recognizer made them (global across runs).
 pub type ObsId = usize;
+
+/// The caller's id of an input frame (odometry pose and scan), handed back on each observation.
+pub type FrameId = usize;
 
 /// One density observation, made each 0.10 m of odometric travel.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -14,8 +17,11 @@ pub struct Observation {
     /// Run the observation belongs to (counts `start_run` calls that ended a run with inputs;
     /// the first run is 0).
     pub run: usize,
-    /// Index of the `push` call (0-based, counted across runs) whose scan made it.
-    pub input_index: usize,
+    /// Id of the input frame whose scan made it, as the caller tagged the frame
+    /// ([`Recognizer::push_frame`](super::Recognizer::push_frame); `push` tags its frames 0, 1,
+    /// 2, … in order, across runs). The harness scores observations by it: it holds the truth of
+    /// every frame it tagged, and the recognizer never sees that truth.
+    pub frame_id: FrameId,
     pub odom_pose: OdomPose,
     /// Odometric travel since the recognizer was created, metres (keeps growing across runs).
     pub travel_m: f64,

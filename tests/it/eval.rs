@@ -171,12 +171,12 @@ impl PlaceRecognizer for LapBack {
         self.runs_started += 1;
         Vec::new()
     }
-    fn push(&mut self, odom: OdomPose, _scan: &Scan) -> Vec<Match> {
+    fn push(&mut self, frame_id: usize, odom: OdomPose, _scan: &Scan) -> Vec<Match> {
         let id = self.obs.len();
         self.obs.push(Observation {
             id,
             run: self.runs_started - 1,
-            input_index: id,
+            frame_id,
             odom_pose: odom,
             travel_m: id as f64 * 0.04,
             psi: 0.0,

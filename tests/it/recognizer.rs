@@ -720,10 +720,10 @@ fn recognizer_runs_and_input_indices() {
     );
     for (k, o) in obs.iter().enumerate() {
         assert_eq!(o.id, k);
-        let (pose, _) = &inputs[o.input_index % 300];
+        let (pose, _) = &inputs[o.frame_id % 300];
         assert_eq!(o.odom_pose, *pose);
     }
-    assert!(obs[first_of_second].input_index >= 300);
+    assert!(obs[first_of_second].frame_id >= 300);
 }
 
 /// An odometry jump (a log gap, a teleport) makes one observation, not one per skipped 0.10 m,
@@ -1148,7 +1148,7 @@ fn decreasing_travel_is_refused() {
     let mut o = Observation {
         id: 0,
         run: 0,
-        input_index: 0,
+        frame_id: 0,
         odom_pose: OdomPose(Pose2::IDENTITY),
         travel_m: 5.0,
         psi: 0.5,
@@ -1200,5 +1200,28 @@ fn verification_rejects_a_density_mismatch_and_counts_it() {
         if !expect_pairs {
             assert!(counts.rejected_density > 0, "{counts:?}");
         }
+    }
+}
+
+/// The harness tags each input frame with an id; every observation hands back the id of the
+/// frame whose scan made it (`push_frame`), and `push` tags frames 0, 1, 2, … itself.
+#[test]
+fn observations_carry_the_frame_id_the_caller_gave() {
+    let layout = BeamLayout::centered(181, std::f64::consts::PI, 32.767, Pose2::IDENTITY);
+    let scan = |t: f64| placewords::scan::Scan {
+        layout: layout.clone(),
+        ranges_m: vec![3.0; layout.count],
+        time_s: t,
+    };
+    let mut tagged = Recognizer::new(RecognizerConfig::default()).unwrap();
+    let mut plain = Recognizer::new(RecognizerConfig::default()).unwrap();
+    for i in 0..60 {
+        let odom = OdomPose(Pose2::new(0.25 * i as f64, 0.0, 0.0));
+        tagged.push_frame(7000 + 3 * i, odom, &scan(i as f64));
+        plain.push(odom, &scan(i as f64));
+    }
+    assert!(tagged.observations().len() > 50);
+    for (t, p) in tagged.observations().iter().zip(plain.observations()) {
+        assert_eq!(t.frame_id, 7000 + 3 * p.frame_id);
     }
 }
