@@ -461,24 +461,33 @@ fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags
     areas_are_walkable(spec, loc, &walls, d);
 }
 
+/// Every segment of every wall (closed walls include the closing one), zero-length ones too:
+/// (wall index, segment index, the segment with half the wall's thickness).
+fn wall_segments(spec: &WorldSpec) -> impl Iterator<Item = (usize, usize, ThickSegment)> + '_ {
+    spec.walls.iter().enumerate().flat_map(|(wi, w)| {
+        let n = w.points_m.len();
+        let m = if w.closed { n } else { n.saturating_sub(1) };
+        (0..m).map(move |j| {
+            let seg = Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n]));
+            let half_thickness_m = w.thickness_m / 2.0;
+            (
+                wi,
+                j,
+                ThickSegment {
+                    seg,
+                    half_thickness_m,
+                },
+            )
+        })
+    })
+}
+
 /// Every wall segment of positive length, as a thick segment owned by its wall.
 fn wall_obstacles(spec: &WorldSpec) -> Obstacles {
-    let mut items = Vec::new();
-    let mut owner = Vec::new();
-    for (wi, w) in spec.walls.iter().enumerate() {
-        let n = w.points_m.len();
-        let m = if w.closed { n } else { n - 1 };
-        for j in 0..m {
-            let s = Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n]));
-            if s.length() > 0.0 {
-                items.push(ThickSegment {
-                    seg: s,
-                    half_thickness_m: w.thickness_m / 2.0,
-                });
-                owner.push(Owner::Wall(wi));
-            }
-        }
-    }
+    let (owner, items) = wall_segments(spec)
+        .filter(|(_, _, t)| t.seg.length() > 0.0)
+        .map(|(wi, _, t)| (Owner::Wall(wi), t))
+        .unzip();
     Obstacles {
         index: SegmentIndex::new(items),
         owner,
@@ -788,25 +797,9 @@ pub const WALL_OVERLAP_M: f64 = 0.5;
 /// Walls drawn twice or over each other: two parallel wall segments less than half their
 /// thicknesses apart that share more than [`WALL_OVERLAP_M`] of length.
 fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
-    let mut segs: Vec<(usize, usize, ThickSegment)> = Vec::new();
-    for (wi, w) in spec.walls.iter().enumerate() {
-        let n = w.points_m.len();
-        let m = if w.closed { n } else { n - 1 };
-        for j in 0..m {
-            let s = Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n]));
-            if s.length() > 0.0 {
-                let half_thickness_m = w.thickness_m / 2.0;
-                segs.push((
-                    wi,
-                    j,
-                    ThickSegment {
-                        seg: s,
-                        half_thickness_m,
-                    },
-                ));
-            }
-        }
-    }
+    let segs: Vec<(usize, usize, ThickSegment)> = wall_segments(spec)
+        .filter(|(_, _, t)| t.seg.length() > 0.0)
+        .collect();
     let index = SegmentIndex::new(segs.iter().map(|x| x.2).collect());
     // One message per pair of walls: a duplicated wall overlaps its twin on every segment.
     let mut reported = std::collections::HashSet::new();
@@ -879,18 +872,7 @@ fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     if !loc.home.valid {
         return;
     }
-    let items: Vec<ThickSegment> = spec
-        .walls
-        .iter()
-        .flat_map(|w| {
-            let n = w.points_m.len();
-            let m = if w.closed { n } else { n - 1 };
-            (0..m).map(move |j| ThickSegment {
-                seg: Segment::new(v(&w.points_m[j]), v(&w.points_m[(j + 1) % n])),
-                half_thickness_m: w.thickness_m / 2.0,
-            })
-        })
-        .collect();
+    let items: Vec<ThickSegment> = wall_segments(spec).map(|(_, _, t)| t).collect();
     let home = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
     let raster = crate::world::raster::Raster::new(&items, &[home], 0.1, 1.0, 0.05);
     let region = raster.reachable(&[home]);
