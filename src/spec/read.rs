@@ -353,6 +353,35 @@ pub(crate) fn ctx_of(kind: &str, id: &Option<String>, i: usize) -> String {
     }
 }
 
+/// Reads a required key of an entity with `read`, storing the offset of its value (or of the
+/// table, when missing) in `slot`; a missing key is reported as "missing key `key` in ctx;
+/// add {add}", with a "did you mean" for near misses.
+#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
+fn required<'t, 'i, T>(
+    t: &'t DeTable<'i>,
+    known: &[&str],
+    key: &str,
+    ctx: &str,
+    at_table: usize,
+    add: &str,
+    d: &mut Diags,
+    slot: &mut usize,
+    read: impl FnOnce(&'t Val<'i>, &mut Diags) -> Option<T>,
+) -> Option<T> {
+    match get(t, key) {
+        None => {
+            let message = format!("missing key `{key}` in {ctx}; add {add}");
+            missing(t, key, known, at_table, message, d);
+            *slot = at_table;
+            None
+        }
+        Some((_, v)) => {
+            *slot = v.span().start;
+            read(v, d)
+        }
+    }
+}
+
 /// Reads a required number key of an entity; stores the value's offset in `slot`.
 #[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
 pub(crate) fn req_number(
@@ -365,24 +394,10 @@ pub(crate) fn req_number(
     d: &mut Diags,
     slot: &mut usize,
 ) -> Option<f64> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = ...` ({what})"),
-                d,
-            );
-            *slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *slot = v.span().start;
-            number(v, key, ctx, d)
-        }
-    }
+    let add = format!("`{key} = ...` ({what})");
+    required(t, known, key, ctx, at_table, &add, d, slot, |v, d| {
+        number(v, key, ctx, d)
+    })
 }
 
 pub(crate) fn opt_number(
@@ -406,6 +421,7 @@ pub(crate) fn opt_number(
     }
 }
 
+#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
 pub(crate) fn req_point(
     t: &DeTable<'_>,
     known: &[&str],
@@ -415,24 +431,10 @@ pub(crate) fn req_point(
     d: &mut Diags,
     slot: &mut usize,
 ) -> Option<[f64; 2]> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = [x, y]` (metres)"),
-                d,
-            );
-            *slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *slot = v.span().start;
-            point(v, key, ctx, d)
-        }
-    }
+    let add = format!("`{key} = [x, y]` (metres)");
+    required(t, known, key, ctx, at_table, &add, d, slot, |v, d| {
+        point(v, key, ctx, d)
+    })
 }
 
 #[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
@@ -446,24 +448,10 @@ pub(crate) fn req_points(
     key_slot: &mut usize,
     spans: &mut Vec<usize>,
 ) -> Option<Vec<[f64; 2]>> {
-    match get(t, key) {
-        None => {
-            missing(
-                t,
-                key,
-                known,
-                at_table,
-                format!("missing key `{key}` in {ctx}; add `{key} = [[x, y], ...]` (metres)"),
-                d,
-            );
-            *key_slot = at_table;
-            None
-        }
-        Some((_, v)) => {
-            *key_slot = v.span().start;
-            points(v, key, ctx, d, spans)
-        }
-    }
+    let add = format!("`{key} = [[x, y], ...]` (metres)");
+    required(t, known, key, ctx, at_table, &add, d, key_slot, |v, d| {
+        points(v, key, ctx, d, spans)
+    })
 }
 
 /// Reads every table of an array of entries (walls, doors, ...) with `read`, keeping the
