@@ -60,8 +60,9 @@ pub struct RecognizerConfig {
     /// Placements the fine alignment tries: `paper` (Eq. 2 as written: the n = min(S₁, S₂)
     /// observations from both words' starts, shifted by d ∈ (−Δmax, Δmax)) or `whole-word`
     /// (the smaller word's n observations at every placement inside the larger word, never past
-    /// its ends) or `chain` (inside the larger word, within ±`chain_alignment_offset` of the
-    /// offset the whole matched n-gram agrees on). Default `chain`.
+    /// its ends) or `chain` (within ±`chain_alignment_offset` of the shift the whole matched
+    /// n-gram agrees on, even past the words' ends, or of the nearest placement inside the
+    /// larger word; ties within `chain_alignment_tie` go to the n-gram's shift). Default `chain`.
     pub alignment: AlignmentMode,
     /// Also recognize revisits driven the other way (paper §VI, future work). The past words are
     /// read backwards: their order reversed, each angle syllable negated (class and size are
@@ -77,6 +78,30 @@ pub struct RecognizerConfig {
     /// scenario A seeds 1..10, which has no opposite revisit: 2 removed every opposite match
     /// there; confirmed on `reverse` seeds 1..10: opposite precision 0.939 → 0.977 mean).
     pub reverse_extra_ngram: usize,
+    /// Chains may bridge one substituted word: (c, p) may extend a chain ending one level-0 word
+    /// further back on both sides, when the two skipped words have the same class (their size
+    /// or angle syllable did not match). The bridged pair does not count towards the n-gram's
+    /// size. Sparse real logs move class boundaries by a few observations between visits, so
+    /// short words fail the size syllable and break chains before τ. Default false: on fhw it
+    /// gives pairs on every noise seed 1..5 (none without), on Intel `--scan-step 3` on 2 of 5
+    /// and Intel's opposite recall 0 → 0.17, but it lowers scenario A's worst 3-level precision
+    /// over seeds 1..10 from 0.958 to 0.940 (RESULTS.md).
+    pub substitutions: bool,
+    /// Also accept an n-gram shorter than the configuration's minimum size when it has at least
+    /// `ngram_travel_min_words` word pairs and its current side spans at least this much
+    /// odometric travel, metres; 0 = off. Long words (a corridor loop where a word is 3–8 m)
+    /// make τ words a long stretch that one path difference breaks. Default 0 (off): with 12 m
+    /// Intel's opposite-direction recall goes 0 → 0.40 (noise seeds 1..5, precision 0.968) and
+    /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 (RESULTS.md).
+    pub ngram_travel_m: f64,
+    /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
+    /// `reverse_extra_ngram` read backwards). Default 4.
+    pub ngram_travel_min_words: usize,
+    /// `alignment = "chain"`: placements whose mean squared Ψ difference is within this of the
+    /// best count as equally good, and the one nearest the n-gram's shift wins (a long word of
+    /// flat Ψ otherwise slid to whatever placement noise favoured). Ψ², default 1e-4 (an RMS
+    /// difference of 0.01, a twelfth of a class of 8).
+    pub chain_alignment_tie: f64,
     /// Verify each match before reporting it (see the fields `verify_*`). Default true.
     pub verify: bool,
     /// Verification, travel: between two consecutive words of a matched n-gram, and from its
@@ -128,6 +153,10 @@ impl Default for RecognizerConfig {
             alignment: AlignmentMode::Chain,
             reverse: true,
             reverse_extra_ngram: 2,
+            substitutions: false,
+            ngram_travel_m: 0.0,
+            ngram_travel_min_words: 4,
+            chain_alignment_tie: 1e-4,
             verify: true,
             verify_travel_ratio: 0.15,
             verify_travel_slack_m: 0.5,
@@ -330,6 +359,8 @@ impl RecognizerConfig {
             ("verify_travel_slack_m", self.verify_travel_slack_m),
             ("verify_turn_deg", self.verify_turn_deg),
             ("verify_max_psi_rms", self.verify_max_psi_rms),
+            ("ngram_travel_m", self.ngram_travel_m),
+            ("chain_alignment_tie", self.chain_alignment_tie),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 bad(field, format!("must be a number of at least 0, got {v}"));

@@ -24,12 +24,21 @@
 //! side's travel and turn measured backwards, and are aligned on the past word's Ψ read
 //! backwards (so past ids decrease as query ids increase).
 //!
+//! **Substitutions** (`substitutions`, off by default). In sparse logs a class boundary moves by
+//! a few observations between visits, a short word then fails the size syllable and the chain
+//! breaks. With substitutions, (c, p) may also extend a chain ending one level-0 word further
+//! back on both sides when the two skipped words have the same class; the skipped pair does not
+//! count towards the n-gram's size, and verification still checks the whole n-gram.
+//!
 //! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
 //! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
 //! least `candidate_gap_m` after p ends. Each word pair is reported at most once per configuration: the
 //! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
 //! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
-//! length). The result of an L-level run is the union of the matches with `levels` ≤ L.
+//! length). The result of an L-level run is the union of the matches with `levels` ≤ L. With
+//! `ngram_travel_m` > 0 a chain of at least `ngram_travel_min_words` pairs (read backwards, plus
+//! `reverse_extra_ngram`) whose current side spans that much travel is reported as if it had
+//! reached τₖ.
 //!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
 //! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
@@ -37,13 +46,16 @@
 //! d ∈ (−Δmax, Δmax) from the words' starts, as Eq. 2 is written; `whole-word` lets the smaller
 //! word sit anywhere inside the larger one (never past its ends), since matched words may differ
 //! in size by the size tolerance and a boundary that moved by more than Δmax paired a long word
-//! metres off; `chain` (default) searches inside the larger word but only within
-//! ±`chain_alignment_offset` of the shift the whole n-gram agrees on (the median over its word
-//! pairs of the travel offset between their centres), because a long word of flat Ψ has no
-//! minimum of its own and slid up to its size-tolerance slack (≈ 1 m) from where its neighbours
-//! put it. Shifts whose whole window lies in the past word's run are preferred (near a run's
-//! start or end, those with the largest overlap); ties go to the smallest |d|. The aligned pairs
-//! whose travel differs by less than `candidate_gap_m` are dropped.
+//! metres off; `chain` (default) searches within ±`chain_alignment_offset` of the shift the
+//! whole n-gram agrees on (the median over its word pairs of the travel offsets between their
+//! start boundaries and between their end boundaries), even past the words' ends, and near the
+//! placement inside the larger word nearest to it; placements within `chain_alignment_tie` of
+//! the least error go to the n-gram's shift. A long word of flat Ψ has no minimum of its own:
+//! inside its own ends it slid to wherever noise favoured, and when both its boundaries had
+//! moved the same way (a level-1 word of scenario A, 1.2 m) no placement inside it was right, so
+//! its pairs fell just outside the 1 m radius. Shifts whose whole window lies in the past word's
+//! run are preferred (near a run's start or end, those with the largest overlap). The aligned
+//! pairs whose travel differs by less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::index::recent_candidates;
@@ -56,9 +68,10 @@ struct Entry {
     past: WordId,
     /// Longest chain per level configuration (0 when a word's level is outside it).
     len: [u16; MAX_LEVELS],
-    /// Per configuration, 2 bits: predecessor slot of the current word on the best chain.
-    back_slot: u8,
-    /// Per configuration: index of the best chain's previous pair in that predecessor's memo.
+    /// Per configuration: the current word of the best chain's previous pair (a predecessor of
+    /// this pair's current word, or across a substitution one word further back).
+    back_word: [WordId; MAX_LEVELS],
+    /// Per configuration: index of the best chain's previous pair in that word's memo.
     back_idx: [u32; MAX_LEVELS],
     /// Bit k: reported in configuration k.
     reported: u8,
@@ -77,6 +90,10 @@ struct Params {
     alignment: AlignmentMode,
     reverse: bool,
     reverse_extra_ngram: usize,
+    substitutions: bool,
+    ngram_travel_m: f64,
+    ngram_travel_min_words: usize,
+    chain_tie: f64,
     verify: bool,
     verify_travel_ratio: f64,
     verify_travel_slack_m: f64,
@@ -132,6 +149,10 @@ impl WordMatcher {
                 alignment: config.alignment,
                 reverse: config.reverse,
                 reverse_extra_ngram: config.reverse_extra_ngram,
+                substitutions: config.substitutions,
+                ngram_travel_m: config.ngram_travel_m,
+                ngram_travel_min_words: config.ngram_travel_min_words,
+                chain_tie: config.chain_alignment_tie,
                 verify: config.verify,
                 verify_travel_ratio: config.verify_travel_ratio,
                 verify_travel_slack_m: config.verify_travel_slack_m,
@@ -339,7 +360,7 @@ impl WordMatcher {
             let pw = self.word(p);
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
-            let mut back_slot = 0u8;
+            let mut back_word = [0 as WordId; MAX_LEVELS];
             let mut back_idx = [0u32; MAX_LEVELS];
             for l in len.iter_mut().take(levels).skip(top) {
                 *l = 1;
@@ -360,12 +381,14 @@ impl WordMatcher {
                     {
                         if el > 0 && el >= *l {
                             *l = el.saturating_add(1);
-                            let shift = 2 * k;
-                            back_slot = (back_slot & !(3 << shift)) | ((ci as u8) << shift);
+                            back_word[k] = cp;
                             back_idx[k] = idx;
                         }
                     }
                 }
+            }
+            if self.params.substitutions {
+                self.bridge_substitution(&cw, p, dir, top, &mut len, &mut back_word, &mut back_idx);
             }
             for (m, &l) in self.longest.iter_mut().zip(&len) {
                 *m = (*m).max(l);
@@ -373,7 +396,7 @@ impl WordMatcher {
             entries.push(Entry {
                 past: p,
                 len,
-                back_slot,
+                back_word,
                 back_idx,
                 reported: 0,
             });
@@ -381,69 +404,146 @@ impl WordMatcher {
         self.memo[d].push(entries);
     }
 
-    /// The pair before (c, p) on the best chain of configuration k.
-    fn step_back(&self, c: WordId, entry: &Entry, k: usize) -> Option<(WordId, usize)> {
-        if entry.len[k] <= 1 {
-            return None;
-        }
-        let slot = ((entry.back_slot >> (2 * k)) & 3) as usize;
-        let cp = *self.word(c).pred_ids().get(slot)?;
-        Some((cp, entry.back_idx[k] as usize))
+    /// The level-0 link of `w` read in direction `dir` (its level-0 predecessor, or read
+    /// backwards, its level-0 successor): the word a substitution skips.
+    fn level0_link(&self, w: WordId, dir: Direction) -> Option<WordId> {
+        let links: &[WordId] = match dir {
+            Direction::Same => self.word(w).pred_ids(),
+            Direction::Opposite => &self.successors[w as usize],
+        };
+        links.iter().copied().find(|&l| self.word(l).level == 0)
     }
 
-    fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
-        for dir in [Direction::Same, Direction::Opposite] {
-            for k in 0..self.params.levels {
-                for idx in 0..self.memo[dir as usize][c as usize].len() {
-                    if let Some(m) = self.report_one(c, idx, k, dir) {
-                        out.push(m);
+    /// Chains across one substituted word (`substitutions`): (c, p) may extend a pair (c'', p'')
+    /// where c'' is a predecessor of c's level-0 predecessor and p'' a link of p's level-0 link,
+    /// when those two skipped words have the same class (their size or angle syllable did not
+    /// match). The bridged pair does not count in the chain's length; direct links win ties.
+    #[allow(clippy::too_many_arguments)]
+    fn bridge_substitution(
+        &self,
+        cw: &Word,
+        p: WordId,
+        dir: Direction,
+        top: usize,
+        len: &mut [u16; MAX_LEVELS],
+        back_word: &mut [WordId; MAX_LEVELS],
+        back_idx: &mut [u32; MAX_LEVELS],
+    ) {
+        let d = dir as usize;
+        let levels = self.params.levels;
+        let Some(c_skip) = cw
+            .pred_ids()
+            .iter()
+            .copied()
+            .find(|&l| self.word(l).level == 0)
+        else {
+            return;
+        };
+        let Some(p_skip) = self.level0_link(p, dir) else {
+            return;
+        };
+        if self.word(c_skip).class != self.word(p_skip).class {
+            return;
+        }
+        for &c2 in self.word(c_skip).pred_ids() {
+            let memo = &self.memo[d][c2 as usize];
+            if memo.is_empty() {
+                continue;
+            }
+            for &p2 in self.past_links(p_skip, dir) {
+                let Ok(idx) = memo.binary_search_by_key(&p2, |e| e.past) else {
+                    continue;
+                };
+                let e = &memo[idx];
+                for k in top..levels {
+                    let el = e.len[k];
+                    if el > 0 && el + 1 > len[k] {
+                        len[k] = el + 1;
+                        back_word[k] = c2;
+                        back_idx[k] = idx as u32;
                     }
                 }
             }
         }
     }
 
-    /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first, and
-    /// how many of its newest pairs are not yet reported; `None` when the chain is shorter than τ.
+    /// The pair before (c, p) on the best chain of configuration k.
+    fn step_back(&self, c: WordId, entry: &Entry, k: usize) -> Option<(WordId, usize)> {
+        if entry.len[k] <= 1 {
+            return None;
+        }
+        let _ = c;
+        Some((entry.back_word[k], entry.back_idx[k] as usize))
+    }
+
+    fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+        for k in 0..self.params.levels {
+            // Every candidate first, then the reports: a candidate's new pairs are counted when
+            // it is reported (see `emit`).
+            let mut found = Vec::new();
+            for dir in [Direction::Same, Direction::Opposite] {
+                for idx in 0..self.memo[dir as usize][c as usize].len() {
+                    if let Some(cand) = self.candidate(c, idx, k, dir) {
+                        found.push(cand);
+                    }
+                }
+            }
+            for cand in found {
+                out.push(self.emit(c, k, cand));
+            }
+        }
+    }
+
+    /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first;
+    /// `None` when the chain is shorter than τ (and not long enough in travel).
     fn tau_chain(
         &self,
         c: WordId,
         idx: usize,
         k: usize,
         dir: Direction,
-    ) -> Option<(Vec<(WordId, usize)>, usize)> {
+    ) -> Option<Vec<(WordId, usize)>> {
         let memo = &self.memo[dir as usize];
         let tau = match dir {
             Direction::Same => self.params.min_ngram[k],
             Direction::Opposite => self.params.min_ngram[k] + self.params.reverse_extra_ngram,
         };
         let e = memo[c as usize][idx];
-        if (e.len[k] as usize) < tau {
+        let by_travel = self.params.ngram_travel_m > 0.0;
+        let min_words = self.params.ngram_travel_min_words.max(1)
+            + match dir {
+                Direction::Same => 0,
+                Direction::Opposite => self.params.reverse_extra_ngram,
+            };
+        let len = e.len[k] as usize;
+        if len < tau && !(by_travel && len >= min_words) {
             return None;
         }
         let mut chain = vec![(c, idx)];
-        let (mut fresh, mut all_fresh) = (1usize, true);
         let (mut wc, mut we) = (c, e);
+        let end_m = self.word(c).end_travel_m;
         while chain.len() < tau {
+            // An n-gram long in travel but short in words (`ngram_travel_m`).
+            if by_travel
+                && chain.len() >= min_words
+                && end_m - self.word(wc).start_travel_m >= self.params.ngram_travel_m
+            {
+                break;
+            }
             let (pc, pidx) = self.step_back(wc, &we, k)?;
             let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
-            if all_fresh && pe.reported & (1 << k) == 0 {
-                fresh += 1;
-            } else {
-                all_fresh = false;
-            }
             (wc, we) = (pc, pe);
         }
-        Some((chain, fresh))
+        Some(chain)
     }
 
-    /// Reports the τ-gram of configuration k ending at memo entry `idx` of `c` (direction
-    /// `dir`) if it is long enough, satisfies the candidate gap, passes verification and has
-    /// unreported pairs.
-    fn report_one(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Match> {
+    /// The τ-gram of configuration k ending at memo entry `idx` of `c` (direction `dir`) if it
+    /// is long enough, satisfies the candidate gap, passes verification and has unreported
+    /// pairs.
+    fn candidate(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Candidate> {
         let d = dir as usize;
-        let (mut chain, fresh) = self.tau_chain(c, idx, k, dir)?;
+        let mut chain = self.tau_chain(c, idx, k, dir)?;
         chain.reverse();
         let word_pairs: Vec<(WordId, WordId)> = chain
             .iter()
@@ -466,25 +566,48 @@ impl WordMatcher {
             self.rejections.add(reason);
             return None;
         }
-        let fresh_from = chain.len() - fresh;
+        Some(Candidate {
+            idx,
+            dir,
+            chain,
+            word_pairs,
+            anchors,
+        })
+    }
+
+    /// Marks a candidate's new pairs reported and makes its match.
+    fn emit(&mut self, c: WordId, k: usize, cand: Candidate) -> Match {
+        let d = cand.dir as usize;
+        // Counted now, not when the candidate was found: another candidate of the same word may
+        // have reported a pair this chain shares since.
+        let fresh = 1 + cand.chain[..cand.chain.len() - 1]
+            .iter()
+            .rev()
+            .take_while(|&&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) == 0)
+            .count();
+        let fresh_from = cand.chain.len() - fresh;
         let mut pairs = Vec::new();
         let mut refs = Vec::with_capacity(fresh);
-        for ((&(wc, widx), &(_, past)), &anchor) in
-            chain.iter().zip(&word_pairs).zip(&anchors).skip(fresh_from)
+        for ((&(wc, widx), &(_, past)), &anchor) in cand
+            .chain
+            .iter()
+            .zip(&cand.word_pairs)
+            .zip(&cand.anchors)
+            .skip(fresh_from)
         {
             self.memo[d][wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
-            self.aligned_pairs(wc, past, dir, anchor, &mut pairs);
+            self.aligned_pairs(wc, past, cand.dir, anchor, &mut pairs);
         }
         self.rejections.accepted += 1;
         pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
-        Some(Match {
+        Match {
             levels: k + 1,
-            ngram_len: self.memo[d][c as usize][idx].len[k] as usize,
+            ngram_len: self.memo[d][c as usize][cand.idx].len[k] as usize,
             word_pairs: refs,
             runs: pairs,
-            direction: dir,
-        })
+            direction: cand.dir,
+        }
     }
 
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
@@ -541,17 +664,23 @@ impl WordMatcher {
     /// whole n-gram agrees on: the median over its word pairs of the offset between the two
     /// words' centres (the past side's travel negated when read backwards).
     fn chain_anchors(&self, word_pairs: &[(WordId, WordId)], dir: Direction) -> Vec<i64> {
-        let read_centre = |w: WordId, dir: Direction| {
-            let word = self.word(w);
-            let centre = 0.5 * (word.start_travel_m + word.end_travel_m);
-            match dir {
-                Direction::Same => centre,
-                Direction::Opposite => -centre,
-            }
-        };
+        // Both boundaries of every word pair, as read: a word of flat Ψ whose boundaries moved
+        // shifts its centre, while most boundaries of the n-gram still agree.
         let mut offsets: Vec<f64> = word_pairs
             .iter()
-            .map(|&(c, p)| read_centre(c, Direction::Same) - read_centre(p, dir))
+            .flat_map(|&(c, p)| {
+                let (cw, pw) = (self.word(c), self.word(p));
+                match dir {
+                    Direction::Same => [
+                        cw.start_travel_m - pw.start_travel_m,
+                        cw.end_travel_m - pw.end_travel_m,
+                    ],
+                    Direction::Opposite => [
+                        cw.start_travel_m + pw.end_travel_m,
+                        cw.end_travel_m + pw.start_travel_m,
+                    ],
+                }
+            })
             .collect();
         offsets.sort_by(f64::total_cmp);
         let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
@@ -606,18 +735,26 @@ impl WordMatcher {
             AlignmentMode::Paper => (-(dmax - 1).max(0), (dmax - 1).max(0)),
             // The smaller word at every placement inside the larger one, never past its ends.
             AlignmentMode::WholeWord => (-(sc - n), sp - n),
-            // Inside the larger word, near the n-gram's shift (the nearest end when that lies
-            // outside).
+            // Near the n-gram's shift (past the words' ends if it lies there), or near the
+            // placement inside the larger word nearest to it.
             AlignmentMode::Chain => {
                 let (lo, hi) = (-(sc - n), sp - n);
-                let a = anchor.clamp(lo, hi);
+                let inside = anchor.clamp(lo, hi);
                 let w = self.params.chain_offset as i64;
-                ((a - w).max(lo), (a + w).min(hi))
+                (
+                    (anchor - w).min((inside - w).max(lo)),
+                    (anchor + w).max((inside + w).min(hi)),
+                )
             }
         };
         // Whole windows first (Eq. 2 sums over all n observations), then the least mean squared
-        // Ψ difference, then the smallest shift from the words' starts.
+        // Ψ difference, then (ties) the shift nearest the n-gram's for `chain`, the smallest
+        // shift from the words' starts otherwise.
         let mut best: Option<(Placement, i64)> = None;
+        let (eps, pivot) = match self.params.alignment {
+            AlignmentMode::Chain => (self.params.chain_tie, anchor),
+            _ => (1e-15, 0),
+        };
         for k in kmin..=kmax {
             let mut w = window(k);
             let count = w.count();
@@ -631,8 +768,9 @@ impl WordMatcher {
                 Some((bw, bk)) => {
                     count > bw.count()
                         || (count == bw.count()
-                            && (w.cost < bw.cost - 1e-15
-                                || ((w.cost - bw.cost).abs() <= 1e-15 && k.abs() < bk.abs())))
+                            && (w.cost < bw.cost - eps
+                                || ((w.cost - bw.cost).abs() <= eps
+                                    && (k - pivot).abs() < (bk - pivot).abs())))
                 }
             };
             if better {
@@ -667,6 +805,16 @@ impl WordMatcher {
             push_pair(out, q.id, pst.id, past.step as i8);
         }
     }
+}
+
+/// An n-gram that passed the gap and verification, before it is reported.
+struct Candidate {
+    idx: usize,
+    dir: Direction,
+    /// (current word, memo index), oldest first.
+    chain: Vec<(WordId, usize)>,
+    word_pairs: Vec<(WordId, WordId)>,
+    anchors: Vec<i64>,
 }
 
 /// A placement of the alignment: windows start at `a` in the current word and `b` in the past

@@ -121,6 +121,13 @@ fn config_defaults_parse_and_validate() {
     let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
     assert_eq!(fields, vec!["kernel_radius_m", "levels", "min_ngram"]);
     assert!(Recognizer::new(bad).is_err());
+    let bad = RecognizerConfig {
+        ngram_travel_m: -1.0,
+        chain_alignment_tie: f64::NAN,
+        ..Default::default()
+    };
+    let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
+    assert_eq!(fields, vec!["ngram_travel_m", "chain_alignment_tie"]);
 }
 
 /// Paper Fig. 2: corridors, a corner and a bifurcation in three classes; the right turn gives
@@ -1223,5 +1230,69 @@ fn observations_carry_the_frame_id_the_caller_gave() {
     assert!(tagged.observations().len() > 50);
     for (t, p) in tagged.observations().iter().zip(plain.observations()) {
         assert_eq!(t.frame_id, 7000 + 3 * p.frame_id);
+    }
+}
+
+/// The second lap with one word of the same class but 40 % longer: chains break there, so
+/// with n-grams of 6 words and 5 matching words on either side nothing matches; with
+/// `substitutions` the chain bridges the word and the lap is recognized, every pair at its place.
+#[test]
+fn a_substituted_word_is_bridged_only_with_substitutions() {
+    let mut lap = random_stretches(5, 11);
+    lap[5].size = 20;
+    let mut changed = lap.clone();
+    changed[5].size = 28; // 40 % longer: the size syllable fails, the travel check does not
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&changed, 0.1, 0, first.last());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let base = config(|c| {
+        c.levels = 1;
+        c.candidate_gap_m = 5.0;
+    });
+    let (_, plain) = run_matcher(&base, &all);
+    assert!(plain.is_empty(), "5-word chains must not reach τ = 6");
+    let bridged = RecognizerConfig {
+        substitutions: true,
+        ..base
+    };
+    let (_, matches) = run_matcher(&bridged, &all);
+    assert!(!matches.is_empty(), "the bridged chain reaches τ");
+    let n = first.len();
+    let grown = (changed[5].size - lap[5].size) as i64;
+    for (query, past) in matches.iter().flat_map(Match::pairs) {
+        let offset = (query - n) as i64 - past as i64;
+        assert!(
+            offset == 0 || offset == grown,
+            "pair ({query}, {past}) is not at its place (offset {offset})"
+        );
+    }
+}
+
+/// A corridor of five long words (6 m each) seen twice: 5 words never make a 6-gram, but
+/// `ngram_travel_m` accepts 4 or more words spanning 12 m.
+#[test]
+fn long_words_match_by_travel_when_asked() {
+    let lap: Vec<Stretch> = [0.3, 0.6, 0.2, 0.7, 0.4]
+        .iter()
+        .map(|&psi| Stretch::new(psi, 60, 0.0))
+        .collect();
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&lap, 0.1, 0, first.last());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let base = config(|c| {
+        c.levels = 1;
+        c.candidate_gap_m = 5.0;
+    });
+    assert!(run_matcher(&base, &all).1.is_empty());
+    let by_travel = RecognizerConfig {
+        ngram_travel_m: 12.0,
+        ..base
+    };
+    let (_, matches) = run_matcher(&by_travel, &all);
+    assert!(!matches.is_empty());
+    assert!(matches.iter().all(|m| m.ngram_len >= 4));
+    let n = first.len();
+    for (query, past) in matches.iter().flat_map(Match::pairs) {
+        assert_eq!(query - n, past);
     }
 }
