@@ -544,6 +544,11 @@ impl WordMatcher {
     fn candidate(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Candidate> {
         let d = dir as usize;
         let mut chain = self.tau_chain(c, idx, k, dir)?;
+        // The chain extends one whose n-gram was verified and reported: only its new pair's
+        // densities need checking (the travel and turn checks are cheap and run in full).
+        let extends_reported = chain
+            .get(1)
+            .is_some_and(|&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) != 0);
         chain.reverse();
         let word_pairs: Vec<(WordId, WordId)> = chain
             .iter()
@@ -561,7 +566,7 @@ impl WordMatcher {
         }
         let anchors = self.chain_anchors(&word_pairs, dir);
         if self.params.verify
-            && let Some(reason) = self.verify(&word_pairs, dir, &anchors)
+            && let Some(reason) = self.verify(&word_pairs, dir, &anchors, extends_reported)
         {
             self.rejections.add(reason);
             return None;
@@ -612,7 +617,8 @@ impl WordMatcher {
 
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
-    /// both sides; the Ψ residual of its aligned pairs must be small.
+    /// both sides; the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
+    /// the n-gram extends a verified one) must be small.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
     fn verify(
@@ -620,6 +626,7 @@ impl WordMatcher {
         word_pairs: &[(WordId, WordId)],
         dir: Direction,
         anchors: &[i64],
+        newest_only: bool,
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
         let past_start = |w: WordId| self.reading_start(w, dir);
@@ -645,7 +652,8 @@ impl WordMatcher {
             }
         }
         let (mut sum, mut count) = (0.0, 0usize);
-        for (&(c, p), &anchor) in word_pairs.iter().zip(anchors) {
+        let from = if newest_only { word_pairs.len() - 1 } else { 0 };
+        for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
             if let Some(w) = self.placement(c, p, dir, anchor) {
                 sum += w.cost * w.count() as f64;
                 count += w.count();
