@@ -91,7 +91,7 @@ pub struct RecognizerConfig {
     /// `ngram_travel_min_words` word pairs and its current side spans at least this much
     /// odometric travel, metres; 0 = off. Long words (a corridor loop where a word is 3–8 m)
     /// make τ words a long stretch that one path difference breaks. Default 0 (off): with 12 m
-    /// Intel's opposite-direction recall goes 0 → 0.40 (noise seeds 1..5, precision 0.968) and
+    /// Intel's opposite-direction recall goes 0 → 0.38 (noise seeds 1..5, precision 0.977) and
     /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 (RESULTS.md).
     pub ngram_travel_m: f64,
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
