@@ -84,15 +84,16 @@ pub struct RecognizerConfig {
     /// size. Sparse real logs move class boundaries by a few observations between visits, so
     /// short words fail the size syllable and break chains before τ. Default false: on fhw it
     /// gives pairs on every noise seed 1..5 (none without), on Intel `--scan-step 3` on 2 of 5
-    /// and Intel's opposite recall 0 → 0.17, but it lowers scenario A's worst 3-level precision
-    /// over seeds 1..10 from 0.958 to 0.940 (RESULTS.md).
+    /// and Intel's opposite recall 0 → 0.16, but it lowers scenario A's worst 3-level precision
+    /// over seeds 1..10 from 0.955 to 0.937 (RESULTS.md).
     pub substitutions: bool,
     /// Also accept an n-gram shorter than the configuration's minimum size when it has at least
     /// `ngram_travel_min_words` word pairs and its current side spans at least this much
     /// odometric travel, metres; 0 = off. Long words (a corridor loop where a word is 3–8 m)
     /// make τ words a long stretch that one path difference breaks. Default 0 (off): with 12 m
     /// Intel's opposite-direction recall goes 0 → 0.38 (noise seeds 1..5, precision 0.977) and
-    /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 (RESULTS.md).
+    /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 and scenario
+    /// A's 3-level precision to 0.693 (RESULTS.md).
     pub ngram_travel_m: f64,
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
