@@ -18,7 +18,8 @@ fn without_timings(v: &mut serde_json::Value) {
 /// same, timings aside, as tests/golden/smoke40-report.json: first minted before matches held
 /// their pairs as ranges (488bccf), re-minted when branch longterm was merged into main (main's
 /// reverse matching, chain alignment and class-boundary levels change figures on purpose), after
-/// checking that the merged `run` gives main's own report. Re-mint only for an intended change
+/// checking that the merged `run` gives main's own report, and again for the chain alignment on
+/// word boundaries (third session). Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]
 fn smoke_40_laps_report_is_unchanged_apart_from_timings() {
