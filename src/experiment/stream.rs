@@ -6,6 +6,8 @@
 //! The report is the one [`super::run_scenario`] gives: the simulator draws each lap from its
 //! run's seeded streams whatever else runs, and each recognizer sees the same frames in the same
 //! order. Only `Experiment::runs` is left empty (so no pictures, no exported matches).
+//!
+//! The lap producer ([`with_laps`]) also feeds `simulate`'s log writer (`super::output`).
 
 use super::{ExperimentError, ExperimentOptions, ProgressSink, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
@@ -37,14 +39,7 @@ pub fn run_scenario_streamed(
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
     opts.progress.start("laps", total as u64);
-    let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
-    let sim_s = std::thread::scope(|s| {
-        let producer = s.spawn(move || simulate_laps(plan, &laps_of, &tx));
-        feed(&mut jobs, rx, &opts.progress);
-        producer
-            .join()
-            .expect("the simulation thread does not panic")
-    });
+    let (sim_s, ()) = with_laps(plan, &laps_of, |rx| feed(&mut jobs, rx, &opts.progress));
     opts.progress.done();
     let sim_s = sim_s?;
     let results: Vec<(Option<usize>, Recognition)> = jobs
@@ -62,6 +57,25 @@ pub fn run_scenario_streamed(
     );
     exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
     Ok(exp)
+}
+
+/// Simulates `plan` (`laps_of(run)` laps per run) on a thread of its own while `consume` takes
+/// the laps, in order, from the receiver it is given; returns the simulation's outcome (seconds
+/// spent simulating) and `consume`'s. Dropping the receiver early stops the simulation.
+pub(super) fn with_laps<T>(
+    plan: &SimPlan,
+    laps_of: &(dyn Fn(usize) -> usize + Sync),
+    consume: impl FnOnce(Receiver<(usize, LapLog)>) -> T,
+) -> (Result<f64, SimError>, T) {
+    let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
+    std::thread::scope(|s| {
+        let producer = s.spawn(move || simulate_laps(plan, laps_of, &tx));
+        let out = consume(rx);
+        let sim = producer
+            .join()
+            .expect("the simulation thread does not panic");
+        (sim, out)
+    })
 }
 
 /// Simulates every lap of every run in order, sending each as it is made (blocks while

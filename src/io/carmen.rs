@@ -8,8 +8,13 @@
 //! - `TRUEPOS true_x true_y true_theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp`.
 //!
 //! Angles in radians, distances in metres.
+//!
+//! Laps are written one at a time ([`LapWriter`]) so a caller can append each lap to its file
+//! as it is made, without holding a whole run's text; lines are read one at a time
+//! ([`RecordStream`]) for the same reason.
 
-use crate::geom::Pose2;
+use crate::geom::{Pose2, wrap_angle};
+use crate::log::LapLog;
 use crate::spec::diag::Diagnostic;
 use std::fmt::Write as _;
 
@@ -119,6 +124,94 @@ fn push_range(out: &mut String, r: f64) {
         let _ = write!(out, " {sign}{whole}.{frac:03}");
     } else {
         let _ = write!(out, " {r:.3}");
+    }
+}
+
+/// Writes the laps of one run as CARMEN text, lap after lap. Per lap a `#` comment naming the
+/// lap and its doors; per frame, in this order: `ODOM` (odometry pose; speeds from the previous
+/// frame, across laps), `FLASER` (the odometry pose in both pose slots, as a robot's logger
+/// would record it) and `TRUEPOS` (ground truth beside the odometry pose). Timestamps are the
+/// frames' `time_s`.
+#[derive(Clone, Debug)]
+pub struct LapWriter {
+    host: String,
+    /// Time and odometry pose of the last frame written.
+    prev: Option<(f64, Pose2)>,
+}
+
+impl LapWriter {
+    /// A writer for a run whose records name `host`.
+    pub fn new(host: &str) -> Self {
+        LapWriter {
+            host: host.to_string(),
+            prev: None,
+        }
+    }
+
+    /// Appends the lines of `lap` to `out`.
+    pub fn write_lap(&mut self, out: &mut String, lap: &LapLog) {
+        let _ = writeln!(
+            out,
+            "# lap {} doors {}: open [{}]",
+            lap.lap,
+            lap.door_config,
+            lap.open_doors.join(" ")
+        );
+        for f in &lap.frames {
+            let odom = f.odom.0;
+            let (tv, rv) = match self.prev {
+                Some((t0, p0)) if f.time_s > t0 => {
+                    let dt = f.time_s - t0;
+                    let d = p0.between(&odom);
+                    let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
+                    (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
+                }
+                _ => (0.0, 0.0),
+            };
+            self.prev = Some((f.time_s, odom));
+            self.write_frame(out, f, (tv, rv));
+        }
+    }
+
+    /// The three lines of one frame, with the odometry speeds `(tv, rv)`.
+    fn write_frame(&self, out: &mut String, f: &crate::log::Frame, (tv, rv): (f64, f64)) {
+        let odom = f.odom.0;
+        let host = self.host.clone();
+        write_record(
+            out,
+            &LogRecord::Odom(OdomRecord {
+                pose: odom,
+                tv_m_s: tv,
+                rv_rad_s: rv,
+                accel_m_s2: 0.0,
+                ipc_timestamp: f.time_s,
+                host: host.clone(),
+                logger_timestamp: f.time_s,
+            }),
+        );
+        write_record(
+            out,
+            &LogRecord::Laser(LaserRecord {
+                start_angle_rad: f.scan.layout.start_angle_rad,
+                fov_rad: f.scan.layout.fov_rad(),
+                ranges_m: f.scan.ranges_m.clone(),
+                pose: odom,
+                odom,
+                ipc_timestamp: f.time_s,
+                host: host.clone(),
+                logger_timestamp: f.time_s,
+            }),
+        );
+        write_record(
+            out,
+            &LogRecord::TruePos(TruePosRecord {
+                truth: f.truth.0,
+                odom,
+                ipc_timestamp: f.time_s,
+                host,
+                logger_timestamp: f.time_s,
+            }),
+        );
     }
 }
 

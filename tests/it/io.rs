@@ -504,3 +504,25 @@ fn a_world_without_a_route_is_still_written_and_a_route_can_be_added() {
     assert_eq!(back.doors.len(), 1);
     assert_eq!(back.walls, spec.walls);
 }
+
+/// A file written piece by piece appears under its name only when committed; abandoned (an
+/// error, a panic), nothing is left, not even the temporary.
+#[test]
+fn an_atomic_file_appears_whole_or_not_at_all() {
+    use placewords::io::atomic::AtomicFile;
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("a.log");
+    let mut f = AtomicFile::create(&p).unwrap();
+    f.write_all(b"one\n").unwrap();
+    assert!(!p.exists(), "not before the commit");
+    f.write_all(b"two\n").unwrap();
+    f.commit().unwrap();
+    assert_eq!(std::fs::read_to_string(&p).unwrap(), "one\ntwo\n");
+    let q = dir.path().join("b.log");
+    let mut g = AtomicFile::create(&q).unwrap();
+    g.write_all(b"half").unwrap();
+    drop(g);
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "only a.log: {left:?}");
+}
