@@ -26,7 +26,7 @@ use super::{Experiment, Scenario, recognizer_config};
 const LAPS_AHEAD: usize = 2;
 
 /// A recognizer with its recording; `levels` is `None` for ICP.
-type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
+pub(super) type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
 
 /// Simulates `scn` and evaluates it lap by lap (see the module doc).
 pub fn run_scenario_streamed(
@@ -34,7 +34,7 @@ pub fn run_scenario_streamed(
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
-    let mut jobs = jobs(scn, &configs, opts.icp)?;
+    let mut jobs = jobs(&configs, scn.evaluation.min_gap_m, opts.icp)?;
     let plan = &scn.sim;
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
@@ -42,10 +42,7 @@ pub fn run_scenario_streamed(
     let (sim_s, ()) = with_laps(plan, &laps_of, |rx| feed(&mut jobs, rx, &opts.progress));
     opts.progress.done();
     let sim_s = sim_s?;
-    let results: Vec<(Option<usize>, Recognition)> = jobs
-        .into_iter()
-        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
-        .collect();
+    let results = finish_jobs(jobs);
     let mut exp = assemble(
         &plan.name,
         plan.seed,
@@ -101,10 +98,11 @@ fn simulate_laps(
     Ok(seconds)
 }
 
-/// One job per level configuration, in order, then ICP's if asked.
-fn jobs(
-    scn: &Scenario,
+/// One job per level configuration, in order, then ICP's if asked (with the evaluation's
+/// `min_gap_m`).
+pub(super) fn jobs(
     configs: &[RecognizerConfig],
+    min_gap_m: f64,
     icp: bool,
 ) -> Result<Vec<Job>, ExperimentError> {
     let mut jobs: Vec<Job> = Vec::new();
@@ -115,7 +113,7 @@ fn jobs(
     }
     if icp {
         let icp = IcpRecognizer::new(IcpConfig {
-            min_gap_m: scn.evaluation.min_gap_m,
+            min_gap_m,
             ..IcpConfig::default()
         });
         jobs.push((None, Box::new(icp), Recording::default()));
@@ -141,6 +139,13 @@ fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink
         let done = jobs.first().map_or(0, |j| j.2.laps());
         progress.status(&progress_message(done, start.elapsed().as_secs_f64()));
     }
+}
+
+/// Hands every job's recording and recognizer over as the scored recognition.
+pub(super) fn finish_jobs(jobs: Vec<Job>) -> Vec<(Option<usize>, Recognition)> {
+    jobs.into_iter()
+        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
+        .collect()
 }
 
 /// "12.3 laps/s, 456 MB (peak 789 MB)": the rate so far and the process's resident memory.
