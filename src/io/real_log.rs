@@ -2,6 +2,11 @@
 //! ([`crate::log::RunLog`]): one run, one lap holding every laser frame, door configuration
 //! `"unknown"`.
 //!
+//! **Whole or streamed.** [`load_run`] reads the log into memory and makes every frame;
+//! [`LogSurvey::read`] then [`stream_frames`] read it twice as a stream (the first pass learns
+//! what the first frame already needs: laser range, which lasers are used, whether stamps serve
+//! as time, the TRUEPOS messages) and make the same frames one at a time.
+//!
 //! **Corrected logs.** The Radish "corrected" logs carry no raw odometry: a laser line's `x y theta`
 //! is the corrected (ground-truth quality) pose and `odom_*` repeats it. The odometry the
 //! recognizer sees is therefore *derived*: for consecutive laser frames k-1, k the corrected

@@ -5,7 +5,7 @@
 //! since the run started; the host is `placewords-sim`. [`LogsWriter`] appends lap after lap to
 //! the open run's file, so a simulation of any length is written in the memory of a few laps.
 
-use crate::io::atomic::{AtomicFile, write_atomic};
+use crate::io::atomic::AtomicFile;
 use crate::io::carmen::LapWriter;
 use crate::log::{LapLog, RunLog};
 use crate::sim::plan::SimPlan;
@@ -174,9 +174,14 @@ impl<'a> LogsWriter<'a> {
         self.close_run()?;
         let p = self.dir.join("manifest.json");
         let runs = std::mem::take(&mut self.runs);
-        let json = serde_json::to_string_pretty(&manifest(self.scn, runs, self.laps_override))
-            .map_err(|e| std::io::Error::other(e.to_string()))?;
-        write_atomic(&p, (json + "\n").as_bytes()).map_err(|e| at(&p, e))?;
+        let manifest = manifest(self.scn, runs, self.laps_override);
+        // Written straight to the file: a million laps' manifest is not held twice as text.
+        let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
+        serde_json::to_writer_pretty(&mut file, &manifest)
+            .map_err(std::io::Error::other)
+            .and_then(|()| file.write_all(b"\n"))
+            .and_then(|()| file.commit())
+            .map_err(|e| at(&p, e))?;
         self.written.push(p);
         Ok(self.written)
     }
