@@ -91,15 +91,6 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         }
         None => RecognizerConfig::default(),
     };
-    let (mut run, skipped) =
-        experiment::real::load_real_run(&args.log, args.lenient, truth, noise.as_ref(), args.seed)?;
-    experiment::real::keep_every_nth_scan(&mut run, args.scan_step as usize);
-    if skipped > 0 {
-        eprintln!(
-            "{}: skipped {skipped} malformed line(s)",
-            args.log.display()
-        );
-    }
     let name = args
         .log
         .file_name()
@@ -121,7 +112,29 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         laps: None,
         progress: super::progress::bar(args.quiet),
     };
-    let exp = experiment::evaluate_runs(&name, args.seed, vec![run], &base, &evaluation, &opts)?;
+    let log = experiment::real::RealLogOptions {
+        lenient: args.lenient,
+        truth,
+        noise,
+        seed: args.seed,
+        scan_step: args.scan_step as usize,
+    };
+    let keep_runs = args.svg.is_some();
+    let (exp, skipped) = experiment::real::recognize_log(
+        &args.log,
+        &log,
+        &name,
+        &base,
+        &evaluation,
+        &opts,
+        keep_runs,
+    )?;
+    if skipped > 0 {
+        eprintln!(
+            "{}: skipped {skipped} malformed line(s)",
+            args.log.display()
+        );
+    }
     let world = picture::empty_world(&exp.runs, &name);
     print_and_write(
         &exp,

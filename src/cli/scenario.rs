@@ -51,12 +51,21 @@ pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
 
 /// `--laps N`: the same limit as `laps` in a file.
 pub fn laps_flag(s: &str) -> Result<usize, String> {
-    let n: i64 = match s.trim().parse::<u64>() {
-        Ok(n) => i64::try_from(n).unwrap_or(i64::MAX),
+    placewords::spec::scenario::check_laps(whole_number(s)?)
+}
+
+/// `simulate --laps N`: any count from 1 to `MAX_STREAMED_LAPS` (laps are written as made).
+pub fn streamed_laps_flag(s: &str) -> Result<usize, String> {
+    placewords::spec::scenario::check_streamed_laps(whole_number(s)?)
+}
+
+/// A whole number, one too large for `i64` read as `i64::MAX` (far too many, not garbage).
+fn whole_number(s: &str) -> Result<i64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(n) => Ok(i64::try_from(n).unwrap_or(i64::MAX)),
         Err(_) => s
             .trim()
             .parse()
-            .map_err(|_| format!("`{s}` is not a whole number"))?,
-    };
-    placewords::spec::scenario::check_laps(n)
+            .map_err(|_| format!("`{s}` is not a whole number")),
+    }
 }

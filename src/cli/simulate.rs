@@ -9,8 +9,9 @@ use std::process::ExitCode;
 pub struct SimulateArgs {
     /// Scenario file (TOML).
     pub scenario: PathBuf,
-    /// Laps per run, replacing the scenario's counts.
-    #[arg(long, value_parser = super::scenario::laps_flag)]
+    /// Laps per run, replacing the scenario's counts (up to a million: laps are written as they
+    /// are made, so memory does not grow with them).
+    #[arg(long, value_parser = super::scenario::streamed_laps_flag)]
     pub laps: Option<usize>,
     /// Output folder for the logs and manifest.
     #[arg(short, long)]

@@ -17,7 +17,7 @@ pub mod suite;
 pub mod sweep;
 
 use crate::geom::{OdomPose, TruePose};
-use crate::log::{LapLog, RunLog};
+use crate::log::{Frame, LapLog, RunLog};
 use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use std::time::Instant;
 
@@ -38,6 +38,18 @@ pub struct LapInfo {
     pub door_config: String,
     /// Ids of the doors open during the lap.
     pub open_doors: Vec<String>,
+}
+
+impl LapInfo {
+    /// What the evaluation keeps of `lap`, of run `run`.
+    pub fn of(run: usize, lap: &LapLog) -> Self {
+        LapInfo {
+            run,
+            lap: lap.lap,
+            door_config: lap.door_config.clone(),
+            open_doors: lap.open_doors.clone(),
+        }
+    }
 }
 
 /// Ground truth of one input frame.
@@ -76,24 +88,29 @@ impl GroundTruth {
         info: LapInfo,
         frames: impl IntoIterator<Item = (TruePose, OdomPose)>,
     ) {
-        let slot = self.laps.len();
+        self.start_lap(info);
+        for (pose, odom) in frames {
+            self.push_frame(pose, odom);
+        }
+    }
+
+    /// Starts a lap whose frames follow ([`Self::push_frame`]).
+    pub fn start_lap(&mut self, info: LapInfo) {
         self.laps.push(info);
-        self.frames
-            .extend(frames.into_iter().map(|(pose, odom)| FrameTruth {
-                pose,
-                odom,
-                lap_slot: slot,
-            }));
+    }
+
+    /// Appends one frame of the last lap started.
+    pub fn push_frame(&mut self, pose: TruePose, odom: OdomPose) {
+        self.frames.push(FrameTruth {
+            pose,
+            odom,
+            lap_slot: self.laps.len().saturating_sub(1),
+        });
     }
 
     /// Appends the truth of one lap of run `run` (laps in the order they are fed).
     pub fn add_lap(&mut self, run: usize, lap: &LapLog) {
-        let info = LapInfo {
-            run,
-            lap: lap.lap,
-            door_config: lap.door_config.clone(),
-            open_doors: lap.open_doors.clone(),
-        };
+        let info = LapInfo::of(run, lap);
         self.push_lap(info, lap.frames.iter().map(|f| (f.truth, f.odom)));
     }
 
@@ -193,8 +210,9 @@ fn thread_cpu_s() -> Option<f64> {
     Some(ns / 1e9)
 }
 
-/// A recognition in progress, fed lap by lap (so a caller need not hold every lap's scans):
-/// the truth of the laps fed, the matches so far and the recognizer's time, in total and per lap.
+/// A recognition in progress, fed lap by lap or frames at a time (so a caller need not hold
+/// every lap's scans): the truth of the frames fed, the matches so far and the recognizer's
+/// time, in total and per lap.
 #[derive(Debug, Default)]
 pub struct Recording {
     truth: GroundTruth,
@@ -202,6 +220,8 @@ pub struct Recording {
     seconds: f64,
     laps: usize,
     lap_seconds: Vec<f64>,
+    /// Seconds of the lap being fed so far (thread CPU where it can be read).
+    lap_so_far: f64,
 }
 
 impl Recording {
@@ -214,20 +234,40 @@ impl Recording {
 
     /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
     pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
+        self.start_lap(LapInfo::of(run, lap));
+        self.frames(rec, &lap.frames);
+        self.end_lap();
+    }
+
+    /// Starts a lap whose frames come in pieces ([`Self::frames`]) until [`Self::end_lap`].
+    pub fn start_lap(&mut self, info: LapInfo) {
+        self.truth.start_lap(info);
+        self.lap_so_far = 0.0;
+    }
+
+    /// Feeds `frames`, the next frames of the lap started, and keeps their truth.
+    pub fn frames(&mut self, rec: &mut dyn PlaceRecognizer, frames: &[Frame]) {
         // Frames are tagged with their index in the truth, which the recognizer hands back.
         let first_id = self.truth.frames.len();
-        self.truth.add_lap(run, lap);
+        for f in frames {
+            self.truth.push_frame(f.truth, f.odom);
+        }
         let (t, cpu) = (Instant::now(), thread_cpu_s());
-        for (i, frame) in lap.frames.iter().enumerate() {
+        for (i, frame) in frames.iter().enumerate() {
             self.matches
                 .extend(rec.push(first_id + i, frame.odom, &frame.scan));
         }
         let s = t.elapsed().as_secs_f64();
         self.seconds += s;
-        self.lap_seconds.push(match (cpu, thread_cpu_s()) {
+        self.lap_so_far += match (cpu, thread_cpu_s()) {
             (Some(a), Some(b)) => b - a,
             _ => s,
-        });
+        };
+    }
+
+    /// Ends the lap started.
+    pub fn end_lap(&mut self) {
+        self.lap_seconds.push(self.lap_so_far);
         self.laps += 1;
     }
 

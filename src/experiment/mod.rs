@@ -43,6 +43,8 @@ pub enum ExperimentError {
     Output(#[from] crate::io::atomic::StageError),
     #[error("{0}")]
     Write(#[from] std::io::Error),
+    #[error(transparent)]
+    RealLog(#[from] crate::io::real_log::RealLogError),
 }
 
 /// What to run.

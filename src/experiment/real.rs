@@ -2,16 +2,27 @@
 //! derived from the corrected increments, each read as the wheel travel that drives it and passed
 //! through the simulator's odometry model ([`crate::sim::odometry::Odometry`], one update per
 //! increment) from a seeded stream; the corrected pose stays the truth.
+//!
+//! `recognize` reads a log as a stream ([`recognize_log_streamed`]): frames go to the
+//! recognizers a chunk at a time and only their truth is kept, so a log of any size fits in the
+//! memory of the recognizers' own state.
 
+use super::stream::{Job, finish_jobs, jobs};
+use super::{Experiment, ExperimentError, ExperimentOptions, assemble, level_configs};
+use crate::eval::LapInfo;
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
-use crate::io::real_log::{RealLogError, TruthSource, load_run};
-use crate::log::RunLog;
+use crate::io::real_log::{LogSurvey, RealLogError, TruthSource, load_run, stream_frames};
+use crate::log::{Frame, RunLog};
+use crate::recognizer::RecognizerConfig;
 use crate::sim::odometry::{
     Odometry, OdometryConfig, OdometryModel, ProportionalError, noisy_motion,
 };
 use crate::sim::rng::{Purpose, SimRng, stream};
+use crate::spec::evaluation::EvaluationSpec;
+use rayon::prelude::*;
 use std::path::Path;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
 /// Axle track the wheel travels of a real increment are expressed with, metres (the simulated
 /// robot's default; only a wheel-radius mismatch depends on it).
@@ -115,15 +126,150 @@ pub fn load_real_run(
 /// be made as sparse as many real logs are. The odometry is untouched: each kept frame still has
 /// its pose, so the recognizer sees the same path sampled less often.
 pub fn keep_every_nth_scan(run: &mut RunLog, k: usize) {
-    if k <= 1 {
-        return;
-    }
     let mut i = 0usize;
     for lap in &mut run.laps {
         lap.frames.retain(|_| {
             i += 1;
-            (i - 1).is_multiple_of(k)
+            keeps_scan(i - 1, k)
         });
+    }
+}
+
+/// Whether [`keep_every_nth_scan`] keeps frame `i` (0-based, counted over the run).
+fn keeps_scan(i: usize, k: usize) -> bool {
+    k <= 1 || i.is_multiple_of(k)
+}
+
+/// How `recognize` reads a real log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RealLogOptions {
+    /// Skip malformed lines (counted) instead of failing at the first.
+    pub lenient: bool,
+    pub truth: TruthSource,
+    /// Odometry noise model; `None`: the corrected increments exactly.
+    pub noise: Option<OdometryConfig>,
+    /// Seed of the odometry noise stream.
+    pub seed: u64,
+    /// Keep every `scan_step`-th scan (1: all).
+    pub scan_step: usize,
+}
+
+/// Recognizes the real log at `path` with every configuration of `opts`; returns the experiment
+/// and the lines skipped. With `keep_runs` (pictures need the scans) the log is loaded whole and
+/// `Experiment::runs` holds it; otherwise it is read as a stream ([`recognize_log_streamed`]).
+/// The report is the same either way.
+pub fn recognize_log(
+    path: &Path,
+    log: &RealLogOptions,
+    name: &str,
+    base: &RecognizerConfig,
+    evaluation: &EvaluationSpec,
+    opts: &ExperimentOptions,
+    keep_runs: bool,
+) -> Result<(Experiment, usize), ExperimentError> {
+    if !keep_runs {
+        return recognize_log_streamed(path, log, name, base, evaluation, opts);
+    }
+    let (mut run, skipped) =
+        load_real_run(path, log.lenient, log.truth, log.noise.as_ref(), log.seed)?;
+    keep_every_nth_scan(&mut run, log.scan_step);
+    let exp = super::evaluate_runs(name, log.seed, vec![run], base, evaluation, opts)?;
+    Ok((exp, skipped))
+}
+
+/// Frames handed to the recognizers at a time.
+const CHUNK_FRAMES: usize = 256;
+
+/// Chunks read ahead of the recognizers at most.
+const CHUNKS_AHEAD: usize = 2;
+
+/// Recognizes the real log at `path` read as a stream, with every configuration of `opts` (as
+/// [`super::evaluate_runs`] does with the log loaded whole, and with the same report): a first
+/// pass surveys the log ([`LogSurvey`]), a second makes its frames on a thread of its own and
+/// hands them, a chunk at a time, to every recognizer (in parallel), keeping only each frame's
+/// truth. Memory holds a few chunks of scans, the truth and the recognizers' own state, whatever
+/// the log's size. `Experiment::runs` is left empty. Returns the skipped lines too.
+pub fn recognize_log_streamed(
+    path: &Path,
+    log: &RealLogOptions,
+    name: &str,
+    base: &RecognizerConfig,
+    evaluation: &EvaluationSpec,
+    opts: &ExperimentOptions,
+) -> Result<(Experiment, usize), ExperimentError> {
+    let configs = level_configs(base, &opts.levels)?;
+    let mut jobs = jobs(&configs, evaluation.min_gap_m, opts.icp)?;
+    let read = ReadOptions {
+        lenient: log.lenient,
+    };
+    let survey = LogSurvey::read(path, read, log.truth)?;
+    let kept = survey.frames().div_ceil(log.scan_step.max(1));
+    opts.progress
+        .start("recognizing", kept.div_ceil(CHUNK_FRAMES) as u64);
+    let (tx, rx) = sync_channel::<Vec<Frame>>(CHUNKS_AHEAD);
+    let read = std::thread::scope(|s| {
+        let producer = s.spawn(|| send_chunks(path, read, &survey, log, tx));
+        feed_chunks(&mut jobs, rx, &opts.progress);
+        producer.join().expect("the log reader does not panic")
+    });
+    opts.progress.done();
+    read?;
+    let results = finish_jobs(jobs);
+    let exp = assemble(name, log.seed, 1, evaluation, &configs, results, Vec::new());
+    Ok((exp, survey.counts.skipped_lines))
+}
+
+/// Reads the frames of the log (after its survey), keeps every `scan_step`-th and sends them in
+/// chunks of [`CHUNK_FRAMES`]; stops early when the receiver is gone.
+fn send_chunks(
+    path: &Path,
+    read: ReadOptions,
+    survey: &LogSurvey,
+    log: &RealLogOptions,
+    tx: SyncSender<Vec<Frame>>,
+) -> Result<(), RealLogError> {
+    let mut rng = stream(log.seed, 0, 0, Purpose::Odometry);
+    let perturb = |inc| match &log.noise {
+        Some(cfg) => perturb_increment(cfg, inc, &mut rng),
+        None => inc,
+    };
+    let (mut chunk, mut i, mut open) = (Vec::with_capacity(CHUNK_FRAMES), 0usize, true);
+    stream_frames(path, read, survey, log.truth, perturb, |frame| {
+        if keeps_scan(i, log.scan_step) && open {
+            chunk.push(frame);
+            if chunk.len() == CHUNK_FRAMES {
+                open = tx.send(std::mem::take(&mut chunk)).is_ok();
+            }
+        }
+        i += 1;
+    })?;
+    if !chunk.is_empty() && open {
+        let _ = tx.send(chunk);
+    }
+    Ok(())
+}
+
+/// Feeds the chunks from `rx` to every job (the jobs in parallel) as frames of one run of one
+/// lap, doors unknown (as a real log's run is); a progress step per chunk.
+fn feed_chunks(jobs: &mut [Job], rx: Receiver<Vec<Frame>>, progress: &super::ProgressSink) {
+    let info = LapInfo {
+        run: 0,
+        lap: 0,
+        door_config: "unknown".into(),
+        open_doors: Vec::new(),
+    };
+    for (_, rec, recording) in jobs.iter_mut() {
+        recording.start_run(rec.as_mut());
+        recording.start_lap(info.clone());
+    }
+    for chunk in rx {
+        jobs.par_iter_mut().for_each(|(_, rec, recording)| {
+            recording.frames(rec.as_mut(), &chunk);
+        });
+        progress.step();
+    }
+    for (_, _, recording) in jobs.iter_mut() {
+        recording.end_lap();
     }
 }
 

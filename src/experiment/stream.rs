@@ -6,6 +6,8 @@
 //! The report is the one [`super::run_scenario`] gives: the simulator draws each lap from its
 //! run's seeded streams whatever else runs, and each recognizer sees the same frames in the same
 //! order. Only `Experiment::runs` is left empty (so no pictures, no exported matches).
+//!
+//! The lap producer ([`with_laps`]) also feeds `simulate`'s log writer (`super::output`).
 
 use super::{ExperimentError, ExperimentOptions, ProgressSink, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
@@ -24,7 +26,7 @@ use super::{Experiment, Scenario, recognizer_config};
 const LAPS_AHEAD: usize = 2;
 
 /// A recognizer with its recording; `levels` is `None` for ICP.
-type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
+pub(super) type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
 
 /// Simulates `scn` and evaluates it lap by lap (see the module doc).
 pub fn run_scenario_streamed(
@@ -32,25 +34,15 @@ pub fn run_scenario_streamed(
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
-    let mut jobs = jobs(scn, &configs, opts.icp)?;
+    let mut jobs = jobs(&configs, scn.evaluation.min_gap_m, opts.icp)?;
     let plan = &scn.sim;
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
     opts.progress.start("laps", total as u64);
-    let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
-    let sim_s = std::thread::scope(|s| {
-        let producer = s.spawn(move || simulate_laps(plan, &laps_of, &tx));
-        feed(&mut jobs, rx, &opts.progress);
-        producer
-            .join()
-            .expect("the simulation thread does not panic")
-    });
+    let (sim_s, ()) = with_laps(plan, &laps_of, |rx| feed(&mut jobs, rx, &opts.progress));
     opts.progress.done();
     let sim_s = sim_s?;
-    let results: Vec<(Option<usize>, Recognition)> = jobs
-        .into_iter()
-        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
-        .collect();
+    let results = finish_jobs(jobs);
     let mut exp = assemble(
         &plan.name,
         plan.seed,
@@ -62,6 +54,25 @@ pub fn run_scenario_streamed(
     );
     exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
     Ok(exp)
+}
+
+/// Simulates `plan` (`laps_of(run)` laps per run) on a thread of its own while `consume` takes
+/// the laps, in order, from the receiver it is given; returns the simulation's outcome (seconds
+/// spent simulating) and `consume`'s. Dropping the receiver early stops the simulation.
+pub(super) fn with_laps<T>(
+    plan: &SimPlan,
+    laps_of: &(dyn Fn(usize) -> usize + Sync),
+    consume: impl FnOnce(Receiver<(usize, LapLog)>) -> T,
+) -> (Result<f64, SimError>, T) {
+    let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
+    std::thread::scope(|s| {
+        let producer = s.spawn(move || simulate_laps(plan, laps_of, &tx));
+        let out = consume(rx);
+        let sim = producer
+            .join()
+            .expect("the simulation thread does not panic");
+        (sim, out)
+    })
 }
 
 /// Simulates every lap of every run in order, sending each as it is made (blocks while
@@ -87,10 +98,11 @@ fn simulate_laps(
     Ok(seconds)
 }
 
-/// One job per level configuration, in order, then ICP's if asked.
-fn jobs(
-    scn: &Scenario,
+/// One job per level configuration, in order, then ICP's if asked (with the evaluation's
+/// `min_gap_m`).
+pub(super) fn jobs(
     configs: &[RecognizerConfig],
+    min_gap_m: f64,
     icp: bool,
 ) -> Result<Vec<Job>, ExperimentError> {
     let mut jobs: Vec<Job> = Vec::new();
@@ -101,7 +113,7 @@ fn jobs(
     }
     if icp {
         let icp = IcpRecognizer::new(IcpConfig {
-            min_gap_m: scn.evaluation.min_gap_m,
+            min_gap_m,
             ..IcpConfig::default()
         });
         jobs.push((None, Box::new(icp), Recording::default()));
@@ -127,6 +139,13 @@ fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink
         let done = jobs.first().map_or(0, |j| j.2.laps());
         progress.status(&progress_message(done, start.elapsed().as_secs_f64()));
     }
+}
+
+/// Hands every job's recording and recognizer over as the scored recognition.
+pub(super) fn finish_jobs(jobs: Vec<Job>) -> Vec<(Option<usize>, Recognition)> {
+    jobs.into_iter()
+        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
+        .collect()
 }
 
 /// "12.3 laps/s, 456 MB (peak 789 MB)": the rate so far and the process's resident memory.

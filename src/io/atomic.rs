@@ -78,6 +78,65 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// A file written piece by piece under its temporary name and renamed onto `path` by
+/// [`AtomicFile::commit`] (as [`write_atomic`] does for bytes held whole); dropped without a
+/// commit, the temporary file is removed. Buffered: many small writes cost one system call per
+/// 64 KiB.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    tmp: PathBuf,
+    out: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl AtomicFile {
+    /// Creates the temporary file beside `path` (and `path`'s parent folders).
+    pub fn create(path: &Path) -> std::io::Result<AtomicFile> {
+        create_parent(path)?;
+        remove_stale_temps(path);
+        let tmp = temp_path(path);
+        let file = std::fs::File::create(&tmp)?;
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            tmp,
+            out: Some(std::io::BufWriter::with_capacity(1 << 16, file)),
+        })
+    }
+
+    /// The final path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes, syncs and renames the file onto its final path.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let out = self.out.take().expect("an uncommitted file has its writer");
+        let file = out.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+        std::fs::rename(&self.tmp, &self.path)
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.out.as_mut().expect("not committed").write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.as_mut().expect("not committed").flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // A committed file was renamed; a failed commit or an abandoned one leaves the temporary.
+        drop(self.out.take());
+        if self.tmp.exists() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
 /// Checks, before any work, that a file can be written at `path`: creates its parent folders
 /// and a temporary file beside it (removed again). An existing folder at `path` is an error.
 pub fn check_writable(path: &Path) -> std::io::Result<()> {

@@ -8,8 +8,13 @@
 //! - `TRUEPOS true_x true_y true_theta odom_x odom_y odom_theta ipc_timestamp host logger_timestamp`.
 //!
 //! Angles in radians, distances in metres.
+//!
+//! Laps are written one at a time ([`LapWriter`]) so a caller can append each lap to its file
+//! as it is made, without holding a whole run's text; lines are read one at a time
+//! ([`RecordStream`]) for the same reason.
 
-use crate::geom::Pose2;
+use crate::geom::{Pose2, wrap_angle};
+use crate::log::LapLog;
 use crate::spec::diag::Diagnostic;
 use std::fmt::Write as _;
 
@@ -122,6 +127,94 @@ fn push_range(out: &mut String, r: f64) {
     }
 }
 
+/// Writes the laps of one run as CARMEN text, lap after lap. Per lap a `#` comment naming the
+/// lap and its doors; per frame, in this order: `ODOM` (odometry pose; speeds from the previous
+/// frame, across laps), `FLASER` (the odometry pose in both pose slots, as a robot's logger
+/// would record it) and `TRUEPOS` (ground truth beside the odometry pose). Timestamps are the
+/// frames' `time_s`.
+#[derive(Clone, Debug)]
+pub struct LapWriter {
+    host: String,
+    /// Time and odometry pose of the last frame written.
+    prev: Option<(f64, Pose2)>,
+}
+
+impl LapWriter {
+    /// A writer for a run whose records name `host`.
+    pub fn new(host: &str) -> Self {
+        LapWriter {
+            host: host.to_string(),
+            prev: None,
+        }
+    }
+
+    /// Appends the lines of `lap` to `out`.
+    pub fn write_lap(&mut self, out: &mut String, lap: &LapLog) {
+        let _ = writeln!(
+            out,
+            "# lap {} doors {}: open [{}]",
+            lap.lap,
+            lap.door_config,
+            lap.open_doors.join(" ")
+        );
+        for f in &lap.frames {
+            let odom = f.odom.0;
+            let (tv, rv) = match self.prev {
+                Some((t0, p0)) if f.time_s > t0 => {
+                    let dt = f.time_s - t0;
+                    let d = p0.between(&odom);
+                    let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
+                    (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
+                }
+                _ => (0.0, 0.0),
+            };
+            self.prev = Some((f.time_s, odom));
+            self.write_frame(out, f, (tv, rv));
+        }
+    }
+
+    /// The three lines of one frame, with the odometry speeds `(tv, rv)`.
+    fn write_frame(&self, out: &mut String, f: &crate::log::Frame, (tv, rv): (f64, f64)) {
+        let odom = f.odom.0;
+        let host = self.host.clone();
+        write_record(
+            out,
+            &LogRecord::Odom(OdomRecord {
+                pose: odom,
+                tv_m_s: tv,
+                rv_rad_s: rv,
+                accel_m_s2: 0.0,
+                ipc_timestamp: f.time_s,
+                host: host.clone(),
+                logger_timestamp: f.time_s,
+            }),
+        );
+        write_record(
+            out,
+            &LogRecord::Laser(LaserRecord {
+                start_angle_rad: f.scan.layout.start_angle_rad,
+                fov_rad: f.scan.layout.fov_rad(),
+                ranges_m: f.scan.ranges_m.clone(),
+                pose: odom,
+                odom,
+                ipc_timestamp: f.time_s,
+                host: host.clone(),
+                logger_timestamp: f.time_s,
+            }),
+        );
+        write_record(
+            out,
+            &LogRecord::TruePos(TruePosRecord {
+                truth: f.truth.0,
+                odom,
+                ipc_timestamp: f.time_s,
+                host,
+                logger_timestamp: f.time_s,
+            }),
+        );
+    }
+}
+
 fn fmt_pose(p: &Pose2) -> String {
     format!("{:.6} {:.6} {:.6}", p.x, p.y, p.theta)
 }
@@ -193,12 +286,7 @@ pub enum CarmenError {
 
 /// Reads a CARMEN log, plain text or gzip (detected by the magic bytes `1f 8b`).
 pub fn read_log(path: &Path, opts: ReadOptions) -> Result<LogReadout, CarmenError> {
-    let name = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|source| CarmenError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    read_log_from(file, &name, opts)
+    RecordStream::open(path, opts)?.collect_all()
 }
 
 /// Reads a log from any byte source, plain or gzip; `name` only names it in messages.
@@ -207,95 +295,162 @@ pub fn read_log_from<R: Read>(
     name: &str,
     opts: ReadOptions,
 ) -> Result<LogReadout, CarmenError> {
-    let mut buf = BufReader::new(src);
-    let head = buf.fill_buf().map_err(|source| CarmenError::Io {
-        path: name.to_string(),
-        source,
-    })?;
-    let gz = head.len() >= 2 && head[0] == 0x1f && head[1] == 0x8b;
-    if gz {
-        let dec = BufReader::new(flate2::bufread::MultiGzDecoder::new(buf));
-        read_lines(dec, name, opts, true)
-    } else {
-        read_lines(buf, name, opts, false)
-    }
+    RecordStream::from_reader(src, name, opts)?.collect_all()
 }
 
 /// Parses a log held in a string; `name` only names it in messages.
 pub fn parse_log_str(src: &str, name: &str, opts: ReadOptions) -> Result<LogReadout, CarmenError> {
-    read_lines(src.as_bytes(), name, opts, false)
+    RecordStream::new(Box::new(src.as_bytes()), name, opts, false).collect_all()
 }
 
-fn read_lines<R: BufRead>(
-    mut r: R,
-    name: &str,
+/// One message read from a stream.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StreamedRecord {
+    pub record: LogRecord,
+    /// Read from an RLASER (rear scanner) line.
+    pub rear_laser: bool,
+}
+
+/// A log read one line at a time ([`Self::next_record`]), so memory holds one line whatever
+/// the log's size; malformed lines are errors located `file:line:col`, or skipped and counted
+/// in lenient mode. [`read_log`] is this stream collected.
+pub struct RecordStream<'a> {
+    r: Box<dyn BufRead + 'a>,
+    name: String,
     opts: ReadOptions,
     gz: bool,
-) -> Result<LogReadout, CarmenError> {
-    let mut out = LogReadout::default();
-    let mut line_no = 0usize;
-    let mut bytes = Vec::new();
-    loop {
-        bytes.clear();
-        match (&mut r).take(MAX_LINE_BYTES).read_until(b'\n', &mut bytes) {
-            Ok(0) => break,
-            Ok(n) if n as u64 == MAX_LINE_BYTES && bytes.last() != Some(&b'\n') => {
-                return Err(CarmenError::Malformed(Diagnostic::error(
-                    name,
-                    (line_no + 1, 1),
+    line_no: usize,
+    bytes: Vec<u8>,
+    /// Everything of a whole read but the records.
+    counts: LogReadout,
+}
+
+impl<'a> RecordStream<'a> {
+    /// Opens the log file at `path`, plain or gzip.
+    pub fn open(path: &Path, opts: ReadOptions) -> Result<RecordStream<'static>, CarmenError> {
+        let name = path.display().to_string();
+        let file = std::fs::File::open(path).map_err(|source| CarmenError::Io {
+            path: name.clone(),
+            source,
+        })?;
+        RecordStream::from_reader(file, &name, opts)
+    }
+
+    /// Reads from any byte source, plain or gzip; `name` only names it in messages.
+    pub fn from_reader<R: Read + 'a>(
+        src: R,
+        name: &str,
+        opts: ReadOptions,
+    ) -> Result<RecordStream<'a>, CarmenError> {
+        let mut buf = BufReader::new(src);
+        let head = buf.fill_buf().map_err(|source| CarmenError::Io {
+            path: name.to_string(),
+            source,
+        })?;
+        let gz = head.len() >= 2 && head[0] == 0x1f && head[1] == 0x8b;
+        Ok(if gz {
+            let dec = BufReader::new(flate2::bufread::MultiGzDecoder::new(buf));
+            RecordStream::new(Box::new(dec), name, opts, true)
+        } else {
+            RecordStream::new(Box::new(buf), name, opts, false)
+        })
+    }
+
+    fn new(r: Box<dyn BufRead + 'a>, name: &str, opts: ReadOptions, gz: bool) -> Self {
+        RecordStream {
+            r,
+            name: name.to_string(),
+            opts,
+            gz,
+            line_no: 0,
+            bytes: Vec::new(),
+            counts: LogReadout::default(),
+        }
+    }
+
+    /// The counts so far (skipped and unknown lines, the first ROBOTLASER1 range); `records`
+    /// and `rear_laser_indices` stay empty.
+    pub fn counts(&self) -> &LogReadout {
+        &self.counts
+    }
+
+    /// The next message, or `None` at the end of the log.
+    pub fn next_record(&mut self) -> Result<Option<StreamedRecord>, CarmenError> {
+        while self.next_line()? {
+            let text = String::from_utf8_lossy(&self.bytes);
+            // A byte-order mark would turn the first message type into an unknown one.
+            let text = match self.line_no {
+                1 => text.strip_prefix('\u{feff}').unwrap_or(&text),
+                _ => &text,
+            };
+            match parse_line(text, &mut self.counts) {
+                Ok(Some(rec)) => return Ok(Some(rec)),
+                Ok(None) => {}
+                Err((col, message)) => {
+                    let d = Diagnostic::error(&self.name, (self.line_no, col), message);
+                    if !self.opts.lenient {
+                        return Err(CarmenError::Malformed(d));
+                    }
+                    self.counts.skipped_lines += 1;
+                    if self.counts.first_skipped.is_none() {
+                        self.counts.first_skipped = Some(d.to_string());
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Reads the next line into `self.bytes`; `false` at the end of the log.
+    fn next_line(&mut self) -> Result<bool, CarmenError> {
+        self.bytes.clear();
+        match (&mut self.r)
+            .take(MAX_LINE_BYTES)
+            .read_until(b'\n', &mut self.bytes)
+        {
+            Ok(0) => Ok(false),
+            Ok(n) if n as u64 == MAX_LINE_BYTES && self.bytes.last() != Some(&b'\n') => {
+                Err(CarmenError::Malformed(Diagnostic::error(
+                    &self.name,
+                    (self.line_no + 1, 1),
                     format!(
                         "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
                         MAX_LINE_BYTES >> 20
                     ),
-                )));
+                )))
             }
-            Ok(_) => {}
-            Err(source) => {
-                return Err(if gz {
-                    CarmenError::Decompress {
-                        path: name.to_string(),
-                        line: line_no,
-                        source,
-                    }
-                } else {
-                    CarmenError::Io {
-                        path: name.to_string(),
-                        source,
-                    }
-                });
+            Ok(_) => {
+                self.line_no += 1;
+                Ok(true)
             }
-        }
-        line_no += 1;
-        let text = String::from_utf8_lossy(&bytes);
-        // A byte-order mark would turn the first message type into an unknown one.
-        let text = if line_no == 1 {
-            text.strip_prefix('\u{feff}')
-                .unwrap_or(&text)
-                .to_string()
-                .into()
-        } else {
-            text
-        };
-        match parse_line(&text, &mut out) {
-            Ok(()) => {}
-            Err((col, message)) => {
-                if opts.lenient {
-                    out.skipped_lines += 1;
-                    if out.first_skipped.is_none() {
-                        out.first_skipped =
-                            Some(Diagnostic::error(name, (line_no, col), message).to_string());
-                    }
-                } else {
-                    return Err(CarmenError::Malformed(Diagnostic::error(
-                        name,
-                        (line_no, col),
-                        message,
-                    )));
-                }
-            }
+            Err(source) if self.gz => Err(CarmenError::Decompress {
+                path: self.name.clone(),
+                line: self.line_no,
+                source,
+            }),
+            Err(source) => Err(CarmenError::Io {
+                path: self.name.clone(),
+                source,
+            }),
         }
     }
-    Ok(out)
+
+    /// Every remaining message, with the counts.
+    fn collect_all(mut self) -> Result<LogReadout, CarmenError> {
+        let mut records = Vec::new();
+        let mut rear = Vec::new();
+        while let Some(r) = self.next_record()? {
+            if r.rear_laser {
+                rear.push(records.len());
+            }
+            records.push(r.record);
+        }
+        Ok(LogReadout {
+            records,
+            rear_laser_indices: rear,
+            ..self.counts
+        })
+    }
 }
 
 /// A whitespace-separated token with its 1-based character column.
@@ -424,13 +579,14 @@ fn clip(s: &str) -> String {
     }
 }
 
-fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
+/// The message on `line` (`None` for blank, comment and unknown lines, which `out` counts).
+fn parse_line(line: &str, out: &mut LogReadout) -> Result<Option<StreamedRecord>, LineErr> {
     let toks = tokenize(line);
     let Some(first) = toks.first() else {
-        return Ok(());
+        return Ok(None);
     };
     if first.s.starts_with('#') {
-        return Ok(());
+        return Ok(None);
     }
     let end_col = line.trim_end().chars().count() + 1;
     let f = Fields {
@@ -593,14 +749,13 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<(), LineErr> {
         }
         _ => {
             out.unknown_lines += 1;
-            return Ok(());
+            return Ok(None);
         }
     };
-    if first.s == "RLASER" {
-        out.rear_laser_indices.push(out.records.len());
-    }
-    out.records.push(rec);
-    Ok(())
+    Ok(Some(StreamedRecord {
+        record: rec,
+        rear_laser: first.s == "RLASER",
+    }))
 }
 
 #[cfg(test)]

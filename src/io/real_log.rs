@@ -2,6 +2,11 @@
 //! ([`crate::log::RunLog`]): one run, one lap holding every laser frame, door configuration
 //! `"unknown"`.
 //!
+//! **Whole or streamed.** [`load_run`] reads the log into memory and makes every frame;
+//! [`LogSurvey::read`] then [`stream_frames`] read it twice as a stream (the first pass learns
+//! what the first frame already needs: laser range, which lasers are used, whether stamps serve
+//! as time, the TRUEPOS messages) and make the same frames one at a time.
+//!
 //! **Corrected logs.** The Radish "corrected" logs carry no raw odometry: a laser line's `x y theta`
 //! is the corrected (ground-truth quality) pose and `odom_*` repeats it. The odometry the
 //! recognizer sees is therefore *derived*: for consecutive laser frames k-1, k the corrected
@@ -30,7 +35,9 @@
 //! (the logged pose is already the laser's). Maximum range, see [`max_range_m`].
 
 use crate::geom::{OdomPose, Pose2, TruePose};
-use crate::io::carmen::{LaserRecord, LogReadout, LogRecord, ReadOptions, TruePosRecord, read_log};
+use crate::io::carmen::{
+    LaserRecord, LogReadout, LogRecord, ReadOptions, RecordStream, TruePosRecord, read_log,
+};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::scan::{BeamLayout, Scan};
 
@@ -43,11 +50,37 @@ pub const NOMINAL_SPEED_M_S: f64 = 0.4;
 
 /// Whether laser stamps can serve as time: at most 10 % of consecutive pairs fail to increase.
 pub fn stamps_usable(lasers: &[&LaserRecord]) -> bool {
-    let bad = lasers
-        .windows(2)
-        .filter(|w| w[1].ipc_timestamp <= w[0].ipc_timestamp)
-        .count();
-    bad * 10 <= lasers.len().saturating_sub(1)
+    let mut check = StampCheck::default();
+    for l in lasers {
+        check.push(l.ipc_timestamp);
+    }
+    check.usable()
+}
+
+/// [`stamps_usable`]'s rule kept stamp by stamp, for a log read as a stream.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StampCheck {
+    last: Option<f64>,
+    /// Stamps seen.
+    pub count: usize,
+    /// Stamps not later than the one before.
+    bad: usize,
+}
+
+impl StampCheck {
+    /// Counts the next laser's stamp.
+    pub fn push(&mut self, t: f64) {
+        if self.last.is_some_and(|p| t <= p) {
+            self.bad += 1;
+        }
+        self.last = Some(t);
+        self.count += 1;
+    }
+
+    /// At most 10 % of consecutive pairs fail to increase.
+    pub fn usable(&self) -> bool {
+        self.bad * 10 <= self.count.saturating_sub(1)
+    }
 }
 
 /// The farthest a TRUEPOS message may be in time from a laser line to serve as its truth, seconds.
@@ -101,18 +134,31 @@ pub fn noise_free(increment: Pose2) -> Pose2 {
 ///
 /// Readings at or beyond it are "no return".
 pub fn max_range_m(readout: &LogReadout) -> f64 {
-    for r in &readout.records {
-        if let LogRecord::Param { name, value } = r
-            && (name == "robot_front_laser_max" || name == "laser_front_laser_max_range")
-            && let Ok(v) = value.parse::<f64>()
-            && v.is_finite()
-            && v > 0.0
+    let param = readout.records.iter().find_map(param_max_range);
+    max_range_or_default(param, readout.robotlaser_max_range_m)
+}
+
+/// The range a `PARAM robot_front_laser_max` (or `laser_front_laser_max_range`) message gives,
+/// if `r` is one and its value is positive.
+fn param_max_range(r: &LogRecord) -> Option<f64> {
+    match r {
+        LogRecord::Param { name, value }
+            if name == "robot_front_laser_max" || name == "laser_front_laser_max_range" =>
         {
-            return v;
+            value
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
         }
+        _ => None,
     }
-    match readout.robotlaser_max_range_m {
-        Some(v) if v.is_finite() && v > 0.0 => v,
+}
+
+/// [`max_range_m`]'s order: the PARAM, then the ROBOTLASER1 field, then the default.
+fn max_range_or_default(param: Option<f64>, robotlaser: Option<f64>) -> f64 {
+    match (param, robotlaser) {
+        (Some(v), _) => v,
+        (None, Some(v)) if v.is_finite() && v > 0.0 => v,
         _ => DEFAULT_MAX_RANGE_M,
     }
 }
@@ -183,70 +229,39 @@ pub fn corrected_to_run(
     name: &str,
     truth: TruthSource,
     max_range_m: f64,
-    mut perturb: impl FnMut(Pose2) -> Pose2,
+    perturb: impl FnMut(Pose2) -> Pose2,
 ) -> Result<RunLog, RealLogError> {
     if lasers.is_empty() {
         return Err(RealLogError::NoLaser(name.to_string()));
     }
-    let mut tp: Vec<(f64, Pose2)> = truepos.iter().map(|t| (t.ipc_timestamp, t.truth)).collect();
-    if truth == TruthSource::TruePos {
-        if tp.is_empty() {
-            return Err(RealLogError::NoTruePos(name.to_string()));
-        }
-        tp.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let tp = sorted_truepos(truepos.iter().map(|t| (t.ipc_timestamp, t.truth)).collect());
+    if truth == TruthSource::TruePos && tp.is_empty() {
+        return Err(RealLogError::NoTruePos(name.to_string()));
     }
-    let t0 = lasers[0].ipc_timestamp;
-    let use_stamps = stamps_usable(lasers);
-    let mut travelled = 0.0f64;
-    let mut frames = Vec::with_capacity(lasers.len());
-    let mut odom = lasers[0].pose;
-    let mut last_time = 0.0f64;
-    for (k, l) in lasers.iter().enumerate() {
-        if k > 0 {
-            let inc = lasers[k - 1].pose.between(&l.pose);
-            odom = odom.compose(&perturb(inc));
-        }
-        if k > 0 {
-            travelled += lasers[k - 1].pose.distance(&l.pose);
-        }
-        let raw = if use_stamps {
-            l.ipc_timestamp - t0
-        } else {
-            travelled / NOMINAL_SPEED_M_S
-        };
-        let time_s = raw.max(last_time);
-        last_time = time_s;
-        let true_pose = match truth {
-            TruthSource::Corrected => l.pose,
-            TruthSource::TruePos => {
-                let (gap, p) = nearest(&tp, l.ipc_timestamp);
-                if gap > TRUEPOS_MAX_GAP_S {
-                    return Err(RealLogError::TruePosGap {
-                        name: name.to_string(),
-                        index: k,
-                        time: l.ipc_timestamp,
-                        gap,
-                        max_gap: TRUEPOS_MAX_GAP_S,
-                    });
-                }
-                p
-            }
-        };
-        let n = l.ranges_m.len();
-        let mut layout = BeamLayout::centered(n, l.fov_rad, max_range_m, Pose2::IDENTITY);
-        layout.start_angle_rad = l.start_angle_rad;
-        frames.push(Frame {
-            time_s,
-            odom: OdomPose(odom),
-            truth: TruePose(true_pose),
-            scan: Scan {
-                layout,
-                ranges_m: l.ranges_m.clone(),
-                time_s,
-            },
-        });
-    }
-    Ok(RunLog {
+    let mut maker = FrameMaker::new(
+        name,
+        truth,
+        &tp,
+        max_range_m,
+        stamps_usable(lasers),
+        perturb,
+    );
+    let frames = lasers
+        .iter()
+        .map(|l| maker.make(l))
+        .collect::<Result<Vec<Frame>, RealLogError>>()?;
+    Ok(one_lap_run(frames))
+}
+
+/// TRUEPOS (time, pose) sorted by time (stably: equal stamps keep file order).
+fn sorted_truepos(mut tp: Vec<(f64, Pose2)>) -> Vec<(f64, Pose2)> {
+    tp.sort_by(|a, b| a.0.total_cmp(&b.0));
+    tp
+}
+
+/// A real log's run: one lap, doors unknown.
+fn one_lap_run(frames: Vec<Frame>) -> RunLog {
+    RunLog {
         run: 0,
         laps: vec![LapLog {
             lap: 0,
@@ -254,7 +269,202 @@ pub fn corrected_to_run(
             open_doors: Vec::new(),
             frames,
         }],
-    })
+    }
+}
+
+/// Makes the frames of a log's lasers, one at a time and in order (the module doc gives every
+/// rule): derived odometry, time, truth and beam layout.
+struct FrameMaker<'a, P> {
+    name: &'a str,
+    truth: TruthSource,
+    /// TRUEPOS (time, pose), sorted by time.
+    truepos: &'a [(f64, Pose2)],
+    max_range_m: f64,
+    use_stamps: bool,
+    perturb: P,
+    /// Lasers made so far.
+    k: usize,
+    /// The previous laser's corrected pose.
+    prev: Option<Pose2>,
+    t0: f64,
+    odom: Pose2,
+    travelled_m: f64,
+    last_time_s: f64,
+}
+
+impl<'a, P: FnMut(Pose2) -> Pose2> FrameMaker<'a, P> {
+    fn new(
+        name: &'a str,
+        truth: TruthSource,
+        truepos: &'a [(f64, Pose2)],
+        max_range_m: f64,
+        use_stamps: bool,
+        perturb: P,
+    ) -> Self {
+        FrameMaker {
+            name,
+            truth,
+            truepos,
+            max_range_m,
+            use_stamps,
+            perturb,
+            k: 0,
+            prev: None,
+            t0: 0.0,
+            odom: Pose2::IDENTITY,
+            travelled_m: 0.0,
+            last_time_s: 0.0,
+        }
+    }
+
+    /// The frame of the next laser `l`.
+    fn make(&mut self, l: &LaserRecord) -> Result<Frame, RealLogError> {
+        match self.prev {
+            Some(prev) => {
+                self.odom = self.odom.compose(&(self.perturb)(prev.between(&l.pose)));
+                self.travelled_m += prev.distance(&l.pose);
+            }
+            None => (self.odom, self.t0) = (l.pose, l.ipc_timestamp),
+        }
+        self.prev = Some(l.pose);
+        let raw = if self.use_stamps {
+            l.ipc_timestamp - self.t0
+        } else {
+            self.travelled_m / NOMINAL_SPEED_M_S
+        };
+        let time_s = raw.max(self.last_time_s);
+        self.last_time_s = time_s;
+        let true_pose = self.true_pose(l)?;
+        self.k += 1;
+        let n = l.ranges_m.len();
+        let mut layout = BeamLayout::centered(n, l.fov_rad, self.max_range_m, Pose2::IDENTITY);
+        layout.start_angle_rad = l.start_angle_rad;
+        Ok(Frame {
+            time_s,
+            odom: OdomPose(self.odom),
+            truth: TruePose(true_pose),
+            scan: Scan {
+                layout,
+                ranges_m: l.ranges_m.clone(),
+                time_s,
+            },
+        })
+    }
+
+    /// The truth of laser `l` (the `k`-th): its corrected pose or the nearest TRUEPOS.
+    fn true_pose(&self, l: &LaserRecord) -> Result<Pose2, RealLogError> {
+        if self.truth == TruthSource::Corrected {
+            return Ok(l.pose);
+        }
+        let (gap, p) = nearest(self.truepos, l.ipc_timestamp);
+        if gap > TRUEPOS_MAX_GAP_S {
+            return Err(RealLogError::TruePosGap {
+                name: self.name.to_string(),
+                index: self.k,
+                time: l.ipc_timestamp,
+                gap,
+                max_gap: TRUEPOS_MAX_GAP_S,
+            });
+        }
+        Ok(p)
+    }
+}
+
+/// What a first pass over a log learns that its first frame already needs: the laser range,
+/// whether it has front lasers, whether their stamps serve as time, and (for
+/// [`TruthSource::TruePos`]) every TRUEPOS message's time and pose (40 bytes each; no scans).
+#[derive(Clone, Debug, Default)]
+pub struct LogSurvey {
+    param_max_range_m: Option<f64>,
+    front: StampCheck,
+    rear: StampCheck,
+    truepos: Vec<(f64, Pose2)>,
+    /// The read's counts (skipped, unknown lines; no records).
+    pub counts: LogReadout,
+}
+
+impl LogSurvey {
+    /// Reads `path` once, as a stream.
+    pub fn read(
+        path: &std::path::Path,
+        opts: ReadOptions,
+        truth: TruthSource,
+    ) -> Result<LogSurvey, RealLogError> {
+        let mut s = LogSurvey::default();
+        let mut stream = RecordStream::open(path, opts)?;
+        while let Some(r) = stream.next_record()? {
+            match &r.record {
+                LogRecord::Laser(l) if r.rear_laser => s.rear.push(l.ipc_timestamp),
+                LogRecord::Laser(l) => s.front.push(l.ipc_timestamp),
+                LogRecord::TruePos(t) if truth == TruthSource::TruePos => {
+                    s.truepos.push((t.ipc_timestamp, t.truth));
+                }
+                other => {
+                    s.param_max_range_m = s.param_max_range_m.or(param_max_range(other));
+                }
+            }
+        }
+        s.counts = stream.counts().clone();
+        s.truepos = sorted_truepos(std::mem::take(&mut s.truepos));
+        Ok(s)
+    }
+
+    /// Whether a laser message is one of the run's frames: front lasers only, unless the log
+    /// has nothing but rear ones (interleaving two scanners would make every other frame look
+    /// backwards).
+    fn uses(&self, rear_laser: bool) -> bool {
+        !rear_laser || self.front.count == 0
+    }
+
+    /// The stamps of the lasers used.
+    fn stamps(&self) -> &StampCheck {
+        if self.front.count > 0 {
+            &self.front
+        } else {
+            &self.rear
+        }
+    }
+
+    /// Frames the run has (lasers used).
+    pub fn frames(&self) -> usize {
+        self.stamps().count
+    }
+}
+
+/// Reads the log at `path` a second time, after its [`LogSurvey`], and hands each frame of its
+/// run to `on_frame` in order: the frames [`load_run`] gives, one at a time, so memory holds one
+/// line and one frame whatever the log's size. `perturb` as for [`log_to_run`].
+pub fn stream_frames(
+    path: &std::path::Path,
+    opts: ReadOptions,
+    survey: &LogSurvey,
+    truth: TruthSource,
+    perturb: impl FnMut(Pose2) -> Pose2,
+    mut on_frame: impl FnMut(Frame),
+) -> Result<(), RealLogError> {
+    let name = path.display().to_string();
+    if survey.frames() == 0 {
+        return Err(RealLogError::NoLaser(name));
+    }
+    if truth == TruthSource::TruePos && survey.truepos.is_empty() {
+        return Err(RealLogError::NoTruePos(name));
+    }
+    let max_range_m = max_range_or_default(
+        survey.param_max_range_m,
+        survey.counts.robotlaser_max_range_m,
+    );
+    let use_stamps = survey.stamps().usable();
+    let tp = &survey.truepos;
+    let mut maker = FrameMaker::new(&name, truth, tp, max_range_m, use_stamps, perturb);
+    let mut stream = RecordStream::open(path, opts)?;
+    while let Some(r) = stream.next_record()? {
+        if let LogRecord::Laser(l) = &r.record
+            && survey.uses(r.rear_laser)
+        {
+            on_frame(maker.make(l)?);
+        }
+    }
+    Ok(())
 }
 
 /// The entry of `sorted` (by time) nearest to `t`: (|gap| seconds, pose). `sorted` is non-empty.

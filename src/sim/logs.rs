@@ -1,84 +1,35 @@
 //! Writing simulated runs as CARMEN logs, plus a JSON manifest.
 //!
-//! Per frame, in this order: `ODOM` (odometry pose; speeds from the previous frame), `FLASER`
-//! (181 ranges; the odometry pose in both pose slots, as a robot's logger would record it) and
-//! `TRUEPOS` (ground truth beside the odometry pose). Timestamps are seconds since the run
-//! started; the host is `placewords-sim`. `#` comment lines mark each lap and its doors.
+//! Each run's log is a header comment, then its laps as [`LapWriter`] writes them (a `#` line
+//! per lap naming its doors; `ODOM`, `FLASER` and `TRUEPOS` per frame). Timestamps are seconds
+//! since the run started; the host is `placewords-sim`. [`LogsWriter`] appends lap after lap to
+//! the open run's file, so a simulation of any length is written in the memory of a few laps.
 
-use crate::geom::{Pose2, wrap_angle};
-use crate::io::atomic::write_atomic;
-use crate::io::carmen::{LaserRecord, LogRecord, OdomRecord, TruePosRecord, write_record};
-use crate::log::RunLog;
+use crate::io::atomic::AtomicFile;
+use crate::io::carmen::LapWriter;
+use crate::log::{LapLog, RunLog};
 use crate::sim::plan::SimPlan;
 use serde::{Deserialize, Serialize};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Host name written in every record.
 pub const HOST: &str = "placewords-sim";
 
-/// The CARMEN text of one run.
-pub fn carmen_log(scn: &SimPlan, run: &RunLog) -> String {
-    let mut out = String::new();
-    out.push_str(&format!(
+/// The comment line that opens run `run`'s log.
+fn header(scn: &SimPlan, run: usize) -> String {
+    format!(
         "# placewords simulation: scenario {}, seed {}, run {}, route {} of world {}\n",
-        scn.name, scn.seed, run.run, scn.route.id, scn.world.name
-    ));
-    let mut prev: Option<(f64, Pose2)> = None;
+        scn.name, scn.seed, run, scn.route.id, scn.world.name
+    )
+}
+
+/// The CARMEN text of one run (the text [`LogsWriter`] writes to its file).
+pub fn carmen_log(scn: &SimPlan, run: &RunLog) -> String {
+    let mut out = header(scn, run.run);
+    let mut writer = LapWriter::new(HOST);
     for lap in &run.laps {
-        out.push_str(&format!(
-            "# lap {} doors {}: open [{}]\n",
-            lap.lap,
-            lap.door_config,
-            lap.open_doors.join(" ")
-        ));
-        for f in &lap.frames {
-            let odom = f.odom.0;
-            let (tv, rv) = match prev {
-                Some((t0, p0)) if f.time_s > t0 => {
-                    let dt = f.time_s - t0;
-                    let d = p0.between(&odom);
-                    let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
-                    (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
-                }
-                _ => (0.0, 0.0),
-            };
-            prev = Some((f.time_s, odom));
-            write_record(
-                &mut out,
-                &LogRecord::Odom(OdomRecord {
-                    pose: odom,
-                    tv_m_s: tv,
-                    rv_rad_s: rv,
-                    accel_m_s2: 0.0,
-                    ipc_timestamp: f.time_s,
-                    host: HOST.into(),
-                    logger_timestamp: f.time_s,
-                }),
-            );
-            write_record(
-                &mut out,
-                &LogRecord::Laser(LaserRecord {
-                    start_angle_rad: f.scan.layout.start_angle_rad,
-                    fov_rad: f.scan.layout.fov_rad(),
-                    ranges_m: f.scan.ranges_m.clone(),
-                    pose: odom,
-                    odom,
-                    ipc_timestamp: f.time_s,
-                    host: HOST.into(),
-                    logger_timestamp: f.time_s,
-                }),
-            );
-            write_record(
-                &mut out,
-                &LogRecord::TruePos(TruePosRecord {
-                    truth: f.truth.0,
-                    odom,
-                    ipc_timestamp: f.time_s,
-                    host: HOST.into(),
-                    logger_timestamp: f.time_s,
-                }),
-            );
-        }
+        writer.write_lap(&mut out, lap);
     }
     out
 }
@@ -118,7 +69,8 @@ pub fn log_file_name(run: usize) -> String {
     format!("run-{run:03}.log")
 }
 
-pub fn manifest(scn: &SimPlan, runs: &[RunLog], laps_override: Option<usize>) -> Manifest {
+/// The manifest of a simulation whose runs are `runs`.
+pub fn manifest(scn: &SimPlan, runs: Vec<ManifestRun>, laps_override: Option<usize>) -> Manifest {
     Manifest {
         placewords_version: env!("CARGO_PKG_VERSION").into(),
         scenario: scn.path.display().to_string(),
@@ -127,25 +79,7 @@ pub fn manifest(scn: &SimPlan, runs: &[RunLog], laps_override: Option<usize>) ->
         route: scn.route.id.clone(),
         seed: scn.seed,
         laps_override,
-        runs: runs
-            .iter()
-            .map(|r| ManifestRun {
-                run: r.run,
-                file: log_file_name(r.run),
-                start_waypoint: scn.runs[r.run].start_waypoint,
-                frames: r.frames().count(),
-                laps: r
-                    .laps
-                    .iter()
-                    .map(|l| ManifestLap {
-                        lap: l.lap,
-                        door_config: l.door_config.clone(),
-                        open_doors: l.open_doors.clone(),
-                        frames: l.frames.len(),
-                    })
-                    .collect(),
-            })
-            .collect(),
+        runs,
     }
 }
 
@@ -157,22 +91,127 @@ pub fn write_logs(
     laps_override: Option<usize>,
     dir: &Path,
 ) -> std::io::Result<Vec<PathBuf>> {
-    let ctx = |p: &Path, e: std::io::Error| {
-        std::io::Error::new(e.kind(), format!("{}: cannot write: {e}", p.display()))
-    };
-    use rayon::prelude::*;
-    let mut written = Vec::new();
-    // Formatting dominates; format the runs in parallel, write them one by one.
-    let texts: Vec<String> = runs.par_iter().map(|r| carmen_log(scn, r)).collect();
-    for (r, text) in runs.iter().zip(texts) {
-        let p = dir.join(log_file_name(r.run));
-        write_atomic(&p, text.as_bytes()).map_err(|e| ctx(&p, e))?;
-        written.push(p);
+    let mut writer = LogsWriter::new(scn, laps_override, dir);
+    for r in runs {
+        writer.start_run(r.run)?;
+        for lap in &r.laps {
+            writer.push_lap(r.run, lap)?;
+        }
     }
-    let p = dir.join("manifest.json");
-    let json = serde_json::to_string_pretty(&manifest(scn, runs, laps_override))
-        .map_err(|e| std::io::Error::other(e.to_string()))?;
-    write_atomic(&p, (json + "\n").as_bytes()).map_err(|e| ctx(&p, e))?;
-    written.push(p);
-    Ok(written)
+    writer.finish()
+}
+
+/// `e` with the path it happened at.
+fn at(p: &Path, e: std::io::Error) -> std::io::Error {
+    std::io::Error::new(e.kind(), format!("{}: cannot write: {e}", p.display()))
+}
+
+/// The log file of the run being written.
+struct OpenRun {
+    file: AtomicFile,
+    carmen: LapWriter,
+    manifest: ManifestRun,
+}
+
+/// Writes a simulation's folder lap by lap: laps arrive in run order, each appended to its run's
+/// `run-NNN.log` (written under a temporary name, renamed when the run ends); [`Self::finish`]
+/// writes `manifest.json`. Holds one lap's text at a time.
+pub struct LogsWriter<'a> {
+    scn: &'a SimPlan,
+    laps_override: Option<usize>,
+    dir: PathBuf,
+    open: Option<OpenRun>,
+    runs: Vec<ManifestRun>,
+    written: Vec<PathBuf>,
+    text: String,
+}
+
+impl<'a> LogsWriter<'a> {
+    /// A writer of `scn`'s logs into `dir` (created if missing).
+    pub fn new(scn: &'a SimPlan, laps_override: Option<usize>, dir: &Path) -> Self {
+        LogsWriter {
+            scn,
+            laps_override,
+            dir: dir.to_path_buf(),
+            open: None,
+            runs: Vec::new(),
+            written: Vec::new(),
+            text: String::new(),
+        }
+    }
+
+    /// Ends the runs before `run` (those without laps get a log with only the header) and opens
+    /// `run`'s log if it is not open yet.
+    pub fn start_run(&mut self, run: usize) -> std::io::Result<()> {
+        while self.runs.len() + usize::from(self.open.is_some()) <= run {
+            self.close_run()?;
+            self.open_run(self.runs.len())?;
+        }
+        Ok(())
+    }
+
+    /// Appends lap `lap` of run `run` (runs in order, laps in order within a run).
+    pub fn push_lap(&mut self, run: usize, lap: &LapLog) -> std::io::Result<()> {
+        self.start_run(run)?;
+        let open = self.open.as_mut().expect("start_run opened the run");
+        self.text.clear();
+        open.carmen.write_lap(&mut self.text, lap);
+        open.file
+            .write_all(self.text.as_bytes())
+            .map_err(|e| at(open.file.path(), e))?;
+        open.manifest.frames += lap.frames.len();
+        open.manifest.laps.push(ManifestLap {
+            lap: lap.lap,
+            door_config: lap.door_config.clone(),
+            open_doors: lap.open_doors.clone(),
+            frames: lap.frames.len(),
+        });
+        Ok(())
+    }
+
+    /// Ends the last run, writes `manifest.json`; returns the paths written.
+    pub fn finish(mut self) -> std::io::Result<Vec<PathBuf>> {
+        self.close_run()?;
+        let p = self.dir.join("manifest.json");
+        let runs = std::mem::take(&mut self.runs);
+        let manifest = manifest(self.scn, runs, self.laps_override);
+        // Written straight to the file: a million laps' manifest is not held twice as text.
+        let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
+        serde_json::to_writer_pretty(&mut file, &manifest)
+            .map_err(std::io::Error::other)
+            .and_then(|()| file.write_all(b"\n"))
+            .and_then(|()| file.commit())
+            .map_err(|e| at(&p, e))?;
+        self.written.push(p);
+        Ok(self.written)
+    }
+
+    fn open_run(&mut self, run: usize) -> std::io::Result<()> {
+        let p = self.dir.join(log_file_name(run));
+        let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
+        file.write_all(header(self.scn, run).as_bytes())
+            .map_err(|e| at(&p, e))?;
+        self.open = Some(OpenRun {
+            file,
+            carmen: LapWriter::new(HOST),
+            manifest: ManifestRun {
+                run,
+                file: log_file_name(run),
+                start_waypoint: self.scn.runs[run].start_waypoint,
+                frames: 0,
+                laps: Vec::new(),
+            },
+        });
+        Ok(())
+    }
+
+    fn close_run(&mut self) -> std::io::Result<()> {
+        if let Some(open) = self.open.take() {
+            let p = open.file.path().to_path_buf();
+            open.file.commit().map_err(|e| at(&p, e))?;
+            self.written.push(p);
+            self.runs.push(open.manifest);
+        }
+        Ok(())
+    }
 }

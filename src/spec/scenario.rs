@@ -385,12 +385,29 @@ fn run_direction(v: &Val<'_>, ctx: &str, d: &mut Diags) -> Option<bool> {
 
 /// A lap count within 1..=[`MAX_LAPS`]; the one rule for files and for `--laps`.
 pub fn check_laps(n: i64) -> Result<usize, String> {
-    if n < 1 {
-        Err(format!("laps = {n}; a run needs 1 lap or more"))
-    } else if n as u64 > MAX_LAPS as u64 {
+    if n as u64 > MAX_LAPS as u64 && n >= 1 {
         Err(format!(
             "laps = {n} is more than {MAX_LAPS}, the most one run may drive (every lap is kept \
              in memory until evaluated); split the laps over several [[runs]]"
+        ))
+    } else {
+        check_streamed_laps(n)
+    }
+}
+
+/// Most laps per run `simulate --laps` accepts: it writes each lap as it is made, so memory is
+/// no limit, but a million laps of the smallest world is about 1.8 TB of logs and days of work.
+pub const MAX_STREAMED_LAPS: usize = 1_000_000;
+
+/// A lap count within 1..=[`MAX_STREAMED_LAPS`], for `simulate --laps` (which holds no lap
+/// after writing it).
+pub fn check_streamed_laps(n: i64) -> Result<usize, String> {
+    if n < 1 {
+        Err(format!("laps = {n}; a run needs 1 lap or more"))
+    } else if n as u64 > MAX_STREAMED_LAPS as u64 {
+        Err(format!(
+            "laps = {n} is more than {MAX_STREAMED_LAPS}, the most `simulate` writes per run \
+             (about 1.8 MB of log per lap of loop-small)"
         ))
     } else {
         Ok(n as usize)

@@ -504,3 +504,127 @@ fn a_world_without_a_route_is_still_written_and_a_route_can_be_added() {
     assert_eq!(back.doors.len(), 1);
     assert_eq!(back.walls, spec.walls);
 }
+
+/// A file written piece by piece appears under its name only when committed; abandoned (an
+/// error, a panic), nothing is left, not even the temporary.
+#[test]
+fn an_atomic_file_appears_whole_or_not_at_all() {
+    use placewords::io::atomic::AtomicFile;
+    use std::io::Write;
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("a.log");
+    let mut f = AtomicFile::create(&p).unwrap();
+    f.write_all(b"one\n").unwrap();
+    assert!(!p.exists(), "not before the commit");
+    f.write_all(b"two\n").unwrap();
+    f.commit().unwrap();
+    assert_eq!(std::fs::read_to_string(&p).unwrap(), "one\ntwo\n");
+    let q = dir.path().join("b.log");
+    let mut g = AtomicFile::create(&q).unwrap();
+    g.write_all(b"half").unwrap();
+    drop(g);
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(left.len(), 1, "only a.log: {left:?}");
+}
+
+/// The frames of a log made one at a time (survey, then a second pass) are the frames of the
+/// log loaded whole, truth from TRUEPOS or from the corrected poses, strict or lenient; a bad
+/// line is the same located error either way.
+#[test]
+fn streamed_frames_are_the_frames_of_the_log_loaded_whole() {
+    use placewords::io::real_log::{LogSurvey, load_run, stream_frames};
+    let mut cases = vec![
+        (fixture("mixed.log"), TruthSource::TruePos, false),
+        (fixture("mixed.log"), TruthSource::Corrected, false),
+        (fixture("malformed.log"), TruthSource::Corrected, true),
+    ];
+    if let Some(dir) = shared("carmen") {
+        cases.push((
+            dir.join("csail-corrected.log.gz"),
+            TruthSource::Corrected,
+            false,
+        ));
+    }
+    for (path, truth, lenient) in cases {
+        let opts = ReadOptions { lenient };
+        let (run, counts) = load_run(&path, opts, truth, noise_free).unwrap();
+        let survey = LogSurvey::read(&path, opts, truth).unwrap();
+        let mut frames = Vec::new();
+        stream_frames(&path, opts, &survey, truth, noise_free, |f| frames.push(f)).unwrap();
+        let whole: Vec<_> = run.frames().cloned().collect();
+        assert_eq!(frames, whole, "{} {truth:?}", path.display());
+        assert_eq!(survey.frames(), whole.len());
+        assert_eq!(survey.counts.skipped_lines, counts.skipped_lines);
+    }
+    let bad = fixture("malformed.log");
+    let e = LogSurvey::read(&bad, ReadOptions::default(), TruthSource::Corrected).unwrap_err();
+    assert!(
+        e.to_string().contains("malformed.log:4:16: FLASER field 3"),
+        "{e}"
+    );
+}
+
+/// `recognize` gives the same report whether it reads the log as a stream or loads it whole
+/// (for pictures): on a simulated log with TRUEPOS lines, thinned, with ICP.
+#[test]
+fn a_log_read_as_a_stream_gives_the_report_of_the_log_loaded_whole() {
+    use placewords::experiment::real::{RealLogOptions, recognize_log};
+    use placewords::experiment::{ExperimentOptions, load_scenario};
+    let scn = load_scenario(&manifest().join("scenarios/smoke.toml")).unwrap();
+    let runs = placewords::sim::simulate(&scn.sim, Some(4), &|| {}).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    placewords::sim::logs::write_logs(&scn.sim, &runs, Some(4), dir.path()).unwrap();
+    let log = dir.path().join("run-001.log");
+    let cases = [
+        (TruthSource::TruePos, "none", 1),
+        (TruthSource::Corrected, "proportional", 3),
+    ];
+    for (truth, noise, scan_step) in cases {
+        let opts = RealLogOptions {
+            lenient: false,
+            truth,
+            noise: placewords::experiment::real::parse_noise_model(noise).unwrap(),
+            seed: 7,
+            scan_step,
+        };
+        let exp = ExperimentOptions {
+            icp: true,
+            ..ExperimentOptions::default()
+        };
+        let report = |keep_runs: bool| {
+            let (e, skipped) = recognize_log(
+                &log,
+                &opts,
+                "run-000",
+                &scn.recognizer,
+                &scn.evaluation,
+                &exp,
+                keep_runs,
+            )
+            .unwrap();
+            assert_eq!(skipped, 0);
+            assert_eq!(e.runs.len(), usize::from(keep_runs));
+            without_seconds(
+                serde_json::from_str(&placewords::report::json::to_json(&e.report)).unwrap(),
+            )
+        };
+        let streamed = report(false);
+        let pairs = |l: &serde_json::Value| l["pairs"].as_u64().unwrap_or(0);
+        let levels = streamed["levels"].as_array().unwrap();
+        assert!(levels.iter().any(|l| pairs(l) > 0), "something matched");
+        assert_eq!(streamed, report(true), "{truth:?}, every {scan_step}");
+    }
+}
+
+/// `v` with every value under a key naming seconds removed (timings differ run to run).
+fn without_seconds(v: serde_json::Value) -> serde_json::Value {
+    match v {
+        serde_json::Value::Object(m) => m
+            .into_iter()
+            .filter(|(k, _)| !k.contains("seconds"))
+            .map(|(k, x)| (k, without_seconds(x)))
+            .collect(),
+        serde_json::Value::Array(a) => a.into_iter().map(without_seconds).collect(),
+        x => x,
+    }
+}

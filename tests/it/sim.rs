@@ -483,6 +483,65 @@ fn golden_digest_of_the_smoke_scenario() {
     );
 }
 
+/// `simulate` writes each lap as it is made; its files are the text the in-memory writer gives
+/// (`carmen_log`), byte for byte: they hash to the golden digest of the smoke scenario (minted
+/// from the in-memory path before the logs were streamed).
+#[test]
+fn simulate_command_streams_the_golden_logs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("logs");
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(["simulate", "scenarios/smoke.toml", "--quiet", "-o"])
+        .arg(&out)
+        .current_dir(root())
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for run in 0..2 {
+        h = fnv1a(
+            &std::fs::read(out.join(format!("run-{run:03}.log"))).unwrap(),
+            h,
+        );
+    }
+    let want = std::fs::read_to_string(root().join("tests/golden/sim-smoke.digest")).unwrap();
+    assert_eq!(want.trim(), format!("{h:016x}"));
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(
+        names.len(),
+        3,
+        "two logs and the manifest, no temporary: {names:?}"
+    );
+}
+
+/// `simulate --laps` takes more laps than a scenario file may hold (it keeps no lap), but not
+/// none, a negative count or garbage.
+#[test]
+fn simulate_takes_more_laps_than_a_file_but_not_none() {
+    use placewords::spec::scenario::{MAX_LAPS, check_laps, check_streamed_laps};
+    assert!(check_laps(MAX_LAPS as i64 + 1).is_err());
+    assert_eq!(check_streamed_laps(100_000), Ok(100_000));
+    assert!(
+        check_streamed_laps(0)
+            .unwrap_err()
+            .contains("1 lap or more")
+    );
+    assert!(check_streamed_laps(-5).is_err());
+    assert!(check_streamed_laps(i64::MAX).is_err());
+    for bad in ["0", "x", "1e3", ""] {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"))
+            .args(["simulate", "scenarios/smoke.toml", "--laps", bad, "-o"])
+            .arg(std::env::temp_dir().join("placewords-never-written"))
+            .current_dir(root())
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "--laps {bad:?}");
+    }
+}
+
 /// A corridor closed by a door: the run ends with an error naming the place and the lap.
 #[test]
 fn a_blocked_robot_ends_the_run_with_an_error_naming_the_place() {
