@@ -467,12 +467,11 @@ impl WordMatcher {
         }
     }
 
-    /// The pair before (c, p) on the best chain of configuration k.
-    fn step_back(&self, c: WordId, entry: &Entry, k: usize) -> Option<(WordId, usize)> {
+    /// The pair before an entry's pair on the best chain of configuration k.
+    fn step_back(entry: &Entry, k: usize) -> Option<(WordId, usize)> {
         if entry.len[k] <= 1 {
             return None;
         }
-        let _ = c;
         Some((entry.back_word[k], entry.back_idx[k] as usize))
     }
 
@@ -530,7 +529,7 @@ impl WordMatcher {
             {
                 break;
             }
-            let (pc, pidx) = self.step_back(wc, &we, k)?;
+            let (pc, pidx) = Self::step_back(&we, k)?;
             let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
             (wc, we) = (pc, pe);
