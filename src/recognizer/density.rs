@@ -88,9 +88,9 @@ pub struct DensityKernel {
 #[derive(Clone, Debug, Default)]
 pub struct RayDeltas {
     stride: isize,
-    /// Per prefix-tree node, in depth-first order.
-    deltas: Vec<i32>,
-    skip: Vec<u32>,
+    /// Per prefix-tree node, in depth-first order: (index step, index just past its subtree),
+    /// side by side so that the walk reads one array.
+    nodes: Vec<(i32, u32)>,
 }
 
 impl DensityKernel {
@@ -167,12 +167,12 @@ impl DensityKernel {
         let stride = stride as isize;
         RayDeltas {
             stride,
-            deltas: self
+            nodes: self
                 .tree_offsets
                 .iter()
-                .map(|&(ox, oy)| (oy as isize * stride + ox as isize) as i32)
+                .zip(&self.tree_skip)
+                .map(|(&(ox, oy), &skip)| ((oy as isize * stride + ox as isize) as i32, skip))
                 .collect(),
-            skip: self.tree_skip.clone(),
         }
     }
 
@@ -194,19 +194,20 @@ impl DensityKernel {
         let mut count = 0u32;
         // Walking the prefix tree visits each shared ray prefix once (about 22 % fewer steps
         // than ray by ray for a 50-cell kernel) and gives the same count.
-        let n = deltas.deltas.len();
+        let nodes = &deltas.nodes[..];
         let mut k = 0;
-        while k < n {
-            let i = (base as isize).wrapping_add(deltas.deltas[k] as isize) as usize & mask;
+        while let Some(&(delta, skip)) = nodes.get(k) {
+            let i = (base as isize).wrapping_add(delta as isize) as usize & mask;
             let v = cells[i];
             if v >= CELL_OCCUPIED_FROM {
-                k = deltas.skip[k] as usize;
+                k = skip as usize;
                 continue;
             }
-            if v != CELL_UNKNOWN && stamps[i] != stamp {
-                stamps[i] = stamp;
-                count += 1;
-            }
+            // Branch-free: whether a free or unknown cell was seen before is data the branch
+            // predictor cannot learn. Stamping an unknown cell is harmless (it never counts).
+            let fresh = (v != CELL_UNKNOWN) & (stamps[i] != stamp);
+            count += fresh as u32;
+            stamps[i] = stamp;
             k += 1;
         }
         count

@@ -80,6 +80,8 @@ pub struct LocalGrid {
     half: i32,
     has_origin: bool,
     visited: Visited,
+    /// `65536 / n` for trace lengths n of up to a window's side (a division per beam saved).
+    inv_steps: Vec<f64>,
 }
 
 impl LocalGrid {
@@ -106,6 +108,7 @@ impl LocalGrid {
             half: side as i32 / 2,
             has_origin: false,
             visited: Visited::default(),
+            inv_steps: (0..=side).map(|n| 65536.0 / n as f64).collect(),
         }
     }
 
@@ -215,6 +218,15 @@ impl LocalGrid {
         // Beam directions by rotation, not a sin_cos per beam (drift over 1000 beams ~1e-13).
         let (mut s, mut c) = (sensor.theta + scan.layout.start_angle_rad).sin_cos();
         let (ds, dc) = scan.layout.step_rad.sin_cos();
+        // Where beams with t trailing zeros start (t < 4; the others start at the sensor): once
+        // per scan rather than a division per beam.
+        let starts: [f64; 4] = std::array::from_fn(|t| {
+            if step <= 0.0 {
+                0.0
+            } else {
+                0.5 * self.cell_m / (step * (1u32 << (t + 1)) as f64)
+            }
+        });
         for i in 0..n {
             let r = scan.ranges_m[i];
             let (bs, bc) = (s, c);
@@ -235,11 +247,7 @@ impl LocalGrid {
             } else {
                 i.trailing_zeros().min(31)
             };
-            let start = if t >= 4 || step <= 0.0 {
-                0.0
-            } else {
-                0.5 * self.cell_m / (step * (1u32 << (t + 1)) as f64)
-            };
+            let start = if t >= 4 { 0.0 } else { starts[t as usize] };
             let (ex, ey) = self.cell_of(sensor.x + bc * len, sensor.y + bs * len);
             if start >= len {
                 if hit {
@@ -270,12 +278,16 @@ impl LocalGrid {
         let (dx, dy) = ((x1 - x0) as i64, (y1 - y0) as i64);
         let n = dx.abs().max(dy.abs());
         if n > 0 {
-            let inv = 65536.0 / n as f64;
+            let inv = match self.inv_steps.get(n as usize) {
+                Some(&inv) => inv,
+                None => 65536.0 / n as f64,
+            };
             let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
             let mut xf = ((x0 as i64) << 16) + 0x8000;
             let mut yf = ((y0 as i64) << 16) + 0x8000;
             let (shift, mask) = (self.shift, self.mask);
-            let cells = &mut self.cells[..];
+            // Exactly side² cells: indices masked by side² − 1 need no bounds check.
+            let cells = &mut self.cells[..=mask];
             for _ in 0..n {
                 let i = (((yf >> 16) << shift) + (xf >> 16)) as usize & mask;
                 cells[i] = FREE_NEXT[(cells[i] & 15) as usize];

@@ -564,8 +564,10 @@ impl WordMatcher {
             return None;
         }
         let anchors = self.chain_anchors(&word_pairs, dir);
+        let mut placed = Vec::new();
         if self.params.verify
-            && let Some(reason) = self.verify(&word_pairs, dir, &anchors, extends_reported)
+            && let Some(reason) =
+                self.verify(&word_pairs, dir, &anchors, extends_reported, &mut placed)
         {
             self.rejections.add(reason);
             return None;
@@ -576,11 +578,12 @@ impl WordMatcher {
             chain,
             word_pairs,
             anchors,
+            placed,
         })
     }
 
     /// Marks a candidate's new pairs reported and makes its match.
-    fn emit(&mut self, c: WordId, k: usize, cand: Candidate) -> Match {
+    fn emit(&mut self, c: WordId, k: usize, mut cand: Candidate) -> Match {
         let d = cand.dir as usize;
         // Counted now, not when the candidate was found: another candidate of the same word may
         // have reported a pair this chain shares since.
@@ -592,16 +595,23 @@ impl WordMatcher {
         let fresh_from = cand.chain.len() - fresh;
         let mut pairs = Vec::new();
         let mut refs = Vec::with_capacity(fresh);
-        for ((&(wc, widx), &(_, past)), &anchor) in cand
+        // Verification placed the last `placed.len()` word pairs already: the same placements.
+        let placed_from = cand.chain.len() - cand.placed.len();
+        for (j, ((&(wc, widx), &(_, past)), &anchor)) in cand
             .chain
             .iter()
             .zip(&cand.word_pairs)
             .zip(&cand.anchors)
+            .enumerate()
             .skip(fresh_from)
         {
             self.memo[d][wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
-            self.aligned_pairs(wc, past, cand.dir, anchor, &mut pairs);
+            let placement = match j.checked_sub(placed_from) {
+                Some(i) => cand.placed[i].take(),
+                None => self.placement(wc, past, cand.dir, anchor),
+            };
+            self.aligned_pairs(wc, past, cand.dir, placement, &mut pairs);
         }
         self.rejections.accepted += 1;
         pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
@@ -617,7 +627,8 @@ impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
     /// both sides; the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
-    /// the n-gram extends a verified one) must be small.
+    /// the n-gram extends a verified one) must be small. The placements it makes (of the pairs
+    /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
     fn verify(
@@ -626,6 +637,7 @@ impl WordMatcher {
         dir: Direction,
         anchors: &[i64],
         newest_only: bool,
+        placed: &mut Vec<Option<Placement>>,
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
         let past_start = |w: WordId| self.reading_start(w, dir);
@@ -653,10 +665,12 @@ impl WordMatcher {
         let (mut sum, mut count) = (0.0, 0usize);
         let from = if newest_only { word_pairs.len() - 1 } else { 0 };
         for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
-            if let Some(w) = self.placement(c, p, dir, anchor) {
+            let placement = self.placement(c, p, dir, anchor);
+            if let Some(w) = &placement {
                 sum += w.cost * w.count() as f64;
                 count += w.count();
             }
+            placed.push(placement);
         }
         let rms = if count == 0 {
             f64::INFINITY
@@ -788,18 +802,18 @@ impl WordMatcher {
     }
 
     /// Eq. 2: aligned observation pairs of current word `c` and past word `p` read in direction
-    /// `dir` (the one place pairs are made; read backwards, the past id decreases as the query
-    /// id increases).
+    /// `dir` at their `placement` (the one place pairs are made; read backwards, the past id
+    /// decreases as the query id increases).
     fn aligned_pairs(
         &self,
         c: WordId,
         p: WordId,
         dir: Direction,
-        anchor: i64,
+        placement: Option<Placement>,
         out: &mut Vec<AlignedRun>,
     ) {
         let obs = self.words.observations();
-        let Some(w) = self.placement(c, p, dir, anchor) else {
+        let Some(w) = placement else {
             return;
         };
         let s2 = self.word(c).first_obs as i64;
@@ -822,6 +836,8 @@ struct Candidate {
     chain: Vec<(WordId, usize)>,
     word_pairs: Vec<(WordId, WordId)>,
     anchors: Vec<i64>,
+    /// Placements verification made, of the last `placed.len()` word pairs.
+    placed: Vec<Option<Placement>>,
 }
 
 /// A placement of the alignment: windows start at `a` in the current word and `b` in the past
