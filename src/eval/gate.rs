@@ -447,4 +447,67 @@ mod tests {
         );
         assert!(o[1].passed, "recall 0 >= 0");
     }
+
+    /// Bounds in `[expect.levels.same]` / `[expect.levels.opposite]` apply to that direction's
+    /// figures alone and their outcomes name the direction.
+    #[test]
+    fn direction_bounds_check_one_direction_and_name_it() {
+        use crate::spec::evaluation::DirectionExpectation;
+        let reports: Vec<Report> = (1..=3)
+            .map(|seed| {
+                let mut r = sample("R", [0.9; 3], [0.5; 3]);
+                r.seed = seed;
+                let d = &mut r.levels[2].scores.directions;
+                (d.same.precision, d.same.pairs) = (0.95, 50);
+                (d.opposite.precision, d.opposite.pairs) = (0.99, 40);
+                d.opposite.recall = 0.3;
+                if seed == 2 {
+                    d.opposite.precision = 0.8;
+                }
+                r
+            })
+            .collect();
+        let mut entry = expect(3, 0.5, 0.0, None);
+        entry.same = Some(DirectionExpectation {
+            min_precision: Some(0.9),
+            ..DirectionExpectation::default()
+        });
+        entry.opposite = Some(DirectionExpectation {
+            min_precision: Some(0.9),
+            min_recall: Some(0.2),
+            ..DirectionExpectation::default()
+        });
+        let spec = ExpectSpec {
+            levels: vec![entry],
+            icp: None,
+            quantile: None,
+        };
+        let o = check_seeds("R", &reports, &spec);
+        assert_eq!(o.len(), 5, "{o:?}");
+        assert!(o[0].passed && o[1].passed && o[2].passed && o[4].passed);
+        assert_eq!(o[2].name(), "R/levels=3/same/precision");
+        assert_eq!(o[3].direction, Some(Direction::Opposite));
+        assert_eq!(
+            o[3].line(),
+            "FAIL R levels=3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
+        );
+        assert_eq!(o[3].name(), "R/levels=3/opposite/precision");
+        assert_eq!(exit_code(&o), 1);
+
+        let none: Vec<Report> = reports
+            .into_iter()
+            .map(|mut r| {
+                r.levels[2].scores.directions.opposite.no_pairs = true;
+                r
+            })
+            .collect();
+        let o = check_seeds("R", &none, &spec);
+        assert!(!o[3].passed);
+        assert!(
+            o[3].line()
+                .ends_with("opposite precision >= 0.900: no opposite matches at any seed"),
+            "{}",
+            o[3].line()
+        );
+    }
 }

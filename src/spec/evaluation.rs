@@ -63,7 +63,7 @@ pub struct LevelExpectation {
     /// Minimum pair precision in [0, 1].
     #[serde(default)]
     pub min_precision: Option<f64>,
-    /// Minimum same-direction recall in [0, 1].
+    /// Minimum recall in [0, 1] (revisits of both directions).
     #[serde(default)]
     pub min_recall: Option<f64>,
     /// Minimum visit recall in [0, 1].
@@ -132,7 +132,7 @@ impl LevelExpectation {
 pub struct Expectation {
     /// Minimum pair precision in [0, 1].
     pub min_precision: Option<f64>,
-    /// Minimum same-direction recall in [0, 1].
+    /// Minimum recall in [0, 1] (revisits of both directions).
     pub min_recall: Option<f64>,
     /// Minimum visit recall in [0, 1].
     pub min_visit_recall: Option<f64>,
@@ -305,7 +305,17 @@ fn direction_expectation(
         return None;
     };
     let ctx = format!("[expect.levels.{dir}] of {entry}");
-    unknown_keys(t, EXPECT_DIRECTION_KEYS, &ctx, d);
+    if let Some((kat, _)) = get(t, "max_seconds_per_lap") {
+        d.at(
+            kat,
+            format!(
+                "`max_seconds_per_lap` in {ctx}: time is not counted per direction; \
+                 bound it in the levels entry itself"
+            ),
+        );
+    }
+    let known = [EXPECT_DIRECTION_KEYS, &["max_seconds_per_lap"]].concat();
+    unknown_keys(t, &known, &ctx, d);
     let e = expectation(t, &ctx, d);
     Some(DirectionExpectation {
         min_precision: e.min_precision,
