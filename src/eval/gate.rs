@@ -448,12 +448,10 @@ mod tests {
         assert!(o[1].passed, "recall 0 >= 0");
     }
 
-    /// Bounds in `[expect.levels.same]` / `[expect.levels.opposite]` apply to that direction's
-    /// figures alone and their outcomes name the direction.
-    #[test]
-    fn direction_bounds_check_one_direction_and_name_it() {
-        use crate::spec::evaluation::DirectionExpectation;
-        let reports: Vec<Report> = (1..=3)
+    /// Three seeds whose levels=3 directions are set: same precision 0.95; opposite precision
+    /// 0.99 (0.8 at seed 2), recall 0.3.
+    fn reports_with_directions() -> Vec<Report> {
+        (1..=3)
             .map(|seed| {
                 let mut r = sample("R", [0.9; 3], [0.5; 3]);
                 r.seed = seed;
@@ -466,23 +464,35 @@ mod tests {
                 }
                 r
             })
-            .collect();
+            .collect()
+    }
+
+    /// levels=3 with precision >= 0.9 for `same`, and precision >= 0.9, recall >= 0.2 for
+    /// `opposite`.
+    fn direction_spec() -> ExpectSpec {
+        use crate::spec::evaluation::DirectionExpectation;
         let mut entry = expect(3, 0.5, 0.0, None);
-        entry.same = Some(DirectionExpectation {
+        let p = DirectionExpectation {
             min_precision: Some(0.9),
             ..DirectionExpectation::default()
-        });
+        };
+        entry.same = Some(p.clone());
         entry.opposite = Some(DirectionExpectation {
-            min_precision: Some(0.9),
             min_recall: Some(0.2),
-            ..DirectionExpectation::default()
+            ..p
         });
-        let spec = ExpectSpec {
+        ExpectSpec {
             levels: vec![entry],
             icp: None,
             quantile: None,
-        };
-        let o = check_seeds("R", &reports, &spec);
+        }
+    }
+
+    /// Bounds in `[expect.levels.same]` / `[expect.levels.opposite]` apply to that direction's
+    /// figures alone and their outcomes name the direction.
+    #[test]
+    fn direction_bounds_check_one_direction_and_name_it() {
+        let o = check_seeds("R", &reports_with_directions(), &direction_spec());
         assert_eq!(o.len(), 5, "{o:?}");
         assert!(o[0].passed && o[1].passed && o[2].passed && o[4].passed);
         assert_eq!(o[2].name(), "R/levels=3/same/precision");
@@ -493,15 +503,15 @@ mod tests {
         );
         assert_eq!(o[3].name(), "R/levels=3/opposite/precision");
         assert_eq!(exit_code(&o), 1);
+    }
 
-        let none: Vec<Report> = reports
-            .into_iter()
-            .map(|mut r| {
-                r.levels[2].scores.directions.opposite.no_pairs = true;
-                r
-            })
-            .collect();
-        let o = check_seeds("R", &none, &spec);
+    #[test]
+    fn a_direction_without_matches_fails_its_precision_bound_by_name() {
+        let mut reports = reports_with_directions();
+        for r in &mut reports {
+            r.levels[2].scores.directions.opposite.no_pairs = true;
+        }
+        let o = check_seeds("R", &reports, &direction_spec());
         assert!(!o[3].passed);
         assert!(
             o[3].line()
@@ -509,5 +519,6 @@ mod tests {
             "{}",
             o[3].line()
         );
+        assert!(o[2].passed, "the same direction is untouched");
     }
 }

@@ -365,6 +365,7 @@ mod tests {
         claim: MatchDirection,
     ) -> Vec<MatchRow> {
         let facing = crate::eval::pair_recall::Facing::of(claimed(claim));
+        let tolerance = spec.heading_tolerance_deg.to_radians();
         let travel = crate::eval::pair_recall::true_travel_m(&logs.truth);
         let pose = |o: &Observation| logs.truth.frames[o.frame_id].pose.0;
         let locate = |i: usize| {
@@ -376,10 +377,7 @@ mod tests {
             let best = logs.observations[..k]
                 .iter()
                 .filter(|p| travel[q.frame_id] - travel[p.frame_id] >= spec.min_gap_m)
-                .filter(|p| {
-                    let tolerance = spec.heading_tolerance_deg.to_radians();
-                    facing.agrees(pose(q).theta, pose(p).theta, tolerance)
-                })
+                .filter(|p| facing.agrees(pose(q).theta, pose(p).theta, tolerance))
                 .map(|p| (pose(q).distance(&pose(p)), p))
                 .filter(|(d, _)| *d <= spec.tp_radius_m)
                 .min_by(|a, b| a.0.total_cmp(&b.0));
