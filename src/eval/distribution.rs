@@ -8,6 +8,7 @@
 //! left out of the precision figures and listed in `no_match_seeds`; its recall (0) counts.
 
 use crate::eval::scores::{Report, Scores};
+use crate::recognizer::Direction;
 use serde::{Deserialize, Serialize};
 
 /// The quantile the `p10` figures use.
@@ -155,9 +156,24 @@ pub fn scores_of<'a>(report: &'a Report, subject: &str) -> Option<&'a Scores> {
 
 /// (seed, value) of `metric` for `subject` in every report that has one.
 pub fn samples(reports: &[Report], subject: &str, metric: Metric) -> Vec<(u64, f64)> {
+    samples_of(reports, subject, None, metric)
+}
+
+/// [`samples`] of one direction's figures alone (`Scores::of_direction`), or with `None` of
+/// both directions' (the top-level figures).
+pub fn samples_of(
+    reports: &[Report],
+    subject: &str,
+    direction: Option<Direction>,
+    metric: Metric,
+) -> Vec<(u64, f64)> {
+    let value = |s: &Scores| match direction {
+        None => metric.of(s),
+        Some(d) => metric.of(&s.of_direction(d)),
+    };
     reports
         .iter()
-        .filter_map(|r| Some((r.seed, metric.of(scores_of(r, subject)?)?)))
+        .filter_map(|r| Some((r.seed, value(scores_of(r, subject)?)?)))
         .collect()
 }
 

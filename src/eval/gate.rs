@@ -2,7 +2,10 @@
 //!
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
 //! testcase): `min_precision`, `min_recall`, `min_visit_recall`, `min_pair_recall` and
-//! `max_seconds_per_lap` of each `[[expect.levels]]` entry and of `[expect.icp]`. A bound applies
+//! `max_seconds_per_lap` of each `[[expect.levels]]` entry and of `[expect.icp]`, then the bounds
+//! of the entry's `[expect.levels.same]` and `[expect.levels.opposite]` sub-tables, checked on
+//! that direction's figures alone (`Scores::of_direction`); their outcomes name the direction
+//! (`reverse/levels=3/opposite/precision`, `FAIL reverse levels=3 opposite precision …`). A bound applies
 //! to the worst seed, or with `quantile = q` to the q-quantile from the worst end
 //! (`eval::distribution`). A bound on a configuration no report holds fails ("not in the
 //! report"), and so does a precision bound when no seed matched anything ("no matches"). Exit
@@ -11,6 +14,7 @@
 
 use crate::eval::distribution::{self, Metric};
 use crate::eval::scores::Report;
+use crate::recognizer::Direction;
 use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
@@ -45,6 +49,9 @@ pub struct Outcome {
     pub scenario: String,
     /// "levels=3" or "icp".
     pub subject: String,
+    /// The direction whose figures alone the bound is on; `None`: both directions.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<Direction>,
     pub bound: Bound,
     /// The bound from the scenario file.
     pub limit: f64,
@@ -66,14 +73,22 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// The testcase name, the same whatever the bound: `B/levels=3/precision`.
+    /// The testcase name, the same whatever the bound: `B/levels=3/precision`, or with a
+    /// direction `reverse/levels=3/opposite/precision`.
     pub fn name(&self) -> String {
-        format!(
-            "{}/{}/{}",
-            self.scenario,
-            self.subject,
-            self.bound.metric().name()
-        )
+        let subject = match self.direction {
+            None => self.subject.clone(),
+            Some(d) => format!("{}/{}", self.subject, direction_name(d)),
+        };
+        format!("{}/{subject}/{}", self.scenario, self.bound.metric().name())
+    }
+
+    /// The configuration, and the direction if the bound is on one: `levels=3 opposite`.
+    fn target(&self) -> String {
+        match self.direction {
+            None => self.subject.clone(),
+            Some(d) => format!("{} {}", self.subject, direction_name(d)),
+        }
     }
 
     fn what_op(&self) -> (&'static str, &'static str) {
@@ -113,17 +128,25 @@ impl Outcome {
                 format!(
                     "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed}, {of})",
                     self.scenario,
-                    self.subject,
+                    self.target(),
                     fmt_value(self.bound, a),
                 )
             }
             _ => format!(
                 "{status} {} {} {what} {op} {limit}: {}",
                 self.scenario,
-                self.subject,
+                self.target(),
                 self.missing.as_deref().unwrap_or("not in the report")
             ),
         }
+    }
+}
+
+/// `same` or `opposite`, as in the scenario file and the report's `directions`.
+pub fn direction_name(d: Direction) -> &'static str {
+    match d {
+        Direction::Same => "same",
+        Direction::Opposite => "opposite",
     }
 }
 
@@ -155,18 +178,27 @@ pub fn check(report: &Report, expect: &ExpectSpec) -> Vec<Outcome> {
 }
 
 /// Checks the reports of a scenario's seeds against `expect`: one outcome per bound, in file
-/// order (levels entries, then ICP; precision, recall, time within each).
+/// order (levels entries, each followed by its same- and opposite-direction bounds, then ICP;
+/// precision, recall, time within each).
 pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> Vec<Outcome> {
-    let mut out = Vec::new();
-    let mut entries: Vec<(String, Expectation)> = expect
-        .levels
-        .iter()
-        .map(|e| (format!("levels={}", e.levels), e.expectation()))
-        .collect();
-    if let Some(e) = &expect.icp {
-        entries.push(("icp".into(), e.clone()));
+    let mut entries: Vec<(String, Option<Direction>, Expectation)> = Vec::new();
+    for e in &expect.levels {
+        let subject = format!("levels={}", e.levels);
+        entries.push((subject.clone(), None, e.expectation()));
+        for (d, de) in [
+            (Direction::Same, &e.same),
+            (Direction::Opposite, &e.opposite),
+        ] {
+            if let Some(de) = de {
+                entries.push((subject.clone(), Some(d), de.expectation()));
+            }
+        }
     }
-    for (subject, e) in entries {
+    if let Some(e) = &expect.icp {
+        entries.push(("icp".into(), None, e.clone()));
+    }
+    let mut out = Vec::new();
+    for (subject, direction, e) in entries {
         let bounds = [
             (Bound::MinPrecision, e.min_precision),
             (Bound::MinRecall, e.min_recall),
@@ -176,10 +208,14 @@ pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> V
         ];
         for (bound, limit) in bounds {
             let Some(limit) = limit else { continue };
+            let target = Target {
+                subject: &subject,
+                direction,
+            };
             out.push(check_bound(
                 scenario,
                 reports,
-                &subject,
+                target,
                 bound,
                 limit,
                 expect.quantile,
@@ -189,23 +225,32 @@ pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> V
     out
 }
 
+/// What a bound is on: a configuration, and optionally one direction's figures alone.
+#[derive(Clone, Copy)]
+struct Target<'a> {
+    subject: &'a str,
+    direction: Option<Direction>,
+}
+
 fn check_bound(
     scenario: &str,
     reports: &[Report],
-    subject: &str,
+    target: Target<'_>,
     bound: Bound,
     limit: f64,
     quantile: Option<f64>,
 ) -> Outcome {
+    let Target { subject, direction } = target;
     let metric = bound.metric();
-    let samples = distribution::samples(reports, subject, metric);
+    let samples = distribution::samples_of(reports, subject, direction, metric);
     let at = distribution::quantile(&samples, quantile.unwrap_or(0.0), metric.higher_is_better());
     let present = reports
         .iter()
         .any(|r| distribution::scores_of(r, subject).is_some());
+    let which = direction.map_or(String::new(), |d| format!("{} ", direction_name(d)));
     let missing = match (at, present) {
         (Some(_), _) => None,
-        (None, true) => Some("no matches at any seed".to_string()),
+        (None, true) => Some(format!("no {which}matches at any seed")),
         (None, false) => Some("not in the report".to_string()),
     };
     let passed = match at {
@@ -216,6 +261,7 @@ fn check_bound(
     Outcome {
         scenario: scenario.to_string(),
         subject: subject.to_string(),
+        direction,
         bound,
         limit,
         quantile,
@@ -277,6 +323,8 @@ mod tests {
             min_visit_recall: None,
             min_pair_recall: None,
             max_seconds_per_lap: s,
+            same: None,
+            opposite: None,
         }
     }
 
@@ -398,5 +446,79 @@ mod tests {
             o[0].line()
         );
         assert!(o[1].passed, "recall 0 >= 0");
+    }
+
+    /// Three seeds whose levels=3 directions are set: same precision 0.95; opposite precision
+    /// 0.99 (0.8 at seed 2), recall 0.3.
+    fn reports_with_directions() -> Vec<Report> {
+        (1..=3)
+            .map(|seed| {
+                let mut r = sample("R", [0.9; 3], [0.5; 3]);
+                r.seed = seed;
+                let d = &mut r.levels[2].scores.directions;
+                (d.same.precision, d.same.pairs) = (0.95, 50);
+                (d.opposite.precision, d.opposite.pairs) = (0.99, 40);
+                d.opposite.recall = 0.3;
+                if seed == 2 {
+                    d.opposite.precision = 0.8;
+                }
+                r
+            })
+            .collect()
+    }
+
+    /// levels=3 with precision >= 0.9 for `same`, and precision >= 0.9, recall >= 0.2 for
+    /// `opposite`.
+    fn direction_spec() -> ExpectSpec {
+        use crate::spec::evaluation::DirectionExpectation;
+        let mut entry = expect(3, 0.5, 0.0, None);
+        let p = DirectionExpectation {
+            min_precision: Some(0.9),
+            ..DirectionExpectation::default()
+        };
+        entry.same = Some(p.clone());
+        entry.opposite = Some(DirectionExpectation {
+            min_recall: Some(0.2),
+            ..p
+        });
+        ExpectSpec {
+            levels: vec![entry],
+            icp: None,
+            quantile: None,
+        }
+    }
+
+    /// Bounds in `[expect.levels.same]` / `[expect.levels.opposite]` apply to that direction's
+    /// figures alone and their outcomes name the direction.
+    #[test]
+    fn direction_bounds_check_one_direction_and_name_it() {
+        let o = check_seeds("R", &reports_with_directions(), &direction_spec());
+        assert_eq!(o.len(), 5, "{o:?}");
+        assert!(o[0].passed && o[1].passed && o[2].passed && o[4].passed);
+        assert_eq!(o[2].name(), "R/levels=3/same/precision");
+        assert_eq!(o[3].direction, Some(Direction::Opposite));
+        assert_eq!(
+            o[3].line(),
+            "FAIL R levels=3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
+        );
+        assert_eq!(o[3].name(), "R/levels=3/opposite/precision");
+        assert_eq!(exit_code(&o), 1);
+    }
+
+    #[test]
+    fn a_direction_without_matches_fails_its_precision_bound_by_name() {
+        let mut reports = reports_with_directions();
+        for r in &mut reports {
+            r.levels[2].scores.directions.opposite.no_pairs = true;
+        }
+        let o = check_seeds("R", &reports, &direction_spec());
+        assert!(!o[3].passed);
+        assert!(
+            o[3].line()
+                .ends_with("opposite precision >= 0.900: no opposite matches at any seed"),
+            "{}",
+            o[3].line()
+        );
+        assert!(o[2].passed, "the same direction is untouched");
     }
 }

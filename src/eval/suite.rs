@@ -328,6 +328,8 @@ mod tests {
                     min_visit_recall: None,
                     min_pair_recall: None,
                     max_seconds_per_lap: None,
+                    same: None,
+                    opposite: None,
                 }],
                 icp: None,
                 quantile: None,

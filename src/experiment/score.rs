@@ -15,8 +15,8 @@ use crate::eval::scores::Report;
 use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
-use crate::io::matches_csv::{MatchRow, MatchesCsvError};
-use crate::recognizer::{Match, Observation};
+use crate::io::matches_csv::{MatchDirection, MatchRow, MatchesCsvError};
+use crate::recognizer::{Direction, Match, Observation};
 use crate::sim::RunLog;
 use crate::sim::logs::Manifest;
 use crate::spec::evaluation::EvaluationSpec;
@@ -70,7 +70,8 @@ pub fn run_frames(runs: &[RunLog]) -> Vec<(usize, usize)> {
 }
 
 /// The distinct pairs of `rec`'s matches as matches-file rows (query run/scan, matched
-/// run/scan, the match's n-gram length as score), with runs laid out as `run_frames` says.
+/// run/scan, the match's n-gram length as score, its direction), with runs laid out as
+/// `run_frames` says.
 pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<MatchRow> {
     let mut starts = Vec::with_capacity(run_frames.len());
     let mut acc = 0;
@@ -104,10 +105,27 @@ pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<Matc
                 matched_run: pr,
                 matched_scan: ps,
                 score: Some(m.ngram_len as f64),
+                direction: written(m.direction),
             });
         }
     }
     rows
+}
+
+/// The direction a matches-file row claims, as a recognizer's match states it.
+fn claimed(d: MatchDirection) -> Direction {
+    match d {
+        MatchDirection::Same => Direction::Same,
+        MatchDirection::Opposite => Direction::Opposite,
+    }
+}
+
+/// A match's direction as the matches file writes it.
+fn written(d: Direction) -> MatchDirection {
+    match d {
+        Direction::Same => MatchDirection::Same,
+        Direction::Opposite => MatchDirection::Opposite,
+    }
 }
 
 /// Reads `dir/manifest.json` and every run's log in it.
@@ -240,7 +258,9 @@ impl LoggedRuns {
         }
     }
 
-    /// `rows` as a recognition: every row one match of one observation pair.
+    /// `rows` as a recognition: every row one match of one observation pair, claiming the
+    /// row's direction (so the evaluation's heading rule, `eval::pair_recall::Facing`, judges
+    /// it as it judges placewords' own matches).
     pub fn recognition(&self, rows: &[MatchRow], path: &str) -> Result<Recognition, ScoreError> {
         let mut matches = Vec::with_capacity(rows.len());
         for (k, r) in rows.iter().enumerate() {
@@ -257,7 +277,9 @@ impl LoggedRuns {
             let q = self.obs_of_scan[at(r.query_run, r.query_scan)?];
             let p = self.obs_of_scan[at(r.matched_run, r.matched_scan)?];
             let (qo, po) = (&self.observations[q], &self.observations[p]);
-            matches.push(Match::from_pairs(1, 1, Vec::new(), [(qo.id, po.id)]));
+            let mut m = Match::from_pairs(1, 1, Vec::new(), [(qo.id, po.id)]);
+            m.direction = claimed(r.direction);
+            matches.push(m);
         }
         Ok(Recognition {
             name: "external".into(),
@@ -297,15 +319,53 @@ mod tests {
     /// The smoke scenario simulated and written as `simulate` writes it.
     fn smoke_logs() -> (tempfile::TempDir, Vec<RunLog>, crate::experiment::Scenario) {
         let scn = load_scenario(Path::new("scenarios/smoke.toml")).expect("smoke loads");
-        let runs = crate::sim::simulate(&scn.sim, None, &|| {}).expect("smoke simulates");
+        logs_of(scn)
+    }
+
+    fn logs_of(
+        scn: crate::experiment::Scenario,
+    ) -> (tempfile::TempDir, Vec<RunLog>, crate::experiment::Scenario) {
+        let runs = crate::sim::simulate(&scn.sim, None, &|| {}).expect("simulates");
         let dir = tempfile::tempdir().expect("temp dir");
         crate::sim::logs::write_logs(&scn.sim, &runs, None, dir.path()).expect("logs written");
         (dir, runs, scn)
     }
 
-    /// For every observation with a revisit, its nearest earlier revisit partner, as rows; with
-    /// `shift` scans added to the matched scan (clamped to the run).
-    fn oracle_rows(logs: &LoggedRuns, spec: &EvaluationSpec, shift: usize) -> Vec<MatchRow> {
+    /// The smoke scenario with its second run driven in reverse: its laps revisit the first
+    /// run's places facing the other way.
+    fn reverse_smoke_logs() -> (tempfile::TempDir, Vec<RunLog>, crate::experiment::Scenario) {
+        let src = std::fs::read_to_string("scenarios/smoke.toml").expect("smoke reads");
+        let world = std::fs::canonicalize("worlds/loop-small.toml").expect("world exists");
+        let src = src
+            .replace(
+                "\"../worlds/loop-small.toml\"",
+                &format!("{:?}", world.display().to_string()),
+            )
+            .replace(
+                "start_waypoint = 2\n",
+                "start_waypoint = 2\ndirection = \"reverse\"\n",
+            );
+        assert!(
+            src.contains("direction = \"reverse\""),
+            "smoke's second run moved"
+        );
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("reverse-smoke.toml");
+        std::fs::write(&path, src).expect("written");
+        logs_of(load_scenario(&path).expect("reverse smoke loads"))
+    }
+
+    /// For every observation with a revisit facing as `claim` says, its nearest earlier such
+    /// partner, as rows claiming `claim`; with `shift` scans added to the matched scan (clamped
+    /// to the run).
+    fn oracle_rows(
+        logs: &LoggedRuns,
+        spec: &EvaluationSpec,
+        shift: usize,
+        claim: MatchDirection,
+    ) -> Vec<MatchRow> {
+        let facing = crate::eval::pair_recall::Facing::of(claimed(claim));
+        let tolerance = spec.heading_tolerance_deg.to_radians();
         let travel = crate::eval::pair_recall::true_travel_m(&logs.truth);
         let pose = |o: &Observation| logs.truth.frames[o.frame_id].pose.0;
         let locate = |i: usize| {
@@ -317,10 +377,7 @@ mod tests {
             let best = logs.observations[..k]
                 .iter()
                 .filter(|p| travel[q.frame_id] - travel[p.frame_id] >= spec.min_gap_m)
-                .filter(|p| {
-                    crate::geom::wrap_angle(pose(q).theta - pose(p).theta).abs()
-                        <= spec.heading_tolerance_deg.to_radians()
-                })
+                .filter(|p| facing.agrees(pose(q).theta, pose(p).theta, tolerance))
                 .map(|p| (pose(q).distance(&pose(p)), p))
                 .filter(|(d, _)| *d <= spec.tp_radius_m)
                 .min_by(|a, b| a.0.total_cmp(&b.0));
@@ -334,6 +391,7 @@ mod tests {
                         matched_run: pr,
                         matched_scan: ps + shift,
                         score: None,
+                        direction: claim,
                     });
                 }
             }
@@ -350,12 +408,12 @@ mod tests {
         let (dir, runs, scn) = smoke_logs();
         let logs = load_logged_runs(dir.path()).expect("logs load");
         let spec = EvaluationSpec::default();
-        let text = write_matches(&oracle_rows(&logs, &spec, 0));
+        let text = write_matches(&oracle_rows(&logs, &spec, 0, MatchDirection::Same));
         let perfect = parse_matches(&text, "perfect.csv").expect("parses");
         let r = score_rows(&logs, &perfect, "perfect.csv", &spec, 1).unwrap();
         let s = &r.levels[0].scores;
         assert_eq!((s.precision, s.recall), (1.0, 1.0), "{s:?}");
-        let shifted = oracle_rows(&logs, &spec, 125);
+        let shifted = oracle_rows(&logs, &spec, 125, MatchDirection::Same);
         assert!(shifted.len() > perfect.len() / 2);
         let r = score_rows(&logs, &shifted, "shifted.csv", &spec, 1).unwrap();
         let s = &r.levels[0].scores;
@@ -376,6 +434,38 @@ mod tests {
         assert!((a.recall - b.recall).abs() <= 0.02, "{a:?} vs {b:?}");
     }
 
+    /// A matches file's `direction` column is scored by the evaluation's heading rule: the
+    /// truth's opposite-direction partners claimed `opposite` are all correct and recall every
+    /// opposite revisit; the same rows claimed `same` (the default of a file without the column)
+    /// are all wrong.
+    #[test]
+    fn opposite_rows_are_scored_per_direction() {
+        let (dir, _, _) = reverse_smoke_logs();
+        let logs = load_logged_runs(dir.path()).expect("logs load");
+        let spec = EvaluationSpec::default();
+        let rows = oracle_rows(&logs, &spec, 0, MatchDirection::Opposite);
+        assert!(rows.len() > 100, "a reverse run revisits: {}", rows.len());
+        let text = write_matches(&rows);
+        let parsed = parse_matches(&text, "opposite.csv").expect("parses");
+        let r = score_rows(&logs, &parsed, "opposite.csv", &spec, 1).unwrap();
+        let s = &r.levels[0].scores;
+        let opp = s.of_direction(Direction::Opposite);
+        assert_eq!((opp.precision, opp.recall), (1.0, 1.0), "{opp:?}");
+        assert_eq!(s.precision, 1.0);
+        assert_eq!(s.of_direction(Direction::Same).pairs, 0);
+
+        let as_same: Vec<MatchRow> = rows
+            .iter()
+            .map(|r| MatchRow {
+                direction: MatchDirection::Same,
+                ..*r
+            })
+            .collect();
+        let r = score_rows(&logs, &as_same, "same.csv", &spec, 1).unwrap();
+        let s = &r.levels[0].scores;
+        assert_eq!((s.precision, s.correct_pairs), (0.0, 0), "{s:?}");
+    }
+
     #[test]
     fn unknown_scans_are_named() {
         let (dir, _, _) = smoke_logs();
@@ -386,6 +476,7 @@ mod tests {
             matched_run: 0,
             matched_scan: 0,
             score: None,
+            direction: MatchDirection::Same,
         };
         let e = score_rows(&logs, &[row], "m.csv", &EvaluationSpec::default(), 1).unwrap_err();
         assert!(

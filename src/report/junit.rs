@@ -10,7 +10,7 @@
 //! configuration spent recognizing over all seeds.
 
 pub use super::xml::escape;
-use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::gate::{Outcome, direction_name, fmt_value};
 use crate::eval::suite::{SuiteReport, reproduce_command};
 use std::fmt::Write;
 
@@ -107,6 +107,9 @@ fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
     if let Some(a) = o.actual {
         props.insert(0, ("value", fmt_value(o.bound, a)));
     }
+    if let Some(d) = o.direction {
+        props.push(("direction", direction_name(d).to_string()));
+    }
     if let Some(seed) = o.seed {
         props.push(("seed", seed.to_string()));
         props.push(("reproduce", reproduce_command(file, seed)));
@@ -183,6 +186,8 @@ mod tests {
                 min_visit_recall: None,
                 min_pair_recall: None,
                 max_seconds_per_lap: None,
+                same: None,
+                opposite: None,
             }],
             icp: None,
             quantile: None,

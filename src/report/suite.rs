@@ -3,7 +3,7 @@
 //! (mean, 10th percentile, worst and its seed, and the gate), and the `--json` summary.
 
 use crate::eval::distribution::{ConfigSpread, Metric, Spread};
-use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::gate::{Outcome, direction_name, fmt_value};
 use crate::eval::suite::{ScenarioResult, SuiteReport};
 use serde::Serialize;
 use std::fmt::Write;
@@ -222,6 +222,9 @@ fn md_outcome(o: &Outcome) -> String {
 struct JsonOutcome<'a> {
     name: String,
     file: &'a str,
+    /// `same` or `opposite` when the bound is on one direction's figures alone.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    direction: Option<&'static str>,
     passed: bool,
     statistic: String,
     value: Option<f64>,
@@ -242,6 +245,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
             sc.outcomes.iter().map(move |o| JsonOutcome {
                 name: o.name(),
                 file: &sc.file,
+                direction: o.direction.map(direction_name),
                 passed: o.passed,
                 statistic: o.statistic(),
                 value: o.actual,
@@ -305,6 +309,8 @@ mod tests {
                     min_visit_recall: None,
                     min_pair_recall: None,
                     max_seconds_per_lap: None,
+                    same: None,
+                    opposite: None,
                 }],
                 ..ExpectSpec::default()
             },

@@ -34,6 +34,8 @@ impl Default for EvaluationSpec {
 /// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`, checked over the
 /// seeds run: each bound applies to the worst seed, or with `quantile = q` to the q-quantile
 /// (nearest rank, counted from the worst seed; `quantile = 0.1` lets the worst tenth miss).
+/// A levels entry may also bound the figures of one direction alone in its sub-tables
+/// `[expect.levels.same]` and `[expect.levels.opposite]` (the report's `directions`).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExpectSpec {
@@ -61,7 +63,7 @@ pub struct LevelExpectation {
     /// Minimum pair precision in [0, 1].
     #[serde(default)]
     pub min_precision: Option<f64>,
-    /// Minimum same-direction recall in [0, 1].
+    /// Minimum recall in [0, 1] (revisits of both directions).
     #[serde(default)]
     pub min_recall: Option<f64>,
     /// Minimum visit recall in [0, 1].
@@ -73,6 +75,42 @@ pub struct LevelExpectation {
     /// Maximum recognition time per lap, seconds.
     #[serde(default)]
     pub max_seconds_per_lap: Option<f64>,
+    /// Bounds on the same-direction figures alone (`[expect.levels.same]`): the matches that
+    /// claim the same direction against the same-direction revisits. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub same: Option<DirectionExpectation>,
+    /// Bounds on the opposite-direction figures alone (`[expect.levels.opposite]`). Default:
+    /// none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opposite: Option<DirectionExpectation>,
+}
+
+/// Bounds on the figures of one direction: those of [`Expectation`] but time, which is not
+/// counted per direction.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DirectionExpectation {
+    /// Minimum precision of this direction's pairs in [0, 1].
+    pub min_precision: Option<f64>,
+    /// Minimum recall of this direction's revisits in [0, 1].
+    pub min_recall: Option<f64>,
+    /// Minimum visit recall in [0, 1].
+    pub min_visit_recall: Option<f64>,
+    /// Minimum pair recall in [0, 1].
+    pub min_pair_recall: Option<f64>,
+}
+
+impl DirectionExpectation {
+    /// The thresholds as an [`Expectation`] without a time budget.
+    pub fn expectation(&self) -> Expectation {
+        Expectation {
+            min_precision: self.min_precision,
+            min_recall: self.min_recall,
+            min_visit_recall: self.min_visit_recall,
+            min_pair_recall: self.min_pair_recall,
+            max_seconds_per_lap: None,
+        }
+    }
 }
 
 impl LevelExpectation {
@@ -94,7 +132,7 @@ impl LevelExpectation {
 pub struct Expectation {
     /// Minimum pair precision in [0, 1].
     pub min_precision: Option<f64>,
-    /// Minimum same-direction recall in [0, 1].
+    /// Minimum recall in [0, 1] (revisits of both directions).
     pub min_recall: Option<f64>,
     /// Minimum visit recall in [0, 1].
     pub min_visit_recall: Option<f64>,
@@ -119,6 +157,15 @@ pub const EXPECT_LEVEL_KEYS: &[&str] = &[
     "min_precision",
     "min_recall",
     "max_seconds_per_lap",
+    "min_visit_recall",
+    "min_pair_recall",
+    "same",
+    "opposite",
+];
+/// Keys of an `[expect.levels.same]` or `[expect.levels.opposite]` sub-table.
+pub const EXPECT_DIRECTION_KEYS: &[&str] = &[
+    "min_precision",
+    "min_recall",
     "min_visit_recall",
     "min_pair_recall",
 ];
@@ -216,6 +263,8 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
             max_seconds_per_lap: e.max_seconds_per_lap,
             min_visit_recall: e.min_visit_recall,
             min_pair_recall: e.min_pair_recall,
+            same: direction_expectation(lt, "same", &ctx, d),
+            opposite: direction_expectation(lt, "opposite", &ctx, d),
         });
     }
     if let Some((_, it)) = table(t, "icp", d) {
@@ -235,6 +284,45 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
         }
     }
     ex
+}
+
+/// The `[expect.levels.<dir>]` sub-table of a levels entry (`dir` is `same` or `opposite`).
+fn direction_expectation(
+    lt: &DeTable<'_>,
+    dir: &str,
+    entry: &str,
+    d: &mut Diags,
+) -> Option<DirectionExpectation> {
+    let (kat, v) = get(lt, dir)?;
+    let DeValue::Table(t) = v.get_ref() else {
+        d.at(
+            kat,
+            format!(
+                "`{dir}` in {entry} must be a table of bounds on the {dir}-direction figures; \
+                 write a `[expect.levels.{dir}]` section with e.g. `min_precision = 0.9`"
+            ),
+        );
+        return None;
+    };
+    let ctx = format!("[expect.levels.{dir}] of {entry}");
+    if let Some((kat, _)) = get(t, "max_seconds_per_lap") {
+        d.at(
+            kat,
+            format!(
+                "`max_seconds_per_lap` in {ctx}: time is not counted per direction; \
+                 bound it in the levels entry itself"
+            ),
+        );
+    }
+    let known = [EXPECT_DIRECTION_KEYS, &["max_seconds_per_lap"]].concat();
+    unknown_keys(t, &known, &ctx, d);
+    let e = expectation(t, &ctx, d);
+    Some(DirectionExpectation {
+        min_precision: e.min_precision,
+        min_recall: e.min_recall,
+        min_visit_recall: e.min_visit_recall,
+        min_pair_recall: e.min_pair_recall,
+    })
 }
 
 fn expectation(t: &DeTable<'_>, ctx: &str, d: &mut Diags) -> Expectation {

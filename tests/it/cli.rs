@@ -151,6 +151,41 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     );
 }
 
+/// Bounds on one direction (`[expect.levels.same]`, `[expect.levels.opposite]`): one that holds
+/// passes; one that does not exits 1, and the line and the JUnit test case name the direction.
+#[test]
+fn check_gates_one_direction_and_names_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = smoke_variant(
+        dir.path(),
+        "directions",
+        "[[expect.levels]]\nlevels = 3\n\n[expect.levels.same]\nmin_precision = 0.5\n\n\
+         [expect.levels.opposite]\nmin_recall = 0.999\n",
+    );
+    let junit = dir.path().join("junit.xml");
+    let args = ["check", "-q", "--seed", "42", scenario.to_str().unwrap()];
+    let o = placewords(&[&args[..], &["--junit", junit.to_str().unwrap()]].concat());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "{out}");
+    assert!(
+        out.contains("PASS smoke levels=3 same precision worst"),
+        "{out}"
+    );
+    assert!(
+        out.contains("FAIL smoke levels=3 opposite recall worst"),
+        "{out}"
+    );
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert!(
+        xml.contains("name=\"smoke/levels=3/opposite/recall\""),
+        "{xml}"
+    );
+    assert!(
+        xml.contains("<property name=\"direction\" value=\"opposite\"/>"),
+        "{xml}"
+    );
+}
+
 /// `recognize` on a real log writes a report with the same schema as `run`.
 #[test]
 fn recognize_reads_a_real_log_and_writes_the_run_schema() {

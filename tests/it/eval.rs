@@ -272,6 +272,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             min_visit_recall: None,
             min_pair_recall: None,
             max_seconds_per_lap: None,
+            same: None,
+            opposite: None,
         }],
         icp: Some(Expectation {
             min_precision: Some(0.5),
@@ -289,6 +291,8 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             min_visit_recall: None,
             min_pair_recall: None,
             max_seconds_per_lap: None,
+            same: None,
+            opposite: None,
         }],
         icp: None,
         quantile: None,

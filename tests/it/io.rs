@@ -5,6 +5,7 @@ use placewords::io::carmen::{
     CarmenError, LaserRecord, LogRecord, OdomRecord, ReadOptions, TruePosRecord, parse_log_str,
     read_log, read_log_from, write_record,
 };
+use placewords::io::matches_csv::{MatchDirection, MatchRow, parse_matches, write_matches};
 use placewords::io::mobilesim::{import_mobilesim, world_to_toml};
 use placewords::io::real_log::{TruthSource, log_to_run, noise_free};
 use placewords::spec::diag::Diagnostic;
@@ -626,5 +627,91 @@ fn without_seconds(v: serde_json::Value) -> serde_json::Value {
             .collect(),
         serde_json::Value::Array(a) => a.into_iter().map(without_seconds).collect(),
         x => x,
+    }
+}
+
+// ---- matches files (`placewords score`) -------------------------------------------------------
+
+fn match_row() -> impl Strategy<Value = MatchRow> {
+    (
+        (0usize..5, 0usize..100_000, 0usize..5, 0usize..100_000),
+        prop::option::of(-1e6f64..1e6),
+        any::<bool>(),
+    )
+        .prop_map(|((qr, qs, mr, ms), score, opposite)| MatchRow {
+            query_run: qr,
+            query_scan: qs,
+            matched_run: mr,
+            matched_scan: ms,
+            score,
+            direction: if opposite {
+                MatchDirection::Opposite
+            } else {
+                MatchDirection::Same
+            },
+        })
+}
+
+/// `rows` under a header with `direction` before `score`, padded with spaces, leaving out the
+/// trailing score when there is none.
+fn direction_first(rows: &[MatchRow]) -> String {
+    let mut s = "query_run, query_scan, matched_run, matched_scan, direction, score\n".to_string();
+    for r in rows {
+        let (q, m) = ((r.query_run, r.query_scan), (r.matched_run, r.matched_scan));
+        let head = format!(" {},{} ,{},{}, {}", q.0, q.1, m.0, m.1, r.direction.name());
+        match r.score {
+            Some(v) => s.push_str(&format!("{head},{v}\n")),
+            None => s.push_str(&format!("{head}\n")),
+        }
+    }
+    s
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(128))]
+
+    /// Rows with any direction and score read back as written, whatever the order of the
+    /// optional columns.
+    #[test]
+    fn matches_rows_round_trip_with_directions(rows in prop::collection::vec(match_row(), 0..40)) {
+        prop_assert_eq!(parse_matches(&write_matches(&rows), "m.csv").unwrap(), rows.clone());
+        prop_assert_eq!(parse_matches(&direction_first(&rows), "m.csv").unwrap(), rows);
+    }
+
+    /// A direction that is neither `same` nor `opposite` is an error at its line and column.
+    #[test]
+    fn a_bad_direction_is_located(
+        rows in prop::collection::vec(match_row(), 1..20),
+        at in any::<prop::sample::Index>(),
+        word in "[a-zA-Z][a-zA-Z0-9_]{0,8}",
+    ) {
+        prop_assume!(word != "same" && word != "opposite");
+        let text = write_matches(&rows);
+        let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+        let k = 1 + at.index(rows.len());
+        let cut = lines[k].rfind(',').unwrap() + 1;
+        lines[k] = format!("{}{word}", &lines[k][..cut]);
+        let e = parse_matches(&lines.join("\n"), "m.csv").unwrap_err().to_string();
+        let want = format!("m.csv:{}:{}: direction `{word}` is neither", k + 1, cut + 1);
+        prop_assert!(e.starts_with(&want), "{} (want {})", e, want);
+    }
+
+    /// Arbitrary lines under either header are rows or located errors, never a panic.
+    #[test]
+    fn arbitrary_matches_lines_never_panic(
+        body in "[0-9a-z, .#\\-\n]{0,200}",
+        with_direction in any::<bool>(),
+    ) {
+        let header = if with_direction {
+            "query_run,query_scan,matched_run,matched_scan,score,direction"
+        } else {
+            "query_run,query_scan,matched_run,matched_scan"
+        };
+        let text = format!("{header}\n{body}");
+        if let Err(e) = parse_matches(&text, "m.csv") {
+            let e = e.to_string();
+            let line: usize = e.split(':').nth(1).unwrap().parse().unwrap();
+            prop_assert!(e.starts_with("m.csv:") && line >= 2 && line <= text.lines().count(), "{}", e);
+        }
     }
 }
