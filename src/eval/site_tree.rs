@@ -328,7 +328,7 @@ pub fn sweep(sites: &[Site], min_gap_m: f64, mut visit: impl FnMut(usize, &SiteT
     let mut tree = SiteTree::new(sites);
     let mut ready = 0;
     for (k, s) in sites.iter().enumerate() {
-        while ready < k && !(s.travel_m - sites[ready].travel_m < min_gap_m) {
+        while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
             ready += 1;
         }
         tree.activate_to(ready);
