@@ -31,16 +31,19 @@
 //! - **Per door configuration**: pairs, matches and observations are attributed to the door
 //!   configuration of the lap of the query observation (for a match: of its first pair's query).
 //!
-//! Revisits are searched with a spatial hash of cell size `r`, in creation order, so the cost is
-//! about linear in the number of observations.
+//! Revisits and visits are searched in a k-d tree of the earlier observations
+//! ([`super::site_tree`]), so the cost grows about as `n log n` in the observations, however
+//! many passes go over one place.
 
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
+use super::site_tree::{LapSet, Query, Site, sweep};
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
 
 /// Scores at one radius.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
@@ -234,32 +237,69 @@ fn truth_lookup(rec: &Recognition) -> impl Fn(ObsId) -> Option<crate::geom::True
     }
 }
 
-/// Truth-side facts about one observation.
-#[derive(Clone, Copy, Debug)]
-struct ObsTruth {
-    x: f64,
-    y: f64,
-    theta: f64,
-    travel_m: f64,
-    /// Door configuration index.
-    config: usize,
-    /// Global lap index (`GroundTruth::laps`).
-    lap: usize,
+/// Observations joined with their truth (shared by the scorers of every facing).
+struct Joined {
+    /// Observation id → position in the observations.
+    index_of: HashMap<ObsId, usize>,
+    /// Per observation (creation order): its site, or [`NO_SITE`] when its frame has no truth.
+    site_of: Vec<u32>,
+    /// The observations with truth, in creation order.
+    sites: Vec<Site>,
+    /// Per site: its door configuration index.
+    site_config: Vec<u32>,
+    /// Per site: its position in the observations.
+    site_obs: Vec<u32>,
 }
+
+/// Marks an observation without truth in `Joined::site_of`.
+const NO_SITE: u32 = u32::MAX;
 
 /// Observations joined with their truth, reusable across radii. It counts the revisits and
 /// matches of one facing ([`Facing::Either`] unless [`Scorer::with_facing`] says otherwise).
 #[derive(Clone)]
 pub struct Scorer {
-    /// Observation id → position in `obs`.
-    index_of: HashMap<ObsId, usize>,
-    /// Per observation (creation order); `None` when its input frame has no truth.
-    obs: Vec<Option<ObsTruth>>,
+    joined: Arc<Joined>,
     configs: Vec<String>,
     config_laps: Vec<usize>,
     min_gap_m: f64,
     heading_tol_rad: f64,
     facing: Facing,
+}
+
+impl Joined {
+    /// `observations` with their true poses (`lap_config`: door configuration of each lap).
+    fn new(observations: &[Observation], truth: &GroundTruth, lap_config: &[u32]) -> Self {
+        let travel = super::pair_recall::true_travel_m(truth);
+        let mut j = Joined {
+            index_of: observations
+                .iter()
+                .enumerate()
+                .map(|(i, o)| (o.id, i))
+                .collect(),
+            site_of: Vec::with_capacity(observations.len()),
+            sites: Vec::new(),
+            site_config: Vec::new(),
+            site_obs: Vec::new(),
+        };
+        for (i, o) in observations.iter().enumerate() {
+            let pose = truth.observation_pose(o);
+            let Some((f, pose)) = truth.frame(o.frame_id).zip(pose) else {
+                j.site_of.push(NO_SITE);
+                continue;
+            };
+            j.site_of.push(j.sites.len() as u32);
+            j.sites.push(Site {
+                x: pose.0.x,
+                y: pose.0.y,
+                theta: pose.0.theta,
+                travel_m: travel[o.frame_id],
+                lap: f.lap_slot,
+            });
+            j.site_config.push(lap_config[f.lap_slot]);
+            j.site_obs.push(i as u32);
+        }
+        j
+    }
 }
 
 impl Scorer {
@@ -274,40 +314,35 @@ impl Scorer {
         for l in &truth.laps {
             config_laps[config_index[l.door_config.as_str()]] += 1;
         }
-        let lap_config: Vec<usize> = truth
+        let lap_config: Vec<u32> = truth
             .laps
             .iter()
-            .map(|l| config_index[l.door_config.as_str()])
-            .collect();
-        let index_of = observations
-            .iter()
-            .enumerate()
-            .map(|(i, o)| (o.id, i))
-            .collect();
-        let travel = super::pair_recall::true_travel_m(truth);
-        let obs = observations
-            .iter()
-            .map(|o| {
-                let pose = truth.observation_pose(o);
-                truth.frame(o.frame_id).zip(pose).map(|(f, pose)| ObsTruth {
-                    x: pose.0.x,
-                    y: pose.0.y,
-                    theta: pose.0.theta,
-                    travel_m: travel[o.frame_id],
-                    config: lap_config[f.lap_slot],
-                    lap: f.lap_slot,
-                })
-            })
+            .map(|l| config_index[l.door_config.as_str()] as u32)
             .collect();
         Scorer {
-            index_of,
-            obs,
+            joined: Arc::new(Joined::new(observations, truth, &lap_config)),
             configs,
             config_laps,
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
             facing: Facing::Either,
         }
+    }
+
+    /// The truth of observation `i` (its position in the observations), if its frame has one.
+    fn site(&self, i: usize) -> Option<&Site> {
+        let k = *self.joined.site_of.get(i)?;
+        self.joined.sites.get(k as usize)
+    }
+
+    /// The door configuration of observation `i`, which has truth.
+    fn config(&self, i: usize) -> usize {
+        self.joined.site_config[self.joined.site_of[i] as usize] as usize
+    }
+
+    /// Observations scored (with or without truth).
+    fn len(&self) -> usize {
+        self.joined.site_of.len()
     }
 
     /// The same scorer counting only revisits facing as `facing` says and matches of that
@@ -321,39 +356,25 @@ impl Scorer {
 
     /// Which observations have a revisit at radius `r`.
     pub fn revisits(&self, r: f64) -> Vec<bool> {
-        let mut has = vec![false; self.obs.len()];
+        let mut has = vec![false; self.len()];
         if r <= 0.0 || !r.is_finite() {
             return has;
         }
-        let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
-        let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
-        let r2 = r * r;
-        for (i, o) in self.obs.iter().enumerate() {
-            let Some(o) = o else { continue };
-            let (cx, cy) = cell(o.x, o.y);
-            'search: for dx in -1..=1 {
-                for dy in -1..=1 {
-                    let Some(list) = grid.get(&(cx + dx, cy + dy)) else {
-                        continue;
-                    };
-                    // Oldest first: the earliest laps hit soonest, and the list is sorted by
-                    // creation, so once the travel gap fails it fails for the rest.
-                    for &j in list {
-                        let p = self.obs[j].expect("only observations with truth are inserted");
-                        if o.travel_m - p.travel_m < self.min_gap_m {
-                            break;
-                        }
-                        let d2 = (o.x - p.x).powi(2) + (o.y - p.y).powi(2);
-                        if d2 <= r2 && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad) {
-                            has[i] = true;
-                            break 'search;
-                        }
-                    }
-                }
-            }
-            grid.entry((cx, cy)).or_default().push(i);
-        }
+        let j = &self.joined;
+        sweep(&j.sites, self.min_gap_m, |k, tree| {
+            has[j.site_obs[k] as usize] = tree.count(&self.query(k, r), true) > 0;
+        });
         has
+    }
+
+    /// The revisit test of site `k` at radius `r`, facing as this scorer counts.
+    fn query(&self, k: usize, r: f64) -> Query<'_> {
+        Query {
+            site: &self.joined.sites[k],
+            r2: r * r,
+            facing: self.facing,
+            tol_rad: self.heading_tol_rad,
+        }
     }
 
     /// The visit recall of `matches` at radius `r` (see [`Metrics::visit_recall`]): earlier laps
@@ -369,40 +390,28 @@ impl Scorer {
             counted
                 .flat_map(|m| m.pairs().map(move |p| (p, Facing::of(m.direction))))
                 .filter_map(|((query, past), claim)| {
-                    let (&qi, &pi) = (self.index_of.get(&query)?, self.index_of.get(&past)?);
-                    let (q, pa) = (self.obs[qi]?, self.obs[pi]?);
+                    let index_of = &self.joined.index_of;
+                    let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
+                    let (q, pa) = (self.site(qi)?, self.site(pi)?);
                     ((q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
                         && claim.agrees(q.theta, pa.theta, self.heading_tol_rad))
                     .then_some((qi, pa.lap))
                 }),
         );
-        let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
-        let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
         let (mut visits, mut found) = (0usize, 0usize);
-        let mut laps: HashSet<usize> = HashSet::new();
-        for (i, o) in self.obs.iter().enumerate() {
-            let Some(o) = o else { continue };
-            let (cx, cy) = cell(o.x, o.y);
+        let mut laps = LapSet::default();
+        let j = &self.joined;
+        sweep(&j.sites, self.min_gap_m, |k, tree| {
             laps.clear();
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for &j in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
-                        let p = self.obs[j].expect("only observations with truth are inserted");
-                        if o.travel_m - p.travel_m < self.min_gap_m {
-                            break;
-                        }
-                        if (o.x - p.x).powi(2) + (o.y - p.y).powi(2) <= r2
-                            && self.facing.agrees(o.theta, p.theta, self.heading_tol_rad)
-                        {
-                            laps.insert(p.lap);
-                        }
-                    }
-                }
-            }
-            visits += laps.len();
-            found += laps.iter().filter(|&&l| matched.contains(i, l)).count();
-            grid.entry((cx, cy)).or_default().push(i);
-        }
+            tree.laps(&self.query(k, r), &mut laps);
+            let i = j.site_obs[k] as usize;
+            visits += laps.list.len();
+            found += laps
+                .list
+                .iter()
+                .filter(|&&l| matched.contains(i, l))
+                .count();
+        });
         ratio(found, visits)
     }
 
@@ -425,16 +434,13 @@ impl Scorer {
         breakdown: bool,
         revisits: &[bool],
     ) -> (Metrics, Vec<DoorConfigMetrics>) {
-        assert_eq!(
-            revisits.len(),
-            self.obs.len(),
-            "revisits of other observations"
-        );
+        assert_eq!(revisits.len(), self.len(), "revisits of other observations");
         let n_cfg = self.configs.len();
         let mut total = Counts::default();
         let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
-        let mut recalled_query = vec![false; self.obs.len()];
-        let mut recalled_any = vec![false; self.obs.len()];
+        let mut recalled_query = vec![false; self.len()];
+        let mut recalled_any = vec![false; self.len()];
+        let index_of = &self.joined.index_of;
         // Packed (query, past) ids (super::pair_set::pack): half the memory of id tuples.
         let mut seen: HashSet<u64> = HashSet::new();
         let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
@@ -445,14 +451,13 @@ impl Scorer {
             let (mut n, mut ok) = (0usize, 0usize);
             let mut match_cfg = None;
             for (query, past) in m.pairs() {
-                let (Some(&qi), Some(&pi)) = (self.index_of.get(&query), self.index_of.get(&past))
-                else {
+                let (Some(&qi), Some(&pi)) = (index_of.get(&query), index_of.get(&past)) else {
                     if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
                     continue;
                 };
-                let (Some(q), Some(pa)) = (self.obs[qi], self.obs[pi]) else {
+                let (Some(q), Some(pa)) = (self.site(qi), self.site(pi)) else {
                     if seen.insert(pack(query, past)) {
                         total.unresolved += 1;
                     }
@@ -463,14 +468,14 @@ impl Scorer {
                 if in_match.insert((query, past)) {
                     n += 1;
                     ok += correct as usize;
-                    match_cfg.get_or_insert(q.config);
+                    match_cfg.get_or_insert(self.config(qi));
                 }
                 if seen.insert(pack(query, past)) {
                     total.pairs += 1;
                     total.correct += correct as usize;
                     if breakdown {
-                        per_cfg[q.config].pairs += 1;
-                        per_cfg[q.config].correct += correct as usize;
+                        per_cfg[self.config(qi)].pairs += 1;
+                        per_cfg[self.config(qi)].correct += correct as usize;
                     }
                     if correct {
                         recalled_query[qi] = true;
@@ -489,8 +494,9 @@ impl Scorer {
                 }
             }
         }
-        for (i, o) in self.obs.iter().enumerate() {
-            let Some(o) = o else { continue };
+        let j = &self.joined;
+        for (&i, &config) in j.site_obs.iter().zip(&j.site_config) {
+            let i = i as usize;
             if !revisits[i] {
                 continue;
             }
@@ -498,7 +504,7 @@ impl Scorer {
             total.recalled += recalled_query[i] as usize;
             total.recalled_any += recalled_any[i] as usize;
             if breakdown {
-                let c = &mut per_cfg[o.config];
+                let c = &mut per_cfg[config as usize];
                 c.revisits += 1;
                 c.recalled += recalled_query[i] as usize;
                 c.recalled_any += recalled_any[i] as usize;

@@ -13,6 +13,7 @@ pub mod metrics;
 pub mod pair_recall;
 pub mod pair_set;
 pub mod scores;
+pub mod site_tree;
 pub mod suite;
 pub mod sweep;
 

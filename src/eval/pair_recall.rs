@@ -19,6 +19,7 @@
 
 use super::GroundTruth;
 use super::pair_set::PairSet;
+use super::site_tree::{Query, Site, sweep};
 use crate::geom::wrap_angle;
 use crate::recognizer::{Direction, Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -92,6 +93,19 @@ struct Placed {
     travel_m: f64,
 }
 
+impl Placed {
+    /// As a site of the pair search (laps are not needed there).
+    fn site(&self) -> Site {
+        Site {
+            x: self.x,
+            y: self.y,
+            theta: self.theta,
+            travel_m: self.travel_m,
+            lap: 0,
+        }
+    }
+}
+
 /// Counts behind [`pair_recall`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairRecall {
@@ -143,7 +157,6 @@ pub fn pair_recall(
         q.travel_m - p.travel_m >= spec.min_gap_m
             && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
     };
-    let possible_pair = |q: &Placed, p: &Placed| near(q, p) && facing.agrees(q.theta, p.theta, tol);
     let index_of: HashMap<ObsId, usize> = observations
         .iter()
         .enumerate()
@@ -159,33 +172,30 @@ pub fn pair_recall(
                 (near(q, pa) && claim.agrees(q.theta, pa.theta, tol)).then_some((qi, pi))
             }),
     );
+    let found = seen.len() as u64;
+    let sites: Vec<Site> = placed.iter().flatten().map(Placed::site).collect();
+    // A long log has millions of observations: hold one copy of their truth during the count.
+    drop((seen, placed, index_of, travel));
     PairRecall {
-        possible: count_possible(&placed, r, &possible_pair),
-        found: seen.len() as u64,
+        possible: count_possible(&sites, spec.min_gap_m, r, facing, tol),
+        found,
     }
 }
 
-/// Every (observation, earlier observation) pair `ok` accepts among those within `r`, found
-/// with a spatial hash of cell `r`.
-fn count_possible(placed: &[Option<Placed>], r: f64, ok: &dyn Fn(&Placed, &Placed) -> bool) -> u64 {
-    let cell = |x: f64, y: f64| ((x / r).floor() as i64, (y / r).floor() as i64);
-    let mut grid: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+/// Every (observation, earlier observation) pair at least `min_gap_m` of travel apart, within
+/// `r` and facing as `facing` says, counted in a k-d tree of the earlier sites
+/// ([`super::site_tree`]).
+fn count_possible(sites: &[Site], min_gap_m: f64, r: f64, facing: Facing, tol_rad: f64) -> u64 {
     let mut n = 0u64;
-    for (i, o) in placed.iter().enumerate() {
-        let Some(o) = o else { continue };
-        let (cx, cy) = cell(o.x, o.y);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for &j in grid.get(&(cx + dx, cy + dy)).into_iter().flatten() {
-                    let p = placed[j]
-                        .as_ref()
-                        .expect("only placed observations are inserted");
-                    n += ok(o, p) as u64;
-                }
-            }
-        }
-        grid.entry((cx, cy)).or_default().push(i);
-    }
+    sweep(sites, min_gap_m, |k, tree| {
+        let q = Query {
+            site: &sites[k],
+            r2: r * r,
+            facing,
+            tol_rad,
+        };
+        n += tree.count(&q, false);
+    });
     n
 }
 

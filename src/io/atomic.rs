@@ -137,6 +137,59 @@ impl Drop for AtomicFile {
     }
 }
 
+/// A scratch file beside `path` (`.NAME.tmpPID`, so stale ones are cleaned like the temporaries
+/// above): written in one pass, read back from the start in another, removed when dropped. It
+/// holds what an output needs at its end but should not keep in memory meanwhile.
+#[derive(Debug)]
+pub struct ScratchFile {
+    tmp: PathBuf,
+    out: std::io::BufWriter<std::fs::File>,
+}
+
+impl ScratchFile {
+    /// Creates the scratch file for `path` (and `path`'s parent folders).
+    pub fn create(path: &Path) -> std::io::Result<ScratchFile> {
+        create_parent(path)?;
+        remove_stale_temps(path);
+        let tmp = temp_path(path);
+        let file = std::fs::File::options()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(true)
+            .open(&tmp)?;
+        Ok(ScratchFile {
+            tmp,
+            out: std::io::BufWriter::with_capacity(1 << 16, file),
+        })
+    }
+
+    /// Everything written so far, from the start (writing again after this is not supported).
+    pub fn read_back(&mut self) -> std::io::Result<std::io::BufReader<std::fs::File>> {
+        use std::io::Seek;
+        self.out.flush()?;
+        let mut file = self.out.get_ref().try_clone()?;
+        file.rewind()?;
+        Ok(std::io::BufReader::new(file))
+    }
+}
+
+impl Write for ScratchFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.out.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.flush()
+    }
+}
+
+impl Drop for ScratchFile {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.tmp);
+    }
+}
+
 /// Checks, before any work, that a file can be written at `path`: creates its parent folders
 /// and a temporary file beside it (removed again). An existing folder at `path` is an error.
 pub fn check_writable(path: &Path) -> std::io::Result<()> {

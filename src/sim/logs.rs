@@ -5,12 +5,14 @@
 //! since the run started; the host is `placewords-sim`. [`LogsWriter`] appends lap after lap to
 //! the open run's file, so a simulation of any length is written in the memory of a few laps.
 
-use crate::io::atomic::AtomicFile;
+use crate::io::atomic::{AtomicFile, ScratchFile};
 use crate::io::carmen::LapWriter;
 use crate::log::{LapLog, RunLog};
 use crate::sim::plan::SimPlan;
+use serde::ser::{Error as _, SerializeSeq, SerializeStruct, Serializer};
 use serde::{Deserialize, Serialize};
-use std::io::Write as _;
+use std::cell::RefCell;
+use std::io::{BufRead as _, Write as _};
 use std::path::{Path, PathBuf};
 
 /// Host name written in every record.
@@ -34,9 +36,9 @@ pub fn carmen_log(scn: &SimPlan, run: &RunLog) -> String {
     out
 }
 
-/// The JSON manifest of a simulation.
+/// The JSON manifest of a simulation (`R`, the runs' type, differs only while it is written).
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Manifest {
+pub struct Manifest<R = ManifestRun> {
     pub placewords_version: String,
     pub scenario: String,
     pub scenario_name: String,
@@ -44,7 +46,7 @@ pub struct Manifest {
     pub route: String,
     pub seed: u64,
     pub laps_override: Option<usize>,
-    pub runs: Vec<ManifestRun>,
+    pub runs: Vec<R>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -64,13 +66,60 @@ pub struct ManifestLap {
     pub frames: usize,
 }
 
+/// File name of the manifest.
+const MANIFEST: &str = "manifest.json";
+
+/// The lines of the laps' scratch file.
+type LapLines = std::io::Lines<std::io::BufReader<std::fs::File>>;
+
+/// A run's manifest entry as [`ManifestRun`] serializes, its laps read from the scratch file
+/// (shared by the runs, read in run order) as they are serialized.
+struct RunOut<'a> {
+    head: &'a RunHead,
+    lines: &'a RefCell<Option<LapLines>>,
+}
+
+/// The laps of one [`RunOut`].
+struct LapsOut<'a>(&'a RunOut<'a>);
+
+impl Serialize for RunOut<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        // The fields of `ManifestRun`, in its order.
+        let mut st = s.serialize_struct("ManifestRun", 5)?;
+        st.serialize_field("run", &self.head.run)?;
+        st.serialize_field("file", &self.head.file)?;
+        st.serialize_field("start_waypoint", &self.head.start_waypoint)?;
+        st.serialize_field("frames", &self.head.frames)?;
+        st.serialize_field("laps", &LapsOut(self))?;
+        st.end()
+    }
+}
+
+impl Serialize for LapsOut<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let n = self.0.head.laps;
+        let mut seq = s.serialize_seq(Some(n))?;
+        let mut lines = self.0.lines.borrow_mut();
+        for _ in 0..n {
+            let line = lines
+                .as_mut()
+                .and_then(Iterator::next)
+                .ok_or_else(|| S::Error::custom("the laps' scratch file ended early"))?
+                .map_err(S::Error::custom)?;
+            let lap: ManifestLap = serde_json::from_str(&line).map_err(S::Error::custom)?;
+            seq.serialize_element(&lap)?;
+        }
+        seq.end()
+    }
+}
+
 /// File name of run `run`'s log.
 pub fn log_file_name(run: usize) -> String {
     format!("run-{run:03}.log")
 }
 
 /// The manifest of a simulation whose runs are `runs`.
-pub fn manifest(scn: &SimPlan, runs: Vec<ManifestRun>, laps_override: Option<usize>) -> Manifest {
+pub fn manifest<R>(scn: &SimPlan, runs: Vec<R>, laps_override: Option<usize>) -> Manifest<R> {
     Manifest {
         placewords_version: env!("CARGO_PKG_VERSION").into(),
         scenario: scn.path.display().to_string(),
@@ -106,22 +155,35 @@ fn at(p: &Path, e: std::io::Error) -> std::io::Error {
     std::io::Error::new(e.kind(), format!("{}: cannot write: {e}", p.display()))
 }
 
+/// A run's manifest entry without its laps (those wait in [`LogsWriter`]'s scratch file).
+#[derive(Clone, Debug)]
+struct RunHead {
+    run: usize,
+    file: String,
+    start_waypoint: usize,
+    frames: usize,
+    laps: usize,
+}
+
 /// The log file of the run being written.
 struct OpenRun {
     file: AtomicFile,
     carmen: LapWriter,
-    manifest: ManifestRun,
+    head: RunHead,
 }
 
 /// Writes a simulation's folder lap by lap: laps arrive in run order, each appended to its run's
-/// `run-NNN.log` (written under a temporary name, renamed when the run ends); [`Self::finish`]
-/// writes `manifest.json`. Holds one lap's text at a time.
+/// `run-NNN.log` (written under a temporary name, renamed when the run ends), its manifest
+/// entry to a scratch file; [`Self::finish`] writes `manifest.json` from them. Holds one lap's
+/// text at a time, so memory does not grow with the laps.
 pub struct LogsWriter<'a> {
     scn: &'a SimPlan,
     laps_override: Option<usize>,
     dir: PathBuf,
     open: Option<OpenRun>,
-    runs: Vec<ManifestRun>,
+    runs: Vec<RunHead>,
+    /// The manifest entries of the laps written, one JSON line each.
+    laps: Option<ScratchFile>,
     written: Vec<PathBuf>,
     text: String,
 }
@@ -135,6 +197,7 @@ impl<'a> LogsWriter<'a> {
             dir: dir.to_path_buf(),
             open: None,
             runs: Vec::new(),
+            laps: None,
             written: Vec::new(),
             text: String::new(),
         }
@@ -159,23 +222,37 @@ impl<'a> LogsWriter<'a> {
         open.file
             .write_all(self.text.as_bytes())
             .map_err(|e| at(open.file.path(), e))?;
-        open.manifest.frames += lap.frames.len();
-        open.manifest.laps.push(ManifestLap {
+        open.head.frames += lap.frames.len();
+        open.head.laps += 1;
+        let entry = ManifestLap {
             lap: lap.lap,
             door_config: lap.door_config.clone(),
             open_doors: lap.open_doors.clone(),
             frames: lap.frames.len(),
-        });
-        Ok(())
+        };
+        let laps = self.laps.as_mut().expect("open_run made the scratch file");
+        serde_json::to_writer(&mut *laps, &entry)
+            .map_err(std::io::Error::other)
+            .and_then(|()| laps.write_all(b"\n"))
+            .map_err(|e| at(&self.dir.join(MANIFEST), e))
     }
 
     /// Ends the last run, writes `manifest.json`; returns the paths written.
     pub fn finish(mut self) -> std::io::Result<Vec<PathBuf>> {
         self.close_run()?;
-        let p = self.dir.join("manifest.json");
-        let runs = std::mem::take(&mut self.runs);
-        let manifest = manifest(self.scn, runs, self.laps_override);
-        // Written straight to the file: a million laps' manifest is not held twice as text.
+        let p = self.dir.join(MANIFEST);
+        let lines = match self.laps.as_mut() {
+            Some(scratch) => Some(scratch.read_back().map_err(|e| at(&p, e))?.lines()),
+            None => None,
+        };
+        let lines = std::cell::RefCell::new(lines);
+        let runs = self.runs.iter().map(|head| RunOut {
+            head,
+            lines: &lines,
+        });
+        let manifest = manifest(self.scn, runs.collect(), self.laps_override);
+        // Written straight to the file, the laps read back one at a time: a million laps'
+        // manifest is never held in memory.
         let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
         serde_json::to_writer_pretty(&mut file, &manifest)
             .map_err(std::io::Error::other)
@@ -191,15 +268,19 @@ impl<'a> LogsWriter<'a> {
         let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
         file.write_all(header(self.scn, run).as_bytes())
             .map_err(|e| at(&p, e))?;
+        if self.laps.is_none() {
+            let scratch = self.dir.join("manifest-laps");
+            self.laps = Some(ScratchFile::create(&scratch).map_err(|e| at(&scratch, e))?);
+        }
         self.open = Some(OpenRun {
             file,
             carmen: LapWriter::new(HOST),
-            manifest: ManifestRun {
+            head: RunHead {
                 run,
                 file: log_file_name(run),
                 start_waypoint: self.scn.runs[run].start_waypoint,
                 frames: 0,
-                laps: Vec::new(),
+                laps: 0,
             },
         });
         Ok(())
@@ -210,7 +291,7 @@ impl<'a> LogsWriter<'a> {
             let p = open.file.path().to_path_buf();
             open.file.commit().map_err(|e| at(&p, e))?;
             self.written.push(p);
-            self.runs.push(open.manifest);
+            self.runs.push(open.head);
         }
         Ok(())
     }

@@ -1,0 +1,436 @@
+//! Earlier observations near a query, found without looking at each of them: the index behind
+//! revisits, visit recall and possible pairs ([`super::metrics`], [`super::pair_recall`]).
+//!
+//! Those figures ask, for every observation in creation order, about the observations made at
+//! least `min_gap_m` of true travel before it that lie within a radius and face a given way.
+//! Scanning every earlier observation in the grid cells around it made scoring quadratic in the
+//! passes over a place (a log of 287 copies of one path ran for more than an hour). Here the
+//! truth sites sit in a static k-d tree over position and heading; a site is *activated* once the
+//! travel gap to the current query is reached ([`sweep`]; observations are in creation order, so
+//! their true travel never decreases and the activated sites are always a prefix), and every node
+//! counts its active sites. A query adds a whole node when every site in it passes the test,
+//! skips it when none can, and tests sites one by one only in nodes that straddle the edge.
+//!
+//! The answers are exactly those of testing every site with the figures' own predicate
+//! ([`Site::agrees_with`]): a node's distance bounds are computed with the same floating-point
+//! operations as a site's distance, which are monotone, so a node said to be all inside (or all
+//! outside) holds no site the predicate would judge otherwise; headings are decided per node
+//! only with a margin of 1e-9 rad, and per site otherwise.
+
+use super::pair_recall::Facing;
+use crate::geom::wrap_angle;
+
+/// The truth of one observation, as the scores use it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Site {
+    pub x: f64,
+    pub y: f64,
+    pub theta: f64,
+    /// True travel up to the observation's frame, metres.
+    pub travel_m: f64,
+    /// Global lap index (`GroundTruth::laps`).
+    pub lap: usize,
+}
+
+impl Site {
+    /// Whether earlier site `p` is within `r2` (squared radius) of `self` and faces as
+    /// `facing` says: the figures' own test, operand for operand.
+    pub fn agrees_with(&self, p: &Site, r2: f64, facing: Facing, tol_rad: f64) -> bool {
+        (self.x - p.x).powi(2) + (self.y - p.y).powi(2) <= r2
+            && facing.agrees(self.theta, p.theta, tol_rad)
+    }
+}
+
+/// Sites in a leaf at most.
+const LEAF: usize = 16;
+/// Headings are classified per node only this far from the tolerance, radians.
+const HEADING_MARGIN_RAD: f64 = 1e-9;
+/// Marks a leaf in `Node::children`.
+const NO_CHILD: u32 = u32::MAX;
+
+/// A box of sites: position and wrapped-heading bounds, laps, its slice of `order`.
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    x: [f64; 2],
+    y: [f64; 2],
+    theta: [f64; 2],
+    lap: [usize; 2],
+    start: u32,
+    end: u32,
+    children: [u32; 2],
+}
+
+/// How much of a node a query takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Cover {
+    None,
+    Part,
+    All,
+}
+
+/// A query: the site asked about, the squared radius, the facing and heading tolerance.
+#[derive(Clone, Copy, Debug)]
+pub struct Query<'q> {
+    pub site: &'q Site,
+    pub r2: f64,
+    pub facing: Facing,
+    pub tol_rad: f64,
+}
+
+/// The sites of one sweep (see the module doc), with the active ones counted per node.
+pub struct SiteTree<'s> {
+    sites: &'s [Site],
+    /// Site indices in tree order (each node holds a contiguous slice).
+    order: Vec<u32>,
+    nodes: Vec<Node>,
+    parent: Vec<u32>,
+    leaf_of: Vec<u32>,
+    active: Vec<u32>,
+    /// Sites `[0, frontier)` are active.
+    frontier: usize,
+}
+
+impl<'s> SiteTree<'s> {
+    /// The tree of `sites` (creation order), none active.
+    pub fn new(sites: &'s [Site]) -> Self {
+        let mut t = SiteTree {
+            sites,
+            order: (0..sites.len() as u32).collect(),
+            nodes: Vec::new(),
+            parent: Vec::new(),
+            leaf_of: vec![0; sites.len()],
+            active: Vec::new(),
+            frontier: 0,
+        };
+        if !sites.is_empty() {
+            t.build(0, sites.len(), NO_CHILD);
+        }
+        t.active = vec![0; t.nodes.len()];
+        t
+    }
+
+    /// Builds the node of `order[start..end]` under `parent`; returns its index.
+    fn build(&mut self, start: usize, end: usize, parent: u32) -> u32 {
+        let id = self.nodes.len() as u32;
+        let node = self.bounds(start, end);
+        self.nodes.push(node);
+        self.parent.push(parent);
+        if end - start <= LEAF {
+            for &s in &self.order[start..end] {
+                self.leaf_of[s as usize] = id;
+            }
+            return id;
+        }
+        let extent = [
+            node.x[1] - node.x[0],
+            node.y[1] - node.y[0],
+            node.theta[1] - node.theta[0],
+        ];
+        let axis = (0..3)
+            .max_by(|&a, &b| extent[a].total_cmp(&extent[b]))
+            .unwrap_or(0);
+        let sites = self.sites;
+        let key = |s: &u32| {
+            let p = &sites[*s as usize];
+            [p.x, p.y, wrap_angle(p.theta)][axis]
+        };
+        let mid = start + (end - start) / 2;
+        self.order[start..end]
+            .select_nth_unstable_by(mid - start, |a, b| key(a).total_cmp(&key(b)));
+        let left = self.build(start, mid, id);
+        let right = self.build(mid, end, id);
+        self.nodes[id as usize].children = [left, right];
+        id
+    }
+
+    /// The bounds of `order[start..end]`, as a leaf.
+    fn bounds(&self, start: usize, end: usize) -> Node {
+        let mut n = Node {
+            x: [f64::INFINITY, f64::NEG_INFINITY],
+            y: [f64::INFINITY, f64::NEG_INFINITY],
+            theta: [f64::INFINITY, f64::NEG_INFINITY],
+            lap: [usize::MAX, 0],
+            start: start as u32,
+            end: end as u32,
+            children: [NO_CHILD; 2],
+        };
+        for &s in &self.order[start..end] {
+            let p = &self.sites[s as usize];
+            let t = wrap_angle(p.theta);
+            n.x = [n.x[0].min(p.x), n.x[1].max(p.x)];
+            n.y = [n.y[0].min(p.y), n.y[1].max(p.y)];
+            n.theta = [n.theta[0].min(t), n.theta[1].max(t)];
+            n.lap = [n.lap[0].min(p.lap), n.lap[1].max(p.lap)];
+        }
+        n
+    }
+
+    /// Activates sites up to (not including) `to`.
+    fn activate_to(&mut self, to: usize) {
+        while self.frontier < to {
+            let mut n = self.leaf_of[self.frontier];
+            while n != NO_CHILD {
+                self.active[n as usize] += 1;
+                n = self.parent[n as usize];
+            }
+            self.frontier += 1;
+        }
+    }
+
+    /// How much of node `n` the query `q` takes.
+    fn cover(&self, n: &Node, q: &Query) -> Cover {
+        let s = q.site;
+        // Distance bounds with the site test's own operations (see the module doc).
+        let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
+        let near = |v: f64, b: [f64; 2]| {
+            let (lo, hi) = (v - b[1], v - b[0]);
+            if lo <= 0.0 && hi >= 0.0 {
+                0.0
+            } else {
+                lo.powi(2).min(hi.powi(2))
+            }
+        };
+        if near(s.x, n.x) + near(s.y, n.y) > q.r2 {
+            return Cover::None;
+        }
+        let inside = far(s.x, n.x) + far(s.y, n.y) <= q.r2;
+        match (inside, heading_cover(s.theta, n.theta, q.facing, q.tol_rad)) {
+            (_, Cover::None) => Cover::None,
+            (true, Cover::All) => Cover::All,
+            _ => Cover::Part,
+        }
+    }
+
+    /// Active sites that `q` takes; with `first`, stops at the first (returns 0 or 1).
+    pub fn count(&self, q: &Query, first: bool) -> u64 {
+        let mut total = 0u64;
+        let mut stack = vec![0u32];
+        while let Some(id) = stack.pop() {
+            let Some(node) = self.live(id) else { continue };
+            match self.cover(node, q) {
+                Cover::None => continue,
+                Cover::All => total += u64::from(self.active[id as usize]),
+                Cover::Part if node.children[0] == NO_CHILD => {
+                    total += self
+                        .leaf_sites(node)
+                        .filter(|p| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad))
+                        .count() as u64;
+                }
+                Cover::Part => stack.extend(node.children),
+            }
+            if first && total > 0 {
+                return 1;
+            }
+        }
+        total
+    }
+
+    /// Adds to `laps` the lap of every active site `q` takes (nodes of one lap already in
+    /// `laps` are skipped).
+    pub fn laps(&self, q: &Query, laps: &mut LapSet) {
+        let mut stack = vec![0u32];
+        while let Some(id) = stack.pop() {
+            let Some(node) = self.live(id) else { continue };
+            if node.lap[0] == node.lap[1] && laps.contains(node.lap[0]) {
+                continue;
+            }
+            match self.cover(node, q) {
+                Cover::None => {}
+                Cover::All if node.lap[0] == node.lap[1] => laps.insert(node.lap[0]),
+                _ if node.children[0] == NO_CHILD => {
+                    for p in self.leaf_sites(node) {
+                        if q.site.agrees_with(p, q.r2, q.facing, q.tol_rad) {
+                            laps.insert(p.lap);
+                        }
+                    }
+                }
+                _ => stack.extend(node.children),
+            }
+        }
+    }
+
+    /// Node `id` when it holds an active site.
+    fn live(&self, id: u32) -> Option<&Node> {
+        (self.active.get(id as usize).copied().unwrap_or(0) > 0).then(|| &self.nodes[id as usize])
+    }
+
+    /// The active sites of a leaf.
+    fn leaf_sites<'a>(&'a self, node: &Node) -> impl Iterator<Item = &'a Site> + 'a {
+        let frontier = self.frontier;
+        self.order[node.start as usize..node.end as usize]
+            .iter()
+            .filter(move |&&s| (s as usize) < frontier)
+            .map(move |&s| &self.sites[s as usize])
+    }
+}
+
+/// How many headings in the wrapped range `range` agree with `theta` as `facing` says.
+fn heading_cover(theta: f64, range: [f64; 2], facing: Facing, tol_rad: f64) -> Cover {
+    let half = (range[1] - range[0]) / 2.0;
+    let mid = range[0] + half;
+    let one = |offset: f64| {
+        let c = wrap_angle(theta - mid - offset).abs();
+        if c + half + HEADING_MARGIN_RAD <= tol_rad {
+            Cover::All
+        } else if c - half - HEADING_MARGIN_RAD > tol_rad {
+            Cover::None
+        } else {
+            Cover::Part
+        }
+    };
+    let (same, opposite) = (|| one(0.0), || one(std::f64::consts::PI));
+    match facing {
+        Facing::Same => same(),
+        Facing::Opposite => opposite(),
+        Facing::Either => match (same(), opposite()) {
+            (Cover::All, _) | (_, Cover::All) => Cover::All,
+            (Cover::None, Cover::None) => Cover::None,
+            _ => Cover::Part,
+        },
+    }
+}
+
+/// A set of laps, emptied in O(1) between queries.
+#[derive(Clone, Debug, Default)]
+pub struct LapSet {
+    /// Per lap: the generation it was last inserted in.
+    stamp: Vec<u64>,
+    generation: u64,
+    /// The laps inserted since the last clear, in insertion order.
+    pub list: Vec<usize>,
+}
+
+impl LapSet {
+    /// Empties the set.
+    pub fn clear(&mut self) {
+        self.generation += 1;
+        self.list.clear();
+    }
+
+    pub fn contains(&self, lap: usize) -> bool {
+        self.stamp.get(lap) == Some(&(self.generation + 1))
+    }
+
+    pub fn insert(&mut self, lap: usize) {
+        if self.stamp.len() <= lap {
+            self.stamp.resize(lap + 1, 0);
+        }
+        if self.stamp[lap] != self.generation + 1 {
+            self.stamp[lap] = self.generation + 1;
+            self.list.push(lap);
+        }
+    }
+}
+
+/// Calls `visit(k, tree)` for every site `k` in order, with exactly the sites before it that
+/// are at least `min_gap_m` of true travel earlier active in `tree` (see the module doc).
+pub fn sweep(sites: &[Site], min_gap_m: f64, mut visit: impl FnMut(usize, &SiteTree)) {
+    let mut tree = SiteTree::new(sites);
+    let mut ready = 0;
+    for (k, s) in sites.iter().enumerate() {
+        while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
+            ready += 1;
+        }
+        tree.activate_to(ready);
+        visit(k, &tree);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Sites on several noisy passes over one path, some driven the other way, on 3 laps.
+    fn passes(seed: u64) -> Vec<Site> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut out = Vec::new();
+        let mut travel = 0.0;
+        for pass in 0..12 {
+            let back = pass % 3 == 2;
+            for k in 0..200 {
+                let u = if back { 200 - k } else { k } as f64 * 0.1;
+                let heading = if back { std::f64::consts::PI } else { 0.0 };
+                out.push(Site {
+                    x: u + rng.random_range(-0.05..0.05),
+                    y: (u * 0.3).sin() + rng.random_range(-0.05..0.05),
+                    theta: heading
+                        + rng.random_range(-0.9..0.9)
+                        + 2.0 * std::f64::consts::PI * (pass % 2) as f64,
+                    travel_m: travel,
+                    lap: pass / 4,
+                });
+                travel += 0.1;
+            }
+        }
+        out
+    }
+
+    /// The brute force: every earlier site beyond the gap, tested one by one.
+    fn brute(sites: &[Site], k: usize, gap: f64, r: f64, facing: Facing) -> Vec<usize> {
+        (0..k)
+            .filter(|&j| sites[k].travel_m - sites[j].travel_m >= gap)
+            .filter(|&j| sites[k].agrees_with(&sites[j], r * r, facing, 0.7))
+            .collect()
+    }
+
+    /// Counts, existence and laps equal the brute force for every site, radius and facing.
+    #[test]
+    fn answers_equal_testing_every_earlier_site() {
+        let sites = passes(3);
+        for r in [0.05, 0.5, 1.0, 3.0] {
+            for facing in [Facing::Same, Facing::Opposite, Facing::Either] {
+                sweep(&sites, 2.0, |k, tree| {
+                    let want = brute(&sites, k, 2.0, r, facing);
+                    let q = Query {
+                        site: &sites[k],
+                        r2: r * r,
+                        facing,
+                        tol_rad: 0.7,
+                    };
+                    assert_eq!(
+                        tree.count(&q, false),
+                        want.len() as u64,
+                        "{k} {r} {facing:?}"
+                    );
+                    assert_eq!(tree.count(&q, true), u64::from(!want.is_empty()));
+                    let mut laps: Vec<usize> = want.iter().map(|&j| sites[j].lap).collect();
+                    laps.dedup();
+                    let mut set = LapSet::default();
+                    set.insert(99);
+                    set.clear();
+                    tree.laps(&q, &mut set);
+                    let mut found = set.list.clone();
+                    found.sort_unstable();
+                    assert_eq!(found, laps, "{k} {r} {facing:?}");
+                });
+            }
+        }
+    }
+
+    #[test]
+    fn no_sites_no_answers() {
+        sweep(&[], 1.0, |_, _| panic!("no site to visit"));
+        let one = [Site {
+            x: 0.0,
+            y: 0.0,
+            theta: 0.0,
+            travel_m: 0.0,
+            lap: 0,
+        }];
+        sweep(&one, 0.0, |k, tree| {
+            let q = Query {
+                site: &one[k],
+                r2: 1.0,
+                facing: Facing::Either,
+                tol_rad: 1.0,
+            };
+            assert_eq!(
+                tree.count(&q, false),
+                0,
+                "a site is not its own earlier site"
+            );
+        });
+    }
+}
