@@ -87,6 +87,11 @@ pub struct RecognizerConfig {
     /// and Intel's opposite recall 0 → 0.16, but it lowers scenario A's worst 3-level precision
     /// over seeds 1..10 from 0.955 to 0.937 (RESULTS.md).
     pub substitutions: bool,
+    /// How far the sizes of the two words a substitution bridges may differ, as a fraction of
+    /// the larger (`substitutions`). Default 0.3: the bridged words keep (nearly) the size
+    /// syllable and differ in their turn angle, which in logs with turns between scans is what
+    /// moves; bridging any same-class word lowered scenario A's worst precision to 0.937.
+    pub substitution_size_ratio: f64,
     /// Also accept an n-gram shorter than the configuration's minimum size when it has at least
     /// `ngram_travel_min_words` word pairs and its current side spans at least this much
     /// odometric travel, metres; 0 = off. Long words (a corridor loop where a word is 3–8 m)
@@ -95,6 +100,14 @@ pub struct RecognizerConfig {
     /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 and scenario
     /// A's 3-level precision to 0.693 (RESULTS.md).
     pub ngram_travel_m: f64,
+    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 12.
+    /// Read backwards, a word's boundaries do not fall where they fell driving the other way (the
+    /// laser looks ahead, so Ψ rises and falls at different places), so opposite chains break
+    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words. Tuned on
+    /// Intel (opposite recall 0 → 0.38 over noise seeds 1..5); confirmed on scenarios A and
+    /// `reverse` (RESULTS.md). Applied to both directions (`ngram_travel_m`) it lowered A's
+    /// precision to 0.69.
+    pub reverse_ngram_travel_m: f64,
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
     pub ngram_travel_min_words: usize,
@@ -154,8 +167,10 @@ impl Default for RecognizerConfig {
             alignment: AlignmentMode::Chain,
             reverse: true,
             reverse_extra_ngram: 2,
-            substitutions: false,
+            substitutions: true,
+            substitution_size_ratio: 0.3,
             ngram_travel_m: 0.0,
+            reverse_ngram_travel_m: 12.0,
             ngram_travel_min_words: 4,
             chain_alignment_tie: 1e-4,
             verify: true,
@@ -310,6 +325,17 @@ impl RecognizerConfig {
                 ),
             );
         }
+        if !(self.substitution_size_ratio.is_finite()
+            && (0.0..=1.0).contains(&self.substitution_size_ratio))
+        {
+            bad(
+                "substitution_size_ratio",
+                format!(
+                    "must be in [0, 1], got {}; the default is 0.3",
+                    self.substitution_size_ratio
+                ),
+            );
+        }
         if !(self.angle_tolerance_deg.is_finite()
             && (0.0..=180.0).contains(&self.angle_tolerance_deg))
         {
@@ -361,6 +387,7 @@ impl RecognizerConfig {
             ("verify_turn_deg", self.verify_turn_deg),
             ("verify_max_psi_rms", self.verify_max_psi_rms),
             ("ngram_travel_m", self.ngram_travel_m),
+            ("reverse_ngram_travel_m", self.reverse_ngram_travel_m),
             ("chain_alignment_tie", self.chain_alignment_tie),
         ] {
             if !(v.is_finite() && v >= 0.0) {

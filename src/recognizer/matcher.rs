@@ -24,11 +24,13 @@
 //! side's travel and turn measured backwards, and are aligned on the past word's Ψ read
 //! backwards (so past ids decrease as query ids increase).
 //!
-//! **Substitutions** (`substitutions`, off by default). In sparse logs a class boundary moves by
-//! a few observations between visits, a short word then fails the size syllable and the chain
-//! breaks. With substitutions, (c, p) may also extend a chain ending one level-0 word further
-//! back on both sides when the two skipped words have the same class; the skipped pair does not
-//! count towards the n-gram's size, and verification still checks the whole n-gram.
+//! **Substitutions** (`substitutions`, on by default). In sparse logs, and with turns between
+//! scans, a word's turn angle (and a little its size) moves between visits; the word then fails
+//! its syllables and the chain breaks. With substitutions, (c, p) may also extend a chain ending
+//! one level-0 word further back on both sides when the two skipped words have the same class
+//! and sizes within `substitution_size_ratio`; the skipped pair does not count towards the
+//! n-gram's size, and verification still checks the whole n-gram. Bridging any same-class word
+//! (no size bound) let unrelated words through and cost scenario A precision.
 //!
 //! **Reporting.** For configuration k with minimum size τₖ, a pair (c, p) whose chain reaches τₖ
 //! is reported when the τₖ-gram ending at it satisfies the gap: its first current word begins at
@@ -36,9 +38,11 @@
 //! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
 //! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
 //! length). The result of an L-level run is the union of the matches with `levels` ≤ L. With
-//! `ngram_travel_m` > 0 a chain of at least `ngram_travel_min_words` pairs (read backwards, plus
+//! `ngram_travel_m` > 0 (same direction) or `reverse_ngram_travel_m` > 0 (read backwards; on by
+//! default) a chain of at least `ngram_travel_min_words` pairs (read backwards, plus
 //! `reverse_extra_ngram`) whose current side spans that much travel is reported as if it had
-//! reached τₖ.
+//! reached τₖ. Read backwards, words split at other places than they did driving the other way
+//! (the laser looks ahead), so opposite chains are runs of a few long words.
 //!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
 //! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
@@ -91,7 +95,9 @@ struct Params {
     reverse: bool,
     reverse_extra_ngram: usize,
     substitutions: bool,
-    ngram_travel_m: f64,
+    substitution_size_ratio: f64,
+    /// Per direction (`Same`, `Opposite`): `ngram_travel_m`, `reverse_ngram_travel_m`.
+    ngram_travel_m: [f64; 2],
     ngram_travel_min_words: usize,
     chain_tie: f64,
     verify: bool,
@@ -150,7 +156,8 @@ impl WordMatcher {
                 reverse: config.reverse,
                 reverse_extra_ngram: config.reverse_extra_ngram,
                 substitutions: config.substitutions,
-                ngram_travel_m: config.ngram_travel_m,
+                substitution_size_ratio: config.substitution_size_ratio,
+                ngram_travel_m: [config.ngram_travel_m, config.reverse_ngram_travel_m],
                 ngram_travel_min_words: config.ngram_travel_min_words,
                 chain_tie: config.chain_alignment_tie,
                 verify: config.verify,
@@ -445,6 +452,10 @@ impl WordMatcher {
         if self.word(c_skip).class != self.word(p_skip).class {
             return;
         }
+        let (a, b) = (self.word(c_skip).size as f64, self.word(p_skip).size as f64);
+        if (a - b).abs() > self.params.substitution_size_ratio * a.max(b) + 1e-9 {
+            return;
+        }
         for &c2 in self.word(c_skip).pred_ids() {
             let memo = &self.memo[d][c2 as usize];
             if memo.is_empty() {
@@ -508,7 +519,8 @@ impl WordMatcher {
             Direction::Opposite => self.params.min_ngram[k] + self.params.reverse_extra_ngram,
         };
         let e = memo[c as usize][idx];
-        let by_travel = self.params.ngram_travel_m > 0.0;
+        let travel_m = self.params.ngram_travel_m[dir as usize];
+        let by_travel = travel_m > 0.0;
         let min_words = self.params.ngram_travel_min_words.max(1)
             + match dir {
                 Direction::Same => 0,
@@ -522,10 +534,11 @@ impl WordMatcher {
         let (mut wc, mut we) = (c, e);
         let end_m = self.word(c).end_travel_m;
         while chain.len() < tau {
-            // An n-gram long in travel but short in words (`ngram_travel_m`).
+            // An n-gram long in travel but short in words (`ngram_travel_m`,
+            // `reverse_ngram_travel_m`).
             if by_travel
                 && chain.len() >= min_words
-                && end_m - self.word(wc).start_travel_m >= self.params.ngram_travel_m
+                && end_m - self.word(wc).start_travel_m >= travel_m
             {
                 break;
             }

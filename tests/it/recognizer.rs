@@ -1233,22 +1233,33 @@ fn observations_carry_the_frame_id_the_caller_gave() {
     }
 }
 
-/// The second lap with one word of the same class but 40 % longer: chains break there, so
-/// with n-grams of 6 words and 5 matching words on either side nothing matches; with
-/// `substitutions` the chain bridges the word and the lap is recognized, every pair at its place.
-#[test]
-fn a_substituted_word_is_bridged_only_with_substitutions() {
+/// Two laps of 11 words, the second with word 5 of the same class but `size` observations
+/// instead of 20 (the first lap's), at 1 level, n-grams of 6 words, without their matches
+/// read backwards.
+fn substituted_laps(size: usize) -> (Vec<Stretch>, Vec<Stretch>, RecognizerConfig) {
     let mut lap = random_stretches(5, 11);
     lap[5].size = 20;
     let mut changed = lap.clone();
-    changed[5].size = 28; // 40 % longer: the size syllable fails, the travel check does not
-    let first = synth::observations(&lap, 0.1, 0, None);
-    let second = synth::observations(&changed, 0.1, 0, first.last());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    changed[5].size = size;
     let base = config(|c| {
         c.levels = 1;
         c.candidate_gap_m = 5.0;
+        c.substitutions = false;
+        c.reverse = false;
     });
+    (lap, changed, base)
+}
+
+/// The second lap with one word of the same class but 40 % longer: chains break there, so
+/// with n-grams of 6 words and 5 matching words on either side nothing matches; with
+/// `substitutions` (the default) the chain bridges the word and the lap is recognized, every
+/// pair at its place.
+#[test]
+fn a_substituted_word_is_bridged_only_with_substitutions() {
+    let (lap, changed, base) = substituted_laps(28); // the size syllable fails, travel does not
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&changed, 0.1, 0, first.last());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
     let (_, plain) = run_matcher(&base, &all);
     assert!(plain.is_empty(), "5-word chains must not reach τ = 6");
     let bridged = RecognizerConfig {
@@ -1266,6 +1277,28 @@ fn a_substituted_word_is_bridged_only_with_substitutions() {
             "pair ({query}, {past}) is not at its place (offset {offset})"
         );
     }
+}
+
+/// A substitution bridges only words of about the same size: the same laps with word 5
+/// 60 % longer (20 vs 32 observations, beyond `substitution_size_ratio` = 0.3) do not match,
+/// and a ratio of 0.4 bridges them.
+#[test]
+fn a_substitution_bridges_only_words_of_about_the_same_size() {
+    let (lap, changed, base) = substituted_laps(32);
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&changed, 0.1, 0, first.last());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let bridged = RecognizerConfig {
+        substitutions: true,
+        ..base.clone()
+    };
+    assert_eq!(bridged.substitution_size_ratio, 0.3);
+    assert!(run_matcher(&bridged, &all).1.is_empty());
+    let loose = RecognizerConfig {
+        substitution_size_ratio: 0.4,
+        ..bridged
+    };
+    assert!(!run_matcher(&loose, &all).1.is_empty());
 }
 
 /// A corridor of five long words (6 m each) seen twice: 5 words never make a 6-gram, but
@@ -1295,4 +1328,41 @@ fn long_words_match_by_travel_when_asked() {
     for (query, past) in matches.iter().flat_map(Match::pairs) {
         assert_eq!(query - n, past);
     }
+}
+
+/// The same corridor driven back the other way: read backwards, 5 words never make the
+/// 8 words an opposite n-gram needs (τ + `reverse_extra_ngram`), but by default
+/// (`reverse_ngram_travel_m` = 12) 6 or more words spanning 12 m are accepted, each pair at
+/// its place read backwards; with `reverse_ngram_travel_m` = 0 nothing matches.
+#[test]
+fn long_words_driven_back_match_by_travel_by_default() {
+    let lap: Vec<Stretch> = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1]
+        .iter()
+        .map(|&psi| Stretch::new(psi, 40, 0.0))
+        .collect();
+    let first = synth::observations(&lap, 0.1, 0, None);
+    let second = synth::observations(&reversed(&lap), 0.1, 0, first.last());
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let base = config(|c| {
+        c.levels = 1;
+        c.candidate_gap_m = 5.0;
+    });
+    assert_eq!(base.reverse_ngram_travel_m, 12.0);
+    let (_, matches) = run_matcher(&base, &all);
+    assert!(!matches.is_empty());
+    assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
+    assert!(matches.iter().all(|m| m.ngram_len >= 6));
+    let n = first.len();
+    for (query, past) in matches.iter().flat_map(Match::pairs) {
+        let at = (query - n) as i64 + past as i64 + 1 - n as i64;
+        assert!(
+            at.abs() <= 2,
+            "pair ({query}, {past}) is {at} observations off"
+        );
+    }
+    let off = RecognizerConfig {
+        reverse_ngram_travel_m: 0.0,
+        ..base
+    };
+    assert!(run_matcher(&off, &all).1.is_empty());
 }
