@@ -100,13 +100,14 @@ pub struct RecognizerConfig {
     /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 and scenario
     /// A's 3-level precision to 0.693 (RESULTS.md).
     pub ngram_travel_m: f64,
-    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 12.
+    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 0.
     /// Read backwards, a word's boundaries do not fall where they fell driving the other way (the
     /// laser looks ahead, so Ψ rises and falls at different places), so opposite chains break
-    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words. Tuned on
-    /// Intel (opposite recall 0 → 0.38 over noise seeds 1..5); confirmed on scenarios A and
-    /// `reverse` (RESULTS.md). Applied to both directions (`ngram_travel_m`) it lowered A's
-    /// precision to 0.69.
+    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words. On Intel
+    /// (noise seeds 1..5) 12 m lifts the opposite-direction recall from 0.03 to 0.38 at
+    /// precision 0.98, and it keeps it up to 40 m; but scenario A, which has no opposite revisit,
+    /// then gets false opposite matches: 3-level precision 0.839 at 12 m, worst seed 0.942 at
+    /// 40 m (RESULTS.md). Off until opposite chains can be told apart better.
     pub reverse_ngram_travel_m: f64,
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
@@ -170,7 +171,7 @@ impl Default for RecognizerConfig {
             substitutions: true,
             substitution_size_ratio: 0.3,
             ngram_travel_m: 0.0,
-            reverse_ngram_travel_m: 12.0,
+            reverse_ngram_travel_m: 0.0,
             ngram_travel_min_words: 4,
             chain_alignment_tie: 1e-4,
             verify: true,

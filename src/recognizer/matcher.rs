@@ -38,8 +38,7 @@
 //! first time a chain reaches τₖ the match carries its τₖ word pairs; when a later word extends a
 //! reported chain, the match carries only the new pair (`ngram_len` still gives the chain
 //! length). The result of an L-level run is the union of the matches with `levels` ≤ L. With
-//! `ngram_travel_m` > 0 (same direction) or `reverse_ngram_travel_m` > 0 (read backwards; on by
-//! default) a chain of at least `ngram_travel_min_words` pairs (read backwards, plus
+//! `ngram_travel_m` > 0 (same direction) or `reverse_ngram_travel_m` > 0 (read backwards) a chain of at least `ngram_travel_min_words` pairs (read backwards, plus
 //! `reverse_extra_ngram`) whose current side spans that much travel is reported as if it had
 //! reached τₖ. Read backwards, words split at other places than they did driving the other way
 //! (the laser looks ahead), so opposite chains are runs of a few long words.

@@ -1330,12 +1330,12 @@ fn long_words_match_by_travel_when_asked() {
     }
 }
 
-/// The same corridor driven back the other way: read backwards, 5 words never make the
-/// 8 words an opposite n-gram needs (τ + `reverse_extra_ngram`), but by default
-/// (`reverse_ngram_travel_m` = 12) 6 or more words spanning 12 m are accepted, each pair at
-/// its place read backwards; with `reverse_ngram_travel_m` = 0 nothing matches.
+/// The same kind of corridor driven back the other way: read backwards, 7 words never make
+/// the 8 words an opposite n-gram needs (τ + `reverse_extra_ngram`), so by default (0) nothing
+/// matches; with `reverse_ngram_travel_m` = 12, 6 or more words spanning 12 m are accepted,
+/// each pair at its place read backwards.
 #[test]
-fn long_words_driven_back_match_by_travel_by_default() {
+fn long_words_driven_back_match_by_travel_when_asked() {
     let lap: Vec<Stretch> = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1]
         .iter()
         .map(|&psi| Stretch::new(psi, 40, 0.0))
@@ -1347,8 +1347,12 @@ fn long_words_driven_back_match_by_travel_by_default() {
         c.levels = 1;
         c.candidate_gap_m = 5.0;
     });
-    assert_eq!(base.reverse_ngram_travel_m, 12.0);
-    let (_, matches) = run_matcher(&base, &all);
+    assert!(run_matcher(&base, &all).1.is_empty());
+    let by_travel = RecognizerConfig {
+        reverse_ngram_travel_m: 12.0,
+        ..base
+    };
+    let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
     assert!(matches.iter().all(|m| m.ngram_len >= 6));
@@ -1360,9 +1364,4 @@ fn long_words_driven_back_match_by_travel_by_default() {
             "pair ({query}, {past}) is {at} observations off"
         );
     }
-    let off = RecognizerConfig {
-        reverse_ngram_travel_m: 0.0,
-        ..base
-    };
-    assert!(run_matcher(&off, &all).1.is_empty());
 }
