@@ -79,13 +79,13 @@ pub struct RecognizerConfig {
     /// there; confirmed on `reverse` seeds 1..10: opposite precision 0.939 → 0.977 mean).
     pub reverse_extra_ngram: usize,
     /// Chains may bridge one substituted word: (c, p) may extend a chain ending one level-0 word
-    /// further back on both sides, when the two skipped words have the same class (their size
-    /// or angle syllable did not match). The bridged pair does not count towards the n-gram's
-    /// size. Sparse real logs move class boundaries by a few observations between visits, so
-    /// short words fail the size syllable and break chains before τ. Default false: on fhw it
-    /// gives pairs on every noise seed 1..5 (none without), on Intel `--scan-step 3` on 2 of 5
-    /// and Intel's opposite recall 0 → 0.16, but it lowers scenario A's worst 3-level precision
-    /// over seeds 1..10 from 0.955 to 0.937 (RESULTS.md).
+    /// further back on both sides, when the two skipped words have the same class and sizes
+    /// within `substitution_size_ratio` (their angle syllable, or their size by a little, did
+    /// not match). The bridged pair does not count towards the n-gram's size. Sparse real logs
+    /// and turns between scans move a word's turn angle between visits, which breaks chains
+    /// before τ. Default true: fhw gets pairs on every noise seed 1..5 (none without, precision
+    /// 1.0); scenarios A, B, C and `reverse` keep 3-level precision ≥ 0.95 on every seed 1..10
+    /// and A's recall rises 0.562 → 0.592 (RESULTS.md).
     pub substitutions: bool,
     /// How far the sizes of the two words a substitution bridges may differ, as a fraction of
     /// the larger (`substitutions`). Default 0.3: the bridged words keep (nearly) the size
