@@ -1033,26 +1033,21 @@ proptest! {
     }
 }
 
-/// Intel thinned to every 2nd scan (about 1 m and up to 60° of turn between scans) still
-/// matches, precisely: observations interpolated back along a long step used to read Ψ from
-/// the far side of the grid's torus, and steps over 2 m were observed once.
-#[test]
-fn thinned_real_log_still_matches() {
-    let log = Path::new("../shared/data/carmen/intel-corrected.log.gz");
+/// The 3-level scores of `recognize`'s defaults on a shipped real log (every `step`-th scan,
+/// noise seed 1); `None` when `../shared/data` is absent.
+fn real_log_scores(name: &str, step: usize) -> Option<placewords::eval::scores::Scores> {
+    let log = Path::new("../shared/data/carmen").join(format!("{name}-corrected.log.gz"));
     if !log.exists() {
-        eprintln!(
-            "skipping thinned_real_log_still_matches: {} is absent",
-            log.display()
-        );
-        return;
+        eprintln!("skipping: {} is absent", log.display());
+        return None;
     }
     use placewords::experiment::{self, ExperimentOptions, real};
     use placewords::io::real_log::TruthSource;
     // `recognize`'s default noise.
     let noise = real::parse_noise_model("proportional").unwrap().unwrap();
     let (mut run, _) =
-        real::load_real_run(log, false, TruthSource::Corrected, Some(&noise), 1).unwrap();
-    real::keep_every_nth_scan(&mut run, 2);
+        real::load_real_run(&log, false, TruthSource::Corrected, Some(&noise), 1).unwrap();
+    real::keep_every_nth_scan(&mut run, step);
     let opts = ExperimentOptions {
         levels: vec![3],
         icp: false,
@@ -1061,7 +1056,7 @@ fn thinned_real_log_still_matches() {
     };
     let spec = placewords::spec::evaluation::EvaluationSpec::default();
     let exp = experiment::evaluate_runs(
-        "intel-step2",
+        name,
         1,
         vec![run],
         &RecognizerConfig::default(),
@@ -1071,16 +1066,35 @@ fn thinned_real_log_still_matches() {
     .unwrap();
     let l = exp.report.level(3).expect("3 levels ran");
     eprintln!(
-        "intel every 2nd scan: {} pairs, precision {:.3}, recall {:.3}",
+        "{name} every {step} scan(s): {} pairs, precision {:.3}, recall {:.3}",
         l.scores.pairs, l.scores.precision, l.scores.recall
     );
-    assert!(l.scores.pairs > 0, "no pair");
-    assert!(
-        l.scores.precision >= 0.9,
-        "precision {}",
-        l.scores.precision
-    );
-    assert!(l.scores.recall >= 0.2, "recall {}", l.scores.recall);
+    Some(l.scores.clone())
+}
+
+/// Intel thinned to every 2nd scan (about 1 m and up to 60° of turn between scans) still
+/// matches, precisely: observations interpolated back along a long step used to read Ψ from
+/// the far side of the grid's torus, and steps over 2 m were observed once.
+#[test]
+fn thinned_real_log_still_matches() {
+    let Some(scores) = real_log_scores("intel", 2) else {
+        return;
+    };
+    assert!(scores.pairs > 0, "no pair");
+    assert!(scores.precision >= 0.9, "precision {}", scores.precision);
+    assert!(scores.recall >= 0.2, "recall {}", scores.recall);
+}
+
+/// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
+/// with the defaults: its revisits' words differ in turn angle, and chains bridge one such word
+/// (`substitutions`); without them it gave none.
+#[test]
+fn fhw_log_matches_with_the_defaults() {
+    let Some(scores) = real_log_scores("fhw", 1) else {
+        return;
+    };
+    assert!(scores.pairs > 0, "no pair");
+    assert!(scores.precision >= 0.9, "precision {}", scores.precision);
 }
 
 /// Observations interpolated along long steps (scans 1.5 and 2.9 m apart) have about the Ψ that
