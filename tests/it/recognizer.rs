@@ -1315,21 +1315,34 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
     assert!(!run_matcher(&loose, &all).1.is_empty());
 }
 
-/// A corridor of five long words (6 m each) seen twice: 5 words never make a 6-gram, but
-/// `ngram_travel_m` accepts 4 or more words spanning 12 m.
-#[test]
-fn long_words_match_by_travel_when_asked() {
-    let lap: Vec<Stretch> = [0.3, 0.6, 0.2, 0.7, 0.4]
+/// A corridor of long words of Ψ `psis`, `size` observations each, driven twice (the second
+/// time backwards when `back`): the first pass's length, every observation, and a 1-level
+/// configuration with a 5 m candidate gap.
+fn corridor_of_long_words(
+    psis: &[f64],
+    size: usize,
+    back: bool,
+) -> (usize, Vec<Observation>, RecognizerConfig) {
+    let lap: Vec<Stretch> = psis
         .iter()
-        .map(|&psi| Stretch::new(psi, 60, 0.0))
+        .map(|&psi| Stretch::new(psi, size, 0.0))
         .collect();
     let first = synth::observations(&lap, 0.1, 0, None);
-    let second = synth::observations(&lap, 0.1, 0, first.last());
+    let again = if back { reversed(&lap) } else { lap };
+    let second = synth::observations(&again, 0.1, 0, first.last());
     let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
     let base = config(|c| {
         c.levels = 1;
         c.candidate_gap_m = 5.0;
     });
+    (first.len(), all, base)
+}
+
+/// A corridor of five long words (6 m each) seen twice: 5 words never make a 6-gram, but
+/// `ngram_travel_m` accepts 4 or more words spanning 12 m.
+#[test]
+fn long_words_match_by_travel_when_asked() {
+    let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4], 60, false);
     assert!(run_matcher(&base, &all).1.is_empty());
     let by_travel = RecognizerConfig {
         ngram_travel_m: 12.0,
@@ -1338,7 +1351,6 @@ fn long_words_match_by_travel_when_asked() {
     let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.ngram_len >= 4));
-    let n = first.len();
     for (query, past) in matches.iter().flat_map(Match::pairs) {
         assert_eq!(query - n, past);
     }
@@ -1350,17 +1362,7 @@ fn long_words_match_by_travel_when_asked() {
 /// each pair at its place read backwards.
 #[test]
 fn long_words_driven_back_match_by_travel_when_asked() {
-    let lap: Vec<Stretch> = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1]
-        .iter()
-        .map(|&psi| Stretch::new(psi, 40, 0.0))
-        .collect();
-    let first = synth::observations(&lap, 0.1, 0, None);
-    let second = synth::observations(&reversed(&lap), 0.1, 0, first.last());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
-    let base = config(|c| {
-        c.levels = 1;
-        c.candidate_gap_m = 5.0;
-    });
+    let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1], 40, true);
     assert!(run_matcher(&base, &all).1.is_empty());
     let by_travel = RecognizerConfig {
         reverse_ngram_travel_m: 12.0,
@@ -1370,7 +1372,6 @@ fn long_words_driven_back_match_by_travel_when_asked() {
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
     assert!(matches.iter().all(|m| m.ngram_len >= 6));
-    let n = first.len();
     for (query, past) in matches.iter().flat_map(Match::pairs) {
         let at = (query - n) as i64 + past as i64 + 1 - n as i64;
         assert!(
