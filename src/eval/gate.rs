@@ -78,7 +78,7 @@ impl Outcome {
     pub fn name(&self) -> String {
         let subject = match self.direction {
             None => self.subject.clone(),
-            Some(d) => format!("{}/{}", self.subject, direction_name(d)),
+            Some(d) => format!("{}/{}", self.subject, d.name()),
         };
         format!("{}/{subject}/{}", self.scenario, self.bound.metric().name())
     }
@@ -87,7 +87,7 @@ impl Outcome {
     fn target(&self) -> String {
         match self.direction {
             None => self.subject.clone(),
-            Some(d) => format!("{} {}", self.subject, direction_name(d)),
+            Some(d) => format!("{} {}", self.subject, d.name()),
         }
     }
 
@@ -139,14 +139,6 @@ impl Outcome {
                 self.missing.as_deref().unwrap_or("not in the report")
             ),
         }
-    }
-}
-
-/// `same` or `opposite`, as in the scenario file and the report's `directions`.
-pub fn direction_name(d: Direction) -> &'static str {
-    match d {
-        Direction::Same => "same",
-        Direction::Opposite => "opposite",
     }
 }
 
@@ -247,7 +239,7 @@ fn check_bound(
     let present = reports
         .iter()
         .any(|r| distribution::scores_of(r, subject).is_some());
-    let which = direction.map_or(String::new(), |d| format!("{} ", direction_name(d)));
+    let which = direction.map_or(String::new(), |d| format!("{} ", d.name()));
     let missing = match (at, present) {
         (Some(_), _) => None,
         (None, true) => Some(format!("no {which}matches at any seed")),

@@ -490,7 +490,7 @@ impl WordMatcher {
             // Every candidate first, then the reports: a candidate's new pairs are counted when
             // it is reported (see `emit`).
             let mut found = Vec::new();
-            for dir in [Direction::Same, Direction::Opposite] {
+            for dir in Direction::BOTH {
                 for idx in 0..self.memo[dir as usize][c as usize].len() {
                     if let Some(cand) = self.candidate(c, idx, k, dir) {
                         found.push(cand);

@@ -103,6 +103,19 @@ pub enum Direction {
     Opposite,
 }
 
+impl Direction {
+    /// Both directions, `Same` first.
+    pub const BOTH: [Direction; 2] = [Direction::Same, Direction::Opposite];
+
+    /// `same` or `opposite`: its name in scenario files, reports and matches files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::Same => "same",
+            Direction::Opposite => "opposite",
+        }
+    }
+}
+
 /// A recognized revisit: an n-gram of current words matched to an n-gram of past words, read
 /// forwards or (direction `Opposite`) backwards.
 ///

@@ -10,7 +10,7 @@
 //! configuration spent recognizing over all seeds.
 
 pub use super::xml::escape;
-use crate::eval::gate::{Outcome, direction_name, fmt_value};
+use crate::eval::gate::{Outcome, fmt_value};
 use crate::eval::suite::{SuiteReport, reproduce_command};
 use std::fmt::Write;
 
@@ -108,7 +108,7 @@ fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
         props.insert(0, ("value", fmt_value(o.bound, a)));
     }
     if let Some(d) = o.direction {
-        props.push(("direction", direction_name(d).to_string()));
+        props.push(("direction", d.name().to_string()));
     }
     if let Some(seed) = o.seed {
         props.push(("seed", seed.to_string()));

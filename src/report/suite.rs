@@ -3,8 +3,9 @@
 //! (mean, 10th percentile, worst and its seed, and the gate), and the `--json` summary.
 
 use crate::eval::distribution::{ConfigSpread, Metric, Spread};
-use crate::eval::gate::{Outcome, direction_name, fmt_value};
+use crate::eval::gate::{Outcome, fmt_value};
 use crate::eval::suite::{ScenarioResult, SuiteReport};
+use crate::recognizer::Direction;
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -245,7 +246,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
             sc.outcomes.iter().map(move |o| JsonOutcome {
                 name: o.name(),
                 file: &sc.file,
-                direction: o.direction.map(direction_name),
+                direction: o.direction.map(Direction::name),
                 passed: o.passed,
                 statistic: o.statistic(),
                 value: o.actual,

@@ -246,8 +246,8 @@ fn markdown_by_level(
             .iter()
             .any(|r| level(r, lv).is_some_and(Scores::has_opposite))
         {
-            for (name, d) in [("same", Direction::Same), ("opposite", Direction::Opposite)] {
-                line(format!("{lv} {name}"), &|r| {
+            for d in Direction::BOTH {
+                line(format!("{lv} {}", d.name()), &|r| {
                     level(r, lv).map(|s| s.of_direction(d))
                 });
             }
