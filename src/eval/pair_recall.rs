@@ -84,28 +84,6 @@ impl Facing {
     }
 }
 
-/// Truth of one observation: position, heading, true travel.
-#[derive(Clone, Copy, Debug)]
-struct Placed {
-    x: f64,
-    y: f64,
-    theta: f64,
-    travel_m: f64,
-}
-
-impl Placed {
-    /// As a site of the pair search (laps are not needed there).
-    fn site(&self) -> Site {
-        Site {
-            x: self.x,
-            y: self.y,
-            theta: self.theta,
-            travel_m: self.travel_m,
-            lap: 0,
-        }
-    }
-}
-
 /// Counts behind [`pair_recall`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairRecall {
@@ -140,20 +118,21 @@ pub fn pair_recall(
         return PairRecall::default();
     }
     let travel = true_travel_m(truth);
-    let placed: Vec<Option<Placed>> = observations
+    let placed: Vec<Option<Site>> = observations
         .iter()
         .map(|o| {
             let f = truth.frame(o.frame_id)?;
-            Some(Placed {
+            Some(Site {
                 x: f.pose.0.x,
                 y: f.pose.0.y,
                 theta: f.pose.0.theta,
                 travel_m: travel[o.frame_id],
+                lap: f.lap_slot,
             })
         })
         .collect();
     let tol = spec.heading_tolerance_deg.to_radians();
-    let near = |q: &Placed, p: &Placed| {
+    let near = |q: &Site, p: &Site| {
         q.travel_m - p.travel_m >= spec.min_gap_m
             && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
     };
@@ -173,7 +152,7 @@ pub fn pair_recall(
             }),
     );
     let found = seen.len() as u64;
-    let sites: Vec<Site> = placed.iter().flatten().map(Placed::site).collect();
+    let sites: Vec<Site> = placed.iter().flatten().copied().collect();
     // A long log has millions of observations: hold one copy of their truth during the count.
     drop((seen, placed, index_of, travel));
     PairRecall {
