@@ -611,6 +611,7 @@ impl PlaceRecognizer for IcpRecognizer {
             odom_pose: odom,
             travel_m: self.travel_m,
             psi: 0.0,
+            lateral_moment: 0.0,
         });
         self.pending.push(id);
         if self.pending.len() >= self.cfg.region_observations {

@@ -620,6 +620,7 @@ pub(crate) mod tests {
                     odom_pose: OdomPose(pose),
                     travel_m: i as f64 * 0.1,
                     psi: 0.5,
+                    lateral_moment: 0.0,
                 });
             }
         }

@@ -173,11 +173,13 @@ fn recognizer_reason(d: &MatchDiagnostics) -> String {
     }
     if v.rejected() > 0 {
         return format!(
-            "every candidate was rejected by verification: {} (travel {}, turn {}, density {})",
+            "every candidate was rejected by verification: {} (travel {}, turn {}, density {}, sides {}, straight {})",
             v.rejected(),
             v.rejected_travel,
             v.rejected_turn,
-            v.rejected_density
+            v.rejected_density,
+            v.rejected_sides,
+            v.rejected_straight
         );
     }
     let chains: Vec<String> = d

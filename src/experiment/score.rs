@@ -236,6 +236,7 @@ fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Ve
                     odom_pose: OdomPose(odom[i]),
                     travel_m: travel,
                     psi: 0.0,
+                    lateral_moment: 0.0,
                 });
             }
             of_scan[i] = obs.len() - 1;

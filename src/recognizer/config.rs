@@ -100,14 +100,14 @@ pub struct RecognizerConfig {
     /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 and scenario
     /// A's 3-level precision to 0.693 (RESULTS.md).
     pub ngram_travel_m: f64,
-    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 0.
+    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 30.
     /// Read backwards, a word's boundaries do not fall where they fell driving the other way (the
     /// laser looks ahead, so Ψ rises and falls at different places), so opposite chains break
-    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words. On Intel
-    /// (noise seeds 1..5) 12 m lifts the opposite-direction recall from 0.03 to 0.38 at
-    /// precision 0.98, and it keeps it up to 40 m; but scenario A, which has no opposite revisit,
-    /// then gets false opposite matches: 3-level precision 0.839 at 12 m, worst seed 0.942 at
-    /// 40 m (RESULTS.md). Off until opposite chains can be told apart better.
+    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words: without
+    /// this rule Intel's opposite-direction recall is 0.03. Shorter spans let through corridors
+    /// that read the same backwards (scenario A, which has no opposite revisit: 3-level precision
+    /// 0.839 at 12 m); with `reverse_verify_max_lateral_rms`, 30 m keeps A's precision
+    /// (RESULTS.md; tuned on A seeds 1–10 and Intel noise seeds 1–3).
     pub reverse_ngram_travel_m: f64,
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
@@ -135,6 +135,25 @@ pub struct RecognizerConfig {
     /// observation pairs must be at most this (Ψ ∈ [0, 1]; a class is 1/`classes` wide).
     /// Default 0.04 (a third of a class of 8; tuned on scenario A seed 3 and Intel).
     pub verify_max_psi_rms: f64,
+    /// Verification, sides: the root mean square difference of the observations'
+    /// `lateral_moment` (where the free space lies across the path, in kernel radii per
+    /// all-free count; a free half disc on one side gives about 0.21) over the n-gram's aligned
+    /// pairs must be at most this. Ψ is the same on both sides of a mirror; this is not. Default
+    /// 0.08 (tuned on scenario A and Intel; 0.05 cost Intel a third of its same-direction recall).
+    pub verify_max_lateral_rms: f64,
+    /// The same bound for n-grams read backwards, where the past side's moment is negated (driven
+    /// the other way, left is right). Default 0.05: chains read backwards are runs of a few long
+    /// words accepted by travel, and a corridor that reads the same backwards needs the tighter
+    /// bound (scenario A, 3-level precision at 30 m: 0.951 worst seed 0.901 with 0.08, 0.977 /
+    /// 0.956 with 0.05).
+    pub reverse_verify_max_lateral_rms: f64,
+    /// Verification, read backwards: the current side of an n-gram matched in the opposite
+    /// direction must turn, its odometric heading changing by at least this from its first word,
+    /// degrees; 0 = off. Default 45. A straight corridor read backwards matches itself mirrored
+    /// about its middle wherever its two halves look alike (scenarios B and C: ~100,000 false
+    /// opposite pairs per seed, 3-level precision 0.940 and 0.918 without it); Intel's
+    /// opposite-direction recall hardly changes (noise seeds 1–3: 0.331–0.465 with 45 or 80).
+    pub reverse_min_turn_deg: f64,
     /// Candidate gap: a past word must end at least this much odometric travel before the
     /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
     /// though both default to 20). Default 20.0.
@@ -171,7 +190,7 @@ impl Default for RecognizerConfig {
             substitutions: true,
             substitution_size_ratio: 0.3,
             ngram_travel_m: 0.0,
-            reverse_ngram_travel_m: 0.0,
+            reverse_ngram_travel_m: 30.0,
             ngram_travel_min_words: 4,
             chain_alignment_tie: 1e-4,
             verify: true,
@@ -179,6 +198,9 @@ impl Default for RecognizerConfig {
             verify_travel_slack_m: 0.5,
             verify_turn_deg: 30.0,
             verify_max_psi_rms: 0.04,
+            verify_max_lateral_rms: 0.08,
+            reverse_verify_max_lateral_rms: 0.05,
+            reverse_min_turn_deg: 45.0,
             candidate_gap_m: 20.0,
             max_candidates: 0,
         }
@@ -387,6 +409,12 @@ impl RecognizerConfig {
             ("verify_travel_slack_m", self.verify_travel_slack_m),
             ("verify_turn_deg", self.verify_turn_deg),
             ("verify_max_psi_rms", self.verify_max_psi_rms),
+            ("verify_max_lateral_rms", self.verify_max_lateral_rms),
+            (
+                "reverse_verify_max_lateral_rms",
+                self.reverse_verify_max_lateral_rms,
+            ),
+            ("reverse_min_turn_deg", self.reverse_min_turn_deg),
             ("ngram_travel_m", self.ngram_travel_m),
             ("reverse_ngram_travel_m", self.reverse_ngram_travel_m),
             ("chain_alignment_tie", self.chain_alignment_tie),

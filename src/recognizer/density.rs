@@ -91,6 +91,17 @@ pub struct RayDeltas {
     /// Per prefix-tree node, in depth-first order: (index step, index just past its subtree),
     /// side by side so that the walk reads one array.
     nodes: Vec<(i32, u32)>,
+    /// Per node, its cell offset (x, y) from the centre (read only when moments are wanted).
+    offsets: Vec<(i16, i16)>,
+}
+
+/// What the kernel counts from a cell: the free cells (the numerator of Ψ) and the sum of their
+/// offsets from the centre, in cells (their first moment: where the free space lies).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FreeCells {
+    pub count: u32,
+    pub moment_x: i32,
+    pub moment_y: i32,
 }
 
 impl DensityKernel {
@@ -173,6 +184,7 @@ impl DensityKernel {
                 .zip(&self.tree_skip)
                 .map(|(&(ox, oy), &skip)| ((oy as isize * stride + ox as isize) as i32, skip))
                 .collect(),
+            offsets: self.tree_offsets.clone(),
         }
     }
 
@@ -188,29 +200,19 @@ impl DensityKernel {
         mask: usize,
         visited: &mut Visited,
     ) -> u32 {
-        visited.begin(cells.len());
-        let stamp = visited.current;
-        let stamps = &mut visited.stamps[..cells.len()];
-        let mut count = 0u32;
-        // Walking the prefix tree visits each shared ray prefix once (about 22 % fewer steps
-        // than ray by ray for a 50-cell kernel) and gives the same count.
-        let nodes = &deltas.nodes[..];
-        let mut k = 0;
-        while let Some(&(delta, skip)) = nodes.get(k) {
-            let i = (base as isize).wrapping_add(delta as isize) as usize & mask;
-            let v = cells[i];
-            if v >= CELL_OCCUPIED_FROM {
-                k = skip as usize;
-                continue;
-            }
-            // Branch-free: whether a free or unknown cell was seen before is data the branch
-            // predictor cannot learn. Stamping an unknown cell is harmless (it never counts).
-            let fresh = (v != CELL_UNKNOWN) & (stamps[i] != stamp);
-            count += fresh as u32;
-            stamps[i] = stamp;
-            k += 1;
-        }
-        count
+        walk::<false>(deltas, cells, base, mask, visited).count
+    }
+
+    /// [`count_free_at`](Self::count_free_at) with the first moment of the cells it counts.
+    pub fn free_cells_at(
+        &self,
+        deltas: &RayDeltas,
+        cells: &[u8],
+        base: usize,
+        mask: usize,
+        visited: &mut Visited,
+    ) -> FreeCells {
+        walk::<true>(deltas, cells, base, mask, visited)
     }
 
     /// Ψ from a free-cell count, in [0, 1].
@@ -223,6 +225,51 @@ impl RayDeltas {
     /// Row stride the deltas were made for.
     pub fn stride(&self) -> usize {
         self.stride as usize
+    }
+}
+
+/// The kernel's walk over its prefix tree from `base` (see [`DensityKernel::count_free_at`]);
+/// with `MOMENTS`, also sums the offsets of the cells it counts.
+#[inline(always)]
+fn walk<const MOMENTS: bool>(
+    deltas: &RayDeltas,
+    cells: &[u8],
+    base: usize,
+    mask: usize,
+    visited: &mut Visited,
+) -> FreeCells {
+    visited.begin(cells.len());
+    let stamp = visited.current;
+    let stamps = &mut visited.stamps[..cells.len()];
+    let (mut count, mut moment_x, mut moment_y) = (0u32, 0i32, 0i32);
+    // Walking the prefix tree visits each shared ray prefix once (about 22 % fewer steps
+    // than ray by ray for a 50-cell kernel) and gives the same count.
+    let nodes = &deltas.nodes[..];
+    let offsets = &deltas.offsets[..nodes.len()];
+    let mut k = 0;
+    while let Some(&(delta, skip)) = nodes.get(k) {
+        let i = (base as isize).wrapping_add(delta as isize) as usize & mask;
+        let v = cells[i];
+        if v >= CELL_OCCUPIED_FROM {
+            k = skip as usize;
+            continue;
+        }
+        // Branch-free: whether a free or unknown cell was seen before is data the branch
+        // predictor cannot learn. Stamping an unknown cell is harmless (it never counts).
+        let fresh = (v != CELL_UNKNOWN) & (stamps[i] != stamp);
+        count += fresh as u32;
+        if MOMENTS {
+            let (ox, oy) = offsets[k];
+            moment_x += fresh as i32 * ox as i32;
+            moment_y += fresh as i32 * oy as i32;
+        }
+        stamps[i] = stamp;
+        k += 1;
+    }
+    FreeCells {
+        count,
+        moment_x,
+        moment_y,
     }
 }
 
@@ -369,18 +416,22 @@ impl DenseGrid {
 
     /// Ψ of cell (x, y).
     pub fn psi(&self, kernel: &DensityKernel, x: usize, y: usize) -> f64 {
+        kernel.psi_of_count(self.free_cells(kernel, x, y).count)
+    }
+
+    /// The free cells the kernel counts from cell (x, y), with their first moment.
+    pub fn free_cells(&self, kernel: &DensityKernel, x: usize, y: usize) -> FreeCells {
         let mut padded = self.clone();
         padded.set_pad(kernel.radius_cells() + 1, CellState::Unknown);
         let deltas = kernel.deltas(padded.stride());
         let base = padded.base(x, y);
-        let n = kernel.count_free_at(
+        kernel.free_cells_at(
             &deltas,
             &padded.cells,
             base,
             usize::MAX,
             &mut Visited::default(),
-        );
-        kernel.psi_of_count(n)
+        )
     }
 }
 
@@ -414,7 +465,8 @@ mod tests {
         assert!(psi > 0.05 && psi < 0.5, "corridor psi {psi}");
     }
 
-    /// The prefix-tree walk counts exactly what walking every ray does.
+    /// The prefix-tree walk counts exactly what walking every ray does, and sums exactly the
+    /// offsets of the cells it counts.
     #[test]
     fn prefix_tree_walk_equals_ray_by_ray() {
         let mut seed = 12345u64;
@@ -459,6 +511,15 @@ mod tests {
             assert_eq!(
                 g.psi(&k, side / 2, side / 2),
                 expected.min(1.0),
+                "radius {radius}"
+            );
+            let moment = seen
+                .iter()
+                .fold((0, 0), |(mx, my), &(x, y)| (mx + x - c, my + y - c));
+            let free = g.free_cells(&k, side / 2, side / 2);
+            assert_eq!(
+                (free.count as usize, free.moment_x, free.moment_y),
+                (seen.len(), moment.0, moment.1),
                 "radius {radius}"
             );
         }

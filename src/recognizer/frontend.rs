@@ -128,16 +128,19 @@ impl DensityFrontEnd {
         at.into_iter()
             .map(|(pose, travel_m)| {
                 debug_assert!(self.grid.kernel_fits(self.kernel_cells, pose.0.x, pose.0.y));
-                let psi = self
+                let density = self
                     .grid
-                    .psi_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
+                    .density_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
+                let (sin, cos) = pose.0.theta.sin_cos();
                 let obs = Observation {
                     id: self.next_id,
                     run: self.run,
                     frame_id,
                     odom_pose: pose,
                     travel_m,
-                    psi,
+                    psi: density.psi,
+                    // On the robot's left axis (−sin θ, cos θ) of the odometry heading.
+                    lateral_moment: cos * density.moment.1 - sin * density.moment.0,
                 };
                 self.next_id += 1;
                 obs

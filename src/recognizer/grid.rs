@@ -17,7 +17,7 @@
 //! the cells there are still crossed by the sparser beams, and about a quarter of the cell
 //! visits are saved.
 
-use super::density::{CellState, DensityKernel, RayDeltas, Visited, cell_state};
+use super::density::{CellState, DensityKernel, FreeCells, RayDeltas, Visited, cell_state};
 use crate::geom::{OdomPose, Pose2};
 use crate::scan::Scan;
 
@@ -298,18 +298,18 @@ impl LocalGrid {
         self.mark(x1, y1, hit);
     }
 
-    /// Free cells the kernel reaches from global cell (cx, cy); `deltas` must be
-    /// `kernel.deltas(self.side())`.
-    pub fn count_free(
+    /// Free cells the kernel reaches from global cell (cx, cy), with their first moment;
+    /// `deltas` must be `kernel.deltas(self.side())`.
+    pub fn free_cells(
         &mut self,
         kernel: &DensityKernel,
         deltas: &RayDeltas,
         cx: i32,
         cy: i32,
-    ) -> u32 {
+    ) -> FreeCells {
         debug_assert_eq!(deltas.stride(), self.side());
         let base = self.index(cx, cy);
-        kernel.count_free_at(deltas, &self.cells, base, self.mask, &mut self.visited)
+        kernel.free_cells_at(deltas, &self.cells, base, self.mask, &mut self.visited)
     }
 
     /// Whether a kernel of `radius_cells` centred on the odometry position (x, y) lies inside the
@@ -322,8 +322,34 @@ impl LocalGrid {
 
     /// Ψ at the cell holding the odometry position (x, y).
     pub fn psi_at(&mut self, kernel: &DensityKernel, deltas: &RayDeltas, x: f64, y: f64) -> f64 {
-        let (cx, cy) = self.cell_of(x, y);
-        let n = self.count_free(kernel, deltas, cx, cy);
-        kernel.psi_of_count(n)
+        self.density_at(kernel, deltas, x, y).psi
     }
+
+    /// Ψ at the cell holding the odometry position (x, y) and where its free cells lie.
+    pub fn density_at(
+        &mut self,
+        kernel: &DensityKernel,
+        deltas: &RayDeltas,
+        x: f64,
+        y: f64,
+    ) -> Density {
+        let (cx, cy) = self.cell_of(x, y);
+        let free = self.free_cells(kernel, deltas, cx, cy);
+        // Moments in kernel radii per all-free count: a free half disc on one side gives ≈ 0.21.
+        let scale = 1.0 / (kernel.full_count() as f64 * kernel.radius_cells().max(1) as f64);
+        Density {
+            psi: kernel.psi_of_count(free.count),
+            moment: (free.moment_x as f64 * scale, free.moment_y as f64 * scale),
+        }
+    }
+}
+
+/// Ψ at a cell and the first moment of the free cells it counts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Density {
+    /// Free-space density Ψ in [0, 1].
+    pub psi: f64,
+    /// Sum of the counted free cells' offsets from the cell (odometry frame axes), in kernel
+    /// radii, divided by the count of an all-free window.
+    pub moment: (f64, f64),
 }

@@ -43,6 +43,25 @@
 //! reached τₖ. Read backwards, words split at other places than they did driving the other way
 //! (the laser looks ahead), so opposite chains are runs of a few long words.
 //!
+//! **Verification** (`verify`). A candidate n-gram is accepted only if it is consistent: the
+//! odometric travel and turn between its words agree on both sides (`verify_travel_*`,
+//! `verify_turn_deg`), the RMS Ψ difference of its aligned pairs is at most
+//! `verify_max_psi_rms`, and the free space lies on the same side of the path at both visits:
+//! the RMS difference of the observations' `lateral_moment` is at most `verify_max_lateral_rms`
+//! (`reverse_verify_max_lateral_rms` read backwards, where the past side's moment is negated,
+//! since driven the other way left is right). Ψ and the words are blind to a reflection: it
+//! negates the turns and reading backwards negates them again, so a corridor read backwards
+//! matched its mirror image (scenario A, which has no opposite revisit, got thousands of false
+//! opposite pairs); the side of the free space is what a reflection changes. Where a place is
+//! symmetric across the path the moment is near zero and decides nothing; the travel rule for
+//! chains read backwards (`reverse_ngram_travel_m`, 30 m) adds the context those need. A
+//! straight corridor is the worst case: read backwards it matches itself mirrored about any
+//! line across it where its doors and recesses happen to be symmetric (the institute floor's
+//! 40 m north corridor, about its middle alcove, in scenarios A, B and C), and its turns cannot
+//! help (there are none). So an n-gram read backwards must turn: the current side's heading must
+//! change by at least `reverse_min_turn_deg` from its first word. Within a stretch whose ends
+//! both turn, reading backwards negates the turns and breaks such false chains at the corners.
+//!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
 //! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
 //! observations. Where the shift may be is the `alignment` setting: `paper` searches
@@ -104,6 +123,9 @@ struct Params {
     verify_travel_slack_m: f64,
     verify_turn_rad: f64,
     verify_max_psi_rms: f64,
+    /// Per direction (`Same`, `Opposite`).
+    verify_max_lateral_rms: [f64; 2],
+    reverse_min_turn_rad: f64,
     /// Odometric travel between observations, metres.
     spacing_m: f64,
 }
@@ -164,6 +186,11 @@ impl WordMatcher {
                 verify_travel_slack_m: config.verify_travel_slack_m,
                 verify_turn_rad: config.verify_turn_deg.to_radians(),
                 verify_max_psi_rms: config.verify_max_psi_rms,
+                verify_max_lateral_rms: [
+                    config.verify_max_lateral_rms,
+                    config.reverse_verify_max_lateral_rms,
+                ],
+                reverse_min_turn_rad: config.reverse_min_turn_deg.to_radians(),
                 spacing_m: config.observation_spacing_m,
             },
             rejections: VerificationCounts::default(),
@@ -660,6 +687,7 @@ impl WordMatcher {
         };
         let turn_tol = self.params.verify_turn_rad;
         let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
+        let mut turned: f64 = 0.0;
         for w in word_pairs.windows(2) {
             let (c0, c1) = (start(w[0].0), start(w[1].0));
             let (p0, p1) = (past_start(w[0].1), past_start(w[1].1));
@@ -673,23 +701,52 @@ impl WordMatcher {
             if wrap_angle(dc.1 - dp.1).abs() > turn_tol || (cum_c.1 - cum_p.1).abs() > turn_tol {
                 return Some(Rejection::Turn);
             }
+            turned = turned.max(cum_c.1.abs());
         }
-        let (mut sum, mut count) = (0.0, 0usize);
+        if dir == Direction::Opposite && turned < self.params.reverse_min_turn_rad {
+            return Some(Rejection::Straight);
+        }
+        let (mut sum, mut lateral, mut count) = (0.0, 0.0, 0usize);
         let from = if newest_only { word_pairs.len() - 1 } else { 0 };
         for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
             let placement = self.placement(c, p, dir, anchor);
             if let Some(w) = &placement {
                 sum += w.cost * w.count() as f64;
+                lateral += self.lateral_squared_error(c, p, dir, w);
                 count += w.count();
             }
             placed.push(placement);
         }
-        let rms = if count == 0 {
-            f64::INFINITY
-        } else {
-            (sum / count as f64).sqrt()
+        let mean = |s: f64| {
+            if count == 0 {
+                f64::INFINITY
+            } else {
+                (s / count as f64).sqrt()
+            }
         };
-        (rms > self.params.verify_max_psi_rms).then_some(Rejection::Density)
+        if mean(sum) > self.params.verify_max_psi_rms {
+            Some(Rejection::Density)
+        } else if mean(lateral) > self.params.verify_max_lateral_rms[dir as usize] {
+            Some(Rejection::Sides)
+        } else {
+            None
+        }
+    }
+
+    /// Σ over the pairs of placement `w` of the squared difference of the observations'
+    /// `lateral_moment`, the past side's negated when read backwards (its left is then our right).
+    fn lateral_squared_error(&self, c: WordId, p: WordId, dir: Direction, w: &Placement) -> f64 {
+        let obs = self.words.observations();
+        let s2 = self.word(c).first_obs as i64;
+        let past = PastSide::of(self.word(p), dir);
+        let sign = past.step as f64;
+        w.r.clone()
+            .map(|i| {
+                let q = obs[(s2 + w.a + i) as usize].lateral_moment;
+                let d = q - sign * obs[past.index(w.b + i)].lateral_moment;
+                d * d
+            })
+            .sum()
     }
 
     /// Per word pair of an n-gram (oldest first), the shift k (past index − current index, from
@@ -933,6 +990,10 @@ pub enum Rejection {
     Turn,
     /// The aligned raw densities differ too much.
     Density,
+    /// The free space lies on different sides of the path at the two visits.
+    Sides,
+    /// Read backwards, its current side turns by less than `reverse_min_turn_deg`.
+    Straight,
 }
 
 /// Counts of candidate n-grams (τ reached, candidate gap satisfied) by outcome, summed over
@@ -943,12 +1004,22 @@ pub struct VerificationCounts {
     pub rejected_travel: usize,
     pub rejected_turn: usize,
     pub rejected_density: usize,
+    /// Free space on different sides of the path (`verify_max_lateral_rms`).
+    #[serde(default)]
+    pub rejected_sides: usize,
+    /// Read backwards along a path that does not turn (`reverse_min_turn_deg`).
+    #[serde(default)]
+    pub rejected_straight: usize,
 }
 
 impl VerificationCounts {
     /// Candidates verification turned down, for any reason.
     pub fn rejected(&self) -> usize {
-        self.rejected_travel + self.rejected_turn + self.rejected_density
+        self.rejected_travel
+            + self.rejected_turn
+            + self.rejected_density
+            + self.rejected_sides
+            + self.rejected_straight
     }
 
     fn add(&mut self, r: Rejection) {
@@ -956,6 +1027,8 @@ impl VerificationCounts {
             Rejection::Travel => self.rejected_travel += 1,
             Rejection::Turn => self.rejected_turn += 1,
             Rejection::Density => self.rejected_density += 1,
+            Rejection::Sides => self.rejected_sides += 1,
+            Rejection::Straight => self.rejected_straight += 1,
         }
     }
 }

@@ -21,9 +21,9 @@ pub(crate) mod types;
 pub(crate) mod words;
 
 pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
-pub use density::{CellState, DenseGrid, DensityKernel, RayDeltas, Visited, density};
+pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use frontend::DensityFrontEnd;
-pub use grid::LocalGrid;
+pub use grid::{Density, LocalGrid};
 pub use matcher::{MatchDiagnostics, VerificationCounts, WordMatcher};
 pub use types::{AlignedRun, Direction, FrameId, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};

@@ -90,6 +90,7 @@ pub fn observations(
                 odom_pose: OdomPose(pose),
                 travel_m: travel,
                 psi: s.psi,
+                lateral_moment: 0.0,
             });
             id += 1;
             input += 1;

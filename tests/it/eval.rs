@@ -180,6 +180,7 @@ impl PlaceRecognizer for LapBack {
             odom_pose: odom,
             travel_m: id as f64 * 0.04,
             psi: 0.0,
+            lateral_moment: 0.0,
         });
         if id >= self.per_lap {
             let p = id - self.per_lap;

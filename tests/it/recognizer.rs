@@ -465,6 +465,113 @@ fn reversed_lap_matches_in_the_opposite_direction() {
     assert!(matches.is_empty(), "reverse = false finds nothing");
 }
 
+/// Where the free space lies across the path at observation `i` of a lap (kernel radii).
+fn side_profile(i: usize) -> f64 {
+    0.15 * (i as f64 / 7.0).sin()
+}
+
+/// A lap driven the other way past the mirror image of every place (the free space on the same
+/// side of the path, not the other) reads the same backwards: Ψ and the words cannot tell, the
+/// side of the free space can. Driven back past the same places, the lap matches in the opposite
+/// direction; past their mirror images, verification turns every candidate down and says why.
+#[test]
+fn a_mirror_image_driven_back_is_not_a_revisit() {
+    let lap = random_stretches(7, 40);
+    let mut first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
+    let n = first.len();
+    for (i, o) in first.iter_mut().enumerate() {
+        o.lateral_moment = side_profile(i);
+    }
+    for (sign, revisit) in [(-1.0, true), (1.0, false)] {
+        let mut second = with_noise(
+            synth::observations(&reversed(&lap), 0.1, 0, first.last()),
+            2,
+        );
+        for (k, o) in second.iter_mut().enumerate() {
+            // Query k is at the place of observation n − 1 − k of the first lap.
+            o.lateral_moment = sign * side_profile(n - 1 - k);
+        }
+        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+        let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
+        let counts = m.verification();
+        assert_eq!(!matches.is_empty(), revisit, "sign {sign}: {counts:?}");
+        if !revisit {
+            assert!(counts.rejected_sides > 0, "{counts:?}");
+        }
+    }
+}
+
+/// Driven the same way, a place whose free space lies on the other side of the path is not the
+/// place: verification rejects it (`rejected_sides`); the same pass with the same sides matches.
+#[test]
+fn free_space_on_the_other_side_is_rejected() {
+    let lap = random_stretches(7, 40);
+    let mut first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
+    for (i, o) in first.iter_mut().enumerate() {
+        o.lateral_moment = side_profile(i);
+    }
+    for (sign, expect_pairs) in [(1.0, true), (-1.0, false)] {
+        let mut second = with_noise(synth::observations(&lap, 0.1, 0, first.last()), 2);
+        for (i, o) in second.iter_mut().enumerate() {
+            o.lateral_moment = sign * side_profile(i);
+        }
+        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+        let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
+        let counts = m.verification();
+        assert_eq!(!matches.is_empty(), expect_pairs, "sign {sign}: {counts:?}");
+        if !expect_pairs {
+            assert!(counts.rejected_sides > 0, "{counts:?}");
+        }
+    }
+}
+
+/// The front end measures where the free space lies across the path: a side corridor on the
+/// left gives a positive `lateral_moment`, driven the other way the same place gives a negative
+/// one of about the same size, and the plain corridor about none.
+#[test]
+fn the_side_of_the_free_space_flips_with_the_direction_of_travel() {
+    let layout = synth::lms200();
+    let walls = synth::corridor_with_branch(30.0, 2.0, 15.0, 3.0);
+    let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
+    let drive = |fe: &mut DensityFrontEnd, from: f64, heading: f64| -> Vec<Observation> {
+        fe.start_run();
+        (0..650)
+            .flat_map(|i| {
+                let x = from + heading.cos() * i as f64 * 0.04;
+                let pose = Pose2::new(x, 0.0, heading);
+                fe.push(
+                    OdomPose(pose),
+                    &synth::scan_of(&walls, pose, &layout, i as f64),
+                )
+            })
+            .collect()
+    };
+    let east = drive(&mut fe, 1.0, 0.0);
+    let west = drive(&mut fe, 28.0, std::f64::consts::PI);
+    let at = |obs: &[Observation], x: f64| {
+        obs.iter()
+            .min_by(|a, b| {
+                (a.odom_pose.0.x - x)
+                    .abs()
+                    .total_cmp(&(b.odom_pose.0.x - x).abs())
+            })
+            .unwrap()
+            .lateral_moment
+    };
+    let (e, w) = (at(&east, 15.0), at(&west, 15.0));
+    eprintln!("lateral moment at the side corridor: east {e:.3}, west {w:.3}");
+    assert!(e > 0.05, "side corridor on the left driving east: {e}");
+    assert!(w < -0.05, "on the right driving west: {w}");
+    assert!((e + w).abs() < 0.03, "about the same size: {e} vs {w}");
+    for x in [6.0, 8.0] {
+        let (e, w) = (at(&east, x), at(&west, x));
+        assert!(
+            e.abs() < 0.02 && w.abs() < 0.02,
+            "plain corridor at {x}: {e}, {w}"
+        );
+    }
+}
+
 #[test]
 fn runs_break_predecessor_chains() {
     let cfg = RecognizerConfig::default();
@@ -1173,6 +1280,7 @@ fn decreasing_travel_is_refused() {
         odom_pose: OdomPose(Pose2::IDENTITY),
         travel_m: 5.0,
         psi: 0.5,
+        lateral_moment: 0.0,
     };
     m.push_observation(&o);
     o.id = 1;
@@ -1316,16 +1424,24 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
 }
 
 /// A corridor of long words of Ψ `psis`, `size` observations each, driven twice (the second
-/// time backwards when `back`): the first pass's length, every observation, and a 1-level
-/// configuration with a 5 m candidate gap.
+/// time backwards when `back`), turning by `turn_deg` and back again in alternate words: the
+/// first pass's length, every observation, and a 1-level configuration with a 5 m candidate gap
+/// and no n-gram accepted by travel.
 fn corridor_of_long_words(
     psis: &[f64],
     size: usize,
     back: bool,
+    turn_deg: f64,
 ) -> (usize, Vec<Observation>, RecognizerConfig) {
+    let turn = |i: usize| match i % 4 {
+        1 => turn_deg,
+        3 => -turn_deg,
+        _ => 0.0,
+    };
     let lap: Vec<Stretch> = psis
         .iter()
-        .map(|&psi| Stretch::new(psi, size, 0.0))
+        .enumerate()
+        .map(|(i, &psi)| Stretch::new(psi, size, turn(i)))
         .collect();
     let first = synth::observations(&lap, 0.1, 0, None);
     let again = if back { reversed(&lap) } else { lap };
@@ -1334,6 +1450,8 @@ fn corridor_of_long_words(
     let base = config(|c| {
         c.levels = 1;
         c.candidate_gap_m = 5.0;
+        c.ngram_travel_m = 0.0;
+        c.reverse_ngram_travel_m = 0.0;
     });
     (first.len(), all, base)
 }
@@ -1342,7 +1460,7 @@ fn corridor_of_long_words(
 /// `ngram_travel_m` accepts 4 or more words spanning 12 m.
 #[test]
 fn long_words_match_by_travel_when_asked() {
-    let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4], 60, false);
+    let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4], 60, false, 0.0);
     assert!(run_matcher(&base, &all).1.is_empty());
     let by_travel = RecognizerConfig {
         ngram_travel_m: 12.0,
@@ -1356,18 +1474,29 @@ fn long_words_match_by_travel_when_asked() {
     }
 }
 
-/// The same kind of corridor driven back the other way: read backwards, 7 words never make
-/// the 8 words an opposite n-gram needs (τ + `reverse_extra_ngram`), so by default (0) nothing
-/// matches; with `reverse_ngram_travel_m` = 12, 6 or more words spanning 12 m are accepted,
-/// each pair at its place read backwards.
+/// The same kind of corridor, with turns, driven back the other way: read backwards, 7 words
+/// never make the 8 words an opposite n-gram needs (τ + `reverse_extra_ngram`), so without the
+/// travel rule nothing matches; with `reverse_ngram_travel_m` = 12, 6 or more words spanning 12 m
+/// are accepted, each pair at its place read backwards. The same corridor without turns is turned
+/// down (`reverse_min_turn_deg`): straight, it would match itself mirrored about its middle.
 #[test]
 fn long_words_driven_back_match_by_travel_when_asked() {
-    let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1], 40, true);
-    assert!(run_matcher(&base, &all).1.is_empty());
+    let psis = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1];
+    let (_, straight, base) = corridor_of_long_words(&psis, 40, true, 0.0);
     let by_travel = RecognizerConfig {
         reverse_ngram_travel_m: 12.0,
-        ..base
+        ..base.clone()
     };
+    let (m, matches) = run_matcher(&by_travel, &straight);
+    assert!(matches.is_empty(), "a straight corridor read backwards");
+    assert!(
+        m.verification().rejected_straight > 0,
+        "{:?}",
+        m.verification()
+    );
+
+    let (n, all, base) = corridor_of_long_words(&psis, 40, true, 60.0);
+    assert!(run_matcher(&base, &all).1.is_empty());
     let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
