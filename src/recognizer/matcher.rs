@@ -62,7 +62,7 @@
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::index::recent_candidates;
-use super::types::{AlignedRun, Direction, Match, Observation, push_pair};
+use super::types::{AlignedRun, Direction, Match, Observation, push_pair, push_run};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
 
@@ -132,6 +132,9 @@ pub struct WordMatcher {
     longest: [u16; MAX_LEVELS],
     /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
     within_gap: usize,
+    /// Whether every observation so far has its index as id (the recognizer's own stream): an
+    /// aligned window then makes its pairs as one run without reading each observation.
+    ids_are_indices: bool,
 }
 
 impl WordMatcher {
@@ -181,6 +184,7 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            ids_are_indices: true,
         })
     }
 
@@ -202,6 +206,7 @@ impl WordMatcher {
             obs.travel_m,
             last
         );
+        self.ids_are_indices &= obs.id == self.words.observations().len();
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
@@ -830,6 +835,11 @@ impl WordMatcher {
         };
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);
+        if self.ids_are_indices && self.beyond_gap(s2, &past, &w) {
+            let (q, pst) = ((s2 + w.a + w.r.start) as usize, past.index(w.b + w.r.start));
+            push_run(out, q, pst, past.step as i8, w.count() as u32);
+            return;
+        }
         for i in w.r {
             let (q, pst) = (&obs[(s2 + w.a + i) as usize], &obs[past.index(w.b + i)]);
             if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
@@ -837,6 +847,21 @@ impl WordMatcher {
             }
             push_pair(out, q.id, pst.id, past.step as i8);
         }
+    }
+
+    /// Whether every pair of placement `w` (current word from observation `s2`) passes the
+    /// candidate gap of `aligned_pairs`: travel never decreases with the index, so the first
+    /// current observation and the latest past one bound every pair's difference (rounding is
+    /// monotone, so the bound holds for the computed differences too).
+    fn beyond_gap(&self, s2: i64, past: &PastSide, w: &Placement) -> bool {
+        if w.count() == 0 {
+            return true;
+        }
+        let obs = self.words.observations();
+        let q_first = obs[(s2 + w.a + w.r.start) as usize].travel_m;
+        let (p0, p1) = (past.index(w.b + w.r.start), past.index(w.b + w.r.end - 1));
+        let p_max = obs[p0].travel_m.max(obs[p1].travel_m);
+        q_first - p_max + 1e-9 >= self.params.candidate_gap_m
     }
 }
 
