@@ -132,6 +132,8 @@ pub struct WordMatcher {
     longest: [u16; MAX_LEVELS],
     /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
     within_gap: usize,
+    /// Working space of `report`.
+    scratch: Scratch,
     /// Whether every observation so far has its index as id (the recognizer's own stream): an
     /// aligned window then makes its pairs as one run without reading each observation.
     ids_are_indices: bool,
@@ -184,6 +186,7 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            scratch: Scratch::default(),
             ids_are_indices: true,
         })
     }
@@ -363,10 +366,10 @@ impl WordMatcher {
         }
 
         let levels = self.params.levels;
-        let mut entries = Vec::new();
         let candidates = recent_candidates(&occ[..end], self.params.max_candidates, |p| {
             self.syllables_match(&cw, self.word(p), dir)
         });
+        let mut entries = Vec::with_capacity(candidates.len());
         for p in candidates {
             let pw = self.word(p);
             let top = cw.level.max(pw.level);
@@ -491,32 +494,36 @@ impl WordMatcher {
     }
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+        let mut scratch = std::mem::take(&mut self.scratch);
         for k in 0..self.params.levels {
             // Every candidate first, then the reports: a candidate's new pairs are counted when
             // it is reported (see `emit`).
-            let mut found = Vec::new();
+            scratch.clear();
             for dir in Direction::BOTH {
                 for idx in 0..self.memo[dir as usize][c as usize].len() {
-                    if let Some(cand) = self.candidate(c, idx, k, dir) {
-                        found.push(cand);
+                    if let Some(cand) = self.candidate(c, idx, k, dir, &mut scratch) {
+                        scratch.found.push(cand);
                     }
                 }
             }
-            for cand in found {
-                out.push(self.emit(c, k, cand));
+            for i in 0..scratch.found.len() {
+                let cand = scratch.found[i].clone();
+                out.push(self.emit(c, k, &cand, &mut scratch));
             }
         }
+        self.scratch = scratch;
     }
 
-    /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first;
-    /// `None` when the chain is shorter than τ (and not long enough in travel).
+    /// Appends to `chain` the τ-gram of configuration k ending at memo entry `idx` of `c`,
+    /// newest pair first; false (nothing appended) when the chain is shorter than τ (and not
+    /// long enough in travel).
     fn tau_chain(
         &self,
-        c: WordId,
-        idx: usize,
+        (c, idx): (WordId, usize),
         k: usize,
         dir: Direction,
-    ) -> Option<Vec<(WordId, usize)>> {
+        chain: &mut Vec<(WordId, usize)>,
+    ) -> bool {
         let memo = &self.memo[dir as usize];
         let tau = match dir {
             Direction::Same => self.params.min_ngram[k],
@@ -532,111 +539,140 @@ impl WordMatcher {
             };
         let len = e.len[k] as usize;
         if len < tau && !(by_travel && len >= min_words) {
-            return None;
+            return false;
         }
-        let mut chain = vec![(c, idx)];
+        let start = chain.len();
+        chain.push((c, idx));
         let (mut wc, mut we) = (c, e);
         let end_m = self.word(c).end_travel_m;
-        while chain.len() < tau {
+        while chain.len() - start < tau {
             // An n-gram long in travel but short in words (`ngram_travel_m`,
             // `reverse_ngram_travel_m`).
             if by_travel
-                && chain.len() >= min_words
+                && chain.len() - start >= min_words
                 && end_m - self.word(wc).start_travel_m >= travel_m
             {
                 break;
             }
-            let (pc, pidx) = Self::step_back(&we, k)?;
+            let Some((pc, pidx)) = Self::step_back(&we, k) else {
+                chain.truncate(start);
+                return false;
+            };
             let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
             (wc, we) = (pc, pe);
         }
-        Some(chain)
+        true
     }
 
     /// The τ-gram of configuration k ending at memo entry `idx` of `c` (direction `dir`) if it
     /// is long enough, satisfies the candidate gap, passes verification and has unreported
-    /// pairs.
-    fn candidate(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Candidate> {
+    /// pairs; its pairs, anchors and placements are appended to `scr`.
+    fn candidate(
+        &mut self,
+        c: WordId,
+        idx: usize,
+        k: usize,
+        dir: Direction,
+        scr: &mut Scratch,
+    ) -> Option<Candidate> {
         let d = dir as usize;
-        let mut chain = self.tau_chain(c, idx, k, dir)?;
-        // The chain extends one whose n-gram was verified and reported: only its new pair's
-        // densities need checking (the travel and turn checks are cheap and run in full).
-        let extends_reported = chain
-            .get(1)
-            .is_some_and(|&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) != 0);
-        chain.reverse();
-        let word_pairs: Vec<(WordId, WordId)> = chain
-            .iter()
-            .map(|&(wc, widx)| (wc, self.memo[d][wc as usize][widx].past))
-            .collect();
-        // The latest past word: the last one read forwards, the first one read backwards.
-        let past_end = word_pairs
-            .iter()
-            .map(|&(_, p)| self.word(p).end_travel_m)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let first_current = self.word(word_pairs[0].0);
-        if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
-            self.within_gap += 1;
+        let (from, placed_from) = (scr.chain.len(), scr.placed.len());
+        if !self.tau_chain((c, idx), k, dir, &mut scr.chain) {
             return None;
         }
-        let anchors = self.chain_anchors(&word_pairs, dir);
-        let mut placed = Vec::new();
+        // The chain extends one whose n-gram was verified and reported: only its new pair's
+        // densities need checking (the travel and turn checks are cheap and run in full).
+        let extends_reported = scr
+            .chain
+            .get(from + 1)
+            .is_some_and(|&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) != 0);
+        scr.chain[from..].reverse();
+        let memo = &self.memo[d];
+        let chain = &scr.chain[from..];
+        scr.word_pairs.extend(
+            chain
+                .iter()
+                .map(|&(wc, widx)| (wc, memo[wc as usize][widx].past)),
+        );
+        let pairs = from..scr.chain.len();
+        if !self.beyond_candidate_gap(&scr.word_pairs[pairs.clone()]) {
+            self.within_gap += 1;
+            scr.truncate(from, placed_from);
+            return None;
+        }
+        self.chain_anchors(
+            &scr.word_pairs[pairs.clone()],
+            dir,
+            &mut scr.offsets,
+            &mut scr.anchors,
+        );
         if self.params.verify
-            && let Some(reason) =
-                self.verify(&word_pairs, dir, &anchors, extends_reported, &mut placed)
+            && let Some(reason) = self.verify(
+                &scr.word_pairs[pairs.clone()],
+                dir,
+                &scr.anchors[pairs.clone()],
+                extends_reported,
+                &mut scr.placed,
+            )
         {
             self.rejections.add(reason);
+            scr.truncate(from, placed_from);
             return None;
         }
         Some(Candidate {
             idx,
             dir,
-            chain,
-            word_pairs,
-            anchors,
-            placed,
+            pairs,
+            placed: placed_from..scr.placed.len(),
         })
     }
 
+    /// Whether the n-gram's first current word begins at least `candidate_gap_m` after its
+    /// latest past word ends (the last one read forwards, the first one read backwards).
+    fn beyond_candidate_gap(&self, word_pairs: &[(WordId, WordId)]) -> bool {
+        let past_end = word_pairs
+            .iter()
+            .map(|&(_, p)| self.word(p).end_travel_m)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let first_current = self.word(word_pairs[0].0);
+        first_current.start_travel_m + 1e-9 >= past_end + self.params.candidate_gap_m
+    }
+
     /// Marks a candidate's new pairs reported and makes its match.
-    fn emit(&mut self, c: WordId, k: usize, mut cand: Candidate) -> Match {
+    fn emit(&mut self, c: WordId, k: usize, cand: &Candidate, scr: &mut Scratch) -> Match {
         let d = cand.dir as usize;
+        let chain = &scr.chain[cand.pairs.clone()];
         // Counted now, not when the candidate was found: another candidate of the same word may
         // have reported a pair this chain shares since.
-        let fresh = 1 + cand.chain[..cand.chain.len() - 1]
+        let fresh = 1 + chain[..chain.len() - 1]
             .iter()
             .rev()
             .take_while(|&&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) == 0)
             .count();
-        let fresh_from = cand.chain.len() - fresh;
-        let mut pairs = Vec::new();
+        let fresh_from = chain.len() - fresh;
         let mut refs = Vec::with_capacity(fresh);
         // Verification placed the last `placed.len()` word pairs already: the same placements.
-        let placed_from = cand.chain.len() - cand.placed.len();
-        for (j, ((&(wc, widx), &(_, past)), &anchor)) in cand
-            .chain
-            .iter()
-            .zip(&cand.word_pairs)
-            .zip(&cand.anchors)
-            .enumerate()
-            .skip(fresh_from)
-        {
+        let placed_from = chain.len() - cand.placed.len();
+        scr.runs.clear();
+        for (j, &(wc, widx)) in chain.iter().enumerate().skip(fresh_from) {
+            let at = cand.pairs.start + j;
+            let (past, anchor) = (scr.word_pairs[at].1, scr.anchors[at]);
             self.memo[d][wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
             let placement = match j.checked_sub(placed_from) {
-                Some(i) => cand.placed[i].take(),
+                Some(i) => scr.placed[cand.placed.start + i].take(),
                 None => self.placement(wc, past, cand.dir, anchor),
             };
-            self.aligned_pairs(wc, past, cand.dir, placement, &mut pairs);
+            self.aligned_pairs(wc, past, cand.dir, placement, &mut scr.runs);
         }
         self.rejections.accepted += 1;
-        pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
         Match {
             levels: k + 1,
             ngram_len: self.memo[d][c as usize][cand.idx].len[k] as usize,
             word_pairs: refs,
-            runs: pairs,
+            // Usually one run: exactly as many as there are, no spare capacity per match.
+            runs: scr.runs.to_vec(),
             direction: cand.dir,
         }
     }
@@ -701,34 +737,35 @@ impl WordMatcher {
     /// the words' starts as read in direction `dir`) that puts the pair at the travel offset the
     /// whole n-gram agrees on: the median over its word pairs of the offset between the two
     /// words' centres (the past side's travel negated when read backwards).
-    fn chain_anchors(&self, word_pairs: &[(WordId, WordId)], dir: Direction) -> Vec<i64> {
+    fn chain_anchors(
+        &self,
+        word_pairs: &[(WordId, WordId)],
+        dir: Direction,
+        offsets: &mut Vec<f64>,
+        anchors: &mut Vec<i64>,
+    ) {
         // Both boundaries of every word pair, as read: a word of flat Ψ whose boundaries moved
         // shifts its centre, while most boundaries of the n-gram still agree.
-        let mut offsets: Vec<f64> = word_pairs
-            .iter()
-            .flat_map(|&(c, p)| {
-                let (cw, pw) = (self.word(c), self.word(p));
-                match dir {
-                    Direction::Same => [
-                        cw.start_travel_m - pw.start_travel_m,
-                        cw.end_travel_m - pw.end_travel_m,
-                    ],
-                    Direction::Opposite => [
-                        cw.start_travel_m + pw.end_travel_m,
-                        cw.end_travel_m + pw.start_travel_m,
-                    ],
-                }
-            })
-            .collect();
+        offsets.clear();
+        offsets.extend(word_pairs.iter().flat_map(|&(c, p)| {
+            let (cw, pw) = (self.word(c), self.word(p));
+            match dir {
+                Direction::Same => [
+                    cw.start_travel_m - pw.start_travel_m,
+                    cw.end_travel_m - pw.end_travel_m,
+                ],
+                Direction::Opposite => [
+                    cw.start_travel_m + pw.end_travel_m,
+                    cw.end_travel_m + pw.start_travel_m,
+                ],
+            }
+        }));
         offsets.sort_by(f64::total_cmp);
         let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
-        word_pairs
-            .iter()
-            .map(|&(c, p)| {
-                let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
-                ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
-            })
-            .collect()
+        anchors.extend(word_pairs.iter().map(|&(c, p)| {
+            let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
+            ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
+        }));
     }
 
     /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
@@ -865,16 +902,47 @@ impl WordMatcher {
     }
 }
 
-/// An n-gram that passed the gap and verification, before it is reported.
+/// An n-gram that passed the gap and verification, before it is reported; its data is in the
+/// matcher's [`Scratch`].
+#[derive(Clone, Debug)]
 struct Candidate {
     idx: usize,
     dir: Direction,
-    /// (current word, memo index), oldest first.
+    /// Its word pairs in `Scratch::{chain, word_pairs, anchors}`, oldest first.
+    pairs: std::ops::Range<usize>,
+    /// The placements verification made (of its last `placed.len()` word pairs) in
+    /// `Scratch::placed`.
+    placed: std::ops::Range<usize>,
+}
+
+/// The candidates of one word and configuration, back to back, kept between words so that
+/// finding and reporting them allocates nothing but the matches.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    found: Vec<Candidate>,
+    /// Per word pair: (current word, memo index), (current word, past word), the n-gram's shift.
     chain: Vec<(WordId, usize)>,
     word_pairs: Vec<(WordId, WordId)>,
     anchors: Vec<i64>,
-    /// Placements verification made, of the last `placed.len()` word pairs.
     placed: Vec<Option<Placement>>,
+    /// Working space of `chain_anchors` and of `emit`.
+    offsets: Vec<f64>,
+    runs: Vec<AlignedRun>,
+}
+
+impl Scratch {
+    fn clear(&mut self) {
+        self.found.clear();
+        self.truncate(0, 0);
+    }
+
+    /// Drops the word pairs from `pairs` on and the placements from `placed` on.
+    fn truncate(&mut self, pairs: usize, placed: usize) {
+        self.chain.truncate(pairs);
+        self.word_pairs.truncate(pairs);
+        self.anchors.truncate(pairs);
+        self.placed.truncate(placed);
+    }
 }
 
 /// A placement of the alignment: windows start at `a` in the current word and `b` in the past
