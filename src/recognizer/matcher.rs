@@ -65,6 +65,8 @@ use super::index::recent_candidates;
 use super::types::{AlignedRun, Direction, Match, Observation, push_pair, push_run};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
+use std::cell::RefCell;
+use std::collections::HashMap;
 
 #[derive(Clone, Copy, Debug)]
 struct Entry {
@@ -134,6 +136,10 @@ pub struct WordMatcher {
     within_gap: usize,
     /// Working space of `report`.
     scratch: Scratch,
+    /// Placements made while reporting the current word, by (current word, past word,
+    /// direction, anchor): a word's level configurations mostly verify the same newest pair at
+    /// the same shift.
+    placements: RefCell<HashMap<PlacementKey, Option<Placement>>>,
     /// Whether every observation so far has its index as id (the recognizer's own stream): an
     /// aligned window then makes its pairs as one run without reading each observation.
     ids_are_indices: bool,
@@ -187,6 +193,7 @@ impl WordMatcher {
             longest: [0; MAX_LEVELS],
             within_gap: 0,
             scratch: Scratch::default(),
+            placements: RefCell::default(),
             ids_are_indices: true,
         })
     }
@@ -494,6 +501,7 @@ impl WordMatcher {
     }
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+        self.placements.get_mut().clear();
         let mut scratch = std::mem::take(&mut self.scratch);
         for k in 0..self.params.levels {
             // Every candidate first, then the reports: a candidate's new pairs are counted when
@@ -787,6 +795,17 @@ impl WordMatcher {
     /// Read in direction `dir`, the past word is its Ψ backwards: offsets count from its last
     /// observation. `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
     fn placement(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
+        let key = (c, p, dir, anchor);
+        if let Some(w) = self.placements.borrow().get(&key) {
+            return w.clone();
+        }
+        let w = self.place(c, p, dir, anchor);
+        self.placements.borrow_mut().insert(key, w.clone());
+        w
+    }
+
+    /// [`placement`](Self::placement), computed.
+    fn place(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
@@ -944,6 +963,10 @@ impl Scratch {
         self.placed.truncate(placed);
     }
 }
+
+/// What a placement is a function of while a word is reported: (current word, past word,
+/// direction, anchor).
+type PlacementKey = (WordId, WordId, Direction, i64);
 
 /// A placement of the alignment: windows start at `a` in the current word and `b` in the past
 /// word; `r` the indices within the windows that lie in the past word's run; `cost` the mean
