@@ -127,7 +127,9 @@ pub struct WordMatcher {
     /// freed.
     memo_forgotten: usize,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
-    lookup: [Vec<(u32, u32)>; MAX_LEVELS],
+    /// Slots `MAX_LEVELS..`: the same for the predecessors of its level-0 predecessor (the
+    /// pairs a substitution bridges to).
+    lookup: [Vec<(u32, u32)>; 2 * MAX_LEVELS],
     stamp: u32,
     rejections: VerificationCounts,
     /// Per level configuration, the longest chain of matching word pairs seen (either direction).
@@ -362,7 +364,18 @@ impl WordMatcher {
         }
         let stamp = self.stamp;
         let c_preds = cw.pred_ids();
-        for (slot, &cp) in c_preds.iter().enumerate() {
+        let skipped = self
+            .params
+            .substitutions
+            .then(|| self.level0_link(c, Direction::Same));
+        let bridged = skipped
+            .flatten()
+            .map_or(&[][..], |s| self.words.word(s).pred_ids());
+        for (slot, &cp) in c_preds
+            .iter()
+            .enumerate()
+            .chain(bridged.iter().enumerate().map(|(i, w)| (MAX_LEVELS + i, w)))
+        {
             let table = &mut self.lookup[slot];
             if table.len() < n_words {
                 table.resize(n_words, (0, 0));
@@ -470,22 +483,25 @@ impl WordMatcher {
         if (a - b).abs() > self.params.substitution_size_ratio * a.max(b) + 1e-9 {
             return;
         }
-        for &c2 in self.word(c_skip).pred_ids() {
+        // The memo entries of c_skip's predecessors, by past word: lookup slots MAX_LEVELS.. (see
+        // `memoise`).
+        for (slot, &c2) in self.word(c_skip).pred_ids().iter().enumerate() {
             let memo = &self.memo[d][c2 as usize];
             if memo.is_empty() {
                 continue;
             }
             for &p2 in self.past_links(p_skip, dir) {
-                let Ok(idx) = memo.binary_search_by_key(&p2, |e| e.past) else {
+                let (s, idx) = self.lookup[MAX_LEVELS + slot][p2 as usize];
+                if s != self.stamp {
                     continue;
-                };
-                let e = &memo[idx];
+                }
+                let e = &memo[idx as usize];
                 for k in top..levels {
                     let el = e.len[k];
                     if el > 0 && el + 1 > len[k] {
                         len[k] = el + 1;
                         back_word[k] = c2;
-                        back_idx[k] = idx as u32;
+                        back_idx[k] = idx;
                     }
                 }
             }
