@@ -136,6 +136,10 @@ pub struct WordMatcher {
     longest: [u16; MAX_LEVELS],
     /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
     within_gap: usize,
+    /// Per word matched so far, where it begins read forwards and read backwards
+    /// ([`reading_start`](Self::reading_start)): verification reads it for every word of every
+    /// candidate n-gram, and a word's first and last observations are far apart in memory.
+    reading_starts: Vec<[(f64, f64); 2]>,
     /// Working space of `report`.
     scratch: Scratch,
     /// Placements made while reporting the current word, by (current word, past word,
@@ -194,6 +198,7 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            reading_starts: Vec::new(),
             scratch: Scratch::default(),
             placements: RefCell::default(),
             ids_are_indices: true,
@@ -314,6 +319,9 @@ impl WordMatcher {
     fn match_words(&mut self, closed: &[WordId]) -> Vec<Match> {
         let mut out = Vec::new();
         for &c in closed {
+            debug_assert_eq!(self.reading_starts.len(), c as usize);
+            let starts = Direction::BOTH.map(|dir| self.measure_reading_start(c, dir));
+            self.reading_starts.push(starts);
             self.link_successors(c);
             self.memoise(c, Direction::Same);
             if self.params.reverse {
@@ -796,6 +804,11 @@ impl WordMatcher {
     /// first observation, or read backwards, of its last one with travel negated (so that
     /// differences between words read backwards come out as travelled that way).
     fn reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        self.reading_starts[w as usize][dir as usize]
+    }
+
+    /// [`reading_start`](Self::reading_start), from the word's observations.
+    fn measure_reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
         let obs = self.words.observations();
         let w = self.word(w);
         match dir {
