@@ -355,43 +355,14 @@ impl WordMatcher {
 
     /// Fills the memo of word `c` in direction `dir`: one entry per matching past word.
     fn memoise(&mut self, c: WordId, dir: Direction) {
-        let n_words = self.words.all_words().len();
         let d = dir as usize;
         debug_assert_eq!(self.memo[d].len(), c as usize);
+        let stamp = self.fill_lookups(c, d);
         let cw = self.word(c).clone();
         let limit = cw.start_travel_m - self.params.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
         let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
-
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            for l in &mut self.lookup {
-                l.fill((0, 0));
-            }
-            self.stamp = 1;
-        }
-        let stamp = self.stamp;
         let c_preds = cw.pred_ids();
-        let skipped = self
-            .params
-            .substitutions
-            .then(|| self.level0_link(c, Direction::Same));
-        let bridged = skipped
-            .flatten()
-            .map_or(&[][..], |s| self.words.word(s).pred_ids());
-        for (slot, &cp) in c_preds
-            .iter()
-            .enumerate()
-            .chain(bridged.iter().enumerate().map(|(i, w)| (MAX_LEVELS + i, w)))
-        {
-            let table = &mut self.lookup[slot];
-            if table.len() < n_words {
-                table.resize(n_words, (0, 0));
-            }
-            for (idx, e) in self.memo[d][cp as usize].iter().enumerate() {
-                table[e.past as usize] = (stamp, idx as u32);
-            }
-        }
 
         let levels = self.params.levels;
         let candidates = recent_candidates(&occ[..end], self.params.max_candidates, |p| {
@@ -444,6 +415,44 @@ impl WordMatcher {
             });
         }
         self.memo[d].push(entries);
+    }
+
+    /// Fills the lookup tables for word `c` in direction `d` under a new stamp (returned): slot i
+    /// maps each past word of the memo of c's i-th predecessor to its entry, slot
+    /// `MAX_LEVELS` + i the same for the i-th predecessor of c's level-0 predecessor (the pairs
+    /// a substitution bridges to).
+    fn fill_lookups(&mut self, c: WordId, d: usize) -> u32 {
+        let n_words = self.words.all_words().len();
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            for l in &mut self.lookup {
+                l.fill((0, 0));
+            }
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let skipped = self
+            .params
+            .substitutions
+            .then(|| self.level0_link(c, Direction::Same));
+        let bridged = skipped
+            .flatten()
+            .map_or(&[][..], |s| self.words.word(s).pred_ids());
+        let c_preds = self.words.word(c).pred_ids();
+        for (slot, &cp) in c_preds
+            .iter()
+            .enumerate()
+            .chain(bridged.iter().enumerate().map(|(i, w)| (MAX_LEVELS + i, w)))
+        {
+            let table = &mut self.lookup[slot];
+            if table.len() < n_words {
+                table.resize(n_words, (0, 0));
+            }
+            for (idx, e) in self.memo[d][cp as usize].iter().enumerate() {
+                table[e.past as usize] = (stamp, idx as u32);
+            }
+        }
+        stamp
     }
 
     /// The level-0 link of `w` read in direction `dir` (its level-0 predecessor, or read
@@ -608,25 +617,8 @@ impl WordMatcher {
         dir: Direction,
         scr: &mut Scratch,
     ) -> Option<Candidate> {
-        let d = dir as usize;
         let (from, placed_from) = (scr.chain.len(), scr.placed.len());
-        if !self.tau_chain((c, idx), k, dir, &mut scr.chain) {
-            return None;
-        }
-        // The chain extends one whose n-gram was verified and reported: only its new pair's
-        // densities need checking (the travel and turn checks are cheap and run in full).
-        let extends_reported = scr
-            .chain
-            .get(from + 1)
-            .is_some_and(|&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) != 0);
-        scr.chain[from..].reverse();
-        let memo = &self.memo[d];
-        let chain = &scr.chain[from..];
-        scr.word_pairs.extend(
-            chain
-                .iter()
-                .map(|&(wc, widx)| (wc, memo[wc as usize][widx].past)),
-        );
+        let extends_reported = self.push_chain((c, idx), k, dir, scr)?;
         let pairs = from..scr.chain.len();
         if !self.beyond_candidate_gap(&scr.word_pairs[pairs.clone()]) {
             self.within_gap += 1;
@@ -658,6 +650,37 @@ impl WordMatcher {
             pairs,
             placed: placed_from..scr.placed.len(),
         })
+    }
+
+    /// Appends to `scr` the τ-gram of configuration k ending at memo entry `idx` of `c`, oldest
+    /// pair first (its chain and word pairs); whether it extends a chain reported in
+    /// configuration k, or `None` (nothing appended) when there is no τ-gram.
+    fn push_chain(
+        &self,
+        (c, idx): (WordId, usize),
+        k: usize,
+        dir: Direction,
+        scr: &mut Scratch,
+    ) -> Option<bool> {
+        let memo = &self.memo[dir as usize];
+        let from = scr.chain.len();
+        if !self.tau_chain((c, idx), k, dir, &mut scr.chain) {
+            return None;
+        }
+        // The chain extends one whose n-gram was verified and reported: only its new pair's
+        // densities need checking (the travel and turn checks are cheap and run in full).
+        let extends_reported = scr
+            .chain
+            .get(from + 1)
+            .is_some_and(|&(wc, widx)| memo[wc as usize][widx].reported & (1 << k) != 0);
+        scr.chain[from..].reverse();
+        let chain = &scr.chain[from..];
+        scr.word_pairs.extend(
+            chain
+                .iter()
+                .map(|&(wc, widx)| (wc, memo[wc as usize][widx].past)),
+        );
+        Some(extends_reported)
     }
 
     /// Whether the n-gram's first current word begins at least `candidate_gap_m` after its
