@@ -81,9 +81,11 @@
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::index::recent_candidates;
-use super::types::{AlignedRun, Direction, Match, Observation, push_pair};
+use super::types::{AlignedRun, Direction, Match, Observation, push_pair, push_run};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
+use std::cell::RefCell;
+use std::collections::HashMap;
 
 #[derive(Clone, Copy, Debug)]
 struct Entry {
@@ -147,13 +149,28 @@ pub struct WordMatcher {
     /// freed.
     memo_forgotten: usize,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
-    lookup: [Vec<(u32, u32)>; MAX_LEVELS],
+    /// Slots `MAX_LEVELS..`: the same for the predecessors of its level-0 predecessor (the
+    /// pairs a substitution bridges to).
+    lookup: [Vec<(u32, u32)>; 2 * MAX_LEVELS],
     stamp: u32,
     rejections: VerificationCounts,
     /// Per level configuration, the longest chain of matching word pairs seen (either direction).
     longest: [u16; MAX_LEVELS],
     /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
     within_gap: usize,
+    /// Per word matched so far, where it begins read forwards and read backwards
+    /// ([`reading_start`](Self::reading_start)): verification reads it for every word of every
+    /// candidate n-gram, and a word's first and last observations are far apart in memory.
+    reading_starts: Vec<[(f64, f64); 2]>,
+    /// Working space of `report`.
+    scratch: Scratch,
+    /// Placements made while reporting the current word, by (current word, past word,
+    /// direction, anchor): a word's level configurations mostly verify the same newest pair at
+    /// the same shift.
+    placements: RefCell<HashMap<PlacementKey, Option<Placement>>>,
+    /// Whether every observation so far has its index as id (the recognizer's own stream): an
+    /// aligned window then makes its pairs as one run without reading each observation.
+    ids_are_indices: bool,
 }
 
 impl WordMatcher {
@@ -208,6 +225,10 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            reading_starts: Vec::new(),
+            scratch: Scratch::default(),
+            placements: RefCell::default(),
+            ids_are_indices: true,
         })
     }
 
@@ -229,6 +250,7 @@ impl WordMatcher {
             obs.travel_m,
             last
         );
+        self.ids_are_indices &= obs.id == self.words.observations().len();
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
@@ -324,6 +346,9 @@ impl WordMatcher {
     fn match_words(&mut self, closed: &[WordId]) -> Vec<Match> {
         let mut out = Vec::new();
         for &c in closed {
+            debug_assert_eq!(self.reading_starts.len(), c as usize);
+            let starts = Direction::BOTH.map(|dir| self.measure_reading_start(c, dir));
+            self.reading_starts.push(starts);
             self.link_successors(c);
             self.memoise(c, Direction::Same);
             if self.params.reverse {
@@ -357,38 +382,20 @@ impl WordMatcher {
 
     /// Fills the memo of word `c` in direction `dir`: one entry per matching past word.
     fn memoise(&mut self, c: WordId, dir: Direction) {
-        let n_words = self.words.all_words().len();
         let d = dir as usize;
         debug_assert_eq!(self.memo[d].len(), c as usize);
+        let stamp = self.fill_lookups(c, d);
         let cw = self.word(c).clone();
         let limit = cw.start_travel_m - self.params.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
         let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
-
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            for l in &mut self.lookup {
-                l.fill((0, 0));
-            }
-            self.stamp = 1;
-        }
-        let stamp = self.stamp;
         let c_preds = cw.pred_ids();
-        for (slot, &cp) in c_preds.iter().enumerate() {
-            let table = &mut self.lookup[slot];
-            if table.len() < n_words {
-                table.resize(n_words, (0, 0));
-            }
-            for (idx, e) in self.memo[d][cp as usize].iter().enumerate() {
-                table[e.past as usize] = (stamp, idx as u32);
-            }
-        }
 
         let levels = self.params.levels;
-        let mut entries = Vec::new();
         let candidates = recent_candidates(&occ[..end], self.params.max_candidates, |p| {
             self.syllables_match(&cw, self.word(p), dir)
         });
+        let mut entries = Vec::with_capacity(candidates.len());
         for p in candidates {
             let pw = self.word(p);
             let top = cw.level.max(pw.level);
@@ -437,6 +444,44 @@ impl WordMatcher {
         self.memo[d].push(entries);
     }
 
+    /// Fills the lookup tables for word `c` in direction `d` under a new stamp (returned): slot i
+    /// maps each past word of the memo of c's i-th predecessor to its entry, slot
+    /// `MAX_LEVELS` + i the same for the i-th predecessor of c's level-0 predecessor (the pairs
+    /// a substitution bridges to).
+    fn fill_lookups(&mut self, c: WordId, d: usize) -> u32 {
+        let n_words = self.words.all_words().len();
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            for l in &mut self.lookup {
+                l.fill((0, 0));
+            }
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let skipped = self
+            .params
+            .substitutions
+            .then(|| self.level0_link(c, Direction::Same));
+        let bridged = skipped
+            .flatten()
+            .map_or(&[][..], |s| self.words.word(s).pred_ids());
+        let c_preds = self.words.word(c).pred_ids();
+        for (slot, &cp) in c_preds
+            .iter()
+            .enumerate()
+            .chain(bridged.iter().enumerate().map(|(i, w)| (MAX_LEVELS + i, w)))
+        {
+            let table = &mut self.lookup[slot];
+            if table.len() < n_words {
+                table.resize(n_words, (0, 0));
+            }
+            for (idx, e) in self.memo[d][cp as usize].iter().enumerate() {
+                table[e.past as usize] = (stamp, idx as u32);
+            }
+        }
+        stamp
+    }
+
     /// The level-0 link of `w` read in direction `dir` (its level-0 predecessor, or read
     /// backwards, its level-0 successor): the word a substitution skips.
     fn level0_link(&self, w: WordId, dir: Direction) -> Option<WordId> {
@@ -482,22 +527,25 @@ impl WordMatcher {
         if (a - b).abs() > self.params.substitution_size_ratio * a.max(b) + 1e-9 {
             return;
         }
-        for &c2 in self.word(c_skip).pred_ids() {
+        // The memo entries of c_skip's predecessors, by past word: lookup slots MAX_LEVELS.. (see
+        // `memoise`).
+        for (slot, &c2) in self.word(c_skip).pred_ids().iter().enumerate() {
             let memo = &self.memo[d][c2 as usize];
             if memo.is_empty() {
                 continue;
             }
             for &p2 in self.past_links(p_skip, dir) {
-                let Ok(idx) = memo.binary_search_by_key(&p2, |e| e.past) else {
+                let (s, idx) = self.lookup[MAX_LEVELS + slot][p2 as usize];
+                if s != self.stamp {
                     continue;
-                };
-                let e = &memo[idx];
+                }
+                let e = &memo[idx as usize];
                 for k in top..levels {
                     let el = e.len[k];
                     if el > 0 && el + 1 > len[k] {
                         len[k] = el + 1;
                         back_word[k] = c2;
-                        back_idx[k] = idx as u32;
+                        back_idx[k] = idx;
                     }
                 }
             }
@@ -513,32 +561,37 @@ impl WordMatcher {
     }
 
     fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+        self.placements.get_mut().clear();
+        let mut scratch = std::mem::take(&mut self.scratch);
         for k in 0..self.params.levels {
             // Every candidate first, then the reports: a candidate's new pairs are counted when
             // it is reported (see `emit`).
-            let mut found = Vec::new();
+            scratch.clear();
             for dir in Direction::BOTH {
                 for idx in 0..self.memo[dir as usize][c as usize].len() {
-                    if let Some(cand) = self.candidate(c, idx, k, dir) {
-                        found.push(cand);
+                    if let Some(cand) = self.candidate(c, idx, k, dir, &mut scratch) {
+                        scratch.found.push(cand);
                     }
                 }
             }
-            for cand in found {
-                out.push(self.emit(c, k, cand));
+            for i in 0..scratch.found.len() {
+                let cand = scratch.found[i].clone();
+                out.push(self.emit(c, k, &cand, &mut scratch));
             }
         }
+        self.scratch = scratch;
     }
 
-    /// The τ-gram of configuration k ending at memo entry `idx` of `c`, newest pair first;
-    /// `None` when the chain is shorter than τ (and not long enough in travel).
+    /// Appends to `chain` the τ-gram of configuration k ending at memo entry `idx` of `c`,
+    /// newest pair first; false (nothing appended) when the chain is shorter than τ (and not
+    /// long enough in travel).
     fn tau_chain(
         &self,
-        c: WordId,
-        idx: usize,
+        (c, idx): (WordId, usize),
         k: usize,
         dir: Direction,
-    ) -> Option<Vec<(WordId, usize)>> {
+        chain: &mut Vec<(WordId, usize)>,
+    ) -> bool {
         let memo = &self.memo[dir as usize];
         let tau = match dir {
             Direction::Same => self.params.min_ngram[k],
@@ -554,111 +607,154 @@ impl WordMatcher {
             };
         let len = e.len[k] as usize;
         if len < tau && !(by_travel && len >= min_words) {
-            return None;
+            return false;
         }
-        let mut chain = vec![(c, idx)];
+        let start = chain.len();
+        chain.push((c, idx));
         let (mut wc, mut we) = (c, e);
         let end_m = self.word(c).end_travel_m;
-        while chain.len() < tau {
+        while chain.len() - start < tau {
             // An n-gram long in travel but short in words (`ngram_travel_m`,
             // `reverse_ngram_travel_m`).
             if by_travel
-                && chain.len() >= min_words
+                && chain.len() - start >= min_words
                 && end_m - self.word(wc).start_travel_m >= travel_m
             {
                 break;
             }
-            let (pc, pidx) = Self::step_back(&we, k)?;
+            let Some((pc, pidx)) = Self::step_back(&we, k) else {
+                chain.truncate(start);
+                return false;
+            };
             let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
             (wc, we) = (pc, pe);
         }
-        Some(chain)
+        true
     }
 
     /// The τ-gram of configuration k ending at memo entry `idx` of `c` (direction `dir`) if it
     /// is long enough, satisfies the candidate gap, passes verification and has unreported
-    /// pairs.
-    fn candidate(&mut self, c: WordId, idx: usize, k: usize, dir: Direction) -> Option<Candidate> {
-        let d = dir as usize;
-        let mut chain = self.tau_chain(c, idx, k, dir)?;
-        // The chain extends one whose n-gram was verified and reported: only its new pair's
-        // densities need checking (the travel and turn checks are cheap and run in full).
-        let extends_reported = chain
-            .get(1)
-            .is_some_and(|&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) != 0);
-        chain.reverse();
-        let word_pairs: Vec<(WordId, WordId)> = chain
-            .iter()
-            .map(|&(wc, widx)| (wc, self.memo[d][wc as usize][widx].past))
-            .collect();
-        // The latest past word: the last one read forwards, the first one read backwards.
-        let past_end = word_pairs
-            .iter()
-            .map(|&(_, p)| self.word(p).end_travel_m)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let first_current = self.word(word_pairs[0].0);
-        if first_current.start_travel_m + 1e-9 < past_end + self.params.candidate_gap_m {
+    /// pairs; its pairs, anchors and placements are appended to `scr`.
+    fn candidate(
+        &mut self,
+        c: WordId,
+        idx: usize,
+        k: usize,
+        dir: Direction,
+        scr: &mut Scratch,
+    ) -> Option<Candidate> {
+        let (from, placed_from) = (scr.chain.len(), scr.placed.len());
+        let extends_reported = self.push_chain((c, idx), k, dir, scr)?;
+        let pairs = from..scr.chain.len();
+        if !self.beyond_candidate_gap(&scr.word_pairs[pairs.clone()]) {
             self.within_gap += 1;
+            scr.truncate(from, placed_from);
             return None;
         }
-        let anchors = self.chain_anchors(&word_pairs, dir);
-        let mut placed = Vec::new();
+        self.chain_anchors(
+            &scr.word_pairs[pairs.clone()],
+            dir,
+            &mut scr.offsets,
+            &mut scr.anchors,
+        );
         if self.params.verify
-            && let Some(reason) =
-                self.verify(&word_pairs, dir, &anchors, extends_reported, &mut placed)
+            && let Some(reason) = self.verify(
+                &scr.word_pairs[pairs.clone()],
+                dir,
+                &scr.anchors[pairs.clone()],
+                extends_reported,
+                &mut scr.placed,
+            )
         {
             self.rejections.add(reason);
+            scr.truncate(from, placed_from);
             return None;
         }
         Some(Candidate {
             idx,
             dir,
-            chain,
-            word_pairs,
-            anchors,
-            placed,
+            pairs,
+            placed: placed_from..scr.placed.len(),
         })
     }
 
+    /// Appends to `scr` the τ-gram of configuration k ending at memo entry `idx` of `c`, oldest
+    /// pair first (its chain and word pairs); whether it extends a chain reported in
+    /// configuration k, or `None` (nothing appended) when there is no τ-gram.
+    fn push_chain(
+        &self,
+        (c, idx): (WordId, usize),
+        k: usize,
+        dir: Direction,
+        scr: &mut Scratch,
+    ) -> Option<bool> {
+        let memo = &self.memo[dir as usize];
+        let from = scr.chain.len();
+        if !self.tau_chain((c, idx), k, dir, &mut scr.chain) {
+            return None;
+        }
+        // The chain extends one whose n-gram was verified and reported: only its new pair's
+        // densities need checking (the travel and turn checks are cheap and run in full).
+        let extends_reported = scr
+            .chain
+            .get(from + 1)
+            .is_some_and(|&(wc, widx)| memo[wc as usize][widx].reported & (1 << k) != 0);
+        scr.chain[from..].reverse();
+        let chain = &scr.chain[from..];
+        scr.word_pairs.extend(
+            chain
+                .iter()
+                .map(|&(wc, widx)| (wc, memo[wc as usize][widx].past)),
+        );
+        Some(extends_reported)
+    }
+
+    /// Whether the n-gram's first current word begins at least `candidate_gap_m` after its
+    /// latest past word ends (the last one read forwards, the first one read backwards).
+    fn beyond_candidate_gap(&self, word_pairs: &[(WordId, WordId)]) -> bool {
+        let past_end = word_pairs
+            .iter()
+            .map(|&(_, p)| self.word(p).end_travel_m)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let first_current = self.word(word_pairs[0].0);
+        first_current.start_travel_m + 1e-9 >= past_end + self.params.candidate_gap_m
+    }
+
     /// Marks a candidate's new pairs reported and makes its match.
-    fn emit(&mut self, c: WordId, k: usize, mut cand: Candidate) -> Match {
+    fn emit(&mut self, c: WordId, k: usize, cand: &Candidate, scr: &mut Scratch) -> Match {
         let d = cand.dir as usize;
+        let chain = &scr.chain[cand.pairs.clone()];
         // Counted now, not when the candidate was found: another candidate of the same word may
         // have reported a pair this chain shares since.
-        let fresh = 1 + cand.chain[..cand.chain.len() - 1]
+        let fresh = 1 + chain[..chain.len() - 1]
             .iter()
             .rev()
             .take_while(|&&(wc, widx)| self.memo[d][wc as usize][widx].reported & (1 << k) == 0)
             .count();
-        let fresh_from = cand.chain.len() - fresh;
-        let mut pairs = Vec::new();
+        let fresh_from = chain.len() - fresh;
         let mut refs = Vec::with_capacity(fresh);
         // Verification placed the last `placed.len()` word pairs already: the same placements.
-        let placed_from = cand.chain.len() - cand.placed.len();
-        for (j, ((&(wc, widx), &(_, past)), &anchor)) in cand
-            .chain
-            .iter()
-            .zip(&cand.word_pairs)
-            .zip(&cand.anchors)
-            .enumerate()
-            .skip(fresh_from)
-        {
+        let placed_from = chain.len() - cand.placed.len();
+        scr.runs.clear();
+        for (j, &(wc, widx)) in chain.iter().enumerate().skip(fresh_from) {
+            let at = cand.pairs.start + j;
+            let (past, anchor) = (scr.word_pairs[at].1, scr.anchors[at]);
             self.memo[d][wc as usize][widx].reported |= 1 << k;
             refs.push((self.word(wc).word_ref(), self.word(past).word_ref()));
             let placement = match j.checked_sub(placed_from) {
-                Some(i) => cand.placed[i].take(),
+                Some(i) => scr.placed[cand.placed.start + i].take(),
                 None => self.placement(wc, past, cand.dir, anchor),
             };
-            self.aligned_pairs(wc, past, cand.dir, placement, &mut pairs);
+            self.aligned_pairs(wc, past, cand.dir, placement, &mut scr.runs);
         }
         self.rejections.accepted += 1;
-        pairs.shrink_to_fit(); // usually one run: do not keep a Vec's spare capacity per match
         Match {
             levels: k + 1,
             ngram_len: self.memo[d][c as usize][cand.idx].len[k] as usize,
             word_pairs: refs,
-            runs: pairs,
+            // Usually one run: exactly as many as there are, no spare capacity per match.
+            runs: scr.runs.to_vec(),
             direction: cand.dir,
         }
     }
@@ -753,40 +849,46 @@ impl WordMatcher {
     /// the words' starts as read in direction `dir`) that puts the pair at the travel offset the
     /// whole n-gram agrees on: the median over its word pairs of the offset between the two
     /// words' centres (the past side's travel negated when read backwards).
-    fn chain_anchors(&self, word_pairs: &[(WordId, WordId)], dir: Direction) -> Vec<i64> {
+    fn chain_anchors(
+        &self,
+        word_pairs: &[(WordId, WordId)],
+        dir: Direction,
+        offsets: &mut Vec<f64>,
+        anchors: &mut Vec<i64>,
+    ) {
         // Both boundaries of every word pair, as read: a word of flat Ψ whose boundaries moved
         // shifts its centre, while most boundaries of the n-gram still agree.
-        let mut offsets: Vec<f64> = word_pairs
-            .iter()
-            .flat_map(|&(c, p)| {
-                let (cw, pw) = (self.word(c), self.word(p));
-                match dir {
-                    Direction::Same => [
-                        cw.start_travel_m - pw.start_travel_m,
-                        cw.end_travel_m - pw.end_travel_m,
-                    ],
-                    Direction::Opposite => [
-                        cw.start_travel_m + pw.end_travel_m,
-                        cw.end_travel_m + pw.start_travel_m,
-                    ],
-                }
-            })
-            .collect();
+        offsets.clear();
+        offsets.extend(word_pairs.iter().flat_map(|&(c, p)| {
+            let (cw, pw) = (self.word(c), self.word(p));
+            match dir {
+                Direction::Same => [
+                    cw.start_travel_m - pw.start_travel_m,
+                    cw.end_travel_m - pw.end_travel_m,
+                ],
+                Direction::Opposite => [
+                    cw.start_travel_m + pw.end_travel_m,
+                    cw.end_travel_m + pw.start_travel_m,
+                ],
+            }
+        }));
         offsets.sort_by(f64::total_cmp);
         let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
-        word_pairs
-            .iter()
-            .map(|&(c, p)| {
-                let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
-                ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
-            })
-            .collect()
+        anchors.extend(word_pairs.iter().map(|&(c, p)| {
+            let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
+            ((start_gap_m - offset_m) / self.params.spacing_m).round() as i64
+        }));
     }
 
     /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
     /// first observation, or read backwards, of its last one with travel negated (so that
     /// differences between words read backwards come out as travelled that way).
     fn reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        self.reading_starts[w as usize][dir as usize]
+    }
+
+    /// [`reading_start`](Self::reading_start), from the word's observations.
+    fn measure_reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
         let obs = self.words.observations();
         let w = self.word(w);
         match dir {
@@ -802,6 +904,17 @@ impl WordMatcher {
     /// Read in direction `dir`, the past word is its Ψ backwards: offsets count from its last
     /// observation. `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
     fn placement(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
+        let key = (c, p, dir, anchor);
+        if let Some(w) = self.placements.borrow().get(&key) {
+            return w.clone();
+        }
+        let w = self.place(c, p, dir, anchor);
+        self.placements.borrow_mut().insert(key, w.clone());
+        w
+    }
+
+    /// [`placement`](Self::placement), computed.
+    fn place(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
@@ -887,6 +1000,11 @@ impl WordMatcher {
         };
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);
+        if self.ids_are_indices && self.beyond_gap(s2, &past, &w) {
+            let (q, pst) = ((s2 + w.a + w.r.start) as usize, past.index(w.b + w.r.start));
+            push_run(out, q, pst, past.step as i8, w.count() as u32);
+            return;
+        }
         for i in w.r {
             let (q, pst) = (&obs[(s2 + w.a + i) as usize], &obs[past.index(w.b + i)]);
             if q.travel_m - pst.travel_m + 1e-9 < self.params.candidate_gap_m {
@@ -895,19 +1013,69 @@ impl WordMatcher {
             push_pair(out, q.id, pst.id, past.step as i8);
         }
     }
+
+    /// Whether every pair of placement `w` (current word from observation `s2`) passes the
+    /// candidate gap of `aligned_pairs`: travel never decreases with the index, so the first
+    /// current observation and the latest past one bound every pair's difference (rounding is
+    /// monotone, so the bound holds for the computed differences too).
+    fn beyond_gap(&self, s2: i64, past: &PastSide, w: &Placement) -> bool {
+        if w.count() == 0 {
+            return true;
+        }
+        let obs = self.words.observations();
+        let q_first = obs[(s2 + w.a + w.r.start) as usize].travel_m;
+        let (p0, p1) = (past.index(w.b + w.r.start), past.index(w.b + w.r.end - 1));
+        let p_max = obs[p0].travel_m.max(obs[p1].travel_m);
+        q_first - p_max + 1e-9 >= self.params.candidate_gap_m
+    }
 }
 
-/// An n-gram that passed the gap and verification, before it is reported.
+/// An n-gram that passed the gap and verification, before it is reported; its data is in the
+/// matcher's [`Scratch`].
+#[derive(Clone, Debug)]
 struct Candidate {
     idx: usize,
     dir: Direction,
-    /// (current word, memo index), oldest first.
+    /// Its word pairs in `Scratch::{chain, word_pairs, anchors}`, oldest first.
+    pairs: std::ops::Range<usize>,
+    /// The placements verification made (of its last `placed.len()` word pairs) in
+    /// `Scratch::placed`.
+    placed: std::ops::Range<usize>,
+}
+
+/// The candidates of one word and configuration, back to back, kept between words so that
+/// finding and reporting them allocates nothing but the matches.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
+    found: Vec<Candidate>,
+    /// Per word pair: (current word, memo index), (current word, past word), the n-gram's shift.
     chain: Vec<(WordId, usize)>,
     word_pairs: Vec<(WordId, WordId)>,
     anchors: Vec<i64>,
-    /// Placements verification made, of the last `placed.len()` word pairs.
     placed: Vec<Option<Placement>>,
+    /// Working space of `chain_anchors` and of `emit`.
+    offsets: Vec<f64>,
+    runs: Vec<AlignedRun>,
 }
+
+impl Scratch {
+    fn clear(&mut self) {
+        self.found.clear();
+        self.truncate(0, 0);
+    }
+
+    /// Drops the word pairs from `pairs` on and the placements from `placed` on.
+    fn truncate(&mut self, pairs: usize, placed: usize) {
+        self.chain.truncate(pairs);
+        self.word_pairs.truncate(pairs);
+        self.anchors.truncate(pairs);
+        self.placed.truncate(placed);
+    }
+}
+
+/// What a placement is a function of while a word is reported: (current word, past word,
+/// direction, anchor).
+type PlacementKey = (WordId, WordId, Direction, i64);
 
 /// A placement of the alignment: windows start at `a` in the current word and `b` in the past
 /// word; `r` the indices within the windows that lie in the past word's run; `cost` the mean

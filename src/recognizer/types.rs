@@ -97,6 +97,24 @@ pub fn push_pair(runs: &mut Vec<AlignedRun>, query: ObsId, past: ObsId, past_ste
     });
 }
 
+/// Appends the `len` pairs `(query + i, past + i·past_step)`, i < `len`, to `runs`, as `len`
+/// calls of [`push_pair`] would (the first may continue the last run; the rest continue it).
+pub(crate) fn push_run(
+    runs: &mut Vec<AlignedRun>,
+    query: ObsId,
+    past: ObsId,
+    past_step: i8,
+    len: u32,
+) {
+    if len == 0 {
+        return;
+    }
+    push_pair(runs, query, past, past_step);
+    if let Some(last) = runs.last_mut() {
+        last.len += len - 1;
+    }
+}
+
 /// Which way the past n-gram was read when it matched.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
