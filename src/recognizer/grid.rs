@@ -298,7 +298,8 @@ impl LocalGrid {
         self.mark(x1, y1, hit);
     }
 
-    /// Free cells the kernel reaches from global cell (cx, cy), with their first moment;
+    /// Free cells the kernel reaches from global cell (cx, cy), with the first moment of the
+    /// space its rays reach;
     /// `deltas` must be `kernel.deltas(self.side())`.
     pub fn free_cells(
         &mut self,
@@ -335,21 +336,24 @@ impl LocalGrid {
     ) -> Density {
         let (cx, cy) = self.cell_of(x, y);
         let free = self.free_cells(kernel, deltas, cx, cy);
-        // Moments in kernel radii per all-free count: a free half disc on one side gives ≈ 0.21.
-        let scale = 1.0 / (kernel.full_count() as f64 * kernel.radius_cells().max(1) as f64);
+        // In kernel radii per node of the tree.
+        let scale = 1.0 / (kernel.node_count().max(1) as f64 * kernel.radius_cells().max(1) as f64);
         Density {
             psi: kernel.psi_of_count(free.count),
-            moment: (free.moment_x as f64 * scale, free.moment_y as f64 * scale),
+            moment: (
+                free.reach_moment.0 as f64 * scale,
+                free.reach_moment.1 as f64 * scale,
+            ),
         }
     }
 }
 
-/// Ψ at a cell and the first moment of the free cells it counts.
+/// Ψ at a cell and the first moment of the space the kernel's rays reach from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Density {
     /// Free-space density Ψ in [0, 1].
     pub psi: f64,
-    /// Sum of the counted free cells' offsets from the cell (odometry frame axes), in kernel
-    /// radii, divided by the count of an all-free window.
+    /// Sum of the offsets from the cell (odometry frame axes) of the prefix-tree nodes the
+    /// kernel's rays reach (see `FreeCells`), in kernel radii, divided by the tree's node count.
     pub moment: (f64, f64),
 }
