@@ -12,7 +12,13 @@ pub type Vec2 = nalgebra::Vector2<f64>;
 
 /// Wraps an angle to (-π, π].
 pub fn wrap_angle(a: f64) -> f64 {
-    let mut r = a % (2.0 * PI);
+    // `%` is a division in software (fmod); below 2π in size it would return `a` itself, so
+    // skip it there (the result is bit-identical).
+    let mut r = if a.abs() < 2.0 * PI {
+        a
+    } else {
+        a % (2.0 * PI)
+    };
     if r <= -PI {
         r += 2.0 * PI;
     } else if r > PI {
