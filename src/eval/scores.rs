@@ -407,9 +407,12 @@ pub(crate) mod tests {
         };
         d.verification.rejected_travel = 3;
         d.verification.rejected_density = 2;
+        d.verification.rejected_straight = 1;
         let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
         assert!(
-            why.contains("rejected by verification: 5 (travel 3, turn 0, density 2)"),
+            why.contains(
+                "rejected by verification: 6 (travel 3, turn 0, density 2, sides 0, straight 1)"
+            ),
             "{why}"
         );
         d.verification = Default::default();
