@@ -27,12 +27,14 @@ pub struct Observation {
     pub travel_m: f64,
     /// Free-space density Ψ in [0, 1].
     pub psi: f64,
-    /// Where Ψ's free space lies across the path: the first moment of the free cells Ψ counts
-    /// along the robot's left axis, in kernel radii per all-free count (positive: more free
-    /// space on the left; a free half disc on one side alone gives about ±0.21). Driven the other
-    /// way, a place's left is its right, so the sign flips; at a place's mirror image it does not.
-    /// Ψ alone cannot tell those two apart. (Only the lateral axis: along the path, the grid
-    /// knows more ahead than behind, so that moment depends on the direction of travel.)
+    /// Where the space around the robot lies across the path: the first moment, along the
+    /// robot's left axis (odometry heading), of the space the density kernel's rays reach (free
+    /// or unknown, up to the first occupied cell), in kernel radii per node of the rays' prefix
+    /// tree (positive: more space on the left; a 3 m side corridor off a 2 m corridor gives
+    /// about ±0.12). Driven the other way, a place's left is its right, so the sign flips; at a
+    /// place's mirror image it does not. Ψ alone cannot tell those two apart. (Only the lateral
+    /// axis: along the path, the grid knows more ahead than behind, so that moment depends on
+    /// the direction of travel.)
     pub lateral_moment: f64,
 }
 
