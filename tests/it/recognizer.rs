@@ -1204,6 +1204,29 @@ fn fhw_log_matches_with_the_defaults() {
     assert!(scores.precision >= 0.9, "precision {}", scores.precision);
 }
 
+/// Intel's revisits driven the other way are recognized with the defaults, precisely: chains
+/// read backwards are accepted by travel (`reverse_ngram_travel_m`), and the side and turn checks
+/// keep the false ones out (without the travel rule its opposite recall was 0.03).
+#[test]
+fn intel_log_matches_driven_the_other_way() {
+    let Some(scores) = real_log_scores("intel", 1) else {
+        return;
+    };
+    let opposite = &scores.directions.opposite;
+    assert!(opposite.pairs > 0, "no opposite pair");
+    assert!(
+        opposite.precision >= 0.9,
+        "opposite precision {}",
+        opposite.precision
+    );
+    assert!(
+        opposite.recall >= 0.2,
+        "opposite recall {}",
+        opposite.recall
+    );
+    assert!(scores.precision >= 0.95, "precision {}", scores.precision);
+}
+
 /// Observations interpolated along long steps (scans 1.5 and 2.9 m apart) have about the Ψ that
 /// dense scans give at the same places: their kernels stay inside the grid's window.
 #[test]
