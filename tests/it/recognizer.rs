@@ -470,6 +470,25 @@ fn side_profile(i: usize) -> f64 {
     0.15 * (i as f64 / 7.0).sin()
 }
 
+/// Whether `second` (observations after `first`) matches, with the first lap's free space on
+/// the side `side_profile` gives and the second's on the side `side_of(k)` gives; and why not.
+fn matches_with_sides(
+    first: &[Observation],
+    mut second: Vec<Observation>,
+    side_of: impl Fn(usize) -> f64,
+) -> (bool, placewords::recognizer::VerificationCounts) {
+    let mut first = first.to_vec();
+    for (i, o) in first.iter_mut().enumerate() {
+        o.lateral_moment = side_profile(i);
+    }
+    for (k, o) in second.iter_mut().enumerate() {
+        o.lateral_moment = side_of(k);
+    }
+    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    (!matches.is_empty(), m.verification())
+}
+
 /// A lap driven the other way past the mirror image of every place (the free space on the same
 /// side of the path, not the other) reads the same backwards: Ψ and the words cannot tell, the
 /// side of the free space can. Driven back past the same places, the lap matches in the opposite
@@ -477,27 +496,18 @@ fn side_profile(i: usize) -> f64 {
 #[test]
 fn a_mirror_image_driven_back_is_not_a_revisit() {
     let lap = random_stretches(7, 40);
-    let mut first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
+    let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
     let n = first.len();
-    for (i, o) in first.iter_mut().enumerate() {
-        o.lateral_moment = side_profile(i);
-    }
     for (sign, revisit) in [(-1.0, true), (1.0, false)] {
-        let mut second = with_noise(
+        let second = with_noise(
             synth::observations(&reversed(&lap), 0.1, 0, first.last()),
             2,
         );
-        for (k, o) in second.iter_mut().enumerate() {
-            // Query k is at the place of observation n − 1 − k of the first lap.
-            o.lateral_moment = sign * side_profile(n - 1 - k);
-        }
-        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
-        let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
-        let counts = m.verification();
-        assert_eq!(!matches.is_empty(), revisit, "sign {sign}: {counts:?}");
-        if !revisit {
-            assert!(counts.rejected_sides > 0, "{counts:?}");
-        }
+        // Query k is at the place of observation n − 1 − k of the first lap.
+        let (matched, counts) =
+            matches_with_sides(&first, second, |k| sign * side_profile(n - 1 - k));
+        assert_eq!(matched, revisit, "sign {sign}: {counts:?}");
+        assert!(revisit || counts.rejected_sides > 0, "{counts:?}");
     }
 }
 
@@ -506,22 +516,12 @@ fn a_mirror_image_driven_back_is_not_a_revisit() {
 #[test]
 fn free_space_on_the_other_side_is_rejected() {
     let lap = random_stretches(7, 40);
-    let mut first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
-    for (i, o) in first.iter_mut().enumerate() {
-        o.lateral_moment = side_profile(i);
-    }
+    let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
     for (sign, expect_pairs) in [(1.0, true), (-1.0, false)] {
-        let mut second = with_noise(synth::observations(&lap, 0.1, 0, first.last()), 2);
-        for (i, o) in second.iter_mut().enumerate() {
-            o.lateral_moment = sign * side_profile(i);
-        }
-        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
-        let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
-        let counts = m.verification();
-        assert_eq!(!matches.is_empty(), expect_pairs, "sign {sign}: {counts:?}");
-        if !expect_pairs {
-            assert!(counts.rejected_sides > 0, "{counts:?}");
-        }
+        let second = with_noise(synth::observations(&lap, 0.1, 0, first.last()), 2);
+        let (matched, counts) = matches_with_sides(&first, second, |i| sign * side_profile(i));
+        assert_eq!(matched, expect_pairs, "sign {sign}: {counts:?}");
+        assert!(expect_pairs || counts.rejected_sides > 0, "{counts:?}");
     }
 }
 
