@@ -548,16 +548,7 @@ fn the_side_of_the_free_space_flips_with_the_direction_of_travel() {
     };
     let east = drive(&mut fe, 1.0, 0.0);
     let west = drive(&mut fe, 28.0, std::f64::consts::PI);
-    let at = |obs: &[Observation], x: f64| {
-        obs.iter()
-            .min_by(|a, b| {
-                (a.odom_pose.0.x - x)
-                    .abs()
-                    .total_cmp(&(b.odom_pose.0.x - x).abs())
-            })
-            .unwrap()
-            .lateral_moment
-    };
+    let at = |obs: &[Observation], x: f64| nearest_to_x(obs, x).lateral_moment;
     let (e, w) = (at(&east, 15.0), at(&west, 15.0));
     eprintln!("lateral moment at the side corridor: east {e:.3}, west {w:.3}");
     assert!(e > 0.05, "side corridor on the left driving east: {e}");
@@ -717,6 +708,17 @@ fn corridor_inputs(layout: &BeamLayout) -> Vec<(OdomPose, placewords::scan::Scan
         .collect()
 }
 
+/// The observation whose odometry x is nearest `x` (the corridor runs along x).
+fn nearest_to_x(obs: &[Observation], x: f64) -> &Observation {
+    obs.iter()
+        .min_by(|a, b| {
+            (a.odom_pose.0.x - x)
+                .abs()
+                .total_cmp(&(b.odom_pose.0.x - x).abs())
+        })
+        .unwrap()
+}
+
 fn front_end_psi(layout: &BeamLayout) -> Vec<Observation> {
     let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
     corridor_inputs(layout)
@@ -773,16 +775,7 @@ fn front_end_corridor_and_bifurcation_with_any_layout() {
     for w in reference.windows(2) {
         assert!((w[1].travel_m - w[0].travel_m - 0.1).abs() < 0.041);
     }
-    let at = |obs: &[Observation], x: f64| {
-        obs.iter()
-            .min_by(|a, b| {
-                (a.odom_pose.0.x - x)
-                    .abs()
-                    .total_cmp(&(b.odom_pose.0.x - x).abs())
-            })
-            .unwrap()
-            .psi
-    };
+    let at = |obs: &[Observation], x: f64| nearest_to_x(obs, x).psi;
     let corridor = at(&reference, 8.0);
     let branch = at(&reference, 15.0);
     assert!(
