@@ -27,6 +27,12 @@ pub trait PlaceRecognizer {
     /// Every observation made so far, in the order made (`observations()[i].id == i` is not
     /// required; ids are looked up).
     fn observations(&self) -> &[Observation];
+    /// Every match returned from now on names as its query only observations at or after this
+    /// index of [`Self::observations`]; the evaluation forgets what it kept to deduplicate
+    /// pairs behind it (`eval::tally`). 0, the default, promises nothing.
+    fn query_horizon(&self) -> usize {
+        0
+    }
     /// A short name for reports and progress bars ("levels=2 [6, 9]", "icp").
     fn name(&self) -> String;
     /// What the recognizer saw, so a run without matches can say why; `None` when it cannot

@@ -34,10 +34,15 @@
 //! Revisits and visits are searched in a k-d tree of the earlier observations
 //! ([`super::site_tree`]), so the cost grows about as `n log n` in the observations, however
 //! many passes go over one place.
+//!
+//! The rules are counted in one place, [`super::tally`], match by match in the order found
+//! (the order "first occurrence" refers to); this module holds the figures, the observations
+//! joined with their truth ([`Scorer`]) and the revisit searches.
 
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
 use super::site_tree::{LapSet, Query, Site, sweep};
+use super::tally::{Scope, Tally};
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
@@ -83,6 +88,15 @@ pub struct Metrics {
     pub pair_recall: f64,
     /// Pairs naming an observation id the recognizer never reported (not scored).
     pub unresolved_pairs: usize,
+    /// Pairs that arrived behind the recognizer's query horizon, after the scoring had
+    /// forgotten the pairs there (`eval::tally`): counted, but perhaps twice. Always 0 for a
+    /// recognizer that keeps its promise; written only when not.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub late_pairs: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Scores of the observations and pairs attributed to one door configuration.
@@ -114,51 +128,26 @@ pub struct DirectionMetrics {
     pub opposite: Metrics,
 }
 
-/// Scores `rec` as DESIGN.md §6 says: at `tp_radius_m`, at every sensitivity radius, and per
-/// door configuration.
+/// Scores `rec` as DESIGN.md §6 says: at `tp_radius_m`, at every sensitivity radius, per door
+/// configuration and per direction. A recognition scored while it was recognized
+/// ([`super::Recording::streaming`]) carries its evaluation; any other is scored now by feeding
+/// its matches, in order, to a [`Tally`] (the one implementation of the rules).
 pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
-    let scorer = Scorer::new(&rec.observations, &rec.truth, spec);
-    let (main, door_configs) = main_metrics(&scorer, rec, spec, true);
-    let sensitivity = spec
-        .sensitivity_radii_m
-        .iter()
-        .map(|&r| scorer.score(&rec.matches, r, false).0)
-        .collect();
-    let direction = |f: Facing| main_metrics(&scorer.with_facing(f), rec, spec, false).0;
-    Evaluation {
-        main,
-        sensitivity,
-        door_configs,
-        directions: DirectionMetrics {
-            same: direction(Facing::Same),
-            opposite: direction(Facing::Opposite),
-        },
+    if let Some((s, e)) = &rec.evaluation
+        && s == spec
+    {
+        return e.clone();
     }
+    let mut tally = Tally::new(spec, Scope::Full);
+    tally.sync(&rec.observations, &rec.truth);
+    for m in &rec.matches {
+        tally.add(m, &rec.truth);
+    }
+    tally.finish(&rec.observations, &rec.truth)
 }
 
-/// The figures at `tp_radius_m` as `scorer` counts them, visit and pair recall included.
-fn main_metrics(
-    scorer: &Scorer,
-    rec: &Recognition,
-    spec: &EvaluationSpec,
-    breakdown: bool,
-) -> (Metrics, Vec<DoorConfigMetrics>) {
-    let r = spec.tp_radius_m;
-    let (mut main, door_configs) = scorer.score(&rec.matches, r, breakdown);
-    main.visit_recall = scorer.visit_recall(&rec.matches, r);
-    main.pair_recall = super::pair_recall::pair_recall(
-        &rec.observations,
-        &rec.matches,
-        &rec.truth,
-        spec,
-        r,
-        scorer.facing,
-    )
-    .ratio();
-    (main, door_configs)
-}
-
-/// Scores observations and matches at one radius against `truth` (no breakdown).
+/// Scores observations and matches at radius `radius_m`, top-level figures only (no visit or
+/// pair recall).
 pub fn score(
     observations: &[Observation],
     matches: &[Match],
@@ -166,9 +155,16 @@ pub fn score(
     spec: &EvaluationSpec,
     radius_m: f64,
 ) -> Metrics {
-    Scorer::new(observations, truth, spec)
-        .score(matches, radius_m, false)
-        .0
+    let spec = EvaluationSpec {
+        tp_radius_m: radius_m,
+        ..spec.clone()
+    };
+    let mut tally = Tally::new(&spec, Scope::Main);
+    tally.sync(observations, truth);
+    for m in matches {
+        tally.add(m, truth);
+    }
+    tally.finish_main(None)
 }
 
 /// One deduplicated observation pair with its true positions, for pictures of what matched.
@@ -205,20 +201,31 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
     out
 }
 
-/// The distinct pairs of `rec`'s matches that `except` does not hold, as [`scored_pairs`] counts
-/// them (pairs without truth left out): `(pairs, correct at radius_m)`. Held as a packed set,
-/// so a long run's millions of pairs cost 8 bytes each.
-pub fn pairs_not_in(rec: &Recognition, except: &PairSet, radius_m: f64) -> (usize, usize) {
-    let truth_of = truth_lookup(rec);
-    let here = PairSet::from_pairs(rec.matches.iter().flat_map(Match::pairs));
-    let (mut pairs, mut correct) = (0, 0);
-    for (query, past) in here.iter().filter(|&(q, p)| !except.contains(q, p)) {
-        if let (Some(q), Some(pa)) = (truth_of(query), truth_of(past)) {
-            pairs += 1;
-            correct += usize::from(q.0.distance(&pa.0) <= radius_m);
-        }
-    }
-    (pairs, correct)
+/// The distinct pairs of `here`'s matches that `fewer`'s do not hold (same observations), as
+/// [`scored_pairs`] counts them (pairs without truth left out): `(pairs, correct at
+/// radius_m)`, by [`super::tally::gain`]'s rule. Held as packed sets, so a long run's millions
+/// of pairs cost 8 bytes each.
+pub fn pairs_not_in(here: &Recognition, fewer: &Recognition, radius_m: f64) -> (usize, usize) {
+    let truth_of = truth_lookup(here);
+    let index_of: HashMap<ObsId, usize> = here
+        .observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect();
+    let resolved = |rec: &Recognition| {
+        let set = PairSet::from_pairs(rec.matches.iter().flat_map(Match::pairs).filter_map(
+            |(q, p)| {
+                truth_of(q)?;
+                truth_of(p)?;
+                Some((*index_of.get(&q)?, *index_of.get(&p)?))
+            },
+        ));
+        set.iter().map(|(q, p)| pack(q, p)).collect::<Vec<u64>>()
+    };
+    let (h, f) = (resolved(here), resolved(fewer));
+    let pose = |i: usize| truth_of(here.observations[i].id).expect("resolved pairs have truth");
+    super::tally::gain(&h, &f, |q, p| pose(q).0.distance(&pose(p).0) <= radius_m)
 }
 
 /// The true pose of an observation of `rec` by id (`None` for an id it does not hold or a
@@ -238,11 +245,14 @@ fn truth_lookup(rec: &Recognition) -> impl Fn(ObsId) -> Option<crate::geom::True
 }
 
 /// Observations joined with their truth (shared by the scorers of every facing).
-struct Joined {
+#[derive(Clone, Debug, Default)]
+pub(super) struct Joined {
     /// Observation id → position in the observations.
     index_of: HashMap<ObsId, usize>,
     /// Per observation (creation order): its site, or [`NO_SITE`] when its frame has no truth.
     site_of: Vec<u32>,
+    /// Per observation: the input frame that made it.
+    frame_of: Vec<usize>,
     /// The observations with truth, in creation order.
     sites: Vec<Site>,
     /// Per site: its door configuration index.
@@ -254,8 +264,8 @@ struct Joined {
 /// Marks an observation without truth in `Joined::site_of`.
 const NO_SITE: u32 = u32::MAX;
 
-/// Observations joined with their truth, reusable across radii. It counts the revisits and
-/// matches of one facing ([`Facing::Either`] unless [`Scorer::with_facing`] says otherwise).
+/// Observations joined with their truth, reusable across radii. It counts the revisits of one
+/// facing ([`Facing::Either`] unless [`Scorer::with_facing`] says otherwise).
 #[derive(Clone)]
 pub struct Scorer {
     joined: Arc<Joined>,
@@ -267,42 +277,38 @@ pub struct Scorer {
 }
 
 impl Joined {
-    /// `observations` with their true poses (`lap_config`: door configuration of each lap).
-    fn new(observations: &[Observation], truth: &GroundTruth, lap_config: &[u32]) -> Self {
-        let travel = super::pair_recall::true_travel_m(truth);
-        let mut j = Joined {
-            index_of: observations
-                .iter()
-                .enumerate()
-                .map(|(i, o)| (o.id, i))
-                .collect(),
-            site_of: Vec::with_capacity(observations.len()),
-            sites: Vec::new(),
-            site_config: Vec::new(),
-            site_obs: Vec::new(),
+    /// Appends observation `o`, at position `i`, with its true pose (`travel`: true travel per
+    /// frame; `lap_config`: door configuration of each lap).
+    fn push(
+        &mut self,
+        i: usize,
+        o: &Observation,
+        truth: &GroundTruth,
+        travel: &[f64],
+        lap_config: &[u32],
+    ) {
+        self.index_of.insert(o.id, i);
+        self.frame_of.push(o.frame_id);
+        let pose = truth.observation_pose(o);
+        let Some((f, pose)) = truth.frame(o.frame_id).zip(pose) else {
+            self.site_of.push(NO_SITE);
+            return;
         };
-        for (i, o) in observations.iter().enumerate() {
-            let pose = truth.observation_pose(o);
-            let Some((f, pose)) = truth.frame(o.frame_id).zip(pose) else {
-                j.site_of.push(NO_SITE);
-                continue;
-            };
-            j.site_of.push(j.sites.len() as u32);
-            j.sites.push(Site {
-                x: pose.0.x,
-                y: pose.0.y,
-                theta: pose.0.theta,
-                travel_m: travel[o.frame_id],
-                lap: f.lap_slot,
-            });
-            j.site_config.push(lap_config[f.lap_slot]);
-            j.site_obs.push(i as u32);
-        }
-        j
+        self.site_of.push(self.sites.len() as u32);
+        self.sites.push(Site {
+            x: pose.0.x,
+            y: pose.0.y,
+            theta: pose.0.theta,
+            travel_m: travel[o.frame_id],
+            lap: f.lap_slot,
+        });
+        self.site_config.push(lap_config[f.lap_slot]);
+        self.site_obs.push(i as u32);
     }
 }
 
 impl Scorer {
+    /// `observations` joined with `truth`, counted with `spec`'s rules.
     pub fn new(observations: &[Observation], truth: &GroundTruth, spec: &EvaluationSpec) -> Self {
         let configs = truth.door_configs();
         let config_index: HashMap<&str, usize> = configs
@@ -319,13 +325,90 @@ impl Scorer {
             .iter()
             .map(|l| config_index[l.door_config.as_str()] as u32)
             .collect();
+        let travel = super::pair_recall::true_travel_m(truth);
+        let mut joined = Joined::default();
+        for (i, o) in observations.iter().enumerate() {
+            joined.push(i, o, truth, &travel, &lap_config);
+        }
         Scorer {
-            joined: Arc::new(Joined::new(observations, truth, &lap_config)),
+            joined: Arc::new(joined),
             configs,
             config_laps,
+            ..Scorer::empty(spec)
+        }
+    }
+
+    /// No observation yet (grown by `eval::tally`).
+    pub(super) fn empty(spec: &EvaluationSpec) -> Self {
+        Scorer {
+            joined: Arc::new(Joined::default()),
+            configs: Vec::new(),
+            config_laps: Vec::new(),
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
             facing: Facing::Either,
+        }
+    }
+
+    /// Counts a lap driven in door configuration `c` (a new one is named `name`).
+    pub(super) fn add_lap(&mut self, c: usize, name: &str) {
+        if c == self.configs.len() {
+            self.configs.push(name.to_string());
+            self.config_laps.push(0);
+        }
+        self.config_laps[c] += 1;
+    }
+
+    /// Appends an observation (see `Joined::push`); the scorer must not be shared.
+    pub(super) fn push_observation(
+        &mut self,
+        i: usize,
+        o: &Observation,
+        truth: &GroundTruth,
+        travel: &[f64],
+        lap_config: &[u32],
+    ) {
+        Arc::get_mut(&mut self.joined)
+            .expect("a growing scorer is not shared")
+            .push(i, o, truth, travel, lap_config);
+    }
+
+    /// Observations joined (with or without truth).
+    pub(super) fn observation_count(&self) -> usize {
+        self.joined.site_of.len()
+    }
+
+    /// Door configurations seen.
+    pub(super) fn config_count(&self) -> usize {
+        self.configs.len()
+    }
+
+    pub(super) fn heading_tol_rad(&self) -> f64 {
+        self.heading_tol_rad
+    }
+
+    pub(super) fn facing(&self) -> Facing {
+        self.facing
+    }
+
+    /// The input frame of observation `i`.
+    pub(super) fn frame_of(&self, i: usize) -> usize {
+        self.joined.frame_of[i]
+    }
+
+    /// The positions and sites of the observations a pair of ids names, when both are known
+    /// and have truth.
+    pub(super) fn resolve(&self, query: ObsId, past: ObsId) -> Option<(usize, usize, Site, Site)> {
+        let index_of = &self.joined.index_of;
+        let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
+        Some((qi, pi, *self.site(qi)?, *self.site(pi)?))
+    }
+
+    /// Whether observations `q` and `p` (positions, both with truth) are within `r`.
+    pub(super) fn within(&self, q: usize, p: usize, r: f64) -> bool {
+        match (self.site(q), self.site(p)) {
+            (Some(a), Some(b)) => ((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt() <= r,
+            _ => false,
         }
     }
 
@@ -336,7 +419,7 @@ impl Scorer {
     }
 
     /// The door configuration of observation `i`, which has truth.
-    fn config(&self, i: usize) -> usize {
+    pub(super) fn config(&self, i: usize) -> usize {
         self.joined.site_config[self.joined.site_of[i] as usize] as usize
     }
 
@@ -345,8 +428,7 @@ impl Scorer {
         self.joined.site_of.len()
     }
 
-    /// The same scorer counting only revisits facing as `facing` says and matches of that
-    /// direction.
+    /// The same scorer counting only revisits facing as `facing` says.
     pub fn with_facing(&self, facing: Facing) -> Self {
         Scorer {
             facing,
@@ -377,140 +459,34 @@ impl Scorer {
         }
     }
 
-    /// The visit recall of `matches` at radius `r` (see [`Metrics::visit_recall`]): earlier laps
-    /// an observation was correctly paired with ÷ earlier laps that revisit it.
-    pub fn visit_recall(&self, matches: &[Match], r: f64) -> f64 {
-        if r <= 0.0 || !r.is_finite() {
-            return 0.0;
-        }
-        let r2 = r * r;
-        // (query observation, lap) for each lap a query observation was correctly paired with.
-        let counted = matches.iter().filter(|m| self.facing.counts(m.direction));
-        let matched = PairSet::from_pairs(
-            counted
-                .flat_map(|m| m.pairs().map(move |p| (p, Facing::of(m.direction))))
-                .filter_map(|((query, past), claim)| {
-                    let index_of = &self.joined.index_of;
-                    let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
-                    let (q, pa) = (self.site(qi)?, self.site(pi)?);
-                    ((q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                        && claim.agrees(q.theta, pa.theta, self.heading_tol_rad))
-                    .then_some((qi, pa.lap))
-                }),
-        );
-        let (mut visits, mut found) = (0usize, 0usize);
-        let mut laps = LapSet::default();
+    /// Calls `visit(i, laps)` for every observation `i` with truth, in order, with the earlier
+    /// laps that revisit it at radius `r` (facing as this scorer counts).
+    pub(super) fn sweep_laps(
+        &self,
+        r: f64,
+        laps: &mut LapSet,
+        mut visit: impl FnMut(usize, &[usize]),
+    ) {
         let j = &self.joined;
         sweep(&j.sites, self.min_gap_m, |k, tree| {
             laps.clear();
-            tree.laps(&self.query(k, r), &mut laps);
-            let i = j.site_obs[k] as usize;
-            visits += laps.list.len();
-            found += laps
-                .list
-                .iter()
-                .filter(|&&l| matched.contains(i, l))
-                .count();
+            tree.laps(&self.query(k, r), laps);
+            visit(j.site_obs[k] as usize, &laps.list);
         });
-        ratio(found, visits)
     }
 
-    /// Scores `matches` at radius `r`; with `breakdown`, also per door configuration.
-    pub fn score(
-        &self,
-        matches: &[Match],
-        r: f64,
-        breakdown: bool,
-    ) -> (Metrics, Vec<DoorConfigMetrics>) {
-        self.score_with_revisits(matches, r, breakdown, &self.revisits(r))
-    }
-
-    /// [`Scorer::score`] with the revisits at `r` already computed (see [`Scorer::revisits`]);
-    /// saves the revisit search when many match sets are scored on the same observations.
-    pub fn score_with_revisits(
-        &self,
-        matches: &[Match],
-        r: f64,
-        breakdown: bool,
-        revisits: &[bool],
-    ) -> (Metrics, Vec<DoorConfigMetrics>) {
-        assert_eq!(revisits.len(), self.len(), "revisits of other observations");
-        let n_cfg = self.configs.len();
-        let mut total = Counts::default();
-        let mut per_cfg = vec![Counts::default(); if breakdown { n_cfg } else { 0 }];
-        let mut recalled_query = vec![false; self.len()];
-        let mut recalled_any = vec![false; self.len()];
-        let index_of = &self.joined.index_of;
-        // Packed (query, past) ids (super::pair_set::pack): half the memory of id tuples.
-        let mut seen: HashSet<u64> = HashSet::new();
-        let mut in_match: HashSet<(ObsId, ObsId)> = HashSet::new();
-        let r2 = r * r;
-        for m in matches.iter().filter(|m| self.facing.counts(m.direction)) {
-            let claim = Facing::of(m.direction);
-            in_match.clear();
-            let (mut n, mut ok) = (0usize, 0usize);
-            let mut match_cfg = None;
-            for (query, past) in m.pairs() {
-                let (Some(&qi), Some(&pi)) = (index_of.get(&query), index_of.get(&past)) else {
-                    if seen.insert(pack(query, past)) {
-                        total.unresolved += 1;
-                    }
-                    continue;
-                };
-                let (Some(q), Some(pa)) = (self.site(qi), self.site(pi)) else {
-                    if seen.insert(pack(query, past)) {
-                        total.unresolved += 1;
-                    }
-                    continue;
-                };
-                let correct = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2) <= r2
-                    && claim.agrees(q.theta, pa.theta, self.heading_tol_rad);
-                if in_match.insert((query, past)) {
-                    n += 1;
-                    ok += correct as usize;
-                    match_cfg.get_or_insert(self.config(qi));
-                }
-                if seen.insert(pack(query, past)) {
-                    total.pairs += 1;
-                    total.correct += correct as usize;
-                    if breakdown {
-                        per_cfg[self.config(qi)].pairs += 1;
-                        per_cfg[self.config(qi)].correct += correct as usize;
-                    }
-                    if correct {
-                        recalled_query[qi] = true;
-                        recalled_any[qi] = true;
-                        recalled_any[pi] = true;
-                    }
-                }
-            }
-            if n > 0 {
-                let good = 2 * ok > n;
-                total.matches += 1;
-                total.correct_matches += good as usize;
-                if let (true, Some(c)) = (breakdown, match_cfg) {
-                    per_cfg[c].matches += 1;
-                    per_cfg[c].correct_matches += good as usize;
-                }
-            }
-        }
+    /// Calls `f(i, config)` for every observation `i` with truth, in order, with its door
+    /// configuration.
+    pub(super) fn each_site(&self, mut f: impl FnMut(usize, usize)) {
         let j = &self.joined;
         for (&i, &config) in j.site_obs.iter().zip(&j.site_config) {
-            let i = i as usize;
-            if !revisits[i] {
-                continue;
-            }
-            total.revisits += 1;
-            total.recalled += recalled_query[i] as usize;
-            total.recalled_any += recalled_any[i] as usize;
-            if breakdown {
-                let c = &mut per_cfg[config as usize];
-                c.revisits += 1;
-                c.recalled += recalled_query[i] as usize;
-                c.recalled_any += recalled_any[i] as usize;
-            }
+            f(i as usize, config as usize);
         }
-        let configs = per_cfg
+    }
+
+    /// `per_cfg` (indexed as the configurations) as named figures at radius `r`.
+    pub(super) fn config_metrics(&self, per_cfg: &[Counts], r: f64) -> Vec<DoorConfigMetrics> {
+        per_cfg
             .iter()
             .enumerate()
             .map(|(i, c)| DoorConfigMetrics {
@@ -518,21 +494,21 @@ impl Scorer {
                 laps: self.config_laps[i],
                 metrics: c.metrics(r),
             })
-            .collect();
-        (total.metrics(r), configs)
+            .collect()
     }
 }
 
+/// What the figures of one facing at one radius count (`eval::tally`).
 #[derive(Clone, Debug, Default)]
-struct Counts {
-    pairs: usize,
-    correct: usize,
-    matches: usize,
-    correct_matches: usize,
-    revisits: usize,
-    recalled: usize,
-    recalled_any: usize,
-    unresolved: usize,
+pub(super) struct Counts {
+    pub(super) pairs: usize,
+    pub(super) correct: usize,
+    pub(super) matches: usize,
+    pub(super) correct_matches: usize,
+    pub(super) revisits: usize,
+    pub(super) recalled: usize,
+    pub(super) recalled_any: usize,
+    pub(super) unresolved: usize,
 }
 
 /// `num / den`, 0 when `den` is 0.
@@ -545,7 +521,7 @@ pub fn ratio(num: usize, den: usize) -> f64 {
 }
 
 impl Counts {
-    fn metrics(&self, r: f64) -> Metrics {
+    pub(super) fn metrics(&self, r: f64) -> Metrics {
         Metrics {
             radius_m: r,
             pairs: self.pairs,
@@ -562,6 +538,7 @@ impl Counts {
             visit_recall: 0.0,
             pair_recall: 0.0,
             unresolved_pairs: self.unresolved,
+            late_pairs: 0,
         }
     }
 }
@@ -681,11 +658,20 @@ pub(crate) mod tests {
     fn visit_recall_counts_every_earlier_lap() {
         let (obs, gt) = circle(4, 40.0);
         let spec = EvaluationSpec::default();
-        let scorer = Scorer::new(&obs, &gt, &spec);
+        let visit_recall = |matches: &[Match]| {
+            let spec = EvaluationSpec {
+                tp_radius_m: 1.0,
+                ..spec.clone()
+            };
+            let mut t = Tally::new(&spec, Scope::Full);
+            t.sync(&obs, &gt);
+            matches.iter().for_each(|m| t.add(m, &gt));
+            t.finish(&obs, &gt).main.visit_recall
+        };
         let nearest = vec![one_match(oracle(&obs, &gt, &spec))];
-        let m = scorer.score(&nearest, 1.0, false).0;
+        let m = score(&obs, &nearest, &gt, &spec, 1.0);
         assert_eq!(m.recall, 1.0);
-        let one_lap = scorer.visit_recall(&nearest, 1.0);
+        let one_lap = visit_recall(&nearest);
         assert!(
             one_lap > 0.4 && one_lap < 0.8,
             "nearest lap only: {one_lap}"
@@ -696,9 +682,9 @@ pub(crate) mod tests {
             .flat_map(|q| (1..=q / per_lap).map(move |k| (q, q - k * per_lap)))
             .map(|(q, p)| pair(&obs, q, p))
             .collect();
-        let every = scorer.visit_recall(&[one_match(all)], 1.0);
+        let every = visit_recall(&[one_match(all)]);
         assert!(every > 0.97, "every earlier lap: {every}");
-        assert_eq!(scorer.visit_recall(&[], 1.0), 0.0);
+        assert_eq!(visit_recall(&[]), 0.0);
     }
 
     #[test]
@@ -757,6 +743,8 @@ pub(crate) mod tests {
                 truth: gt.clone(),
                 diagnostics: None,
                 lap_seconds: Vec::new(),
+                evaluation: None,
+                level_gain: None,
             };
             evaluate(&rec, &EvaluationSpec::default())
         };
@@ -814,6 +802,8 @@ pub(crate) mod tests {
             truth: gt,
             diagnostics: None,
             lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -861,6 +851,8 @@ pub(crate) mod tests {
             truth: gt,
             diagnostics: None,
             lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);

@@ -3,7 +3,11 @@
 //! The flow is: [`recognize_runs`] feeds the frames of simulated (or logged) runs to a
 //! [`PlaceRecognizer`] in order, keeping the ground truth of every frame to itself
 //! ([`GroundTruth`]); [`metrics::evaluate`] turns the recognizer's matches into observation pairs
-//! and scores them (DESIGN.md §6); [`sweep`] repeats this over a grid of thresholds;
+//! and scores them (DESIGN.md §6) through a [`tally::Tally`], which counts each match as it
+//! arrives: a [`Recording::streaming`] feeds it while the recognizer runs and keeps no match,
+//! forgetting the pairs behind the recognizer's query horizon, so a thousand-lap run is scored
+//! in memory that grows with its observations, not its pairs; [`sweep`] repeats this over a
+//! grid of thresholds;
 //! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
 //! [`gate`] compares a report with a scenario's `[expect]` block.
 
@@ -16,13 +20,16 @@ pub mod scores;
 pub mod site_tree;
 pub mod suite;
 pub mod sweep;
+pub mod tally;
 
 use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::recognizer::{Match, MatchDiagnostics, Observation};
+use crate::spec::evaluation::EvaluationSpec;
 use std::time::Instant;
+use tally::{Scope, Tally};
 
-pub use metrics::{Metrics, evaluate};
+pub use metrics::{Evaluation, Metrics, evaluate};
 
 /// The interface a recognizer implements to be scored lives below `eval` and `baseline` in
 /// [`crate::place`]; re-exported here for the evaluation's users.
@@ -167,6 +174,12 @@ pub struct Recognition {
     /// thread that fed them (so a loaded machine does not blur how the work grows with history),
     /// wall clock where the thread's CPU time cannot be read; empty when not recorded.
     pub lap_seconds: Vec<f64>,
+    /// The evaluation, with the rules it was made with, when the matches were scored as they
+    /// arrived ([`Recording::streaming`]; `matches` is then empty).
+    pub evaluation: Option<(EvaluationSpec, Evaluation)>,
+    /// `(pairs, correct pairs)` this recognition found that the level configuration with one
+    /// level fewer did not, when counted as the matches arrived (`Report::set_level_gains`).
+    pub level_gain: Option<(usize, usize)>,
 }
 
 impl Recognition {
@@ -213,8 +226,9 @@ fn thread_cpu_s() -> Option<f64> {
 
 /// A recognition in progress, fed lap by lap or frames at a time (so a caller need not hold
 /// every lap's scans): the truth of the frames fed, the matches so far and the recognizer's
-/// time, in total and per lap.
-#[derive(Debug, Default)]
+/// time, in total and per lap. [`Recording::streaming`] scores the matches as they arrive
+/// instead of keeping them ([`tally`]).
+#[derive(Default)]
 pub struct Recording {
     truth: GroundTruth,
     matches: Vec<Match>,
@@ -223,14 +237,43 @@ pub struct Recording {
     lap_seconds: Vec<f64>,
     /// Seconds of the lap being fed so far (thread CPU where it can be read).
     lap_so_far: f64,
+    /// Scores the matches as they arrive, when streaming.
+    tally: Option<(EvaluationSpec, Tally)>,
+    level_gain: Option<(usize, usize)>,
+    closed: bool,
 }
 
 impl Recording {
+    /// A recording that scores each match with `spec` as it arrives and keeps none: memory
+    /// grows with the observations, not with the pairs (`Recognition::matches` stays empty).
+    pub fn streaming(spec: &EvaluationSpec) -> Self {
+        Recording {
+            tally: Some((spec.clone(), Tally::new(spec, Scope::Full))),
+            ..Recording::default()
+        }
+    }
+
+    /// Keeps (or scores) matches `found`, after the frames and observations they name.
+    fn take(&mut self, rec: &dyn PlaceRecognizer, found: Vec<Match>) {
+        match &mut self.tally {
+            Some((_, tally)) => {
+                if !found.is_empty() {
+                    tally.sync(rec.observations(), &self.truth);
+                    for m in &found {
+                        tally.add(m, &self.truth);
+                    }
+                }
+            }
+            None => self.matches.extend(found),
+        }
+    }
+
     /// Starts a run (call before each run's first lap, the first run included).
     pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer) {
         let t = Instant::now();
-        self.matches.extend(rec.start_run());
+        let found = rec.start_run();
         self.seconds += t.elapsed().as_secs_f64();
+        self.take(rec, found);
     }
 
     /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
@@ -253,10 +296,10 @@ impl Recording {
         for f in frames {
             self.truth.push_frame(f.truth, f.odom);
         }
+        let mut found = Vec::new();
         let (t, cpu) = (Instant::now(), thread_cpu_s());
         for (i, frame) in frames.iter().enumerate() {
-            self.matches
-                .extend(rec.push(first_id + i, frame.odom, &frame.scan));
+            found.extend(rec.push(first_id + i, frame.odom, &frame.scan));
         }
         let s = t.elapsed().as_secs_f64();
         self.seconds += s;
@@ -264,6 +307,8 @@ impl Recording {
             (Some(a), Some(b)) => b - a,
             _ => s,
         };
+        // Scored outside the timing: the recognizer's time is its own.
+        self.take(rec, found);
     }
 
     /// Ends the lap started.
@@ -277,20 +322,81 @@ impl Recording {
         self.laps
     }
 
-    /// Ends the input and hands over the recognition.
-    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer) -> Recognition {
+    /// When streaming: forgets the pairs whose query lies before observation `horizon` (no
+    /// later match of the recognizer names one, `PlaceRecognizer::query_horizon`).
+    pub fn forget_behind(&mut self, horizon: usize) {
+        if let Some((_, tally)) = &mut self.tally {
+            tally.evict_below(horizon);
+        }
+    }
+
+    /// When streaming: the distinct pairs held to deduplicate, and those that arrived behind
+    /// the horizon (0 for a recognizer that keeps its promise).
+    pub fn pairs_held(&self) -> Option<(usize, usize)> {
+        self.tally
+            .as_ref()
+            .map(|(_, t)| (t.pairs_held(), t.late_pairs()))
+    }
+
+    /// When streaming: keep the distinct pairs forgotten, to compare level configurations
+    /// ([`Self::take_forgotten`]).
+    pub fn keep_forgotten(&mut self) {
+        if let Some((_, tally)) = &mut self.tally {
+            tally.keep_forgotten();
+        }
+    }
+
+    /// The distinct pairs forgotten since the last call (see [`tally::Tally::take_forgotten`]).
+    pub fn take_forgotten(&mut self) -> Vec<u64> {
+        self.tally
+            .as_mut()
+            .map(|(_, t)| t.take_forgotten())
+            .unwrap_or_default()
+    }
+
+    /// Adds to the level gain: of `here` (this recording's forgotten pairs), those `fewer` (the
+    /// configuration with a level fewer) does not hold ([`tally::gain`]).
+    pub fn add_level_gain(&mut self, here: &[u64], fewer: &[u64]) {
+        let Some((_, tally)) = &self.tally else {
+            return;
+        };
+        let (p, c) = tally::gain(here, fewer, |q, p| tally.within_radius(q, p));
+        let g = self.level_gain.get_or_insert((0, 0));
+        g.0 += p;
+        g.1 += c;
+    }
+
+    /// Ends the input: adds the matches closing the last run produced (once).
+    pub fn close(&mut self, rec: &mut dyn PlaceRecognizer) {
+        if self.closed {
+            return;
+        }
+        self.closed = true;
         let t = Instant::now();
-        self.matches.extend(rec.finish());
+        let found = rec.finish();
         self.seconds += t.elapsed().as_secs_f64();
+        self.take(rec, found);
+    }
+
+    /// Ends the input and hands over the recognition (scored, when streaming).
+    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer) -> Recognition {
+        self.close(rec);
+        let observations = rec.observations().to_vec();
+        let evaluation = self.tally.take().map(|(spec, tally)| {
+            let e = tally.finish(&observations, &self.truth);
+            (spec, e)
+        });
         Recognition {
             name: rec.name(),
-            observations: rec.observations().to_vec(),
+            observations,
             matches: self.matches,
             seconds: self.seconds,
             laps: self.laps,
             truth: self.truth,
             diagnostics: rec.diagnostics(),
             lap_seconds: self.lap_seconds,
+            evaluation,
+            level_gain: self.level_gain,
         }
     }
 }

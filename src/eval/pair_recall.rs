@@ -164,7 +164,13 @@ pub fn pair_recall(
 /// Every (observation, earlier observation) pair at least `min_gap_m` of travel apart, within
 /// `r` and facing as `facing` says, counted in a k-d tree of the earlier sites
 /// ([`super::site_tree`]).
-fn count_possible(sites: &[Site], min_gap_m: f64, r: f64, facing: Facing, tol_rad: f64) -> u64 {
+pub(super) fn count_possible(
+    sites: &[Site],
+    min_gap_m: f64,
+    r: f64,
+    facing: Facing,
+    tol_rad: f64,
+) -> u64 {
     let mut n = 0u64;
     sweep(sites, min_gap_m, |k, tree| {
         let q = Query {

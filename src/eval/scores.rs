@@ -30,9 +30,8 @@
 
 use super::Recognition;
 use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
-use super::pair_set::PairSet;
 use super::sweep::{PrCurve, SweepResult};
-use crate::recognizer::{Match, MatchDiagnostics};
+use crate::recognizer::MatchDiagnostics;
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 
@@ -321,10 +320,13 @@ impl Report {
             let (Some(here), Some(fewer)) = (rec_of(lr.levels), rec_of(below)) else {
                 continue;
             };
-            // Packed sets, not a map of every pair: a long run holds millions. A pair without
-            // truth there has none here either (same observations), so it is left out of both.
-            let fewer = PairSet::from_pairs(fewer.matches.iter().flat_map(Match::pairs));
-            let (pairs, correct_pairs) = pairs_not_in(here, &fewer, radius_m);
+            // Counted as the matches arrived when they were scored so (the two configurations
+            // compared as they forgot their pairs, `experiment::stream`); from the matches
+            // otherwise.
+            let (pairs, correct_pairs) = match here.level_gain {
+                Some(gain) => gain,
+                None => pairs_not_in(here, fewer, radius_m),
+            };
             lr.only_here = Some(LevelGain {
                 than_levels: below,
                 pairs,

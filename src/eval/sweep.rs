@@ -11,6 +11,7 @@
 //! recognizer can do it.
 
 use super::metrics::{Metrics, Scorer, f1};
+use super::tally::{Scope, Tally};
 use super::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs};
 use crate::log::RunLog;
 use crate::recognizer::{Match, Observation};
@@ -73,8 +74,13 @@ where
         .map(|p| {
             let mut rec = make(p);
             let r: Recognition = recognize_runs(rec.as_mut(), runs);
-            let scorer = Scorer::new(&r.observations, &r.truth, spec);
-            let metrics = scorer.score(&r.matches, spec.tp_radius_m, false).0;
+            let metrics = super::metrics::score(
+                &r.observations,
+                &r.matches,
+                &r.truth,
+                spec,
+                spec.tp_radius_m,
+            );
             on_done();
             SweepResult {
                 point: p.clone(),
@@ -103,9 +109,11 @@ where
     grid.par_iter()
         .map(|p| {
             let matches = matches_of(p);
-            let metrics = scorer
-                .score_with_revisits(&matches, spec.tp_radius_m, false, &revisits)
-                .0;
+            let mut tally = Tally::over(&scorer, spec, Scope::Main);
+            for m in &matches {
+                tally.add(m, truth);
+            }
+            let metrics = tally.finish_main(Some(&revisits));
             on_done();
             SweepResult {
                 point: p.clone(),

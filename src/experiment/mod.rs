@@ -112,6 +112,9 @@ impl PlaceRecognizer for Recognizer {
     fn observations(&self) -> &[Observation] {
         Recognizer::observations(self)
     }
+    fn query_horizon(&self) -> usize {
+        Recognizer::query_horizon(self)
+    }
     fn name(&self) -> String {
         let c = self.config();
         format!("levels={} {:?}", c.levels, thresholds(c))

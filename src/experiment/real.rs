@@ -7,7 +7,7 @@
 //! recognizers a chunk at a time and only their truth is kept, so a log of any size fits in the
 //! memory of the recognizers' own state.
 
-use super::stream::{Job, finish_jobs, jobs};
+use super::stream::{Job, finish_jobs, jobs, settle};
 use super::{Experiment, ExperimentError, ExperimentOptions, assemble, level_configs};
 use crate::eval::LapInfo;
 use crate::geom::{Pose2, wrap_angle};
@@ -198,7 +198,7 @@ pub fn recognize_log_streamed(
     opts: &ExperimentOptions,
 ) -> Result<(Experiment, usize), ExperimentError> {
     let configs = level_configs(base, &opts.levels)?;
-    let mut jobs = jobs(&configs, evaluation.min_gap_m, opts.icp)?;
+    let mut jobs = jobs(&configs, evaluation, opts.icp)?;
     let read = ReadOptions {
         lenient: log.lenient,
     };
@@ -266,6 +266,7 @@ fn feed_chunks(jobs: &mut [Job], rx: Receiver<Vec<Frame>>, progress: &super::Pro
         jobs.par_iter_mut().for_each(|(_, rec, recording)| {
             recording.frames(rec.as_mut(), &chunk);
         });
+        settle(jobs, false);
         progress.step();
     }
     for (_, _, recording) in jobs.iter_mut() {

@@ -291,6 +291,8 @@ impl LoggedRuns {
             truth: self.truth.clone(),
             diagnostics: None,
             lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
         })
     }
 }

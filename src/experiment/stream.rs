@@ -1,7 +1,10 @@
 //! A scenario run lap by lap: each lap is simulated on one thread and fed to every recognizer
 //! on another as soon as it is made, then dropped. Memory holds at most a few laps of scans
 //! (not every run's), plus the truth of every frame and the recognizers' own state, so a run of
-//! a thousand laps fits where holding its scans would not.
+//! a thousand laps fits where holding its scans would not. Matches are scored as they arrive
+//! ([`crate::eval::Recording::streaming`], `eval::tally`) and dropped: after each lap every job
+//! forgets the pairs behind the recognizers' query horizon ([`settle`]), so neither the matches
+//! nor their pairs are held.
 //!
 //! The report is the one [`super::run_scenario`] gives: the simulator draws each lap from its
 //! run's seeded streams whatever else runs, and each recognizer sees the same frames in the same
@@ -16,6 +19,7 @@ use crate::log::LapLog;
 use crate::recognizer::{Recognizer, RecognizerConfig};
 use crate::sim::runner::RunSim;
 use crate::sim::{SimError, SimPlan};
+use crate::spec::evaluation::EvaluationSpec;
 use rayon::prelude::*;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Instant;
@@ -34,7 +38,7 @@ pub fn run_scenario_streamed(
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
-    let mut jobs = jobs(&configs, scn.evaluation.min_gap_m, opts.icp)?;
+    let mut jobs = jobs(&configs, &scn.evaluation, opts.icp)?;
     let plan = &scn.sim;
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
@@ -99,26 +103,80 @@ fn simulate_laps(
 }
 
 /// One job per level configuration, in order, then ICP's if asked (with the evaluation's
-/// `min_gap_m`).
+/// `min_gap_m`). Each scores its matches as they arrive ([`Recording::streaming`]); a
+/// configuration with one level fewer than another keeps what it forgets, to count the other's
+/// gain ([`settle`]).
 pub(super) fn jobs(
     configs: &[RecognizerConfig],
-    min_gap_m: f64,
+    evaluation: &EvaluationSpec,
     icp: bool,
 ) -> Result<Vec<Job>, ExperimentError> {
     let mut jobs: Vec<Job> = Vec::new();
     for cfg in configs {
         let rec =
             Recognizer::new(cfg.clone()).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
-        jobs.push((Some(cfg.levels), Box::new(rec), Recording::default()));
+        jobs.push((
+            Some(cfg.levels),
+            Box::new(rec),
+            Recording::streaming(evaluation),
+        ));
+    }
+    for (here, fewer) in gain_pairs(&jobs) {
+        jobs[here].2.keep_forgotten();
+        jobs[fewer].2.keep_forgotten();
     }
     if icp {
         let icp = IcpRecognizer::new(IcpConfig {
-            min_gap_m,
+            min_gap_m: evaluation.min_gap_m,
             ..IcpConfig::default()
         });
-        jobs.push((None, Box::new(icp), Recording::default()));
+        jobs.push((None, Box::new(icp), Recording::streaming(evaluation)));
     }
     Ok(jobs)
+}
+
+/// `(job, job with one level fewer)` for every level configuration whose gain is reported.
+fn gain_pairs(jobs: &[Job]) -> Vec<(usize, usize)> {
+    let levels: Vec<Option<usize>> = jobs.iter().map(|j| j.0).collect();
+    let mut out = Vec::new();
+    for (i, l) in levels.iter().enumerate() {
+        let Some(l) = l else { continue };
+        if let Some(k) = levels.iter().position(|&m| m == Some(l.saturating_sub(1))) {
+            out.push((i, k));
+        }
+    }
+    out
+}
+
+/// Lets every job forget the pairs behind the recognizers' query horizons, and counts the level
+/// gains of what they forgot (`last`: the input has ended; everything goes). The level
+/// configurations forget behind one common horizon, the earliest of theirs, so the pairs each
+/// forgets are those the one with a level fewer forgets at the same time; ICP behind its own.
+pub(super) fn settle(jobs: &mut [Job], last: bool) {
+    let common = jobs
+        .iter()
+        .filter(|j| j.0.is_some())
+        .map(|j| j.1.query_horizon())
+        .min()
+        .unwrap_or(0);
+    for (levels, rec, recording) in jobs.iter_mut() {
+        let h = match (last, levels.is_some()) {
+            (true, _) => usize::MAX,
+            (false, true) => common,
+            (false, false) => rec.query_horizon(),
+        };
+        recording.forget_behind(h);
+    }
+    let pairs = gain_pairs(jobs);
+    if pairs.is_empty() {
+        return;
+    }
+    let forgotten: Vec<Vec<u64>> = jobs.iter_mut().map(|j| j.2.take_forgotten()).collect();
+    for (here, fewer) in pairs {
+        jobs[here]
+            .2
+            .add_level_gain(&forgotten[here], &forgotten[fewer]);
+    }
 }
 
 /// Feeds each lap from `rx` to every job (the jobs in parallel), starting a run at each new
@@ -135,14 +193,20 @@ fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink
             }
             recording.lap(rec.as_mut(), run, &lap);
         });
+        settle(jobs, false);
         progress.step();
         let done = jobs.first().map_or(0, |j| j.2.laps());
         progress.status(&progress_message(done, start.elapsed().as_secs_f64()));
     }
 }
 
-/// Hands every job's recording and recognizer over as the scored recognition.
-pub(super) fn finish_jobs(jobs: Vec<Job>) -> Vec<(Option<usize>, Recognition)> {
+/// Ends every job's input and hands its recording and recognizer over as the scored
+/// recognition.
+pub(super) fn finish_jobs(mut jobs: Vec<Job>) -> Vec<(Option<usize>, Recognition)> {
+    for (_, rec, recording) in &mut jobs {
+        recording.close(rec.as_mut());
+    }
+    settle(&mut jobs, true);
     jobs.into_iter()
         .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
         .collect()
@@ -171,4 +235,64 @@ pub fn resident_memory_mb() -> Option<(f64, f64)> {
             .ok()
     };
     Some((kb("VmRSS:")? / 1024.0, kb("VmHWM:")? / 1024.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiment::load_scenario;
+    use std::path::Path;
+
+    /// Scoring as matches arrive keeps only the pairs a later match could repeat (those with
+    /// a query in the last τ·(span + 1) level-0 words, several laps of the small loop): over the
+    /// smoke scenario driven for 30 + 10 laps, each place matched to its 8 most recent
+    /// look-alikes as the long-term scenario does (so the pairs each lap adds stop growing too),
+    /// what each configuration holds stops growing with the laps while the pairs it scored do
+    /// not, none arrived behind the horizon, and the 3-level configuration's gain over the
+    /// 2-level one is counted.
+    #[test]
+    fn streamed_scoring_forgets_the_pairs_behind_the_horizon() {
+        let scn = load_scenario(Path::new("scenarios/smoke.toml")).expect("smoke loads");
+        let mut base = recognizer_config(&scn).unwrap();
+        base.max_candidates = 8;
+        let configs = level_configs(&base, &[2, 3]).unwrap();
+        let mut jobs = jobs(&configs, &scn.evaluation, false).unwrap();
+        let laps_of = |run: usize| [30, 10][run];
+        let mut held_at = Vec::new();
+        let (sim, ()) = with_laps(&scn.sim, &laps_of, |rx| {
+            let mut current = None;
+            for (run, lap) in rx {
+                for (_, rec, recording) in jobs.iter_mut() {
+                    if current != Some(run) {
+                        recording.start_run(rec.as_mut());
+                    }
+                    recording.lap(rec.as_mut(), run, &lap);
+                }
+                current = Some(run);
+                settle(&mut jobs, false);
+                held_at.push(jobs[1].2.pairs_held().expect("streaming").0);
+            }
+        });
+        sim.expect("simulates");
+        let late: Vec<usize> = jobs.iter().map(|j| j.2.pairs_held().unwrap().1).collect();
+        let results = finish_jobs(jobs);
+        let (_, e) = results[1].1.evaluation.as_ref().expect("scored as it went");
+        assert!(results[1].1.matches.is_empty(), "no match is kept");
+        // Held pairs flatten out: laps 30–40 hold at most a third more than laps 15–20 did,
+        // and at the end a small part of what was scored.
+        let (mid, end) = (held_at[14..20].iter().max(), held_at[30..].iter().max());
+        let (mid, end) = (*mid.unwrap(), *end.unwrap());
+        assert!(
+            3 * end <= 4 * mid,
+            "held {mid} at laps 15-20, {end} at laps 31-40"
+        );
+        assert!(3 * end < e.main.pairs, "{end} of {} held", e.main.pairs);
+        for (_, rec) in &results {
+            let (_, e) = rec.evaluation.as_ref().expect("scored as it went");
+            assert_eq!(e.main.late_pairs, 0);
+        }
+        assert_eq!(late, [0, 0]);
+        assert!(results[0].1.level_gain.is_none());
+        assert!(results[1].1.level_gain.is_some());
+    }
 }

@@ -300,6 +300,26 @@ impl WordMatcher {
         self.words.observations()
     }
 
+    /// The first observation (index) a match found from now on may pair as its query: what
+    /// lets the evaluation score matches as they come and forget pairs behind it
+    /// (`eval::tally`). A match's query observations lie in the current words of its n-gram
+    /// (a placement never leaves the current word), an n-gram is at most τ pairs (τ plus
+    /// `reverse_extra_ngram` read backwards; chains long in travel stop at τ too), each step back
+    /// goes to a predecessor, one word of at most [`WordLevels::max_span_l0`] level-0 words, or
+    /// across a substitution one level-0 word further. So every future n-gram starts within
+    /// τ·(span + 1) level-0 words of the newest closed one.
+    pub fn query_horizon(&self) -> usize {
+        let p = &self.params;
+        let tau = p.min_ngram[..p.levels].iter().max().copied().unwrap_or(1)
+            + if p.reverse { p.reverse_extra_ngram } else { 0 };
+        let back = tau * (self.words.max_span_l0() + 1) + 1;
+        let closed = self.words.closed_l0();
+        match closed.checked_sub(back) {
+            Some(i) => self.words.level0(i).map_or(0, |w| w.first_obs),
+            None => 0,
+        }
+    }
+
     /// Candidate n-grams accepted and rejected by verification so far.
     pub fn verification(&self) -> VerificationCounts {
         self.rejections

@@ -147,6 +147,12 @@ impl Recognizer {
         self.back.observations()
     }
 
+    /// Every match found from now on pairs only observations at or after this index of
+    /// [`Self::observations`] as its query (see `WordMatcher::query_horizon`).
+    pub fn query_horizon(&self) -> usize {
+        self.back.query_horizon()
+    }
+
     /// Words of every level (for tests and plots).
     pub fn words(&self) -> &WordLevels {
         self.back.words()

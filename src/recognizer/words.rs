@@ -427,4 +427,25 @@ impl WordLevels {
     pub fn levels(&self) -> usize {
         self.levels
     }
+
+    /// The most level-0 words one word of any level can span (the bound each rule enforces:
+    /// `paper` fuses j − l − 1 … j, l ≤ levels − 1; `boundaries` at most 2·(levels − 1) + 1
+    /// words between the two ends of a bump).
+    pub fn max_span_l0(&self) -> usize {
+        match self.rule {
+            MultiLevelRule::Paper => self.levels + 1,
+            MultiLevelRule::Boundaries => 2 * self.levels + 1,
+        }
+    }
+
+    /// Level-0 words closed so far.
+    pub fn closed_l0(&self) -> usize {
+        self.by_level[0].len()
+    }
+
+    /// Level-0 word `i` (its index in level 0), if closed.
+    pub fn level0(&self, i: usize) -> Option<&Word> {
+        let id = *self.by_level[0].get(i)?;
+        Some(&self.words[id as usize])
+    }
 }

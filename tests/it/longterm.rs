@@ -52,3 +52,40 @@ fn smoke_40_laps_report_is_unchanged_apart_from_timings() {
         "the 40-lap smoke report changed (timings aside)"
     );
 }
+
+/// `run` scores matches as they arrive unless it must keep them (pictures, exported matches):
+/// both ways give the same report, timings aside, at 1, 2 and 3 levels with the level gains and
+/// with the ICP baseline.
+#[test]
+fn scoring_as_matches_arrive_gives_the_report_of_scoring_them_at_the_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let report = |keep: bool| {
+        let out = dir.path().join(format!("r-{keep}.json"));
+        let svg = dir.path().join("svg");
+        let mut args = vec![
+            "run",
+            "scenarios/smoke.toml",
+            "--laps",
+            "6",
+            "--icp",
+            "-q",
+            "--report",
+            out.to_str().unwrap(),
+        ];
+        if keep {
+            args.extend(["--svg", svg.to_str().unwrap()]);
+        }
+        let o = placewords(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        without_timings(&mut v);
+        v
+    };
+    let (streamed, kept) = (report(false), report(true));
+    let levels = streamed["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 3);
+    assert!(levels[2]["only_here"].is_object(), "level gains reported");
+    assert!(levels[2]["pairs"].as_u64().unwrap() > 100, "smoke matches");
+    assert!(streamed == kept, "streamed and kept reports differ");
+}

@@ -1,0 +1,543 @@
+//! Scoring as matches arrive: the one implementation of the counting rules of
+//! [`super::metrics`] (DESIGN.md §6), fed one match at a time.
+//!
+//! A [`Tally`] learns the truth and the observations as they are made ([`Tally::sync`]), counts
+//! each match's pairs the moment it arrives ([`Tally::add`]) and keeps of them only what the
+//! rules still need:
+//!
+//! - **Deduplication.** A pair counts once however many matches repeat it, so the tally keeps
+//!   the distinct pairs it has counted, but only those whose query lies at or after the
+//!   recognizer's *query horizon* ([`crate::place::PlaceRecognizer::query_horizon`]): no later
+//!   match can name an older query, so [`Tally::evict_below`] forgets the pairs behind it. A
+//!   recognizer that promises nothing (horizon 0) has every distinct pair kept to the end, as
+//!   before. A pair that arrives behind the horizon anyway is counted and reported in
+//!   [`Metrics::late_pairs`] (always 0 for a recognizer that keeps its promise; tests check it).
+//! - **Recall.** Per observation, one flag per figure: the query (or either side) of a correct
+//!   pair.
+//! - **Visit recall.** The earlier laps each query observation was correctly paired with, one
+//!   packed `u64` per (observation, lap), not per pair.
+//! - **Pair recall.** The count of distinct correct pairs.
+//!
+//! What needs every observation's truth (which observations have a revisit, which earlier laps
+//! pass there, how many pairs could have been found) is computed at [`Tally::finish`] from the
+//! truth sites ([`super::site_tree`]). So memory grows with the observations and with the
+//! (observation, lap) pairs found, never with the aligned pairs: `placewords run` and
+//! `recognize` score a thousand-lap run this way while it is recognized ([`super::Recording`]),
+//! and [`super::evaluate`] scores a finished recognition by feeding its matches in order.
+
+use super::GroundTruth;
+use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
+use super::pair_recall::{Facing, PairRecall, count_possible};
+use super::pair_set::pack;
+use super::site_tree::{LapSet, Site};
+use crate::recognizer::{Match, ObsId, Observation};
+use crate::spec::evaluation::EvaluationSpec;
+use std::collections::{HashMap, HashSet};
+
+/// What a tally counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    /// Everything [`Evaluation`] holds: every radius, per door configuration, per direction,
+    /// visit and pair recall.
+    Full,
+    /// The top-level figures at `tp_radius_m` only, without visit and pair recall (sweeps).
+    Main,
+}
+
+/// Index of a facing in the per-pair flags.
+fn facing_bit(f: Facing) -> u8 {
+    match f {
+        Facing::Either => 0,
+        Facing::Same => 1,
+        Facing::Opposite => 2,
+    }
+}
+
+/// One figure: a facing at a radius.
+#[derive(Clone, Debug)]
+struct Slot {
+    facing: Facing,
+    radius_m: f64,
+    /// Counted per door configuration too.
+    breakdown: bool,
+    /// Visit and pair recall counted too.
+    recalls: bool,
+    counts: Counts,
+    per_cfg: Vec<Counts>,
+    /// Per observation: the query of a correct pair.
+    recalled_query: Vec<bool>,
+    /// Per observation: either side of a correct pair.
+    recalled_any: Vec<bool>,
+    /// Distinct pairs found that could have been found (pair recall's numerator).
+    found: u64,
+    /// The match being counted: its distinct pairs, the correct ones, its door configuration.
+    n: usize,
+    ok: usize,
+    cfg: Option<usize>,
+}
+
+impl Slot {
+    fn new(facing: Facing, radius_m: f64, breakdown: bool, recalls: bool) -> Self {
+        Slot {
+            facing,
+            radius_m,
+            breakdown,
+            recalls,
+            counts: Counts::default(),
+            per_cfg: Vec::new(),
+            recalled_query: Vec::new(),
+            recalled_any: Vec::new(),
+            found: 0,
+            n: 0,
+            ok: 0,
+            cfg: None,
+        }
+    }
+}
+
+/// Scores matches as they arrive (see the module doc).
+pub struct Tally {
+    spec: EvaluationSpec,
+    scorer: Scorer,
+    slots: Vec<Slot>,
+    /// True travel per frame so far, and the running sum.
+    travel: Vec<f64>,
+    travel_acc: f64,
+    /// Door configuration index of each lap synced.
+    lap_config: Vec<u32>,
+    config_index: HashMap<String, usize>,
+    /// Distinct resolved pairs at or after the horizon, packed `(query, past)` observation
+    /// indices → bits: seen by facing (0 either, 1 same, 2 opposite), found for pair recall by
+    /// facing (3 + the same).
+    window: HashMap<u64, u8>,
+    /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
+    /// recognizer that names unknown observations is broken, not long-running).
+    unresolved: HashMap<u64, u8>,
+    /// (query index, lap) → claims (bit 0 same, bit 1 opposite) of the correct pairs joining
+    /// them, for queries at or after the horizon.
+    visits_window: HashMap<u64, u8>,
+    /// The same behind the horizon: `query << 32 | lap << 2 | claims`.
+    visits: Vec<u64>,
+    /// Query indices below this were forgotten.
+    evicted_below: usize,
+    late_pairs: usize,
+    /// Pairs forgotten since the last [`Tally::take_forgotten`], when asked to keep them.
+    forgotten: Option<Vec<u64>>,
+    in_match: HashSet<(ObsId, ObsId)>,
+}
+
+impl Tally {
+    /// An empty tally counting `scope` with `spec`'s rules.
+    pub fn new(spec: &EvaluationSpec, scope: Scope) -> Self {
+        Self::with_scorer(spec, scope, Scorer::empty(spec))
+    }
+
+    /// A tally over the observations and truth `scorer` already joined (no [`Self::sync`]).
+    pub fn over(scorer: &Scorer, spec: &EvaluationSpec, scope: Scope) -> Self {
+        let mut t = Self::with_scorer(spec, scope, scorer.clone());
+        t.grow_slots();
+        t
+    }
+
+    fn with_scorer(spec: &EvaluationSpec, scope: Scope, scorer: Scorer) -> Self {
+        let r = spec.tp_radius_m;
+        let mut slots = vec![Slot::new(
+            Facing::Either,
+            r,
+            scope == Scope::Full,
+            scope == Scope::Full,
+        )];
+        if scope == Scope::Full {
+            slots.extend(
+                spec.sensitivity_radii_m
+                    .iter()
+                    .map(|&s| Slot::new(Facing::Either, s, false, false)),
+            );
+            slots.push(Slot::new(Facing::Same, r, false, true));
+            slots.push(Slot::new(Facing::Opposite, r, false, true));
+        }
+        Tally {
+            spec: spec.clone(),
+            scorer,
+            slots,
+            travel: Vec::new(),
+            travel_acc: 0.0,
+            lap_config: Vec::new(),
+            config_index: HashMap::new(),
+            window: HashMap::new(),
+            unresolved: HashMap::new(),
+            visits_window: HashMap::new(),
+            visits: Vec::new(),
+            evicted_below: 0,
+            late_pairs: 0,
+            forgotten: None,
+            in_match: HashSet::new(),
+        }
+    }
+
+    /// Keep the distinct resolved pairs forgotten by [`Self::evict_below`] until
+    /// [`Self::take_forgotten`] (to compare level configurations, `Report::set_level_gains`).
+    pub fn keep_forgotten(&mut self) {
+        self.forgotten.get_or_insert_with(Vec::new);
+    }
+
+    /// Learns the laps, frames and observations added to `truth` and `observations` since the
+    /// last call (both only ever grow; call before adding matches that name new observations).
+    pub fn sync(&mut self, observations: &[Observation], truth: &GroundTruth) {
+        for lap in &truth.laps[self.lap_config.len()..] {
+            let next = self.config_index.len();
+            let c = *self
+                .config_index
+                .entry(lap.door_config.clone())
+                .or_insert(next);
+            self.scorer.add_lap(c, &lap.door_config);
+            self.lap_config.push(c as u32);
+        }
+        // As `pair_recall::true_travel_m`, operand for operand.
+        for i in self.travel.len()..truth.frames.len() {
+            if i > 0 {
+                let (prev, f) = (&truth.frames[i - 1], &truth.frames[i]);
+                if truth.laps[prev.lap_slot].run == truth.laps[f.lap_slot].run {
+                    self.travel_acc += prev.pose.0.distance(&f.pose.0);
+                }
+            }
+            self.travel.push(self.travel_acc);
+        }
+        let known = self.scorer.observation_count();
+        for (i, o) in observations.iter().enumerate().skip(known) {
+            self.scorer
+                .push_observation(i, o, truth, &self.travel, &self.lap_config);
+        }
+        self.grow_slots();
+    }
+
+    /// Sizes the per-observation and per-configuration tables to what is known.
+    fn grow_slots(&mut self) {
+        let (n, configs) = (self.scorer.observation_count(), self.scorer.config_count());
+        for s in &mut self.slots {
+            s.recalled_query.resize(n, false);
+            s.recalled_any.resize(n, false);
+            if s.breakdown {
+                s.per_cfg.resize(configs, Counts::default());
+            }
+        }
+    }
+
+    /// Counts match `m` (its observations must be synced).
+    pub fn add(&mut self, m: &Match, truth: &GroundTruth) {
+        let claim = Facing::of(m.direction);
+        let claim_bit = facing_bit(claim);
+        let tol = self.scorer.heading_tol_rad();
+        let r_main = self.spec.tp_radius_m;
+        let counts = |s: &Slot| s.facing.counts(m.direction);
+        for s in &mut self.slots {
+            (s.n, s.ok, s.cfg) = (0, 0, None);
+        }
+        self.in_match.clear();
+        for (query, past) in m.pairs() {
+            let resolved = self.scorer.resolve(query, past);
+            let Some((qi, pi, q, pa)) = resolved else {
+                let flags = self.unresolved.entry(pack(query, past)).or_insert(0);
+                let before = *flags;
+                for s in self.slots.iter_mut().filter(|s| counts(s)) {
+                    if before & (1 << facing_bit(s.facing)) == 0 {
+                        s.counts.unresolved += 1;
+                    }
+                }
+                *flags |= 1 | (1 << claim_bit);
+                continue;
+            };
+            if qi < self.evicted_below {
+                self.late_pairs += 1;
+            }
+            let d2 = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2);
+            let agrees = claim.agrees(q.theta, pa.theta, tol);
+            let new_in_match = self.in_match.insert((query, past));
+            let key = pack(qi, pi);
+            let before = self.window.get(&key).copied().unwrap_or(0);
+            let cfg = self.scorer.config(qi);
+            let mut recalls = false;
+            for s in self.slots.iter_mut().filter(|s| counts(s)) {
+                let correct = d2 <= s.radius_m * s.radius_m && agrees;
+                recalls |= s.recalls;
+                if new_in_match {
+                    s.n += 1;
+                    s.ok += usize::from(correct);
+                    s.cfg.get_or_insert(cfg);
+                }
+                if before & (1 << facing_bit(s.facing)) == 0 {
+                    s.counts.pairs += 1;
+                    s.counts.correct += usize::from(correct);
+                    if s.breakdown {
+                        s.per_cfg[cfg].pairs += 1;
+                        s.per_cfg[cfg].correct += usize::from(correct);
+                    }
+                    if correct {
+                        s.recalled_query[qi] = true;
+                        s.recalled_any[qi] = true;
+                        s.recalled_any[pi] = true;
+                    }
+                }
+            }
+            let mut after = before | 1 | (1 << claim_bit);
+            if recalls && self.could_be_found(qi, pi, claim, truth) {
+                for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
+                    let bit = 1 << (3 + facing_bit(s.facing));
+                    if before & bit == 0 {
+                        s.found += 1;
+                        after |= bit;
+                    }
+                }
+            }
+            self.window.insert(key, after);
+            if recalls && d2 <= r_main * r_main && agrees {
+                let claims = if claim == Facing::Same { 1 } else { 2 };
+                *self.visits_window.entry(pack(qi, pa.lap)).or_insert(0) |= claims;
+            }
+        }
+        for s in self.slots.iter_mut().filter(|s| counts(s) && s.n > 0) {
+            let good = 2 * s.ok > s.n;
+            s.counts.matches += 1;
+            s.counts.correct_matches += usize::from(good);
+            if let (true, Some(c)) = (s.breakdown, s.cfg) {
+                s.per_cfg[c].matches += 1;
+                s.per_cfg[c].correct_matches += usize::from(good);
+            }
+        }
+    }
+
+    /// Pair recall's test of a pair claimed `claim`: the two frames' true positions within
+    /// `tp_radius_m`, at least `min_gap_m` of true travel apart, facing as claimed
+    /// (`pair_recall::pair_recall`'s rule).
+    fn could_be_found(&self, qi: usize, pi: usize, claim: Facing, truth: &GroundTruth) -> bool {
+        let r = self.spec.tp_radius_m;
+        if r <= 0.0 || !r.is_finite() {
+            return false;
+        }
+        let (fq, fp) = (self.scorer.frame_of(qi), self.scorer.frame_of(pi));
+        let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
+        self.travel[fq] - self.travel[fp] >= self.spec.min_gap_m
+            && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
+            && claim.agrees(q.theta, p.theta, self.scorer.heading_tol_rad())
+    }
+
+    /// Forgets the pairs whose query index is below `query_index` (a recognizer's query horizon:
+    /// no later match names such a query).
+    pub fn evict_below(&mut self, query_index: usize) {
+        let h = query_index.min(self.scorer.observation_count());
+        if h <= self.evicted_below {
+            return;
+        }
+        let behind = |k: u64| ((k >> 32) as usize) < h;
+        match &mut self.forgotten {
+            Some(gone) => {
+                let from = gone.len();
+                self.window.retain(|&k, _| {
+                    let keep = !behind(k);
+                    if !keep {
+                        gone.push(k);
+                    }
+                    keep
+                });
+                gone[from..].sort_unstable();
+            }
+            None => self.window.retain(|&k, _| !behind(k)),
+        }
+        let from = self.visits.len();
+        let visits = &mut self.visits;
+        self.visits_window.retain(|&k, &mut claims| {
+            let keep = !behind(k);
+            if !keep {
+                visits.push((k >> 32) << 32 | (k & 0xffff_ffff) << 2 | u64::from(claims));
+            }
+            keep
+        });
+        self.visits[from..].sort_unstable();
+        self.evicted_below = h;
+    }
+
+    /// The distinct resolved pairs forgotten since the last call, packed `(query, past)`
+    /// indices, sorted within each eviction (see [`Self::keep_forgotten`]).
+    pub fn take_forgotten(&mut self) -> Vec<u64> {
+        self.forgotten
+            .as_mut()
+            .map(std::mem::take)
+            .unwrap_or_default()
+    }
+
+    /// Whether the pair of observation indices `(q, p)` is within `tp_radius_m` (true
+    /// positions, no heading test: a level configuration's gain counts it correct so).
+    pub fn within_radius(&self, q: usize, p: usize) -> bool {
+        self.scorer.within(q, p, self.spec.tp_radius_m)
+    }
+
+    /// Distinct pairs held to deduplicate (those at or after the horizon).
+    pub fn pairs_held(&self) -> usize {
+        self.window.len()
+    }
+
+    /// Pairs that arrived behind the horizon so far (see [`Metrics::late_pairs`]).
+    pub fn late_pairs(&self) -> usize {
+        self.late_pairs
+    }
+
+    /// Observations synced so far.
+    pub fn observations(&self) -> usize {
+        self.scorer.observation_count()
+    }
+
+    /// The top-level figures at `tp_radius_m` (a [`Scope::Main`] tally), with the revisits at
+    /// that radius when already computed.
+    pub fn finish_main(self, revisits: Option<&[bool]>) -> Metrics {
+        let r = self.spec.tp_radius_m;
+        let computed;
+        let revisits = match revisits {
+            Some(v) => v,
+            None => {
+                computed = self.scorer.revisits(r);
+                &computed
+            }
+        };
+        self.slots[0].metrics(revisits, &self.scorer).0
+    }
+
+    /// Every figure (a [`Scope::Full`] tally), after syncing what `observations` and `truth` add.
+    pub fn finish(mut self, observations: &[Observation], truth: &GroundTruth) -> Evaluation {
+        self.sync(observations, truth);
+        self.evict_below(usize::MAX);
+        // Late pairs (none from a recognizer that keeps its horizon) may repeat an entry.
+        self.visits.sort_unstable();
+        self.visits.dedup_by(|b, a| {
+            let same = *a >> 2 == *b >> 2;
+            if same {
+                *a |= *b & 3;
+            }
+            same
+        });
+        let sites = self.frame_sites(observations, truth);
+        let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
+        for s in &self.slots {
+            let scorer = self.scorer.with_facing(s.facing);
+            let revisits = scorer.revisits(s.radius_m);
+            let (mut m, cfgs) = s.metrics(&revisits, &scorer);
+            if s.recalls {
+                m.visit_recall = self.visit_recall(&scorer, s.radius_m);
+                let possible = if s.radius_m <= 0.0 || !s.radius_m.is_finite() {
+                    0
+                } else {
+                    let tol = self.scorer.heading_tol_rad();
+                    count_possible(&sites, self.spec.min_gap_m, s.radius_m, s.facing, tol)
+                };
+                m.pair_recall = PairRecall {
+                    possible,
+                    found: s.found,
+                }
+                .ratio();
+            }
+            m.late_pairs = self.late_pairs;
+            metrics.push((m, cfgs));
+        }
+        let n_sens = self.spec.sensitivity_radii_m.len();
+        let mut it = metrics.into_iter();
+        let (main, door_configs) = it.next().expect("the main figure");
+        let sensitivity = it.by_ref().take(n_sens).map(|(m, _)| m).collect();
+        let (same, opposite) = (it.next().expect("same").0, it.next().expect("opposite").0);
+        Evaluation {
+            main,
+            sensitivity,
+            door_configs,
+            directions: DirectionMetrics { same, opposite },
+        }
+    }
+
+    /// Visit recall at radius `r` as `scorer` faces: the earlier laps each observation was
+    /// correctly paired with ÷ the earlier laps that revisit it.
+    fn visit_recall(&self, scorer: &Scorer, r: f64) -> f64 {
+        if r <= 0.0 || !r.is_finite() {
+            return 0.0;
+        }
+        let need: u64 = match scorer.facing() {
+            Facing::Either => 3,
+            Facing::Same => 1,
+            Facing::Opposite => 2,
+        };
+        let found_with = |i: usize, lap: usize| {
+            let base = (i as u64) << 32 | (lap as u64) << 2;
+            let k = self.visits.partition_point(|&v| v < base);
+            self.visits
+                .get(k)
+                .is_some_and(|&v| v >> 2 == base >> 2 && v & need != 0)
+        };
+        let (mut visits, mut found) = (0usize, 0usize);
+        let mut laps = LapSet::default();
+        scorer.sweep_laps(r, &mut laps, |i, laps| {
+            visits += laps.len();
+            found += laps.iter().filter(|&&l| found_with(i, l)).count();
+        });
+        super::metrics::ratio(found, visits)
+    }
+
+    /// Pair recall's sites: each observation's frame truth (not moved to the observation).
+    fn frame_sites(&self, observations: &[Observation], truth: &GroundTruth) -> Vec<Site> {
+        observations
+            .iter()
+            .filter_map(|o| {
+                let f = truth.frame(o.frame_id)?;
+                Some(Site {
+                    x: f.pose.0.x,
+                    y: f.pose.0.y,
+                    theta: f.pose.0.theta,
+                    travel_m: self.travel[o.frame_id],
+                    lap: f.lap_slot,
+                })
+            })
+            .collect()
+    }
+}
+
+impl Slot {
+    /// The slot's figures with `revisits` (per observation), and per door configuration when
+    /// it breaks them down.
+    fn metrics(&self, revisits: &[bool], scorer: &Scorer) -> (Metrics, Vec<DoorConfigMetrics>) {
+        let mut total = self.counts.clone();
+        let mut per_cfg = self.per_cfg.clone();
+        scorer.each_site(|i, config| {
+            if !revisits[i] {
+                return;
+            }
+            total.revisits += 1;
+            total.recalled += usize::from(self.recalled_query[i]);
+            total.recalled_any += usize::from(self.recalled_any[i]);
+            if self.breakdown {
+                let c = &mut per_cfg[config];
+                c.revisits += 1;
+                c.recalled += usize::from(self.recalled_query[i]);
+                c.recalled_any += usize::from(self.recalled_any[i]);
+            }
+        });
+        let configs = if self.breakdown {
+            scorer.config_metrics(&per_cfg, self.radius_m)
+        } else {
+            Vec::new()
+        };
+        (total.metrics(self.radius_m), configs)
+    }
+}
+
+/// The pairs of `here` (sorted packed observation indices) that `fewer` (sorted) does not hold,
+/// and how many of them `correct` accepts: what a level configuration found that the one with
+/// a level fewer did not (`Report::set_level_gains`).
+pub fn gain(here: &[u64], fewer: &[u64], correct: impl Fn(usize, usize) -> bool) -> (usize, usize) {
+    let (mut pairs, mut ok, mut j) = (0, 0, 0);
+    for &k in here {
+        while j < fewer.len() && fewer[j] < k {
+            j += 1;
+        }
+        if fewer.get(j) == Some(&k) {
+            continue;
+        }
+        pairs += 1;
+        ok += usize::from(correct((k >> 32) as usize, (k & 0xffff_ffff) as usize));
+    }
+    (pairs, ok)
+}
