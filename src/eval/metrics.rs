@@ -207,12 +207,7 @@ pub fn scored_pairs(rec: &Recognition, radius_m: f64) -> Vec<ScoredPair> {
 /// of pairs cost 8 bytes each.
 pub fn pairs_not_in(here: &Recognition, fewer: &Recognition, radius_m: f64) -> (usize, usize) {
     let truth_of = truth_lookup(here);
-    let index_of: HashMap<ObsId, usize> = here
-        .observations
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.id, i))
-        .collect();
+    let index_of = index_of(&here.observations);
     let resolved = |rec: &Recognition| {
         let set = PairSet::from_pairs(rec.matches.iter().flat_map(Match::pairs).filter_map(
             |(q, p)| {
@@ -231,17 +226,21 @@ pub fn pairs_not_in(here: &Recognition, fewer: &Recognition, radius_m: f64) -> (
 /// The true pose of an observation of `rec` by id (`None` for an id it does not hold or a
 /// frame without truth).
 fn truth_lookup(rec: &Recognition) -> impl Fn(ObsId) -> Option<crate::geom::TruePose> + '_ {
-    let index_of: HashMap<ObsId, usize> = rec
-        .observations
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.id, i))
-        .collect();
+    let index_of = index_of(&rec.observations);
     move |id| {
         index_of
             .get(&id)
             .and_then(|&i| rec.truth.observation_pose(&rec.observations[i]))
     }
+}
+
+/// Observation id → position in `observations`.
+fn index_of(observations: &[Observation]) -> HashMap<ObsId, usize> {
+    observations
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.id, i))
+        .collect()
 }
 
 /// Observations joined with their truth (shared by the scorers of every facing).
@@ -279,7 +278,7 @@ pub struct Scorer {
 impl Joined {
     /// Appends observation `o`, at position `i`, with its true pose (`travel`: true travel per
     /// frame; `lap_config`: door configuration of each lap).
-    fn push(
+    pub(super) fn push(
         &mut self,
         i: usize,
         o: &Observation,
@@ -359,18 +358,9 @@ impl Scorer {
         self.config_laps[c] += 1;
     }
 
-    /// Appends an observation (see `Joined::push`); the scorer must not be shared.
-    pub(super) fn push_observation(
-        &mut self,
-        i: usize,
-        o: &Observation,
-        truth: &GroundTruth,
-        travel: &[f64],
-        lap_config: &[u32],
-    ) {
-        Arc::get_mut(&mut self.joined)
-            .expect("a growing scorer is not shared")
-            .push(i, o, truth, travel, lap_config);
+    /// The joined observations, to append to (`eval::tally`); the scorer must not be shared.
+    pub(super) fn joined_mut(&mut self) -> &mut Joined {
+        Arc::get_mut(&mut self.joined).expect("a growing scorer is not shared")
     }
 
     /// Observations joined (with or without truth).

@@ -15,15 +15,13 @@
 //!   way the figure counts (same, opposite or either) and it is found when a match claiming
 //!   that pair's direction holds it. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
 //!   observation per earlier lap suffices), it counts every observation of every earlier pass,
-//!   so it is the figure closest to the paper's "matches that could be obtained".
+//!   so it is the figure closest to the paper's "matches that could be obtained". Counted by
+//!   `eval::tally` (found, as matches arrive) and [`count_possible`] (the denominator).
 
 use super::GroundTruth;
-use super::pair_set::PairSet;
 use super::site_tree::{Query, Site, sweep};
 use crate::geom::wrap_angle;
-use crate::recognizer::{Direction, Match, ObsId, Observation};
-use crate::spec::evaluation::EvaluationSpec;
-use std::collections::HashMap;
+use crate::recognizer::Direction;
 
 /// Distance along the true path from the first frame to each frame, metres.
 pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
@@ -84,7 +82,8 @@ impl Facing {
     }
 }
 
-/// Counts behind [`pair_recall`].
+/// Counts behind pair recall (`eval::tally` counts `found` as matches arrive and `possible` at
+/// the end, [`count_possible`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairRecall {
     /// Pairs that could have been found.
@@ -101,63 +100,6 @@ impl PairRecall {
         } else {
             self.found as f64 / self.possible as f64
         }
-    }
-}
-
-/// Pair recall of `matches` at radius `r` over the pairs facing as `facing` says (see the
-/// module docs).
-pub fn pair_recall(
-    observations: &[Observation],
-    matches: &[Match],
-    truth: &GroundTruth,
-    spec: &EvaluationSpec,
-    r: f64,
-    facing: Facing,
-) -> PairRecall {
-    if r <= 0.0 || !r.is_finite() {
-        return PairRecall::default();
-    }
-    let travel = true_travel_m(truth);
-    let placed: Vec<Option<Site>> = observations
-        .iter()
-        .map(|o| {
-            let f = truth.frame(o.frame_id)?;
-            Some(Site {
-                x: f.pose.0.x,
-                y: f.pose.0.y,
-                theta: f.pose.0.theta,
-                travel_m: travel[o.frame_id],
-                lap: f.lap_slot,
-            })
-        })
-        .collect();
-    let tol = spec.heading_tolerance_deg.to_radians();
-    let near = |q: &Site, p: &Site| {
-        q.travel_m - p.travel_m >= spec.min_gap_m
-            && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
-    };
-    let index_of: HashMap<ObsId, usize> = observations
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.id, i))
-        .collect();
-    let counted = matches.iter().filter(|m| facing.counts(m.direction));
-    let seen = PairSet::from_pairs(
-        counted
-            .flat_map(|m| m.pairs().map(move |p| (p, Facing::of(m.direction))))
-            .filter_map(|((query, past), claim)| {
-                let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
-                let (q, pa) = (placed[qi].as_ref()?, placed[pi].as_ref()?);
-                (near(q, pa) && claim.agrees(q.theta, pa.theta, tol)).then_some((qi, pi))
-            }),
-    );
-    let found = seen.len() as u64;
-    let sites: Vec<Site> = placed.iter().flatten().copied().collect();
-    // A long log has millions of observations: hold one copy of their truth during the count.
-    drop((seen, placed, index_of, travel));
-    PairRecall {
-        possible: count_possible(&sites, spec.min_gap_m, r, facing, tol),
-        found,
     }
 }
 
@@ -188,9 +130,35 @@ pub(super) fn count_possible(
 mod tests {
     use super::*;
     use crate::eval::metrics::tests::circle;
+    use crate::eval::tally::{Scope, Tally};
+    use crate::recognizer::{Match, Observation};
+    use crate::spec::evaluation::EvaluationSpec;
 
     fn one_match(_obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
         Match::from_pairs(1, 1, vec![], pairs.iter().copied())
+    }
+
+    /// Pair recall at 1 m of `matches`, over the pairs facing as `facing` says (scored as
+    /// every figure is, by `eval::tally`).
+    fn pair_recall(
+        obs: &[Observation],
+        matches: &[Match],
+        gt: &GroundTruth,
+        facing: Facing,
+    ) -> f64 {
+        let spec = EvaluationSpec {
+            tp_radius_m: 1.0,
+            ..EvaluationSpec::default()
+        };
+        let mut t = Tally::new(&spec, Scope::Full);
+        t.sync(obs, gt);
+        matches.iter().for_each(|m| t.add(m, gt));
+        let e = t.finish(obs, gt);
+        match facing {
+            Facing::Either => e.main.pair_recall,
+            Facing::Same => e.directions.same.pair_recall,
+            Facing::Opposite => e.directions.opposite.pair_recall,
+        }
     }
 
     /// Every possible pair found scores 1; only the nearest neighbour of one earlier lap scores
@@ -209,32 +177,14 @@ mod tests {
                 }
             }
         }
-        let full = pair_recall(
-            &obs,
-            &[one_match(&obs, &all)],
-            &gt,
-            &spec,
-            1.0,
-            Facing::Same,
-        );
-        assert_eq!(full.found, full.possible);
-        assert_eq!(full.ratio(), 1.0);
-        // One pair per observation, one lap back.
+        let full = pair_recall(&obs, &[one_match(&obs, &all)], &gt, Facing::Same);
+        assert_eq!(full, 1.0);
+        // One pair per observation, one lap back: found / possible is their share of `all`.
         let nearest: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
-        let some = pair_recall(
-            &obs,
-            &[one_match(&obs, &nearest)],
-            &gt,
-            &spec,
-            1.0,
-            Facing::Same,
-        );
-        assert!(some.ratio() < 0.1, "{some:?}");
-        assert_eq!(some.found, nearest.len() as u64);
-        assert_eq!(
-            pair_recall(&obs, &[], &gt, &spec, 1.0, Facing::Same).ratio(),
-            0.0
-        );
+        let some = pair_recall(&obs, &[one_match(&obs, &nearest)], &gt, Facing::Same);
+        assert_eq!(some, nearest.len() as f64 / all.len() as f64);
+        assert!(some < 0.1, "{some}");
+        assert_eq!(pair_recall(&obs, &[], &gt, Facing::Same), 0.0);
     }
 
     /// A pair facing the other way is found only by a match claiming the opposite direction.
@@ -244,35 +194,19 @@ mod tests {
         for f in &mut gt.frames[400..] {
             f.pose.0.theta += std::f64::consts::PI;
         }
-        let spec = EvaluationSpec::default();
         let m = one_match(&obs, &[(400, 0), (450, 50)]);
-        let pr = pair_recall(
-            &obs,
-            std::slice::from_ref(&m),
-            &gt,
-            &spec,
-            1.0,
-            Facing::Either,
-        );
-        assert_eq!(pr.found, 0);
+        let claimed_same = pair_recall(&obs, std::slice::from_ref(&m), &gt, Facing::Either);
+        assert_eq!(claimed_same, 0.0);
         // Claimed as opposite, the same pairs are found, in the opposite and top-level figures.
         let opposite = Match {
             direction: Direction::Opposite,
             ..m
         };
         for facing in [Facing::Opposite, Facing::Either] {
-            let pr = pair_recall(
-                &obs,
-                std::slice::from_ref(&opposite),
-                &gt,
-                &spec,
-                1.0,
-                facing,
-            );
-            assert_eq!(pr.found, 2, "{facing:?}");
+            let pr = pair_recall(&obs, std::slice::from_ref(&opposite), &gt, facing);
+            assert!(pr > 0.0, "{facing:?}");
         }
-        let pr = pair_recall(&obs, &[opposite], &gt, &spec, 1.0, Facing::Same);
-        assert_eq!(pr.found, 0);
+        assert_eq!(pair_recall(&obs, &[opposite], &gt, Facing::Same), 0.0);
     }
 
     #[test]

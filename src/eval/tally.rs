@@ -206,7 +206,8 @@ impl Tally {
         let known = self.scorer.observation_count();
         for (i, o) in observations.iter().enumerate().skip(known) {
             self.scorer
-                .push_observation(i, o, truth, &self.travel, &self.lap_config);
+                .joined_mut()
+                .push(i, o, truth, &self.travel, &self.lap_config);
         }
         self.grow_slots();
     }
