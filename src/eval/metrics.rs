@@ -246,8 +246,10 @@ fn index_of(observations: &[Observation]) -> HashMap<ObsId, usize> {
 /// Observations joined with their truth (shared by the scorers of every facing).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Joined {
-    /// Observation id → position in the observations.
-    index_of: HashMap<ObsId, usize>,
+    /// Observation id → position in the observations, once an id is not its position; `None`
+    /// while every id equals its position (placewords' own recognizer: no map of a million
+    /// observations is kept).
+    index_of: Option<HashMap<ObsId, usize>>,
     /// Per observation (creation order): its site, or [`NO_SITE`] when its frame has no truth.
     site_of: Vec<u32>,
     /// Per observation: the input frame that made it.
@@ -276,6 +278,14 @@ pub struct Scorer {
 }
 
 impl Joined {
+    /// The position of the observation with id `id`, if joined.
+    fn position(&self, id: ObsId) -> Option<usize> {
+        match &self.index_of {
+            None => (id < self.site_of.len()).then_some(id),
+            Some(m) => m.get(&id).copied(),
+        }
+    }
+
     /// Appends observation `o`, at position `i`, with its true pose (`travel`: true travel per
     /// frame; `lap_config`: door configuration of each lap).
     pub(super) fn push(
@@ -286,7 +296,17 @@ impl Joined {
         travel: &[f64],
         lap_config: &[u32],
     ) {
-        self.index_of.insert(o.id, i);
+        match &mut self.index_of {
+            None if o.id == i => {}
+            None => {
+                let mut m: HashMap<ObsId, usize> = (0..i).map(|k| (k, k)).collect();
+                m.insert(o.id, i);
+                self.index_of = Some(m);
+            }
+            Some(m) => {
+                m.insert(o.id, i);
+            }
+        }
         self.frame_of.push(o.frame_id);
         let pose = truth.observation_pose(o);
         let Some((f, pose)) = truth.frame(o.frame_id).zip(pose) else {
@@ -389,8 +409,7 @@ impl Scorer {
     /// The positions and sites of the observations a pair of ids names, when both are known
     /// and have truth.
     pub(super) fn resolve(&self, query: ObsId, past: ObsId) -> Option<(usize, usize, Site, Site)> {
-        let index_of = &self.joined.index_of;
-        let (&qi, &pi) = (index_of.get(&query)?, index_of.get(&past)?);
+        let (qi, pi) = (self.joined.position(query)?, self.joined.position(past)?);
         Some((qi, pi, *self.site(qi)?, *self.site(pi)?))
     }
 
@@ -730,7 +749,7 @@ pub(crate) mod tests {
                 }],
                 seconds: 0.0,
                 laps: 2,
-                truth: gt.clone(),
+                truth: std::sync::Arc::new(gt.clone()),
                 diagnostics: None,
                 lap_seconds: Vec::new(),
                 evaluation: None,
@@ -789,7 +808,7 @@ pub(crate) mod tests {
             matches,
             seconds: 1.0,
             laps: 3,
-            truth: gt,
+            truth: std::sync::Arc::new(gt),
             diagnostics: None,
             lap_seconds: Vec::new(),
             evaluation: None,
@@ -838,7 +857,7 @@ pub(crate) mod tests {
             matches,
             seconds: 0.0,
             laps: 2,
-            truth: gt,
+            truth: std::sync::Arc::new(gt),
             diagnostics: None,
             lap_seconds: Vec::new(),
             evaluation: None,

@@ -26,6 +26,7 @@ use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::recognizer::{Match, MatchDiagnostics, Observation};
 use crate::spec::evaluation::EvaluationSpec;
+use std::sync::Arc;
 use std::time::Instant;
 use tally::{Scope, Tally};
 
@@ -107,6 +108,16 @@ impl GroundTruth {
         self.laps.push(info);
     }
 
+    /// Appends the truth of `frames`, the next frames of the last lap started; returns the
+    /// input index of the first (the index the recognizer is handed back).
+    pub fn push_frames(&mut self, frames: &[Frame]) -> usize {
+        let first = self.frames.len();
+        for f in frames {
+            self.push_frame(f.truth, f.odom);
+        }
+        first
+    }
+
     /// Appends one frame of the last lap started.
     pub fn push_frame(&mut self, pose: TruePose, odom: OdomPose) {
         self.frames.push(FrameTruth {
@@ -166,8 +177,8 @@ pub struct Recognition {
     pub seconds: f64,
     /// Number of laps fed.
     pub laps: usize,
-    /// Truth of every frame fed, by input index.
-    pub truth: GroundTruth,
+    /// Truth of every frame fed, by input index (shared by the recognitions of one input).
+    pub truth: Arc<GroundTruth>,
     /// What the recognizer saw (to say why nothing matched), when it tells.
     pub diagnostics: Option<MatchDiagnostics>,
     /// Seconds the recognizer spent on each lap's frames, in the order fed: CPU time of the
@@ -206,15 +217,19 @@ pub fn recognize_runs_with_progress(
     runs: &[RunLog],
     on_lap: &mut dyn FnMut(usize),
 ) -> Recognition {
+    let mut truth = GroundTruth::default();
     let mut recording = Recording::default();
     for run in runs {
-        recording.start_run(rec);
+        recording.start_run(rec, &truth);
         for lap in &run.laps {
-            recording.lap(rec, run.run, lap);
+            truth.start_lap(LapInfo::of(run.run, lap));
+            let first = truth.push_frames(&lap.frames);
+            recording.lap(rec, &lap.frames, first, &truth);
             on_lap(recording.laps);
         }
     }
-    recording.finish(rec)
+    recording.close(rec, &truth);
+    recording.finish(rec, Arc::new(truth))
 }
 
 /// CPU time of the calling thread, seconds (Linux: /proc/thread-self/schedstat; `None` elsewhere).
@@ -225,12 +240,12 @@ fn thread_cpu_s() -> Option<f64> {
 }
 
 /// A recognition in progress, fed lap by lap or frames at a time (so a caller need not hold
-/// every lap's scans): the truth of the frames fed, the matches so far and the recognizer's
-/// time, in total and per lap. [`Recording::streaming`] scores the matches as they arrive
-/// instead of keeping them ([`tally`]).
+/// every lap's scans): the matches so far and the recognizer's time, in total and per lap. The
+/// truth of the frames is the caller's ([`GroundTruth::push_frames`] before each feed), so the
+/// recognizers of one input share one copy. [`Recording::streaming`] scores the matches as they
+/// arrive instead of keeping them ([`tally`]).
 #[derive(Default)]
 pub struct Recording {
-    truth: GroundTruth,
     matches: Vec<Match>,
     seconds: f64,
     laps: usize,
@@ -254,13 +269,13 @@ impl Recording {
     }
 
     /// Keeps (or scores) matches `found`, after the frames and observations they name.
-    fn take(&mut self, rec: &dyn PlaceRecognizer, found: Vec<Match>) {
+    fn take(&mut self, rec: &dyn PlaceRecognizer, truth: &GroundTruth, found: Vec<Match>) {
         match &mut self.tally {
             Some((_, tally)) => {
                 if !found.is_empty() {
-                    tally.sync(rec.observations(), &self.truth);
+                    tally.sync(rec.observations(), truth);
                     for m in &found {
-                        tally.add(m, &self.truth);
+                        tally.add(m, truth);
                     }
                 }
             }
@@ -269,33 +284,41 @@ impl Recording {
     }
 
     /// Starts a run (call before each run's first lap, the first run included).
-    pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer) {
+    pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer, truth: &GroundTruth) {
         let t = Instant::now();
         let found = rec.start_run();
         self.seconds += t.elapsed().as_secs_f64();
-        self.take(rec, found);
+        self.take(rec, truth, found);
     }
 
-    /// Feeds every frame of `lap` (of run `run`) and keeps its truth.
-    pub fn lap(&mut self, rec: &mut dyn PlaceRecognizer, run: usize, lap: &LapLog) {
-        self.start_lap(LapInfo::of(run, lap));
-        self.frames(rec, &lap.frames);
+    /// Feeds every frame of a lap (`truth` holds them from input index `first_id`) and times
+    /// it as one lap.
+    pub fn lap(
+        &mut self,
+        rec: &mut dyn PlaceRecognizer,
+        frames: &[Frame],
+        first_id: usize,
+        truth: &GroundTruth,
+    ) {
+        self.start_lap();
+        self.frames(rec, frames, first_id, truth);
         self.end_lap();
     }
 
     /// Starts a lap whose frames come in pieces ([`Self::frames`]) until [`Self::end_lap`].
-    pub fn start_lap(&mut self, info: LapInfo) {
-        self.truth.start_lap(info);
+    pub fn start_lap(&mut self) {
         self.lap_so_far = 0.0;
     }
 
-    /// Feeds `frames`, the next frames of the lap started, and keeps their truth.
-    pub fn frames(&mut self, rec: &mut dyn PlaceRecognizer, frames: &[Frame]) {
-        // Frames are tagged with their index in the truth, which the recognizer hands back.
-        let first_id = self.truth.frames.len();
-        for f in frames {
-            self.truth.push_frame(f.truth, f.odom);
-        }
+    /// Feeds `frames`, the next frames of the lap started, whose truth `truth` already holds
+    /// from input index `first_id` on.
+    pub fn frames(
+        &mut self,
+        rec: &mut dyn PlaceRecognizer,
+        frames: &[Frame],
+        first_id: usize,
+        truth: &GroundTruth,
+    ) {
         let mut found = Vec::new();
         let (t, cpu) = (Instant::now(), thread_cpu_s());
         for (i, frame) in frames.iter().enumerate() {
@@ -308,7 +331,7 @@ impl Recording {
             _ => s,
         };
         // Scored outside the timing: the recognizer's time is its own.
-        self.take(rec, found);
+        self.take(rec, truth, found);
     }
 
     /// Ends the lap started.
@@ -367,7 +390,7 @@ impl Recording {
     }
 
     /// Ends the input: adds the matches closing the last run produced (once).
-    pub fn close(&mut self, rec: &mut dyn PlaceRecognizer) {
+    pub fn close(&mut self, rec: &mut dyn PlaceRecognizer, truth: &GroundTruth) {
         if self.closed {
             return;
         }
@@ -375,24 +398,25 @@ impl Recording {
         let t = Instant::now();
         let found = rec.finish();
         self.seconds += t.elapsed().as_secs_f64();
-        self.take(rec, found);
+        self.take(rec, truth, found);
     }
 
-    /// Ends the input and hands over the recognition (scored, when streaming).
-    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer) -> Recognition {
-        self.close(rec);
+    /// Hands over the recognition (scored, when streaming), after [`Self::close`]; `truth` is
+    /// the truth of every frame fed.
+    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer, truth: Arc<GroundTruth>) -> Recognition {
+        self.close(rec, &truth);
         let observations = rec.observations().to_vec();
-        let evaluation = self.tally.take().map(|(spec, tally)| {
-            let e = tally.finish(&observations, &self.truth);
-            (spec, e)
-        });
+        let evaluation = self
+            .tally
+            .take()
+            .map(|(spec, tally)| (spec, tally.finish(&observations, &truth)));
         Recognition {
             name: rec.name(),
             observations,
             matches: self.matches,
             seconds: self.seconds,
             laps: self.laps,
-            truth: self.truth,
+            truth,
             diagnostics: rec.diagnostics(),
             lap_seconds: self.lap_seconds,
             evaluation,

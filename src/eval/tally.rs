@@ -542,3 +542,49 @@ pub fn gain(here: &[u64], fewer: &[u64], correct: impl Fn(usize, usize) -> bool)
     }
     (pairs, ok)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::metrics::tests::circle;
+
+    /// Observation ids need not be positions: the same observations and match with every id
+    /// moved by 1000 score the same, and a match naming ids never reported is not scored.
+    #[test]
+    fn ids_that_are_not_positions_score_the_same() {
+        let (obs, gt) = circle(3, 40.0);
+        let spec = EvaluationSpec::default();
+        let pairs: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
+        let score = |obs: &[Observation], shift: usize| {
+            let m = Match::from_pairs(
+                1,
+                1,
+                vec![],
+                pairs.iter().map(|&(q, p)| (q + shift, p + shift)),
+            );
+            let mut t = Tally::new(&spec, Scope::Full);
+            t.sync(obs, &gt);
+            t.add(&m, &gt);
+            t.finish(obs, &gt)
+        };
+        let moved: Vec<Observation> = obs
+            .iter()
+            .map(|o| Observation {
+                id: o.id + 1000,
+                ..o.clone()
+            })
+            .collect();
+        let (dense, sparse) = (score(&obs, 0), score(&moved, 1000));
+        assert!(
+            dense.main.pairs > 400 && dense.main.precision == 1.0,
+            "{:?}",
+            dense.main
+        );
+        assert_eq!(dense, sparse);
+        let unknown = score(&obs, 5000);
+        assert_eq!(
+            (unknown.main.pairs, unknown.main.unresolved_pairs),
+            (0, pairs.len())
+        );
+    }
+}

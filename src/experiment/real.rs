@@ -9,7 +9,7 @@
 
 use super::stream::{Job, finish_jobs, jobs, settle};
 use super::{Experiment, ExperimentError, ExperimentOptions, assemble, level_configs};
-use crate::eval::LapInfo;
+use crate::eval::{GroundTruth, LapInfo};
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
 use crate::io::real_log::{LogSurvey, RealLogError, TruthSource, load_run, stream_frames};
@@ -207,14 +207,15 @@ pub fn recognize_log_streamed(
     opts.progress
         .start("recognizing", kept.div_ceil(CHUNK_FRAMES) as u64);
     let (tx, rx) = sync_channel::<Vec<Frame>>(CHUNKS_AHEAD);
+    let mut truth = GroundTruth::default();
     let read = std::thread::scope(|s| {
         let producer = s.spawn(|| send_chunks(path, read, &survey, log, tx));
-        feed_chunks(&mut jobs, rx, &opts.progress);
+        feed_chunks(&mut jobs, &mut truth, rx, &opts.progress);
         producer.join().expect("the log reader does not panic")
     });
     opts.progress.done();
     read?;
-    let results = finish_jobs(jobs);
+    let results = finish_jobs(jobs, truth);
     let exp = assemble(name, log.seed, 1, evaluation, &configs, results, Vec::new());
     Ok((exp, survey.counts.skipped_lines))
 }
@@ -250,21 +251,29 @@ fn send_chunks(
 }
 
 /// Feeds the chunks from `rx` to every job (the jobs in parallel) as frames of one run of one
-/// lap, doors unknown (as a real log's run is); a progress step per chunk.
-fn feed_chunks(jobs: &mut [Job], rx: Receiver<Vec<Frame>>, progress: &super::ProgressSink) {
-    let info = LapInfo {
+/// lap, doors unknown (as a real log's run is), with their truth kept once in `truth`; a
+/// progress step per chunk.
+fn feed_chunks(
+    jobs: &mut [Job],
+    truth: &mut GroundTruth,
+    rx: Receiver<Vec<Frame>>,
+    progress: &super::ProgressSink,
+) {
+    truth.start_lap(LapInfo {
         run: 0,
         lap: 0,
         door_config: "unknown".into(),
         open_doors: Vec::new(),
-    };
+    });
     for (_, rec, recording) in jobs.iter_mut() {
-        recording.start_run(rec.as_mut());
-        recording.start_lap(info.clone());
+        recording.start_run(rec.as_mut(), truth);
+        recording.start_lap();
     }
     for chunk in rx {
+        let first = truth.push_frames(&chunk);
+        let truth = &*truth;
         jobs.par_iter_mut().for_each(|(_, rec, recording)| {
-            recording.frames(rec.as_mut(), &chunk);
+            recording.frames(rec.as_mut(), &chunk, first, truth);
         });
         settle(jobs, false);
         progress.step();

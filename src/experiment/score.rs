@@ -288,7 +288,7 @@ impl LoggedRuns {
             matches,
             seconds: 0.0,
             laps: self.laps,
-            truth: self.truth.clone(),
+            truth: std::sync::Arc::new(self.truth.clone()),
             diagnostics: None,
             lap_seconds: Vec::new(),
             evaluation: None,

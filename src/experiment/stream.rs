@@ -14,13 +14,14 @@
 
 use super::{ExperimentError, ExperimentOptions, ProgressSink, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
-use crate::eval::{PlaceRecognizer, Recognition, Recording};
+use crate::eval::{GroundTruth, LapInfo, PlaceRecognizer, Recognition, Recording};
 use crate::log::LapLog;
 use crate::recognizer::{Recognizer, RecognizerConfig};
 use crate::sim::runner::RunSim;
 use crate::sim::{SimError, SimPlan};
 use crate::spec::evaluation::EvaluationSpec;
 use rayon::prelude::*;
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Instant;
 
@@ -43,10 +44,13 @@ pub fn run_scenario_streamed(
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
     opts.progress.start("laps", total as u64);
-    let (sim_s, ()) = with_laps(plan, &laps_of, |rx| feed(&mut jobs, rx, &opts.progress));
+    let mut truth = GroundTruth::default();
+    let (sim_s, ()) = with_laps(plan, &laps_of, |rx| {
+        feed(&mut jobs, &mut truth, rx, &opts.progress)
+    });
     opts.progress.done();
     let sim_s = sim_s?;
-    let results = finish_jobs(jobs);
+    let results = finish_jobs(jobs, truth);
     let mut exp = assemble(
         &plan.name,
         plan.seed,
@@ -180,18 +184,29 @@ pub(super) fn settle(jobs: &mut [Job], last: bool) {
 }
 
 /// Feeds each lap from `rx` to every job (the jobs in parallel), starting a run at each new
-/// run index; tells `progress` a step per lap and a status of laps per second and memory.
-fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink) {
+/// run index, with the laps' truth kept once in `truth`; tells `progress` a step per lap and a
+/// status of laps per second and memory.
+fn feed(
+    jobs: &mut [Job],
+    truth: &mut GroundTruth,
+    rx: Receiver<(usize, LapLog)>,
+    progress: &ProgressSink,
+) {
     let start = Instant::now();
     let mut current = None;
     for (run, lap) in rx {
         let new_run = current != Some(run);
         current = Some(run);
+        if new_run {
+            let truth = &*truth;
+            jobs.par_iter_mut()
+                .for_each(|(_, rec, recording)| recording.start_run(rec.as_mut(), truth));
+        }
+        truth.start_lap(LapInfo::of(run, &lap));
+        let first = truth.push_frames(&lap.frames);
+        let truth = &*truth;
         jobs.par_iter_mut().for_each(|(_, rec, recording)| {
-            if new_run {
-                recording.start_run(rec.as_mut());
-            }
-            recording.lap(rec.as_mut(), run, &lap);
+            recording.lap(rec.as_mut(), &lap.frames, first, truth);
         });
         settle(jobs, false);
         progress.step();
@@ -201,14 +216,18 @@ fn feed(jobs: &mut [Job], rx: Receiver<(usize, LapLog)>, progress: &ProgressSink
 }
 
 /// Ends every job's input and hands its recording and recognizer over as the scored
-/// recognition.
-pub(super) fn finish_jobs(mut jobs: Vec<Job>) -> Vec<(Option<usize>, Recognition)> {
+/// recognition; `truth` is the truth of every frame fed, shared by the recognitions.
+pub(super) fn finish_jobs(
+    mut jobs: Vec<Job>,
+    truth: GroundTruth,
+) -> Vec<(Option<usize>, Recognition)> {
     for (_, rec, recording) in &mut jobs {
-        recording.close(rec.as_mut());
+        recording.close(rec.as_mut(), &truth);
     }
     settle(&mut jobs, true);
+    let truth = Arc::new(truth);
     jobs.into_iter()
-        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut())))
+        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut(), truth.clone())))
         .collect()
 }
 
@@ -259,14 +278,19 @@ mod tests {
         let mut jobs = jobs(&configs, &scn.evaluation, false).unwrap();
         let laps_of = |run: usize| [30, 10][run];
         let mut held_at = Vec::new();
+        let mut truth = GroundTruth::default();
         let (sim, ()) = with_laps(&scn.sim, &laps_of, |rx| {
             let mut current = None;
             for (run, lap) in rx {
-                for (_, rec, recording) in jobs.iter_mut() {
-                    if current != Some(run) {
-                        recording.start_run(rec.as_mut());
+                if current != Some(run) {
+                    for (_, rec, recording) in jobs.iter_mut() {
+                        recording.start_run(rec.as_mut(), &truth);
                     }
-                    recording.lap(rec.as_mut(), run, &lap);
+                }
+                truth.start_lap(LapInfo::of(run, &lap));
+                let first = truth.push_frames(&lap.frames);
+                for (_, rec, recording) in jobs.iter_mut() {
+                    recording.lap(rec.as_mut(), &lap.frames, first, &truth);
                 }
                 current = Some(run);
                 settle(&mut jobs, false);
@@ -275,7 +299,7 @@ mod tests {
         });
         sim.expect("simulates");
         let late: Vec<usize> = jobs.iter().map(|j| j.2.pairs_held().unwrap().1).collect();
-        let results = finish_jobs(jobs);
+        let results = finish_jobs(jobs, truth);
         let (_, e) = results[1].1.evaluation.as_ref().expect("scored as it went");
         assert!(results[1].1.matches.is_empty(), "no match is kept");
         // Held pairs flatten out: laps 30–40 hold at most a third more than laps 15–20 did,
