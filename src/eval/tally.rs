@@ -571,7 +571,7 @@ mod tests {
             .iter()
             .map(|o| Observation {
                 id: o.id + 1000,
-                ..o.clone()
+                ..*o
             })
             .collect();
         let (dense, sparse) = (score(&obs, 0), score(&moved, 1000));
