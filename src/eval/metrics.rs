@@ -143,7 +143,7 @@ pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
     for m in &rec.matches {
         tally.add(m, &rec.truth);
     }
-    tally.finish(&rec.observations, &rec.truth)
+    tally.finish(&rec.truth)
 }
 
 /// Scores observations and matches at radius `radius_m`, top-level figures only (no visit or
@@ -251,15 +251,51 @@ pub(super) struct Joined {
     /// observations is kept).
     index_of: Option<HashMap<ObsId, usize>>,
     /// Per observation (creation order): its site, or [`NO_SITE`] when its frame has no truth.
-    site_of: Vec<u32>,
+    site_of: Dense,
     /// Per observation: the input frame that made it.
-    frame_of: Vec<usize>,
+    frame_of: Vec<u32>,
     /// The observations with truth, in creation order.
     sites: Vec<Site>,
     /// Per site: its door configuration index.
     site_config: Vec<u32>,
     /// Per site: its position in the observations.
-    site_obs: Vec<u32>,
+    site_obs: Dense,
+}
+
+/// A map of positions kept as the identity (no storage) until an entry differs: observation →
+/// site and site → observation are the identity while every observation has truth, the usual
+/// case, so a log of a million observations keeps no tables.
+#[derive(Clone, Debug, Default)]
+struct Dense {
+    len: usize,
+    /// The entries, once one is not its own position.
+    table: Option<Vec<u32>>,
+}
+
+impl Dense {
+    fn push(&mut self, v: u32) {
+        match &mut self.table {
+            None if v as usize == self.len => {}
+            None => {
+                let mut t: Vec<u32> = (0..self.len as u32).collect();
+                t.push(v);
+                self.table = Some(t);
+            }
+            Some(t) => t.push(v),
+        }
+        self.len += 1;
+    }
+
+    fn get(&self, i: usize) -> Option<u32> {
+        match &self.table {
+            None => (i < self.len).then_some(i as u32),
+            Some(t) => t.get(i).copied(),
+        }
+    }
+
+    fn len(&self) -> usize {
+        self.len
+    }
 }
 
 /// Marks an observation without truth in `Joined::site_of`.
@@ -278,6 +314,11 @@ pub struct Scorer {
 }
 
 impl Joined {
+    /// The observation (position) of site `k`.
+    fn obs_of_site(&self, k: usize) -> usize {
+        self.site_obs.get(k).expect("a site of an observation") as usize
+    }
+
     /// The position of the observation with id `id`, if joined.
     fn position(&self, id: ObsId) -> Option<usize> {
         match &self.index_of {
@@ -286,14 +327,13 @@ impl Joined {
         }
     }
 
-    /// Appends observation `o`, at position `i`, with its true pose (`travel`: true travel per
-    /// frame; `lap_config`: door configuration of each lap).
+    /// Appends observation `o`, at position `i`, with its true pose (`lap_config`: door
+    /// configuration of each lap).
     pub(super) fn push(
         &mut self,
         i: usize,
         o: &Observation,
         truth: &GroundTruth,
-        travel: &[f64],
         lap_config: &[u32],
     ) {
         match &mut self.index_of {
@@ -307,7 +347,7 @@ impl Joined {
                 m.insert(o.id, i);
             }
         }
-        self.frame_of.push(o.frame_id);
+        self.frame_of.push(o.frame_id as u32);
         let pose = truth.observation_pose(o);
         let Some((f, pose)) = truth.frame(o.frame_id).zip(pose) else {
             self.site_of.push(NO_SITE);
@@ -318,7 +358,7 @@ impl Joined {
             x: pose.0.x,
             y: pose.0.y,
             theta: pose.0.theta,
-            travel_m: travel[o.frame_id],
+            travel_m: f.travel_m,
             lap: f.lap_slot,
         });
         self.site_config.push(lap_config[f.lap_slot]);
@@ -344,10 +384,9 @@ impl Scorer {
             .iter()
             .map(|l| config_index[l.door_config.as_str()] as u32)
             .collect();
-        let travel = super::pair_recall::true_travel_m(truth);
         let mut joined = Joined::default();
         for (i, o) in observations.iter().enumerate() {
-            joined.push(i, o, truth, &travel, &lap_config);
+            joined.push(i, o, truth, &lap_config);
         }
         Scorer {
             joined: Arc::new(joined),
@@ -403,7 +442,7 @@ impl Scorer {
 
     /// The input frame of observation `i`.
     pub(super) fn frame_of(&self, i: usize) -> usize {
-        self.joined.frame_of[i]
+        self.joined.frame_of[i] as usize
     }
 
     /// The positions and sites of the observations a pair of ids names, when both are known
@@ -423,13 +462,18 @@ impl Scorer {
 
     /// The truth of observation `i` (its position in the observations), if its frame has one.
     fn site(&self, i: usize) -> Option<&Site> {
-        let k = *self.joined.site_of.get(i)?;
+        let k = self.joined.site_of.get(i)?;
         self.joined.sites.get(k as usize)
     }
 
     /// The door configuration of observation `i`, which has truth.
     pub(super) fn config(&self, i: usize) -> usize {
-        self.joined.site_config[self.joined.site_of[i] as usize] as usize
+        let k = self
+            .joined
+            .site_of
+            .get(i)
+            .expect("an observation with truth");
+        self.joined.site_config[k as usize] as usize
     }
 
     /// Observations scored (with or without truth).
@@ -453,7 +497,7 @@ impl Scorer {
         }
         let j = &self.joined;
         sweep(&j.sites, self.min_gap_m, |k, tree| {
-            has[j.site_obs[k] as usize] = tree.count(&self.query(k, r), true) > 0;
+            has[j.obs_of_site(k)] = tree.count(&self.query(k, r), true) > 0;
         });
         has
     }
@@ -480,7 +524,7 @@ impl Scorer {
         sweep(&j.sites, self.min_gap_m, |k, tree| {
             laps.clear();
             tree.laps(&self.query(k, r), laps);
-            visit(j.site_obs[k] as usize, &laps.list);
+            visit(j.obs_of_site(k), &laps.list);
         });
     }
 
@@ -488,8 +532,8 @@ impl Scorer {
     /// configuration.
     pub(super) fn each_site(&self, mut f: impl FnMut(usize, usize)) {
         let j = &self.joined;
-        for (&i, &config) in j.site_obs.iter().zip(&j.site_config) {
-            f(i as usize, config as usize);
+        for (k, &config) in j.site_config.iter().enumerate() {
+            f(j.obs_of_site(k), config as usize);
         }
     }
 
@@ -564,7 +608,7 @@ pub fn f1(precision: f64, recall: f64) -> f64 {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::eval::{FrameTruth, LapInfo};
+    use crate::eval::LapInfo;
     use crate::geom::{OdomPose, Pose2, TruePose};
     use crate::recognizer::Direction;
     /// An aligned pair (query, past).
@@ -580,7 +624,7 @@ pub(crate) mod tests {
         let mut obs = Vec::new();
         let mut gt = GroundTruth::default();
         for lap in 0..laps {
-            gt.laps.push(LapInfo {
+            gt.start_lap(LapInfo {
                 run: 0,
                 lap,
                 door_config: if lap % 2 == 0 { "closed" } else { "open" }.into(),
@@ -594,11 +638,7 @@ pub(crate) mod tests {
                     a + std::f64::consts::FRAC_PI_2,
                 );
                 let i = obs.len();
-                gt.frames.push(FrameTruth {
-                    pose: TruePose(pose),
-                    odom: OdomPose(pose),
-                    lap_slot: lap,
-                });
+                gt.push_frame(TruePose(pose), OdomPose(pose));
                 obs.push(Observation {
                     id: i,
                     run: 0,
@@ -675,7 +715,7 @@ pub(crate) mod tests {
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(&obs, &gt);
             matches.iter().for_each(|m| t.add(m, &gt));
-            t.finish(&obs, &gt).main.visit_recall
+            t.finish(&gt).main.visit_recall
         };
         let nearest = vec![one_match(oracle(&obs, &gt, &spec))];
         let m = score(&obs, &nearest, &gt, &spec, 1.0);

@@ -69,6 +69,9 @@ pub struct FrameTruth {
     pub odom: crate::geom::OdomPose,
     /// Index into [`GroundTruth::laps`].
     pub lap_slot: usize,
+    /// Distance along the true path from the first frame, metres (a run boundary adds none;
+    /// `eval::pair_recall::true_travel_m`).
+    pub travel_m: f64,
 }
 
 /// Ground truth of every frame fed to a recognizer, indexed by the global input index
@@ -120,10 +123,20 @@ impl GroundTruth {
 
     /// Appends one frame of the last lap started.
     pub fn push_frame(&mut self, pose: TruePose, odom: OdomPose) {
+        let lap_slot = self.laps.len().saturating_sub(1);
+        let run_of = |slot: usize| self.laps.get(slot).map(|l| l.run);
+        let travel_m = match self.frames.last() {
+            Some(prev) if run_of(prev.lap_slot) == run_of(lap_slot) => {
+                prev.travel_m + prev.pose.0.distance(&pose.0)
+            }
+            Some(prev) => prev.travel_m,
+            None => 0.0,
+        };
         self.frames.push(FrameTruth {
             pose,
             odom,
-            lap_slot: self.laps.len().saturating_sub(1),
+            lap_slot,
+            travel_m,
         });
     }
 
@@ -169,7 +182,8 @@ impl GroundTruth {
 pub struct Recognition {
     /// The recognizer's name.
     pub name: String,
-    /// Every observation, as the recognizer reported them at the end.
+    /// Every observation, as the recognizer reported them at the end; empty when the matches
+    /// were scored as they arrived (`evaluation` is set; nothing needs them after).
     pub observations: Vec<Observation>,
     /// Every match, in the order found.
     pub matches: Vec<Match>,
@@ -403,24 +417,59 @@ impl Recording {
 
     /// Hands over the recognition (scored, when streaming), after [`Self::close`]; `truth` is
     /// the truth of every frame fed.
-    pub fn finish(mut self, rec: &mut dyn PlaceRecognizer, truth: Arc<GroundTruth>) -> Recognition {
-        self.close(rec, &truth);
-        let observations = rec.observations().to_vec();
-        let evaluation = self
-            .tally
-            .take()
-            .map(|(spec, tally)| (spec, tally.finish(&observations, &truth)));
-        Recognition {
+    pub fn finish(self, rec: &mut dyn PlaceRecognizer, truth: Arc<GroundTruth>) -> Recognition {
+        self.end(rec, &truth).finish(truth)
+    }
+
+    /// Takes from the recognizer all that [`Ended::finish`] needs (after [`Self::close`]), so
+    /// the recognizer can be dropped before the scoring's last count.
+    pub fn end(mut self, rec: &mut dyn PlaceRecognizer, truth: &GroundTruth) -> Ended {
+        self.close(rec, truth);
+        // Scored as they arrived, the observations are not needed again (a long log has
+        // millions): the tally keeps what it needs of them.
+        let observations = match &mut self.tally {
+            Some((_, tally)) => {
+                tally.sync(rec.observations(), truth);
+                Vec::new()
+            }
+            None => rec.observations().to_vec(),
+        };
+        Ended {
             name: rec.name(),
-            observations,
-            matches: self.matches,
-            seconds: self.seconds,
-            laps: self.laps,
-            truth,
             diagnostics: rec.diagnostics(),
-            lap_seconds: self.lap_seconds,
+            observations,
+            recording: self,
+        }
+    }
+}
+
+/// A recording whose recognizer is done ([`Recording::end`]).
+pub struct Ended {
+    name: String,
+    diagnostics: Option<MatchDiagnostics>,
+    observations: Vec<Observation>,
+    recording: Recording,
+}
+
+impl Ended {
+    /// The recognition, scored when the recording was streaming.
+    pub fn finish(self, truth: Arc<GroundTruth>) -> Recognition {
+        let r = self.recording;
+        let evaluation = r.tally.map(|(spec, tally)| {
+            let e = tally.finish(&truth);
+            (spec, e)
+        });
+        Recognition {
+            name: self.name,
+            observations: self.observations,
+            matches: r.matches,
+            seconds: r.seconds,
+            laps: r.laps,
+            truth,
+            diagnostics: self.diagnostics,
+            lap_seconds: r.lap_seconds,
             evaluation,
-            level_gain: self.level_gain,
+            level_gain: r.level_gain,
         }
     }
 }

@@ -23,21 +23,10 @@ use super::site_tree::{Query, Site, sweep};
 use crate::geom::wrap_angle;
 use crate::recognizer::Direction;
 
-/// Distance along the true path from the first frame to each frame, metres.
+/// Distance along the true path from the first frame to each frame, metres (kept with each
+/// frame's truth as it is pushed, [`super::FrameTruth::travel_m`]).
 pub fn true_travel_m(truth: &GroundTruth) -> Vec<f64> {
-    let mut out = Vec::with_capacity(truth.frames.len());
-    let mut acc = 0.0;
-    for (i, f) in truth.frames.iter().enumerate() {
-        if i > 0 {
-            let prev = &truth.frames[i - 1];
-            let same_run = truth.laps[prev.lap_slot].run == truth.laps[f.lap_slot].run;
-            if same_run {
-                acc += prev.pose.0.distance(&f.pose.0);
-            }
-        }
-        out.push(acc);
-    }
-    out
+    truth.frames.iter().map(|f| f.travel_m).collect()
 }
 
 /// Whether two true headings agree as a same-direction pair must.
@@ -153,7 +142,7 @@ mod tests {
         let mut t = Tally::new(&spec, Scope::Full);
         t.sync(obs, gt);
         matches.iter().for_each(|m| t.add(m, gt));
-        let e = t.finish(obs, gt);
+        let e = t.finish(gt);
         match facing {
             Facing::Either => e.main.pair_recall,
             Facing::Same => e.directions.same.pair_recall,

@@ -65,9 +65,9 @@ struct Slot {
     counts: Counts,
     per_cfg: Vec<Counts>,
     /// Per observation: the query of a correct pair.
-    recalled_query: Vec<bool>,
+    recalled_query: Bits,
     /// Per observation: either side of a correct pair.
-    recalled_any: Vec<bool>,
+    recalled_any: Bits,
     /// Distinct pairs found that could have been found (pair recall's numerator).
     found: u64,
     /// The match being counted: its distinct pairs, the correct ones, its door configuration.
@@ -85,8 +85,8 @@ impl Slot {
             recalls,
             counts: Counts::default(),
             per_cfg: Vec::new(),
-            recalled_query: Vec::new(),
-            recalled_any: Vec::new(),
+            recalled_query: Bits::default(),
+            recalled_any: Bits::default(),
             found: 0,
             n: 0,
             ok: 0,
@@ -100,9 +100,6 @@ pub struct Tally {
     spec: EvaluationSpec,
     scorer: Scorer,
     slots: Vec<Slot>,
-    /// True travel per frame so far, and the running sum.
-    travel: Vec<f64>,
-    travel_acc: f64,
     /// Door configuration index of each lap synced.
     lap_config: Vec<u32>,
     config_index: HashMap<String, usize>,
@@ -160,8 +157,6 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            travel: Vec::new(),
-            travel_acc: 0.0,
             lap_config: Vec::new(),
             config_index: HashMap::new(),
             window: HashMap::new(),
@@ -193,21 +188,9 @@ impl Tally {
             self.scorer.add_lap(c, &lap.door_config);
             self.lap_config.push(c as u32);
         }
-        // As `pair_recall::true_travel_m`, operand for operand.
-        for i in self.travel.len()..truth.frames.len() {
-            if i > 0 {
-                let (prev, f) = (&truth.frames[i - 1], &truth.frames[i]);
-                if truth.laps[prev.lap_slot].run == truth.laps[f.lap_slot].run {
-                    self.travel_acc += prev.pose.0.distance(&f.pose.0);
-                }
-            }
-            self.travel.push(self.travel_acc);
-        }
         let known = self.scorer.observation_count();
         for (i, o) in observations.iter().enumerate().skip(known) {
-            self.scorer
-                .joined_mut()
-                .push(i, o, truth, &self.travel, &self.lap_config);
+            self.scorer.joined_mut().push(i, o, truth, &self.lap_config);
         }
         self.grow_slots();
     }
@@ -216,8 +199,8 @@ impl Tally {
     fn grow_slots(&mut self) {
         let (n, configs) = (self.scorer.observation_count(), self.scorer.config_count());
         for s in &mut self.slots {
-            s.recalled_query.resize(n, false);
-            s.recalled_any.resize(n, false);
+            s.recalled_query.resize(n);
+            s.recalled_any.resize(n);
             if s.breakdown {
                 s.per_cfg.resize(configs, Counts::default());
             }
@@ -274,14 +257,14 @@ impl Tally {
                         s.per_cfg[cfg].correct += usize::from(correct);
                     }
                     if correct {
-                        s.recalled_query[qi] = true;
-                        s.recalled_any[qi] = true;
-                        s.recalled_any[pi] = true;
+                        s.recalled_query.set(qi);
+                        s.recalled_any.set(qi);
+                        s.recalled_any.set(pi);
                     }
                 }
             }
             let mut after = before | 1 | (1 << claim_bit);
-            if recalls && self.could_be_found(qi, pi, claim, truth) {
+            if recalls && self.could_be_found((qi, &q), (pi, &pa), claim, truth) {
                 for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
                     let bit = 1 << (3 + facing_bit(s.facing));
                     if before & bit == 0 {
@@ -310,14 +293,21 @@ impl Tally {
     /// Pair recall's test of a pair claimed `claim`: the two frames' true positions within
     /// `tp_radius_m`, at least `min_gap_m` of true travel apart, facing as claimed
     /// (`pair_recall::pair_recall`'s rule).
-    fn could_be_found(&self, qi: usize, pi: usize, claim: Facing, truth: &GroundTruth) -> bool {
+    fn could_be_found(
+        &self,
+        (qi, qs): (usize, &Site),
+        (pi, ps): (usize, &Site),
+        claim: Facing,
+        truth: &GroundTruth,
+    ) -> bool {
         let r = self.spec.tp_radius_m;
         if r <= 0.0 || !r.is_finite() {
             return false;
         }
         let (fq, fp) = (self.scorer.frame_of(qi), self.scorer.frame_of(pi));
         let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
-        self.travel[fq] - self.travel[fp] >= self.spec.min_gap_m
+        // A site's travel is its frame's.
+        qs.travel_m - ps.travel_m >= self.spec.min_gap_m
             && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
             && claim.agrees(q.theta, p.theta, self.scorer.heading_tol_rad())
     }
@@ -402,9 +392,9 @@ impl Tally {
         self.slots[0].metrics(revisits, &self.scorer).0
     }
 
-    /// Every figure (a [`Scope::Full`] tally), after syncing what `observations` and `truth` add.
-    pub fn finish(mut self, observations: &[Observation], truth: &GroundTruth) -> Evaluation {
-        self.sync(observations, truth);
+    /// Every figure (a [`Scope::Full`] tally) of the observations synced ([`Self::sync`] the
+    /// last ones first).
+    pub fn finish(mut self, truth: &GroundTruth) -> Evaluation {
         self.evict_below(usize::MAX);
         // Late pairs (none from a recognizer that keeps its horizon) may repeat an entry.
         self.visits.sort_unstable();
@@ -415,7 +405,7 @@ impl Tally {
             }
             same
         });
-        let sites = self.frame_sites(observations, truth);
+        let sites = self.frame_sites(truth);
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
         for s in &self.slots {
             let scorer = self.scorer.with_facing(s.facing);
@@ -479,16 +469,15 @@ impl Tally {
     }
 
     /// Pair recall's sites: each observation's frame truth (not moved to the observation).
-    fn frame_sites(&self, observations: &[Observation], truth: &GroundTruth) -> Vec<Site> {
-        observations
-            .iter()
-            .filter_map(|o| {
-                let f = truth.frame(o.frame_id)?;
+    fn frame_sites(&self, truth: &GroundTruth) -> Vec<Site> {
+        (0..self.scorer.observation_count())
+            .filter_map(|i| {
+                let f = truth.frame(self.scorer.frame_of(i))?;
                 Some(Site {
                     x: f.pose.0.x,
                     y: f.pose.0.y,
                     theta: f.pose.0.theta,
-                    travel_m: self.travel[o.frame_id],
+                    travel_m: f.travel_m,
                     lap: f.lap_slot,
                 })
             })
@@ -507,13 +496,14 @@ impl Slot {
                 return;
             }
             total.revisits += 1;
-            total.recalled += usize::from(self.recalled_query[i]);
-            total.recalled_any += usize::from(self.recalled_any[i]);
+            let (query, any) = (self.recalled_query.get(i), self.recalled_any.get(i));
+            total.recalled += usize::from(query);
+            total.recalled_any += usize::from(any);
             if self.breakdown {
                 let c = &mut per_cfg[config];
                 c.revisits += 1;
-                c.recalled += usize::from(self.recalled_query[i]);
-                c.recalled_any += usize::from(self.recalled_any[i]);
+                c.recalled += usize::from(query);
+                c.recalled_any += usize::from(any);
             }
         });
         let configs = if self.breakdown {
@@ -522,6 +512,25 @@ impl Slot {
             Vec::new()
         };
         (total.metrics(self.radius_m), configs)
+    }
+}
+
+/// One flag per observation, 64 to a word (125 KB per figure for a million observations).
+#[derive(Clone, Debug, Default)]
+struct Bits(Vec<u64>);
+
+impl Bits {
+    /// Room for flags `0..n` (new ones unset).
+    fn resize(&mut self, n: usize) {
+        self.0.resize(n.div_ceil(64), 0);
+    }
+
+    fn set(&mut self, i: usize) {
+        self.0[i / 64] |= 1 << (i % 64);
+    }
+
+    fn get(&self, i: usize) -> bool {
+        self.0.get(i / 64).is_some_and(|w| w >> (i % 64) & 1 == 1)
     }
 }
 
@@ -565,7 +574,7 @@ mod tests {
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(obs, &gt);
             t.add(&m, &gt);
-            t.finish(obs, &gt)
+            t.finish(&gt)
         };
         let moved: Vec<Observation> = obs
             .iter()

@@ -225,9 +225,16 @@ pub(super) fn finish_jobs(
         recording.close(rec.as_mut(), &truth);
     }
     settle(&mut jobs, true);
+    // Each recognizer is dropped as soon as its recording has taken what it needs, before any
+    // tally makes its last count: the peak memory of a long log is the end of recognition.
+    let ended: Vec<(Option<usize>, crate::eval::Ended)> = jobs
+        .into_iter()
+        .map(|(levels, mut rec, recording)| (levels, recording.end(rec.as_mut(), &truth)))
+        .collect();
     let truth = Arc::new(truth);
-    jobs.into_iter()
-        .map(|(levels, mut rec, recording)| (levels, recording.finish(rec.as_mut(), truth.clone())))
+    ended
+        .into_iter()
+        .map(|(levels, e)| (levels, e.finish(truth.clone())))
         .collect()
 }
 
