@@ -8,6 +8,7 @@ MEMORY.csv: lines `laps,peak_rss_mb` (from `/usr/bin/time -v`, one run per line)
 Plain SVG, no plotting library needed.
 """
 import json
+import math
 import sys
 
 
@@ -42,7 +43,8 @@ def main():
     ]
     mem = [tuple(float(v) for v in l.split(",")) for l in open(memory) if l.strip()]
     ms = 1000.0
-    ymax_t = max(y for _, y in smooth) * ms * 1.15
+    # A multiple of 4 ms, so the four grid steps fall on whole milliseconds.
+    ymax_t = 4 * math.ceil(max(y for _, y in smooth) * ms * 1.15 / 4)
     ymax_m = max(1024.0, max(m for _, m in mem) * 1.15)
     xmax = max(len(secs), max(l for l, _ in mem))
     parts = [
