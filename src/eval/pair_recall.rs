@@ -16,7 +16,7 @@
 //!   that pair's direction holds it. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
 //!   observation per earlier lap suffices), it counts every observation of every earlier pass,
 //!   so it is the figure closest to the paper's "matches that could be obtained". Counted by
-//!   `eval::tally` (found, as matches arrive) and [`count_possible`] (the denominator).
+//!   `eval::tally` (found, as matches arrive) and `count_possible` (the denominator).
 
 use super::GroundTruth;
 use super::site_tree::{Query, Site, sweep};
@@ -72,7 +72,7 @@ impl Facing {
 }
 
 /// Counts behind pair recall (`eval::tally` counts `found` as matches arrive and `possible` at
-/// the end, [`count_possible`]).
+/// the end, `count_possible`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairRecall {
     /// Pairs that could have been found.
