@@ -417,9 +417,9 @@ impl Scorer {
         self.config_laps[c] += 1;
     }
 
-    /// The joined observations, to append to (`eval::tally`); the scorer must not be shared.
+    /// The joined observations, to append to (`eval::tally`; copied first if shared).
     pub(super) fn joined_mut(&mut self) -> &mut Joined {
-        Arc::get_mut(&mut self.joined).expect("a growing scorer is not shared")
+        Arc::make_mut(&mut self.joined)
     }
 
     /// Observations joined (with or without truth).

@@ -430,9 +430,13 @@ impl Tally {
         }
         let n_sens = self.spec.sensitivity_radii_m.len();
         let mut it = metrics.into_iter();
-        let (main, door_configs) = it.next().expect("the main figure");
+        // A `Scope::Main` tally has the first figure only; the others stay empty.
+        let (main, door_configs) = it.next().unwrap_or_default();
         let sensitivity = it.by_ref().take(n_sens).map(|(m, _)| m).collect();
-        let (same, opposite) = (it.next().expect("same").0, it.next().expect("opposite").0);
+        let (same, opposite) = (
+            it.next().unwrap_or_default().0,
+            it.next().unwrap_or_default().0,
+        );
         Evaluation {
             main,
             sensitivity,
