@@ -308,6 +308,8 @@ pub struct Scorer {
     joined: Arc<Joined>,
     configs: Vec<String>,
     config_laps: Vec<usize>,
+    /// Door configuration index of each lap joined.
+    lap_config: Vec<u32>,
     min_gap_m: f64,
     heading_tol_rad: f64,
     facing: Facing,
@@ -329,13 +331,7 @@ impl Joined {
 
     /// Appends observation `o`, at position `i`, with its true pose (`lap_config`: door
     /// configuration of each lap).
-    pub(super) fn push(
-        &mut self,
-        i: usize,
-        o: &Observation,
-        truth: &GroundTruth,
-        lap_config: &[u32],
-    ) {
+    fn push(&mut self, i: usize, o: &Observation, truth: &GroundTruth, lap_config: &[u32]) {
         match &mut self.index_of {
             None if o.id == i => {}
             None => {
@@ -369,57 +365,44 @@ impl Joined {
 impl Scorer {
     /// `observations` joined with `truth`, counted with `spec`'s rules.
     pub fn new(observations: &[Observation], truth: &GroundTruth, spec: &EvaluationSpec) -> Self {
-        let configs = truth.door_configs();
-        let config_index: HashMap<&str, usize> = configs
-            .iter()
-            .enumerate()
-            .map(|(i, c)| (c.as_str(), i))
-            .collect();
-        let mut config_laps = vec![0; configs.len()];
-        for l in &truth.laps {
-            config_laps[config_index[l.door_config.as_str()]] += 1;
-        }
-        let lap_config: Vec<u32> = truth
-            .laps
-            .iter()
-            .map(|l| config_index[l.door_config.as_str()] as u32)
-            .collect();
-        let mut joined = Joined::default();
-        for (i, o) in observations.iter().enumerate() {
-            joined.push(i, o, truth, &lap_config);
-        }
-        Scorer {
-            joined: Arc::new(joined),
-            configs,
-            config_laps,
-            ..Scorer::empty(spec)
-        }
+        let mut scorer = Scorer::empty(spec);
+        scorer.sync(observations, truth);
+        scorer
     }
 
-    /// No observation yet (grown by `eval::tally`).
+    /// No observation yet (grown by [`Self::sync`]).
     pub(super) fn empty(spec: &EvaluationSpec) -> Self {
         Scorer {
             joined: Arc::new(Joined::default()),
             configs: Vec::new(),
             config_laps: Vec::new(),
+            lap_config: Vec::new(),
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
             facing: Facing::Either,
         }
     }
 
-    /// Counts a lap driven in door configuration `c` (a new one is named `name`).
-    pub(super) fn add_lap(&mut self, c: usize, name: &str) {
-        if c == self.configs.len() {
-            self.configs.push(name.to_string());
-            self.config_laps.push(0);
+    /// Joins the laps and observations added to `truth` and `observations` since the last call
+    /// (both only ever grow). Door configurations are numbered in order of first appearance.
+    pub(super) fn sync(&mut self, observations: &[Observation], truth: &GroundTruth) {
+        for lap in &truth.laps[self.lap_config.len()..] {
+            let c = match self.configs.iter().position(|c| *c == lap.door_config) {
+                Some(c) => c,
+                None => {
+                    self.configs.push(lap.door_config.clone());
+                    self.config_laps.push(0);
+                    self.configs.len() - 1
+                }
+            };
+            self.config_laps[c] += 1;
+            self.lap_config.push(c as u32);
         }
-        self.config_laps[c] += 1;
-    }
-
-    /// The joined observations, to append to (`eval::tally`; copied first if shared).
-    pub(super) fn joined_mut(&mut self) -> &mut Joined {
-        Arc::make_mut(&mut self.joined)
+        let known = self.observation_count();
+        let joined = Arc::make_mut(&mut self.joined);
+        for (i, o) in observations.iter().enumerate().skip(known) {
+            joined.push(i, o, truth, &self.lap_config);
+        }
     }
 
     /// Observations joined (with or without truth).

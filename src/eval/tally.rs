@@ -100,9 +100,6 @@ pub struct Tally {
     spec: EvaluationSpec,
     scorer: Scorer,
     slots: Vec<Slot>,
-    /// Door configuration index of each lap synced.
-    lap_config: Vec<u32>,
-    config_index: HashMap<String, usize>,
     /// Distinct resolved pairs at or after the horizon, packed `(query, past)` observation
     /// indices → bits: seen by facing (0 either, 1 same, 2 opposite), found for pair recall by
     /// facing (3 + the same).
@@ -157,8 +154,6 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            lap_config: Vec::new(),
-            config_index: HashMap::new(),
             window: HashMap::new(),
             unresolved: HashMap::new(),
             visits_window: HashMap::new(),
@@ -179,19 +174,7 @@ impl Tally {
     /// Learns the laps, frames and observations added to `truth` and `observations` since the
     /// last call (both only ever grow; call before adding matches that name new observations).
     pub fn sync(&mut self, observations: &[Observation], truth: &GroundTruth) {
-        for lap in &truth.laps[self.lap_config.len()..] {
-            let next = self.config_index.len();
-            let c = *self
-                .config_index
-                .entry(lap.door_config.clone())
-                .or_insert(next);
-            self.scorer.add_lap(c, &lap.door_config);
-            self.lap_config.push(c as u32);
-        }
-        let known = self.scorer.observation_count();
-        for (i, o) in observations.iter().enumerate().skip(known) {
-            self.scorer.joined_mut().push(i, o, truth, &self.lap_config);
-        }
+        self.scorer.sync(observations, truth);
         self.grow_slots();
     }
 
