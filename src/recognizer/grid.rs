@@ -1,10 +1,13 @@
 //! The local occupancy grid around the robot, in the odometry frame.
 //!
-//! A square window of 2ⁿ × 2ⁿ cells stored as a torus: global cell (x, y) lives at index
-//! (y·2ⁿ + x) mod 4ⁿ, which is one-to-one inside any 2ⁿ × 2ⁿ window and lets the density kernel
-//! read it with constant index steps. When the robot moves to another cell the window scrolls
-//! with it: the cells that leave it are cleared, so everything farther than about
-//! `grid_radius_m` from the robot is forgotten.
+//! A square window of L × L cells (the memory) stored in a torus of 2ⁿ × 2ⁿ ≥ L × L cells:
+//! global cell (x, y) lives at index (y·2ⁿ + x) mod 4ⁿ, which is one-to-one inside any
+//! 2ⁿ × 2ⁿ window and lets the density kernel read it with constant index steps. When the robot
+//! moves to another cell the window scrolls with it: the cells that leave it are cleared, so
+//! everything farther than L/2 cells from the robot along either axis is forgotten. The torus is
+//! larger than the window when a kernel may be centred far from the robot (observations
+//! interpolated back along a long step): it then reads forgotten cells as unknown, never cells
+//! of the window's far side.
 //!
 //! Each cell holds a small counter: 0 unknown, 1..=7 free, 8..=15 occupied. A beam passing a cell
 //! lowers it by one (a first pass makes it 4, free); a beam ending in it raises it by three (a
@@ -70,8 +73,10 @@ fn floor_i32(v: f64) -> i32 {
 pub struct LocalGrid {
     cell_m: f64,
     radius_m: f64,
-    /// log2 of the side.
+    /// log2 of the torus's side.
     shift: u32,
+    /// Side L of the window of remembered cells (at most the torus's side).
+    window: i32,
     /// side² − 1.
     mask: usize,
     cells: Vec<u8>,
@@ -98,14 +103,31 @@ impl LocalGrid {
     pub fn with_margin(cell_m: f64, radius_m: f64, margin_m: f64) -> Self {
         let half = ((radius_m + margin_m.max(0.0)) / cell_m).ceil() as i32 + 2;
         let side = ((2 * half + 1) as u32).next_power_of_two() as usize;
+        Self::with_window(cell_m, radius_m, side, side)
+    }
+
+    /// A grid that remembers the cells within `memory_m` of the robot along either axis (at
+    /// least `radius_m`), in a torus large enough that a kernel of `reach_m` (its radius plus
+    /// how far from the robot it may be centred) reads no cell of the window's far side.
+    pub fn with_memory(cell_m: f64, radius_m: f64, memory_m: f64, reach_m: f64) -> Self {
+        let half = ((memory_m.max(radius_m) / cell_m).round() as usize).max(1);
+        let reach = (reach_m.max(0.0) / cell_m).ceil() as usize;
+        // A kernel cell u cells from the window's centre must satisfy half + u < side (and
+        // −half − u ≥ window − side) so that no alias of it lies inside the window.
+        let side = (2 * half).max(half + reach + 2).next_power_of_two();
+        Self::with_window(cell_m, radius_m, 2 * half, side)
+    }
+
+    fn with_window(cell_m: f64, radius_m: f64, window: usize, side: usize) -> Self {
         LocalGrid {
             cell_m,
             radius_m,
+            window: window as i32,
             shift: side.trailing_zeros(),
             mask: side * side - 1,
             cells: vec![0; side * side],
             origin: (0, 0),
-            half: side as i32 / 2,
+            half: window as i32 / 2,
             has_origin: false,
             visited: Visited::default(),
             inv_steps: (0..=side).map(|n| 65536.0 / n as f64).collect(),
@@ -135,7 +157,7 @@ impl LocalGrid {
     }
 
     fn inside(&self, x: i32, y: i32) -> bool {
-        let side = self.side() as i32;
+        let side = self.window;
         self.has_origin
             && x >= self.origin.0
             && y >= self.origin.1
@@ -153,7 +175,7 @@ impl LocalGrid {
 
     /// Scrolls the window so that it is centred on global cell (cx, cy), clearing what leaves it.
     pub fn recenter(&mut self, cx: i32, cy: i32) {
-        let side = self.side() as i32;
+        let side = self.window;
         let new_origin = (cx - self.half, cy - self.half);
         if !self.has_origin {
             self.origin = new_origin;
@@ -313,12 +335,15 @@ impl LocalGrid {
         kernel.free_cells_at(deltas, &self.cells, base, self.mask, &mut self.visited)
     }
 
-    /// Whether a kernel of `radius_cells` centred on the odometry position (x, y) lies inside the
-    /// window (so it reads no cell twice and none from the far side of the torus).
+    /// Whether a kernel of `radius_cells` centred on the odometry position (x, y) reads no cell
+    /// twice and none from the far side of the torus: each of its cells lies in the window or
+    /// where no alias of it does.
     pub fn kernel_fits(&self, radius_cells: usize, x: f64, y: f64) -> bool {
         let (cx, cy) = self.cell_of(x, y);
         let r = radius_cells as i32;
-        self.inside(cx - r, cy - r) && self.inside(cx + r, cy + r)
+        let side = self.side() as i32;
+        let fits = |c: i32, o: i32| c - r - o >= self.window - side && c + r - o < side;
+        self.has_origin && fits(cx, self.origin.0) && fits(cy, self.origin.1)
     }
 
     /// Ψ at the cell holding the odometry position (x, y).

@@ -649,6 +649,55 @@ fn alignment_recovers_a_shift() {
     }
 }
 
+/// A grid that remembers less than its torus holds gives, at the robot, the Ψ of a grid whose
+/// torus is exactly its window, and a kernel centred far back along a step reads the cells it
+/// forgot as unknown: the torus's far side (ahead of the robot) never leaks into it.
+#[test]
+fn a_larger_torus_forgets_what_its_window_forgets() {
+    use placewords::recognizer::{DensityKernel, LocalGrid};
+    let layout = synth::lms200();
+    let walls = synth::corridor_with_branch(30.0, 2.0, 15.0, 3.0);
+    let kernel = DensityKernel::new(50, 1.0);
+    // Window 6.4 m either way (256 cells) in both; the second's torus is 512 cells.
+    let mut exact = LocalGrid::with_margin(0.05, 3.0, 3.0);
+    let mut large = LocalGrid::with_memory(0.05, 3.0, 6.4, 10.0);
+    assert_eq!((exact.side(), large.side()), (256, 512));
+    let (de, dl) = (kernel.deltas(exact.side()), kernel.deltas(large.side()));
+    for i in 0..600 {
+        let pose = Pose2::new(0.5 + i as f64 * 0.04, 0.0, 0.0);
+        let scan = synth::scan_of(&walls, pose, &layout, i as f64 * 0.1);
+        exact.integrate(&OdomPose(pose), &scan);
+        large.integrate(&OdomPose(pose), &scan);
+        if i % 10 == 0 {
+            let (a, b) = (
+                exact.psi_at(&kernel, &de, pose.x, pose.y),
+                large.psi_at(&kernel, &dl, pose.x, pose.y),
+            );
+            assert_eq!(a, b, "x = {}", pose.x);
+        }
+    }
+    // The robot is at x = 24.46; 6.4 m back (x < 18.1) is forgotten. A kernel centred 5 m back
+    // reads free cells only on its near side.
+    let (x, y) = (24.46 - 5.0, 0.0);
+    assert!(large.kernel_fits(50, x, y));
+    assert!(!exact.kernel_fits(50, x, y), "the exact torus would wrap");
+    let (cx, cy) = large.cell_of(x, y);
+    let mut forgotten_free = 0;
+    for dy in -50..=50 {
+        for dx in -50..=-30 {
+            if large.state(cx + dx, cy + dy) == CellState::Free {
+                forgotten_free += 1;
+            }
+        }
+    }
+    assert_eq!(forgotten_free, 0, "cells beyond the window are forgotten");
+    let psi = large.psi_at(&kernel, &dl, x, y);
+    assert!(
+        psi > 0.0 && psi < 0.5,
+        "Ψ {psi}: about half the kernel is forgotten"
+    );
+}
+
 /// One scan into open space marks its field of view free up to 2.5 m but for isolated cells
 /// between 8-connected beam lines beyond 1.4 m, where 1° beams are more than half a cell apart
 /// (under 5 %; the next scans fill them), and nothing behind the sensor.
@@ -1136,6 +1185,15 @@ proptest! {
 /// The 3-level scores of `recognize`'s defaults on a shipped real log (every `step`-th scan,
 /// noise seed 1); `None` when `../shared/data` is absent.
 fn real_log_scores(name: &str, step: usize) -> Option<placewords::eval::scores::Scores> {
+    real_log_scores_at(name, step, 1)
+}
+
+/// [`real_log_scores`] with the odometry noise of `seed`.
+fn real_log_scores_at(
+    name: &str,
+    step: usize,
+    seed: u64,
+) -> Option<placewords::eval::scores::Scores> {
     let log = Path::new("../shared/data/carmen").join(format!("{name}-corrected.log.gz"));
     if !log.exists() {
         eprintln!("skipping: {} is absent", log.display());
@@ -1146,7 +1204,7 @@ fn real_log_scores(name: &str, step: usize) -> Option<placewords::eval::scores::
     // `recognize`'s default noise.
     let noise = real::parse_noise_model("proportional").unwrap().unwrap();
     let (mut run, _) =
-        real::load_real_run(&log, false, TruthSource::Corrected, Some(&noise), 1).unwrap();
+        real::load_real_run(&log, false, TruthSource::Corrected, Some(&noise), seed).unwrap();
     real::keep_every_nth_scan(&mut run, step);
     let opts = ExperimentOptions {
         levels: vec![3],
@@ -1185,6 +1243,25 @@ fn thinned_real_log_still_matches() {
     assert!(scores.recall >= 0.2, "recall {}", scores.recall);
 }
 
+/// Intel thinned to every 3rd scan (about 1.6 m between scans, steps up to 3.3 m with odometry
+/// noise) matches on every noise seed, precisely: a step longer than the interpolation limit
+/// (3 m before) was observed once where 30 observations were due, its words broke, and no seed
+/// gave a pair.
+#[test]
+fn sparser_real_log_matches_on_every_noise_seed() {
+    for seed in 1..=5 {
+        let Some(scores) = real_log_scores_at("intel", 3, seed) else {
+            return;
+        };
+        assert!(scores.pairs > 0, "seed {seed}: no pair");
+        assert!(
+            scores.precision >= 0.9,
+            "seed {seed}: precision {}",
+            scores.precision
+        );
+    }
+}
+
 /// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
 /// with the defaults: its revisits' words differ in turn angle, and chains bridge one such word
 /// (`substitutions`); without them it gave none.
@@ -1221,7 +1298,8 @@ fn intel_log_matches_driven_the_other_way() {
 }
 
 /// Observations interpolated along long steps (scans 1.5 and 2.9 m apart) have about the Ψ that
-/// dense scans give at the same places: their kernels stay inside the grid's window.
+/// dense scans give at the same places: their kernels never read the far side of the grid's
+/// torus.
 #[test]
 fn long_steps_keep_psi_close_to_dense_scans() {
     let layout = synth::lms200();
@@ -1256,6 +1334,34 @@ fn long_steps_keep_psi_close_to_dense_scans() {
         assert!(diffs.len() > 100, "{} observations compared", diffs.len());
         assert!(mean <= 0.03, "mean |ΔΨ| {mean} with scans every {every}");
     }
+}
+
+/// A step of up to `max_interpolation_m` (here scans 4.4 m apart) is observed once per spacing
+/// it passes, so words keep their sizes; a longer jump is observed once.
+#[test]
+fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
+    let layout = synth::lms200();
+    let inputs = corridor_inputs(&layout);
+    let count = |max_interpolation_m: f64| {
+        let cfg = config(|c| c.max_interpolation_m = max_interpolation_m);
+        let mut fe = DensityFrontEnd::new(&cfg).unwrap();
+        let obs: Vec<Observation> = inputs
+            .iter()
+            .step_by(110)
+            .flat_map(|(o, s)| fe.push(*o, s))
+            .collect();
+        for w in obs.windows(2) {
+            assert!(w[1].travel_m >= w[0].travel_m);
+        }
+        obs.len()
+    };
+    // 6 steps of 4.4 m: 26.4 m of travel.
+    assert_eq!(count(RecognizerConfig::default().max_interpolation_m), 264);
+    assert_eq!(
+        count(4.0),
+        6,
+        "each jump longer than the limit makes one observation"
+    );
 }
 
 /// The grid's shortcut (one scan per observation step, beams thinned near the sensor) stays
