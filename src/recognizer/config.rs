@@ -25,8 +25,8 @@ pub struct RecognizerConfig {
     pub integrate_every_scan: bool,
     /// Side of a local grid cell, metres. Default 0.05.
     pub grid_cell_m: f64,
-    /// Radius of the local grid around the robot, metres; cells farther away are forgotten.
-    /// Default 3.0.
+    /// How far from the robot each scan is traced into the local grid, metres (cells are
+    /// forgotten beyond `grid_memory_m`). Default 3.0.
     pub grid_radius_m: f64,
     /// How far from the robot, along either axis, the local grid remembers cells, metres (at
     /// least `grid_radius_m`); farther cells are forgotten, and read as unknown by a kernel
@@ -314,6 +314,14 @@ impl RecognizerConfig {
                 format!(
                     "must be a positive distance, got {}; the default is 6.4",
                     self.grid_memory_m
+                ),
+            );
+        } else if positive(self.grid_radius_m) && self.grid_memory_m < self.grid_radius_m {
+            bad(
+                "grid_memory_m",
+                format!(
+                    "{} m is less than grid_radius_m ({} m); the grid must remember what a scan traces",
+                    self.grid_memory_m, self.grid_radius_m
                 ),
             );
         } else if positive(self.grid_cell_m)

@@ -128,6 +128,19 @@ fn config_defaults_parse_and_validate() {
     };
     let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
     assert_eq!(fields, vec!["ngram_travel_m", "chain_alignment_tie"]);
+    // The grid must remember at least what a scan traces.
+    let bad = RecognizerConfig {
+        grid_memory_m: 2.0,
+        ..Default::default()
+    };
+    let problems = bad.problems();
+    assert_eq!(problems.len(), 1);
+    assert_eq!(problems[0].field, "grid_memory_m");
+    assert!(
+        problems[0].problem.contains("grid_radius_m"),
+        "{}",
+        problems[0]
+    );
 }
 
 /// Paper Fig. 2: corridors, a corner and a bifurcation in three classes; the right turn gives
