@@ -161,8 +161,23 @@ pub fn no_pairs_reason(
     Some(why.join("; "))
 }
 
-/// The recognizer's side of a run without pairs.
+/// The recognizer's side of a run without pairs, with a word on steps too long to observe
+/// along their length when there were any.
 fn recognizer_reason(d: &MatchDiagnostics) -> String {
+    let why = matcher_reason(d);
+    match d.long_steps {
+        0 => why,
+        n => format!(
+            "{why}; {n} step{} between scans {} longer than max_interpolation_m and observed \
+             once where more observations were due (words break there: raise it)",
+            plural(n),
+            if n == 1 { "was" } else { "were" }
+        ),
+    }
+}
+
+/// What the matcher saw of a run without pairs.
+fn matcher_reason(d: &MatchDiagnostics) -> String {
     let v = &d.verification;
     if v.accepted > 0 {
         return format!(
@@ -406,6 +421,7 @@ pub(crate) mod tests {
             min_ngram: vec![6, 9],
             within_gap: 0,
             verification: Default::default(),
+            long_steps: 0,
         };
         d.verification.rejected_travel = 3;
         d.verification.rejected_density = 2;
@@ -423,6 +439,13 @@ pub(crate) mod tests {
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
+            "{why}"
+        );
+        d.long_steps = 3;
+        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("3 steps between scans were longer than max_interpolation_m"),
             "{why}"
         );
         let why = no_pairs_reason(&Metrics::default(), None, &spec).unwrap();

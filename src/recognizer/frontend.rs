@@ -45,6 +45,8 @@ pub struct DensityFrontEnd {
     run: usize,
     inputs: usize,
     next_id: usize,
+    /// Steps longer than `max_interpolation_m` that passed more than one spacing.
+    long_steps: usize,
 }
 
 impl DensityFrontEnd {
@@ -71,6 +73,7 @@ impl DensityFrontEnd {
             run: 0,
             inputs: 0,
             next_id: 0,
+            long_steps: 0,
         })
     }
 
@@ -130,7 +133,10 @@ impl DensityFrontEnd {
                     at.push((OdomPose(pose), travel.min(self.travel_m)));
                 }
             }
-            _ => at.push((odom, self.travel_m)),
+            _ => {
+                self.long_steps += usize::from(passed > 1.0 && previous.is_some());
+                at.push((odom, self.travel_m))
+            }
         }
         self.next_obs_travel_m += passed * self.spacing_m;
         at.into_iter()
@@ -177,6 +183,12 @@ impl DensityFrontEnd {
     /// The density kernel in use.
     pub fn kernel(&self) -> &DensityKernel {
         &self.kernel
+    }
+
+    /// Steps between scans so far that were longer than `max_interpolation_m` and passed more
+    /// than one observation spacing: each was observed once, and the words there break.
+    pub fn long_steps(&self) -> usize {
+        self.long_steps
     }
 
     /// Odometric travel so far, metres.

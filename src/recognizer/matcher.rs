@@ -333,6 +333,7 @@ impl WordMatcher {
             min_ngram: self.params.min_ngram[..levels].to_vec(),
             within_gap: self.within_gap,
             verification: self.rejections,
+            long_steps: 0,
         }
     }
 
@@ -1233,6 +1234,15 @@ pub struct MatchDiagnostics {
     pub within_gap: usize,
     /// Candidate n-grams by verification outcome.
     pub verification: VerificationCounts,
+    /// Steps between scans longer than `max_interpolation_m`, each observed once where one
+    /// observation per spacing was due (filled by [`crate::recognizer::Recognizer`]; written
+    /// only when not 0).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub long_steps: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Σ (a − b)², four lanes at a time.

@@ -173,6 +173,9 @@ impl Recognizer {
 
     /// What the matcher saw so far, to say why nothing matched.
     pub fn diagnostics(&self) -> MatchDiagnostics {
-        self.back.diagnostics()
+        MatchDiagnostics {
+            long_steps: self.front.long_steps(),
+            ..self.back.diagnostics()
+        }
     }
 }

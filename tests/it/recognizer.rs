@@ -1207,6 +1207,16 @@ fn real_log_scores_at(
     step: usize,
     seed: u64,
 ) -> Option<placewords::eval::scores::Scores> {
+    real_log_scores_with(name, step, seed, &RecognizerConfig::default())
+}
+
+/// [`real_log_scores_at`] with recognizer settings `cfg`.
+fn real_log_scores_with(
+    name: &str,
+    step: usize,
+    seed: u64,
+    cfg: &RecognizerConfig,
+) -> Option<placewords::eval::scores::Scores> {
     let log = Path::new("../shared/data/carmen").join(format!("{name}-corrected.log.gz"));
     if !log.exists() {
         eprintln!("skipping: {} is absent", log.display());
@@ -1226,15 +1236,7 @@ fn real_log_scores_at(
         ..ExperimentOptions::default()
     };
     let spec = placewords::spec::evaluation::EvaluationSpec::default();
-    let exp = experiment::evaluate_runs(
-        name,
-        1,
-        vec![run],
-        &RecognizerConfig::default(),
-        &spec,
-        &opts,
-    )
-    .unwrap();
+    let exp = experiment::evaluate_runs(name, 1, vec![run], cfg, &spec, &opts).unwrap();
     let l = exp.report.level(3).expect("3 levels ran");
     eprintln!(
         "{name} every {step} scan(s): {} pairs, precision {:.3}, recall {:.3}",
@@ -1273,6 +1275,24 @@ fn sparser_real_log_matches_on_every_noise_seed() {
             scores.precision
         );
     }
+}
+
+/// A log too sparse for the interpolation limit says so when it gives no pair: Intel every 3rd
+/// scan with the old 3 m limit names the steps it observed once.
+#[test]
+fn too_long_steps_are_named_when_nothing_matches() {
+    let cfg = config(|c| c.max_interpolation_m = 3.0);
+    let Some(scores) = real_log_scores_with("intel", 3, 1, &cfg) else {
+        return;
+    };
+    assert_eq!(scores.pairs, 0, "the old limit gave no pair");
+    let why = scores.no_pairs_reason.expect("a reason");
+    assert!(
+        why.contains("steps between scans were longer than max_interpolation_m"),
+        "{why}"
+    );
+    let long_steps = scores.diagnostics.expect("diagnostics").long_steps;
+    assert!(long_steps > 10, "{long_steps} long steps");
 }
 
 /// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
@@ -1366,14 +1386,17 @@ fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
         for w in obs.windows(2) {
             assert!(w[1].travel_m >= w[0].travel_m);
         }
-        obs.len()
+        (obs.len(), fe.long_steps())
     };
     // 6 steps of 4.4 m: 26.4 m of travel.
-    assert_eq!(count(RecognizerConfig::default().max_interpolation_m), 264);
+    assert_eq!(
+        count(RecognizerConfig::default().max_interpolation_m),
+        (264, 0)
+    );
     assert_eq!(
         count(4.0),
-        6,
-        "each jump longer than the limit makes one observation"
+        (6, 6),
+        "each jump longer than the limit makes one observation, and is counted"
     );
 }
 
