@@ -132,6 +132,21 @@ pub fn text_table(report: &Report) -> String {
             let _ = writeln!(out, "{label}: no matches: {why}");
         }
     }
+    // Every configuration sees the same scans; say it once, where the reason did not.
+    let long_steps = rows(report)
+        .into_iter()
+        .filter(|(_, s)| s.no_pairs_reason.is_none())
+        .find_map(|(_, s)| s.diagnostics.as_ref().map(|d| d.long_steps))
+        .filter(|&n| n > 0);
+    if let Some(n) = long_steps {
+        let _ = writeln!(
+            out,
+            "note: {n} step{} between scans {} longer than max_interpolation_m and observed once \
+             where more observations were due (raise it to observe them along their length)",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "was" } else { "were" }
+        );
+    }
     for (label, s) in rows(report) {
         if s.sensitivity.is_empty() && s.door_configs.is_empty() {
             continue;
@@ -347,6 +362,23 @@ mod tests {
 
     /// Where opposite revisits exist, the terminal table and Table I add a row per direction
     /// under the level row; without them, neither does.
+    /// Steps too long to observe along their length are noted once when there are pairs (and
+    /// are part of the reason when there are none).
+    #[test]
+    fn long_steps_are_noted_once() {
+        let mut rep = sample("A", [0.9; 3], [0.2; 3]);
+        assert!(!text_table(&rep).contains("max_interpolation_m"));
+        for l in &mut rep.levels {
+            l.scores.diagnostics = Some(crate::recognizer::MatchDiagnostics {
+                long_steps: 2,
+                ..Default::default()
+            });
+        }
+        let t = text_table(&rep);
+        assert_eq!(t.matches("max_interpolation_m").count(), 1, "{t}");
+        assert!(t.contains("note: 2 steps between scans were longer"), "{t}");
+    }
+
     #[test]
     fn rows_per_direction_where_opposite_revisits_exist() {
         let plain = sample("A", [0.9; 3], [0.2; 3]);
