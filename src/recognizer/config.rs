@@ -468,8 +468,25 @@ impl RecognizerConfig {
             bad(
                 "max_interpolation_m",
                 format!(
-                    "must be a distance in [0, 20], got {}; the default is 3",
+                    "must be a distance in [0, 20], got {}; the default is 5",
                     self.max_interpolation_m
+                ),
+            );
+        } else if positive(self.grid_cell_m)
+            && positive(self.kernel_radius_m)
+            && (self.max_interpolation_m + self.kernel_radius_m) / self.grid_cell_m
+                > MAX_GRID_HALF_CELLS
+        {
+            // The grid's torus must reach a kernel centred this far back.
+            bad(
+                "max_interpolation_m",
+                format!(
+                    "{} m plus the kernel radius ({} m) is more than {} cells of {} m; use a \
+                     shorter limit or larger cells",
+                    self.max_interpolation_m,
+                    self.kernel_radius_m,
+                    MAX_GRID_HALF_CELLS,
+                    self.grid_cell_m
                 ),
             );
         }

@@ -128,6 +128,16 @@ fn config_defaults_parse_and_validate() {
     };
     let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
     assert_eq!(fields, vec!["ngram_travel_m", "chain_alignment_tie"]);
+    // Fine cells with a long interpolation limit would need a torus of gigabytes.
+    let bad = RecognizerConfig {
+        grid_cell_m: 0.001,
+        grid_radius_m: 0.9,
+        grid_memory_m: 0.95,
+        kernel_radius_m: 0.8,
+        ..Default::default()
+    };
+    let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
+    assert_eq!(fields, vec!["max_interpolation_m"]);
     // The grid must remember at least what a scan traces.
     let bad = RecognizerConfig {
         grid_memory_m: 2.0,
