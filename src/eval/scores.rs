@@ -168,12 +168,21 @@ fn recognizer_reason(d: &MatchDiagnostics) -> String {
     match d.long_steps {
         0 => why,
         n => format!(
-            "{why}; {n} step{} between scans {} longer than max_interpolation_m and observed \
-             once where more observations were due (words break there: raise it)",
-            plural(n),
-            if n == 1 { "was" } else { "were" }
+            "{why}; {} (words break there: raise it)",
+            long_steps_sentence(n)
         ),
     }
+}
+
+/// `n` steps between scans too long to observe along their length, in words (the reason of a
+/// run without pairs, and the table's note when there are pairs).
+pub fn long_steps_sentence(n: usize) -> String {
+    format!(
+        "{n} step{} between scans {} longer than max_interpolation_m and observed once where \
+         more observations were due",
+        plural(n),
+        if n == 1 { "was" } else { "were" }
+    )
 }
 
 /// What the matcher saw of a run without pairs.

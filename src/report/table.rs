@@ -141,10 +141,8 @@ pub fn text_table(report: &Report) -> String {
     if let Some(n) = long_steps {
         let _ = writeln!(
             out,
-            "note: {n} step{} between scans {} longer than max_interpolation_m and observed once \
-             where more observations were due (raise it to observe them along their length)",
-            if n == 1 { "" } else { "s" },
-            if n == 1 { "was" } else { "were" }
+            "note: {} (raise it to observe them along their length)",
+            crate::eval::scores::long_steps_sentence(n)
         );
     }
     for (label, s) in rows(report) {
