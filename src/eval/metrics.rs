@@ -86,6 +86,13 @@ pub struct Metrics {
     /// [`super::pair_recall`]). Computed at `tp_radius_m` only (0 elsewhere).
     #[serde(default)]
     pub pair_recall: f64,
+    /// The longest stretch of true travel, metres, along which consecutive observations of one
+    /// run all have a revisit (of this figure's facing): the most evidence a place gives to
+    /// chain. A recognizer that needs τ words of a few metres each finds nothing where this is
+    /// shorter. Computed where revisits are counted (0 per door configuration; written only
+    /// when not 0).
+    #[serde(default, skip_serializing_if = "is_zero_m")]
+    pub longest_revisit_m: f64,
     /// Pairs naming an observation id the recognizer never reported (not scored).
     pub unresolved_pairs: usize,
     /// Pairs that arrived behind the recognizer's query horizon, after the scoring had
@@ -97,6 +104,11 @@ pub struct Metrics {
 
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// Whether a length is 0 (serde: such fields are written only when not).
+pub(super) fn is_zero_m(m: &f64) -> bool {
+    *m == 0.0
 }
 
 /// Scores of the observations and pairs attributed to one door configuration.
@@ -310,6 +322,8 @@ pub struct Scorer {
     config_laps: Vec<usize>,
     /// Door configuration index of each lap joined.
     lap_config: Vec<u32>,
+    /// Run of each lap joined.
+    lap_run: Vec<usize>,
     min_gap_m: f64,
     heading_tol_rad: f64,
     facing: Facing,
@@ -377,6 +391,7 @@ impl Scorer {
             configs: Vec::new(),
             config_laps: Vec::new(),
             lap_config: Vec::new(),
+            lap_run: Vec::new(),
             min_gap_m: spec.min_gap_m,
             heading_tol_rad: spec.heading_tolerance_deg.to_radians(),
             facing: Facing::Either,
@@ -397,6 +412,7 @@ impl Scorer {
             };
             self.config_laps[c] += 1;
             self.lap_config.push(c as u32);
+            self.lap_run.push(lap.run);
         }
         let known = self.observation_count();
         let joined = Arc::make_mut(&mut self.joined);
@@ -447,6 +463,37 @@ impl Scorer {
     fn site(&self, i: usize) -> Option<&Site> {
         let k = self.joined.site_of.get(i)?;
         self.joined.sites.get(k as usize)
+    }
+
+    /// The longest stretch of true travel, metres, along which consecutive observations of one
+    /// run all have a revisit (`revisits`, per observation): see
+    /// [`Metrics::longest_revisit_m`]. Travel is the observations' frames' (observations made
+    /// along one step between scans share it).
+    pub(super) fn longest_revisit_m(&self, revisits: &[bool]) -> f64 {
+        let j = &self.joined;
+        let mut longest = 0.0f64;
+        // (observation position, site) of the previous observation with truth, and where the
+        // current stretch began.
+        let mut prev: Option<(usize, &Site)> = None;
+        let mut began_m: Option<f64> = None;
+        for (k, s) in j.sites.iter().enumerate() {
+            let i = j.obs_of_site(k);
+            let continues = prev.is_some_and(|(pi, p)| {
+                pi + 1 == i && self.lap_run.get(p.lap) == self.lap_run.get(s.lap)
+            });
+            if !revisits.get(i).copied().unwrap_or(false) {
+                began_m = None;
+            } else {
+                let from = match began_m {
+                    Some(b) if continues => b,
+                    _ => s.travel_m,
+                };
+                began_m = Some(from);
+                longest = longest.max(s.travel_m - from);
+            }
+            prev = Some((i, s));
+        }
+        longest
     }
 
     /// The door configuration of observation `i`, which has truth.
@@ -573,6 +620,7 @@ impl Counts {
             recall_either_side: ratio(self.recalled_any, self.revisits),
             visit_recall: 0.0,
             pair_recall: 0.0,
+            longest_revisit_m: 0.0,
             unresolved_pairs: self.unresolved,
             late_pairs: 0,
         }
@@ -750,6 +798,35 @@ pub(crate) mod tests {
         obs.truncate(300);
         let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 1.0);
         assert_eq!((m.revisits, m.recall), (0, 0.0));
+    }
+
+    /// The longest revisit stretch is the true travel along which consecutive observations all
+    /// have a revisit: a detour off the first lap's path (frames 500..519) splits the second
+    /// lap's stretch, leaving 520..799.
+    #[test]
+    fn longest_revisit_stretch_is_split_by_a_detour() {
+        let (obs, mut gt) = circle(2, 40.0);
+        let spec = EvaluationSpec::default();
+        // The first lap's last metre already revisits its start (frames 390..399), and the
+        // whole second lap follows on.
+        let m = score(&obs, &[], &gt, &spec, 1.0);
+        assert!(
+            (m.longest_revisit_m - 40.9).abs() < 0.01,
+            "{}",
+            m.longest_revisit_m
+        );
+        for f in &mut gt.frames[500..520] {
+            f.pose.0.x += 20.0;
+        }
+        let m = score(&obs, &[], &gt, &spec, 1.0);
+        assert!(
+            (m.longest_revisit_m - 27.9).abs() < 0.01,
+            "{}",
+            m.longest_revisit_m
+        );
+        // Three quarters of a lap revisit nothing.
+        let m = score(&obs[..300], &[], &gt, &spec, 1.0);
+        assert_eq!(m.longest_revisit_m, 0.0);
     }
 
     /// A second lap facing the other way is an opposite-direction revisit, not a same-direction

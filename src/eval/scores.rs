@@ -11,6 +11,7 @@
 //!                 "pairs": 10234, "correct_pairs": 9518, "no_pairs": false,
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
+//!                 "longest_revisit_m": 62.5,
 //!                 "recognize_seconds_per_lap": 0.8, "recognize_seconds_by_lap": [0.7, 0.8, ...],
 //!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
@@ -26,7 +27,9 @@
 //!
 //! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN); then
 //! `"no_pairs_reason"` says why when it can tell, and `"diagnostics"` (the recognizer's longest
-//! chains and verification counts, when it tells) gives the figures behind it.
+//! chains, verification counts and mean word length, when it tells) gives the figures behind
+//! it. `"longest_revisit_m"` (written when not 0, here and in each direction's figures) is the
+//! longest stretch of true travel along which every observation has a revisit.
 
 use super::Recognition;
 use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
@@ -48,6 +51,10 @@ pub struct Scores {
     pub correct_matches: usize,
     pub revisits: usize,
     pub recall_either_side: f64,
+    /// The longest stretch of true travel along which every observation has a revisit, metres
+    /// (see `eval::metrics::Metrics::longest_revisit_m`; written only when not 0).
+    #[serde(default, skip_serializing_if = "super::metrics::is_zero_m")]
+    pub longest_revisit_m: f64,
     /// Share of (observation, earlier lap through the same spot) pairs recognized: rewards
     /// matching across door changes (see `eval::metrics::Metrics::visit_recall`).
     #[serde(default)]
@@ -98,6 +105,7 @@ impl Scores {
             correct_matches: m.correct_matches,
             revisits: m.revisits,
             recall_either_side: m.recall_either_side,
+            longest_revisit_m: m.longest_revisit_m,
             visit_recall: m.visit_recall,
             pair_recall: m.pair_recall,
             recognize_seconds_per_lap,
@@ -129,20 +137,21 @@ impl Scores {
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
         let e = super::evaluate(rec, spec);
         Scores {
-            no_pairs_reason: no_pairs_reason(&e.main, rec.diagnostics.as_ref(), spec),
+            no_pairs_reason: no_pairs_reason(&e, rec.diagnostics.as_ref(), spec),
             diagnostics: rec.diagnostics.clone(),
             ..Scores::new(&e, rec.seconds_per_lap())
         }
     }
 }
 
-/// Why `m` has no pair, as far as the truth and the recognizer's `diagnostics` tell; `None` when
-/// there are pairs.
+/// Why evaluation `e` has no pair, as far as the truth and the recognizer's `diagnostics` tell;
+/// `None` when there are pairs.
 pub fn no_pairs_reason(
-    m: &Metrics,
+    e: &Evaluation,
     diagnostics: Option<&MatchDiagnostics>,
     spec: &EvaluationSpec,
 ) -> Option<String> {
+    let m = &e.main;
     if m.pairs > 0 {
         return None;
     }
@@ -154,11 +163,54 @@ pub fn no_pairs_reason(
         ));
     }
     match diagnostics {
-        Some(d) => why.push(recognizer_reason(d)),
+        Some(d) => {
+            why.push(recognizer_reason(d));
+            if m.revisits > 0 && d.verification.accepted + d.verification.rejected() == 0 {
+                why.extend(revisit_length_reason(e, d));
+            }
+        }
         None if why.is_empty() => why.push("the recognizer does not say why".into()),
         None => {}
     }
     Some(why.join("; "))
+}
+
+/// Whether the revisits are long enough for a chain of τ words (the smallest τ; more read
+/// backwards) at the run's mean word length: when they are not, no tolerance on the words can
+/// help; when they are, the words differ between visits.
+fn revisit_length_reason(e: &Evaluation, d: &MatchDiagnostics) -> Option<String> {
+    let tau = *d.min_ngram.first()?;
+    if d.mean_word_m <= 0.0 || tau == 0 {
+        return None;
+    }
+    let backwards = tau + d.reverse_extra_ngram;
+    let (same_need_m, opposite_need_m) =
+        (tau as f64 * d.mean_word_m, backwards as f64 * d.mean_word_m);
+    let (same_m, opposite_m) = (
+        e.directions.same.longest_revisit_m,
+        e.directions.opposite.longest_revisit_m,
+    );
+    let stretch = format!(
+        "the longest stretch along which every observation has a revisit is {same_m:.1} m \
+         driven the same way and {opposite_m:.1} m the other way, and a word spans {:.1} m on \
+         average",
+        d.mean_word_m
+    );
+    let need = if backwards == tau {
+        format!("τ = {tau} words need about {same_need_m:.0} m")
+    } else {
+        format!(
+            "τ = {tau} words need about {same_need_m:.0} m ({backwards} read backwards, about \
+             {opposite_need_m:.0} m)"
+        )
+    };
+    Some(if same_m < same_need_m && opposite_m < opposite_need_m {
+        format!("{stretch}: {need}, so the revisits are too short for a chain")
+    } else {
+        format!(
+            "{stretch}: {need}, so the revisits are long enough and the words differ between visits"
+        )
+    })
 }
 
 /// The recognizer's side of a run without pairs, with a word on steps too long to observe
@@ -421,9 +473,12 @@ pub(crate) mod tests {
     #[test]
     fn no_pairs_reason_names_the_cause() {
         let spec = EvaluationSpec::default();
-        let none = Metrics {
-            revisits: 10,
-            ..Metrics::default()
+        let none = Evaluation {
+            main: Metrics {
+                revisits: 10,
+                ..Metrics::default()
+            },
+            ..Evaluation::default()
         };
         let mut d = MatchDiagnostics {
             longest_chain: vec![7, 9],
@@ -431,6 +486,8 @@ pub(crate) mod tests {
             within_gap: 0,
             verification: Default::default(),
             long_steps: 0,
+            reverse_extra_ngram: 0,
+            mean_word_m: 0.0,
         };
         d.verification.rejected_travel = 3;
         d.verification.rejected_density = 2;
@@ -457,10 +514,59 @@ pub(crate) mod tests {
             why.contains("3 steps between scans were longer than max_interpolation_m"),
             "{why}"
         );
-        let why = no_pairs_reason(&Metrics::default(), None, &spec).unwrap();
+        let why = no_pairs_reason(&Evaluation::default(), None, &spec).unwrap();
         assert!(why.starts_with("no observation has a revisit"), "{why}");
-        let some = Metrics { pairs: 1, ..none };
+        let mut some = none.clone();
+        some.main.pairs = 1;
         assert_eq!(no_pairs_reason(&some, Some(&d), &spec), None);
+    }
+
+    /// When no chain is long enough, the reason says whether the revisits are shorter than τ
+    /// words of the run's mean length (nothing to chain) or long enough (the words differ).
+    #[test]
+    fn no_pairs_reason_compares_revisit_length_with_tau_words() {
+        let spec = EvaluationSpec::default();
+        let mut e = Evaluation::default();
+        e.main.revisits = 300;
+        e.main.longest_revisit_m = 20.2;
+        e.directions.same.longest_revisit_m = 11.2;
+        e.directions.opposite.longest_revisit_m = 9.0;
+        let d = MatchDiagnostics {
+            longest_chain: vec![4],
+            min_ngram: vec![6],
+            mean_word_m: 2.5,
+            ..MatchDiagnostics::default()
+        };
+        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("is 11.2 m driven the same way and 9.0 m the other way"),
+            "{why}"
+        );
+        assert!(why.contains("a word spans 2.5 m on average"), "{why}");
+        assert!(why.contains("τ = 6 words need about 15 m,"), "{why}");
+        assert!(why.contains("too short for a chain"), "{why}");
+        // Read backwards a chain needs more words: 16 m is enough driven the same way, not
+        // the other way.
+        let d = MatchDiagnostics {
+            reverse_extra_ngram: 2,
+            ..d
+        };
+        e.directions.opposite.longest_revisit_m = 16.0;
+        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        assert!(
+            why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
+            "{why}"
+        );
+        assert!(why.contains("too short for a chain"), "{why}");
+        e.directions.same.longest_revisit_m = 16.0;
+        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        assert!(why.contains("the words differ between visits"), "{why}");
+        // Verification's counts are the reason when candidates were made.
+        let mut v = d.clone();
+        v.verification.rejected_turn = 2;
+        let why = no_pairs_reason(&e, Some(&v), &spec).unwrap();
+        assert!(!why.contains("stretch"), "{why}");
     }
 
     pub(crate) fn sample(scenario: &str, p: [f64; 3], r: [f64; 3]) -> Report {

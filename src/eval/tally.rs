@@ -498,7 +498,11 @@ impl Slot {
         } else {
             Vec::new()
         };
-        (total.metrics(self.radius_m), configs)
+        let metrics = Metrics {
+            longest_revisit_m: scorer.longest_revisit_m(revisits),
+            ..total.metrics(self.radius_m)
+        };
+        (metrics, configs)
     }
 }
 

@@ -158,6 +158,10 @@ pub struct WordMatcher {
     longest: [u16; MAX_LEVELS],
     /// Chains that reached τ but whose n-gram began within the candidate gap of its past side.
     within_gap: usize,
+    /// Level-0 words closed so far, and the travel they span (each word's observations times
+    /// the spacing), metres.
+    level0_words: usize,
+    level0_travel_m: f64,
     /// Per word matched so far, where it begins read forwards and read backwards
     /// ([`reading_start`](Self::reading_start)): verification reads it for every word of every
     /// candidate n-gram, and a word's first and last observations are far apart in memory.
@@ -225,6 +229,8 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            level0_words: 0,
+            level0_travel_m: 0.0,
             reading_starts: Vec::new(),
             scratch: Scratch::default(),
             placements: RefCell::default(),
@@ -334,6 +340,16 @@ impl WordMatcher {
             within_gap: self.within_gap,
             verification: self.rejections,
             long_steps: 0,
+            reverse_extra_ngram: if self.params.reverse {
+                self.params.reverse_extra_ngram
+            } else {
+                0
+            },
+            mean_word_m: if self.level0_words == 0 {
+                0.0
+            } else {
+                self.level0_travel_m / self.level0_words as f64
+            },
         }
     }
 
@@ -378,6 +394,11 @@ impl WordMatcher {
                 self.memo[Direction::Opposite as usize].push(Vec::new());
             }
             self.report(c, &mut out);
+            let (level, size) = (self.word(c).level, self.word(c).size);
+            if level == 0 {
+                self.level0_words += 1;
+                self.level0_travel_m += size as f64 * self.params.spacing_m;
+            }
             let class = self.word(c).class as usize;
             self.occurrences[class].push(c);
         }
@@ -1223,7 +1244,7 @@ impl VerificationCounts {
 }
 
 /// What the matcher saw, so that a run without matches can say why.
-#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MatchDiagnostics {
     /// Per level configuration (index k: k + 1 levels), the longest chain of matching word pairs
     /// found, in word pairs.
@@ -1239,6 +1260,14 @@ pub struct MatchDiagnostics {
     /// only when not 0).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub long_steps: usize,
+    /// Words a chain read backwards needs beyond τ (`reverse_extra_ngram`; 0 without reverse
+    /// matching).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub reverse_extra_ngram: usize,
+    /// Mean travel a level-0 word spans, metres (0 before the first word closes): a chain of
+    /// τ words needs a revisit about τ times this long.
+    #[serde(default)]
+    pub mean_word_m: f64,
 }
 
 fn is_zero(n: &usize) -> bool {

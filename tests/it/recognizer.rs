@@ -1305,6 +1305,47 @@ fn too_long_steps_are_named_when_nothing_matches() {
     assert!(long_steps > 10, "{long_steps} long steps");
 }
 
+/// A run without pairs says whether its revisits could hold a chain of τ words at all: with τ
+/// far above Intel's chains, the reason compares the longest stretch of revisits in each
+/// direction (`longest_revisit_m`) with τ words of the run's mean word length, and says "too
+/// short" exactly when both directions fall short.
+#[test]
+fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
+    for tau in [30, 45] {
+        let cfg = config(|c| {
+            c.min_ngram = vec![tau; 4];
+            c.ngram_travel_m = 0.0;
+            c.reverse_ngram_travel_m = 0.0;
+        });
+        let Some(scores) = real_log_scores_with("intel", 1, 1, &cfg) else {
+            return;
+        };
+        assert_eq!(scores.pairs, 0, "τ = {tau}: no chain is that long");
+        let why = scores.no_pairs_reason.expect("a reason");
+        let d = scores.diagnostics.expect("diagnostics");
+        assert!((1.0..5.0).contains(&d.mean_word_m), "{}", d.mean_word_m);
+        let (same_m, opposite_m) = (
+            scores.directions.same.longest_revisit_m,
+            scores.directions.opposite.longest_revisit_m,
+        );
+        assert!(same_m > 40.0 && opposite_m > 40.0, "{same_m} {opposite_m}");
+        assert!(scores.longest_revisit_m >= same_m.max(opposite_m), "{why}");
+        let backwards = tau + cfg.reverse_extra_ngram;
+        let too_short =
+            same_m < tau as f64 * d.mean_word_m && opposite_m < backwards as f64 * d.mean_word_m;
+        assert_eq!(why.contains("too short for a chain"), too_short, "{why}");
+        assert_eq!(
+            why.contains("the words differ between visits"),
+            !too_short,
+            "{why}"
+        );
+        assert!(
+            why.contains(&format!("{same_m:.1} m driven the same way")),
+            "{why}"
+        );
+    }
+}
+
 /// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
 /// with the defaults: its revisits' words differ in turn angle, and chains bridge one such word
 /// (`substitutions`); without them it gave none.
