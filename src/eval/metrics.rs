@@ -854,6 +854,7 @@ pub(crate) mod tests {
                 lap_seconds: Vec::new(),
                 evaluation: None,
                 level_gain: None,
+                rejected: Vec::new(),
             };
             evaluate(&rec, &EvaluationSpec::default())
         };
@@ -913,6 +914,7 @@ pub(crate) mod tests {
             lap_seconds: Vec::new(),
             evaluation: None,
             level_gain: None,
+            rejected: Vec::new(),
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -962,6 +964,7 @@ pub(crate) mod tests {
             lap_seconds: Vec::new(),
             evaluation: None,
             level_gain: None,
+            rejected: Vec::new(),
         };
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);

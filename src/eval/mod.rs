@@ -24,7 +24,9 @@ pub mod tally;
 
 use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
-use crate::recognizer::{Match, MatchDiagnostics, Observation};
+use crate::recognizer::{
+    Direction, Match, MatchDiagnostics, ObsId, Observation, RejectedCandidate, Rejection,
+};
 use crate::spec::evaluation::EvaluationSpec;
 use std::sync::Arc;
 use std::time::Instant;
@@ -205,6 +207,54 @@ pub struct Recognition {
     /// `(pairs, correct pairs)` this recognition found that the level configuration with one
     /// level fewer did not, when counted as the matches arrived (`Report::set_level_gains`).
     pub level_gain: Option<(usize, usize)>,
+    /// The candidates the recognizer's verification turned down (the first 10,000, as its
+    /// diagnostics sample them), with the truth of each one's observation pair: whether
+    /// verification turned down true revisits or look-alikes.
+    pub rejected: Vec<RejectedTruth>,
+}
+
+/// A candidate the recognizer's verification turned down, with the true poses of the
+/// observation pair it was sampled at (`recognizer::RejectedCandidate`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RejectedTruth {
+    pub query: TruePose,
+    pub past: TruePose,
+    pub direction: Direction,
+    pub reason: Rejection,
+}
+
+/// The truth of the rejected candidates `rejected`, whose observations are among
+/// `observations` (those without truth are left out).
+fn rejected_truth(
+    rejected: &[RejectedCandidate],
+    observations: &[Observation],
+    truth: &GroundTruth,
+) -> Vec<RejectedTruth> {
+    // The recognizer's own ids are the observations' indices; anything else is looked up.
+    let by_index = observations.iter().enumerate().all(|(i, o)| o.id == i);
+    let map: std::collections::HashMap<ObsId, &Observation> = if by_index {
+        Default::default()
+    } else {
+        observations.iter().map(|o| (o.id, o)).collect()
+    };
+    let find = |id: ObsId| {
+        if by_index {
+            observations.get(id)
+        } else {
+            map.get(&id).copied()
+        }
+    };
+    rejected
+        .iter()
+        .filter_map(|r| {
+            Some(RejectedTruth {
+                query: truth.observation_pose(find(r.query)?)?,
+                past: truth.observation_pose(find(r.past)?)?,
+                direction: r.direction,
+                reason: r.reason,
+            })
+        })
+        .collect()
 }
 
 impl Recognition {
@@ -434,10 +484,15 @@ impl Recording {
             }
             None => rec.observations().to_vec(),
         };
+        let diagnostics = rec.diagnostics();
+        let rejected = diagnostics.as_ref().map_or_else(Vec::new, |d| {
+            rejected_truth(&d.rejected, rec.observations(), truth)
+        });
         Ended {
             name: rec.name(),
-            diagnostics: rec.diagnostics(),
+            diagnostics,
             observations,
+            rejected,
             recording: self,
         }
     }
@@ -448,6 +503,7 @@ pub struct Ended {
     name: String,
     diagnostics: Option<MatchDiagnostics>,
     observations: Vec<Observation>,
+    rejected: Vec<RejectedTruth>,
     recording: Recording,
 }
 
@@ -470,6 +526,7 @@ impl Ended {
             lap_seconds: r.lap_seconds,
             evaluation,
             level_gain: r.level_gain,
+            rejected: self.rejected,
         }
     }
 }

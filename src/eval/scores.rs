@@ -12,6 +12,8 @@
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
 //!                 "longest_revisit_m": 62.5,
+//!                 "rejected_candidates": { "sampled": 25, "correct": 22, "correct_travel": 10,
+//!                                          "correct_turn": 8, ... } | absent,
 //!                 "recognize_seconds_per_lap": 0.8, "recognize_seconds_by_lap": [0.7, 0.8, ...],
 //!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
@@ -34,7 +36,7 @@
 use super::Recognition;
 use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
 use super::sweep::{PrCurve, SweepResult};
-use crate::recognizer::MatchDiagnostics;
+use crate::recognizer::{MatchDiagnostics, Rejection};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 
@@ -76,6 +78,10 @@ pub struct Scores {
     /// rejected by verification, with counts per reason).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub no_pairs_reason: Option<String>,
+    /// The candidates the recognizer's verification turned down (as sampled), and how many of
+    /// them the truth says were right; `None` when none was turned down.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rejected_candidates: Option<RejectedScores>,
     /// What the recognizer saw (longest chains, verification counts), when it tells.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diagnostics: Option<MatchDiagnostics>,
@@ -113,6 +119,7 @@ impl Scores {
             door_configs: Vec::new(),
             directions: DirectionMetrics::default(),
             no_pairs_reason: None,
+            rejected_candidates: None,
             diagnostics: None,
         }
     }
@@ -136,8 +143,10 @@ impl Scores {
     /// Evaluates `rec` with `spec` and takes its timing.
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
         let e = super::evaluate(rec, spec);
+        let rejected = RejectedScores::of(&rec.rejected, spec);
         Scores {
-            no_pairs_reason: no_pairs_reason(&e, rec.diagnostics.as_ref(), spec),
+            no_pairs_reason: no_pairs_reason(&e, rec.diagnostics.as_ref(), rejected.as_ref(), spec),
+            rejected_candidates: rejected,
             diagnostics: rec.diagnostics.clone(),
             ..Scores::new(&e, rec.seconds_per_lap())
         }
@@ -149,6 +158,7 @@ impl Scores {
 pub fn no_pairs_reason(
     e: &Evaluation,
     diagnostics: Option<&MatchDiagnostics>,
+    rejected: Option<&RejectedScores>,
     spec: &EvaluationSpec,
 ) -> Option<String> {
     let m = &e.main;
@@ -168,11 +178,86 @@ pub fn no_pairs_reason(
             if m.revisits > 0 && d.verification.accepted + d.verification.rejected() == 0 {
                 why.extend(revisit_length_reason(e, d));
             }
+            if d.verification.accepted == 0 {
+                why.extend(rejected.map(|r| r.sentence(spec)));
+            }
         }
         None if why.is_empty() => why.push("the recognizer does not say why".into()),
         None => {}
     }
     Some(why.join("; "))
+}
+
+/// The candidates verification turned down, scored against the truth at their sampled
+/// observation pairs (`eval::Recognition::rejected`).
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct RejectedScores {
+    /// Rejected candidates sampled (the recognizer keeps the first 10,000).
+    pub sampled: usize,
+    /// Of them, those whose pair is correct at `tp_radius_m` (same place, facing as the
+    /// candidate's direction claims): true revisits that verification turned down.
+    pub correct: usize,
+    /// `correct` per rejection reason.
+    pub correct_travel: usize,
+    pub correct_turn: usize,
+    pub correct_density: usize,
+    pub correct_sides: usize,
+    pub correct_straight: usize,
+}
+
+impl RejectedScores {
+    /// The scores of `rejected` with `spec`'s radius and heading tolerance; `None` when empty.
+    pub fn of(rejected: &[super::RejectedTruth], spec: &EvaluationSpec) -> Option<Self> {
+        if rejected.is_empty() {
+            return None;
+        }
+        let tol = spec.heading_tolerance_deg.to_radians();
+        let mut s = RejectedScores {
+            sampled: rejected.len(),
+            ..RejectedScores::default()
+        };
+        for r in rejected {
+            let (q, p) = (r.query.0, r.past.0);
+            let right = q.distance(&p) <= spec.tp_radius_m
+                && super::pair_recall::Facing::of(r.direction).agrees(q.theta, p.theta, tol);
+            if !right {
+                continue;
+            }
+            s.correct += 1;
+            match r.reason {
+                Rejection::Travel => s.correct_travel += 1,
+                Rejection::Turn => s.correct_turn += 1,
+                Rejection::Density => s.correct_density += 1,
+                Rejection::Sides => s.correct_sides += 1,
+                Rejection::Straight => s.correct_straight += 1,
+            }
+        }
+        Some(s)
+    }
+
+    /// What the truth says of the rejected candidates, in words.
+    fn sentence(&self, spec: &EvaluationSpec) -> String {
+        if self.correct == 0 {
+            return format!(
+                "by the ground truth none of the {} rejected candidates sampled paired the same \
+                 place (within {} m): verification turned down look-alikes",
+                self.sampled, spec.tp_radius_m
+            );
+        }
+        format!(
+            "by the ground truth {} of the {} rejected candidates sampled paired the same place \
+             (within {} m; travel {}, turn {}, density {}, sides {}, straight {}): verification \
+             turned down true revisits",
+            self.correct,
+            self.sampled,
+            spec.tp_radius_m,
+            self.correct_travel,
+            self.correct_turn,
+            self.correct_density,
+            self.correct_sides,
+            self.correct_straight
+        )
+    }
 }
 
 /// Whether the revisits are long enough for a chain of τ words (the smallest τ; more read
@@ -487,12 +572,13 @@ pub(crate) mod tests {
             verification: Default::default(),
             long_steps: 0,
             reverse_extra_ngram: 0,
+            rejected: Vec::new(),
             mean_word_m: 0.0,
         };
         d.verification.rejected_travel = 3;
         d.verification.rejected_density = 2;
         d.verification.rejected_straight = 1;
-        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
         assert!(
             why.contains(
                 "rejected by verification: 6 (travel 3, turn 0, density 2, sides 0, straight 1)"
@@ -501,24 +587,24 @@ pub(crate) mod tests {
         );
         d.verification = Default::default();
         d.longest_chain = vec![4, 8];
-        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
             "{why}"
         );
         d.long_steps = 3;
-        let why = no_pairs_reason(&none, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("3 steps between scans were longer than max_interpolation_m"),
             "{why}"
         );
-        let why = no_pairs_reason(&Evaluation::default(), None, &spec).unwrap();
+        let why = no_pairs_reason(&Evaluation::default(), None, None, &spec).unwrap();
         assert!(why.starts_with("no observation has a revisit"), "{why}");
         let mut some = none.clone();
         some.main.pairs = 1;
-        assert_eq!(no_pairs_reason(&some, Some(&d), &spec), None);
+        assert_eq!(no_pairs_reason(&some, Some(&d), None, &spec), None);
     }
 
     /// When no chain is long enough, the reason says whether the revisits are shorter than τ
@@ -537,7 +623,7 @@ pub(crate) mod tests {
             mean_word_m: 2.5,
             ..MatchDiagnostics::default()
         };
-        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("is 11.2 m driven the same way and 9.0 m the other way"),
@@ -553,20 +639,101 @@ pub(crate) mod tests {
             ..d
         };
         e.directions.opposite.longest_revisit_m = 16.0;
-        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
         assert!(
             why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
             "{why}"
         );
         assert!(why.contains("too short for a chain"), "{why}");
         e.directions.same.longest_revisit_m = 16.0;
-        let why = no_pairs_reason(&e, Some(&d), &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
         assert!(why.contains("the words differ between visits"), "{why}");
         // Verification's counts are the reason when candidates were made.
         let mut v = d.clone();
         v.verification.rejected_turn = 2;
-        let why = no_pairs_reason(&e, Some(&v), &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&v), None, &spec).unwrap();
         assert!(!why.contains("stretch"), "{why}");
+    }
+
+    /// Rejected candidates are scored at their sampled pair: right when the two true poses are
+    /// within the radius and face as the candidate's direction claims; the reason then says
+    /// whether verification turned down true revisits or look-alikes.
+    #[test]
+    fn rejected_candidates_are_scored_against_the_truth() {
+        use crate::eval::RejectedTruth;
+        use crate::geom::{Pose2, TruePose};
+        use crate::recognizer::Direction;
+        let spec = EvaluationSpec::default();
+        let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
+        let r = |q, p, direction, reason| RejectedTruth {
+            query: q,
+            past: p,
+            direction,
+            reason,
+        };
+        let rejected = [
+            // The same place, facing alike: a true revisit turned down by the turn check.
+            r(
+                at(0.0, 0.0),
+                at(0.5, 10.0),
+                Direction::Same,
+                Rejection::Turn,
+            ),
+            // The same place driven the other way, claimed opposite: right too.
+            r(
+                at(0.0, 0.0),
+                at(0.3, 175.0),
+                Direction::Opposite,
+                Rejection::Sides,
+            ),
+            // Claimed the same direction but driven the other way: wrong.
+            r(
+                at(0.0, 0.0),
+                at(0.3, 175.0),
+                Direction::Same,
+                Rejection::Turn,
+            ),
+            // A look-alike 5 m away.
+            r(
+                at(0.0, 0.0),
+                at(5.0, 0.0),
+                Direction::Same,
+                Rejection::Travel,
+            ),
+        ];
+        let s = RejectedScores::of(&rejected, &spec).expect("four sampled");
+        assert_eq!((s.sampled, s.correct), (4, 2));
+        assert_eq!(
+            (s.correct_turn, s.correct_sides, s.correct_travel),
+            (1, 1, 0)
+        );
+        assert_eq!(RejectedScores::of(&[], &spec), None);
+        let mut e = Evaluation::default();
+        e.main.revisits = 10;
+        let d = MatchDiagnostics {
+            longest_chain: vec![8],
+            min_ngram: vec![6],
+            verification: crate::recognizer::VerificationCounts {
+                rejected_turn: 2,
+                rejected_sides: 1,
+                rejected_travel: 1,
+                ..Default::default()
+            },
+            ..MatchDiagnostics::default()
+        };
+        let why = no_pairs_reason(&e, Some(&d), Some(&s), &spec).unwrap();
+        assert!(
+            why.contains("every candidate was rejected by verification: 4"),
+            "{why}"
+        );
+        assert!(
+            why.contains("2 of the 4 rejected candidates sampled paired the same place"),
+            "{why}"
+        );
+        assert!(why.contains("turned down true revisits"), "{why}");
+        let none_right = RejectedScores::of(&rejected[3..], &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d), Some(&none_right), &spec).unwrap();
+        assert!(why.contains("turned down look-alikes"), "{why}");
     }
 
     pub(crate) fn sample(scenario: &str, p: [f64; 3], r: [f64; 3]) -> Report {

@@ -293,6 +293,7 @@ impl LoggedRuns {
             lap_seconds: Vec::new(),
             evaluation: None,
             level_gain: None,
+            rejected: Vec::new(),
         })
     }
 }

@@ -81,7 +81,7 @@
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
 use super::index::recent_candidates;
-use super::types::{AlignedRun, Direction, Match, Observation, push_pair, push_run};
+use super::types::{AlignedRun, Direction, Match, ObsId, Observation, push_pair, push_run};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
 use std::cell::RefCell;
@@ -162,6 +162,9 @@ pub struct WordMatcher {
     /// the spacing), metres.
     level0_words: usize,
     level0_travel_m: f64,
+    /// The first `MAX_REJECTED_SAMPLES` candidates verification turned down, one observation
+    /// pair each (so the harness can tell whether they were right).
+    rejected: Vec<RejectedCandidate>,
     /// Per word matched so far, where it begins read forwards and read backwards
     /// ([`reading_start`](Self::reading_start)): verification reads it for every word of every
     /// candidate n-gram, and a word's first and last observations are far apart in memory.
@@ -229,6 +232,7 @@ impl WordMatcher {
             stamp: 0,
             longest: [0; MAX_LEVELS],
             within_gap: 0,
+            rejected: Vec::new(),
             level0_words: 0,
             level0_travel_m: 0.0,
             reading_starts: Vec::new(),
@@ -339,6 +343,7 @@ impl WordMatcher {
             min_ngram: self.params.min_ngram[..levels].to_vec(),
             within_gap: self.within_gap,
             verification: self.rejections,
+            rejected: self.rejected.clone(),
             long_steps: 0,
             reverse_extra_ngram: if self.params.reverse {
                 self.params.reverse_extra_ngram
@@ -710,6 +715,11 @@ impl WordMatcher {
             )
         {
             self.rejections.add(reason);
+            if self.rejected.len() < MAX_REJECTED_SAMPLES {
+                let (&newest, &anchor) =
+                    (&scr.word_pairs[pairs.end - 1], &scr.anchors[pairs.end - 1]);
+                self.rejected.push(self.sample(newest, anchor, dir, reason));
+            }
             scr.truncate(from, placed_from);
             return None;
         }
@@ -719,6 +729,28 @@ impl WordMatcher {
             pairs,
             placed: placed_from..scr.placed.len(),
         })
+    }
+
+    /// A rejected candidate's sample: the middle observation of its newest current word `c`,
+    /// and the past observation the n-gram's shift `anchor` aligns with it (clamped into the
+    /// past word `p`).
+    fn sample(
+        &self,
+        (c, p): (WordId, WordId),
+        anchor: i64,
+        dir: Direction,
+        reason: Rejection,
+    ) -> RejectedCandidate {
+        let (cw, pw) = (self.word(c), self.word(p));
+        let i = cw.size as i64 / 2;
+        let j = (i + anchor).clamp(0, pw.size as i64 - 1);
+        let obs = self.words.observations();
+        RejectedCandidate {
+            query: obs[cw.first_obs + i as usize].id,
+            past: obs[PastSide::of(pw, dir).index(j)].id,
+            direction: dir,
+            reason,
+        }
     }
 
     /// Appends to `scr` the τ-gram of configuration k ending at memo entry `idx` of `c`, oldest
@@ -1191,6 +1223,19 @@ impl PastSide {
     }
 }
 
+/// Rejected candidates sampled at most (the first ones; 24 bytes each).
+const MAX_REJECTED_SAMPLES: usize = 10_000;
+
+/// A candidate n-gram verification turned down, as one observation pair: the middle of its
+/// newest current word and the past observation its shift aligns with it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RejectedCandidate {
+    pub query: ObsId,
+    pub past: ObsId,
+    pub direction: Direction,
+    pub reason: Rejection,
+}
+
 /// Why verification turned a candidate n-gram down.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rejection {
@@ -1264,6 +1309,10 @@ pub struct MatchDiagnostics {
     /// matching).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub reverse_extra_ngram: usize,
+    /// The first 10,000 candidates verification turned down, one observation pair each (not
+    /// written: the harness scores them against the truth, see `eval::Recognition::rejected`).
+    #[serde(skip)]
+    pub rejected: Vec<RejectedCandidate>,
     /// Mean travel a level-0 word spans, metres (0 before the first word closes): a chain of
     /// τ words needs a revisit about τ times this long.
     #[serde(default)]

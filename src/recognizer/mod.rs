@@ -24,7 +24,9 @@ pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig,
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use frontend::DensityFrontEnd;
 pub use grid::{Density, LocalGrid};
-pub use matcher::{MatchDiagnostics, VerificationCounts, WordMatcher};
+pub use matcher::{
+    MatchDiagnostics, RejectedCandidate, Rejection, VerificationCounts, WordMatcher,
+};
 pub use types::{AlignedRun, Direction, FrameId, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};
 

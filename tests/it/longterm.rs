@@ -22,8 +22,9 @@ fn without_timings(v: &mut serde_json::Value) {
 /// word boundaries (third session), for bounded substitutions (fourth) and for the side and turn
 /// checks of verification (fifth: 311,880 → 311,897 pairs at 3 levels, precision 0.9985 both;
 /// 3,375 → 3,374 matches with the side cue as a moment of the reached tree nodes), and for
-/// added keys only (eighth: `longest_revisit_m`, `diagnostics.mean_word_m` and
-/// `diagnostics.reverse_extra_ngram`; every other value identical).
+/// added keys only (eighth: `longest_revisit_m`, `rejected_candidates`,
+/// `diagnostics.mean_word_m` and `diagnostics.reverse_extra_ngram`; every other value
+/// identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]

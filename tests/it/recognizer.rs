@@ -1346,6 +1346,29 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
     }
 }
 
+/// The candidates verification turns down are scored against the truth: on Intel every one is
+/// sampled (far fewer than 10,000), and the per-reason counts of the right ones add up.
+#[test]
+fn rejected_candidates_are_counted_against_the_truth() {
+    let Some(scores) = real_log_scores_at("intel", 1, 1) else {
+        return;
+    };
+    let v = scores.diagnostics.expect("diagnostics").verification;
+    assert!(v.rejected() > 0, "Intel has rejected candidates");
+    let r = scores.rejected_candidates.expect("scored rejections");
+    assert_eq!(r.sampled, v.rejected());
+    assert!(r.correct <= r.sampled);
+    assert_eq!(
+        r.correct,
+        r.correct_travel
+            + r.correct_turn
+            + r.correct_density
+            + r.correct_sides
+            + r.correct_straight
+    );
+    assert!(r.correct_travel <= v.rejected_travel && r.correct_turn <= v.rejected_turn);
+}
+
 /// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
 /// with the defaults: its revisits' words differ in turn angle, and chains bridge one such word
 /// (`substitutions`); without them it gave none.
