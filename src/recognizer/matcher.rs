@@ -61,6 +61,9 @@
 //! help (there are none). So an n-gram read backwards must turn: the current side's heading must
 //! change by at least `reverse_min_turn_deg` from its first word. Within a stretch whose ends
 //! both turn, reading backwards negates the turns and breaks such false chains at the corners.
+//! The first 10,000 candidates verification turns down are kept as one observation pair each
+//! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
+//! the checks turned down look-alikes or true revisits.
 //!
 //! **Fine alignment** (paper §IV, Eq. 2). Each reported word pair is aligned by the shift
 //! minimising the mean squared Ψ difference between n = min(S₁, S₂) current and past
@@ -743,7 +746,7 @@ impl WordMatcher {
     ) -> RejectedCandidate {
         let (cw, pw) = (self.word(c), self.word(p));
         let i = cw.size as i64 / 2;
-        let j = (i + anchor).clamp(0, pw.size as i64 - 1);
+        let j = (i + anchor).clamp(0, (pw.size as i64 - 1).max(0));
         let obs = self.words.observations();
         RejectedCandidate {
             query: obs[cw.first_obs + i as usize].id,
