@@ -223,6 +223,20 @@ pub struct RejectedTruth {
     pub reason: Rejection,
 }
 
+impl RejectedTruth {
+    /// Whether the pair is correct with `spec`'s rules: within `tp_radius_m`, facing as the
+    /// candidate's direction claims (a true revisit that verification turned down).
+    pub fn is_right(&self, spec: &EvaluationSpec) -> bool {
+        let (q, p) = (self.query.0, self.past.0);
+        q.distance(&p) <= spec.tp_radius_m
+            && pair_recall::Facing::of(self.direction).agrees(
+                q.theta,
+                p.theta,
+                spec.heading_tolerance_deg.to_radians(),
+            )
+    }
+}
+
 /// The truth of the rejected candidates `rejected`, whose observations are among
 /// `observations` (those without truth are left out).
 fn rejected_truth(

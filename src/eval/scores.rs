@@ -211,18 +211,11 @@ impl RejectedScores {
         if rejected.is_empty() {
             return None;
         }
-        let tol = spec.heading_tolerance_deg.to_radians();
         let mut s = RejectedScores {
             sampled: rejected.len(),
             ..RejectedScores::default()
         };
-        for r in rejected {
-            let (q, p) = (r.query.0, r.past.0);
-            let right = q.distance(&p) <= spec.tp_radius_m
-                && super::pair_recall::Facing::of(r.direction).agrees(q.theta, p.theta, tol);
-            if !right {
-                continue;
-            }
+        for r in rejected.iter().filter(|r| r.is_right(spec)) {
             s.correct += 1;
             match r.reason {
                 Rejection::Travel => s.correct_travel += 1,

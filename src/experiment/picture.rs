@@ -1,15 +1,17 @@
 //! Pictures of an experiment: the world with the true and odometry paths (odometry placed at the
 //! run's true start); the true path coloured where revisits were recognized, recognized wrongly
-//! and missed, with the worst clusters of wrong pairs as lines; and a strip of recall and
-//! precision per lap with the door configurations marked.
+//! and missed, with the worst clusters of wrong pairs as lines and marks where verification
+//! turned down true revisits; and a strip of recall and precision per lap with the door
+//! configurations marked.
 
 use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
 use crate::eval::pair_recall::Facing;
 use crate::log::RunLog;
+use crate::recognizer::Rejection;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
-    LegendEntry, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
+    LegendEntry, MarkOverlay, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
 };
 use crate::spec::evaluation::EvaluationSpec;
 use crate::world::World;
@@ -22,6 +24,7 @@ const CORRECT_COLOR: &str = "#2ca02c";
 const WRONG_COLOR: &str = "#d62728";
 const MISSED_COLOR: &str = "#222222";
 const PLAIN_COLOR: &str = "#c7c7c7";
+const TURNED_DOWN_COLOR: &str = "#9467bd";
 
 fn true_paths(runs: &[RunLog], label: &str) -> Vec<PathOverlay> {
     runs.iter()
@@ -112,6 +115,8 @@ pub fn matches_svg(
                 dashed: false,
             }));
     }
+    let right_rejected = rec.rejected.iter().filter(|r| r.is_right(&spec)).count();
+    opts.marks = turned_down_marks(&rec.rejected, &spec, 2 * WORST_CLUSTERS);
     let clusters = worst_wrong_clusters(&status.wrong_pairs, WORST_CLUSTERS);
     let shown: usize = clusters.iter().map(|c| c.2).sum();
     opts.segments = clusters
@@ -156,7 +161,72 @@ pub fn matches_svg(
             WRONG_COLOR,
         ),
     ];
+    if !rec.rejected.is_empty() {
+        opts.legend.push(legend(
+            format!(
+                "verification turned down {right_rejected} true revisits, {} look-alikes \
+                 (candidates sampled)",
+                rec.rejected.len() - right_rejected
+            ),
+            TURNED_DOWN_COLOR,
+        ));
+        if right_rejected > 0 {
+            opts.notes.push(
+                "purple marks: true revisits turned down per 5 m, and the check that did most \
+                 (Tr travel, Tu turn, D density, S sides, St straight)"
+                    .into(),
+            );
+        }
+    }
     render_world_svg(world, &opts)
+}
+
+/// Marks where verification turned down true revisits: the rejected candidates the truth
+/// calls right, grouped by the 5 m cell of their query, the `k` largest groups, each at its
+/// mean query position with its size and its most frequent check.
+fn turned_down_marks(
+    rejected: &[crate::eval::RejectedTruth],
+    spec: &EvaluationSpec,
+    k: usize,
+) -> Vec<MarkOverlay> {
+    type Group = (crate::geom::Vec2, usize, [usize; 5]);
+    let mut groups: HashMap<(i64, i64), Group> = HashMap::new();
+    for r in rejected.iter().filter(|r| r.is_right(spec)) {
+        let at = crate::geom::Vec2::new(r.query.0.x, r.query.0.y);
+        let cell = (
+            (at.x / CLUSTER_CELL_M).floor() as i64,
+            (at.y / CLUSTER_CELL_M).floor() as i64,
+        );
+        let g = groups
+            .entry(cell)
+            .or_insert((crate::geom::Vec2::zeros(), 0, [0; 5]));
+        g.0 += at;
+        g.1 += 1;
+        let check = match r.reason {
+            Rejection::Travel => 0,
+            Rejection::Turn => 1,
+            Rejection::Density => 2,
+            Rejection::Sides => 3,
+            Rejection::Straight => 4,
+        };
+        g.2[check] += 1;
+    }
+    let mut list: Vec<((i64, i64), Group)> = groups.into_iter().collect();
+    // Largest first; ties by cell so the picture does not depend on hash order.
+    list.sort_by(|x, y| y.1.1.cmp(&x.1.1).then(x.0.cmp(&y.0)));
+    const CHECKS: [&str; 5] = ["Tr", "Tu", "D", "S", "St"];
+    list.into_iter()
+        .take(k)
+        .map(|(_, (sum, n, by_check))| {
+            let check = (0..5).max_by_key(|&c| (by_check[c], 5 - c)).unwrap_or(0);
+            MarkOverlay {
+                at: sum / n as f64,
+                text: format!("{n} {}", CHECKS[check]),
+                color: TURNED_DOWN_COLOR.into(),
+                class: "turned-down".into(),
+            }
+        })
+        .collect()
 }
 
 /// Wrong-pair clusters drawn as lines in the matches picture.
@@ -504,5 +574,36 @@ mod tests {
         let c = worst_wrong_clusters(&wrong, 2);
         assert_eq!(c.iter().map(|c| c.2).collect::<Vec<_>>(), [5, 2]);
         assert_eq!(c[0].0, v(1.0, 1.0));
+    }
+
+    /// True revisits that verification turned down are marked per 5 m cell with their count
+    /// and the check that did most; look-alikes it turned down are not marked.
+    #[test]
+    fn turned_down_true_revisits_are_marked() {
+        use crate::eval::RejectedTruth;
+        use crate::recognizer::Direction;
+        let at = |x: f64| TruePose(Pose2::new(x, 1.0, 0.0));
+        let r = |q: f64, p: f64, reason| RejectedTruth {
+            query: at(q),
+            past: at(p),
+            direction: Direction::Same,
+            reason,
+        };
+        let rejected = [
+            r(1.0, 1.2, Rejection::Turn),
+            r(2.0, 2.3, Rejection::Turn),
+            r(3.0, 3.1, Rejection::Sides),
+            r(12.0, 12.5, Rejection::Travel),
+            // A look-alike 20 m away.
+            r(30.0, 10.0, Rejection::Turn),
+        ];
+        let marks = turned_down_marks(&rejected, &EvaluationSpec::default(), 8);
+        let texts: Vec<&str> = marks.iter().map(|m| m.text.as_str()).collect();
+        assert_eq!(texts, ["3 Tu", "1 Tr"]);
+        assert_eq!(marks[0].at, crate::geom::Vec2::new(2.0, 1.0));
+        assert_eq!(
+            turned_down_marks(&rejected, &EvaluationSpec::default(), 1).len(),
+            1
+        );
     }
 }
