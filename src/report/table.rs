@@ -145,6 +145,19 @@ pub fn text_table(report: &Report) -> String {
             crate::eval::scores::long_steps_sentence(n)
         );
     }
+    // Where there are pairs (the reason says it otherwise): what verification turned down.
+    for (label, s) in rows(report) {
+        if let (None, Some(r)) = (&s.no_pairs_reason, &s.rejected_candidates) {
+            let _ = writeln!(
+                out,
+                "{label}: verification turned down {} true revisits and {} look-alikes (of {} \
+                 candidates sampled)",
+                r.correct,
+                r.sampled - r.correct,
+                r.sampled
+            );
+        }
+    }
     for (label, s) in rows(report) {
         if s.sensitivity.is_empty() && s.door_configs.is_empty() {
             continue;
@@ -362,6 +375,28 @@ mod tests {
     /// under the level row; without them, neither does.
     /// Steps too long to observe along their length are noted once when there are pairs (and
     /// are part of the reason when there are none).
+    /// With pairs, each level's line says how many true revisits and look-alikes verification
+    /// turned down; without, its reason says it and the line is not repeated.
+    #[test]
+    fn turned_down_candidates_are_told_per_level() {
+        let mut rep = sample("A", [0.9; 3], [0.2; 3]);
+        assert!(!text_table(&rep).contains("verification turned down"));
+        for l in &mut rep.levels {
+            l.scores.rejected_candidates = Some(crate::eval::scores::RejectedScores {
+                sampled: 25,
+                correct: 22,
+                ..Default::default()
+            });
+        }
+        rep.levels[0].scores.no_pairs_reason = Some("every candidate was rejected".into());
+        let t = text_table(&rep);
+        assert_eq!(t.matches("verification turned down").count(), 2, "{t}");
+        assert!(
+            t.contains("verification turned down 22 true revisits and 3 look-alikes (of 25"),
+            "{t}"
+        );
+    }
+
     #[test]
     fn long_steps_are_noted_once() {
         let mut rep = sample("A", [0.9; 3], [0.2; 3]);
