@@ -148,13 +148,17 @@ pub fn text_table(report: &Report) -> String {
     // Where there are pairs (the reason says it otherwise): what verification turned down.
     for (label, s) in rows(report) {
         if let (None, Some(r)) = (&s.no_pairs_reason, &s.rejected_candidates) {
+            let s = |n: usize| if n == 1 { "" } else { "s" };
+            let alike = r.sampled - r.correct;
             let _ = writeln!(
                 out,
-                "{label}: verification turned down {} true revisits and {} look-alikes (of {} \
-                 candidates sampled)",
+                "{label}: verification turned down {} true revisit{} and {alike} look-alike{} \
+                 (of {} candidate{} sampled)",
                 r.correct,
-                r.sampled - r.correct,
-                r.sampled
+                s(r.correct),
+                s(alike),
+                r.sampled,
+                s(r.sampled)
             );
         }
     }
