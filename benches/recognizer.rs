@@ -7,7 +7,7 @@ use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use placewords::geom::OdomPose;
 use placewords::recognizer::synth::{self, LoopFloor, SplitMix};
 use placewords::recognizer::{
-    DensityFrontEnd, DensityKernel, LocalGrid, Observation, Recognizer, RecognizerConfig,
+    DensityFrontEnd, DensityKernel, DensityObservation, LocalGrid, Recognizer, RecognizerConfig,
     WordLevels, WordMatcher,
 };
 use placewords::scan::Scan;
@@ -34,8 +34,8 @@ fn lap_inputs(seed: u64) -> Vec<(OdomPose, Scan)> {
 fn observation_laps(
     n: usize,
     first_seed: u64,
-    after: Option<Observation>,
-) -> Vec<Vec<Observation>> {
+    after: Option<DensityObservation>,
+) -> Vec<Vec<DensityObservation>> {
     let mut last = after;
     (0..n)
         .map(|i| {

@@ -157,13 +157,15 @@ fn observe(runs: &[RunLog], cfg: RecognizerConfig) -> Result<Vec<Obs>> {
         }
     }
     rec.finish();
+    let words = rec.words();
     Ok(rec
         .observations()
         .iter()
-        .map(|o| Obs {
+        .zip(words.psi().iter().zip(words.lateral_moments()))
+        .map(|(o, (&psi, &lateral))| Obs {
             travel_m: o.travel_m,
-            psi: o.psi,
-            lateral: o.lateral_moment,
+            psi,
+            lateral,
             heading: o.odom_pose.0.theta,
             truth: truth.observation_pose(o).map(|p| p.0),
         })

@@ -11,7 +11,7 @@
 //! way; the recognizer's `reverse` setting is turned off here).
 
 use crate::geom::Vec2;
-use crate::recognizer::{Match, Recognizer, RecognizerConfig, Word};
+use crate::recognizer::{Recognizer, RecognizerConfig, Word, WordMatch as Match};
 use crate::sim::Frame;
 use crate::sim::robot::RouteTracker;
 use crate::world::{DoorStates, Route, World};

@@ -33,7 +33,7 @@
 
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::PlaceRecognizer;
-use crate::recognizer::{FrameId, Match, Observation};
+use crate::place::{FrameId, Match, Observation};
 use crate::scan::Scan;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -566,7 +566,8 @@ impl IcpRecognizer {
                 (q, past.obs[k])
             })
             .collect::<Vec<_>>();
-        Match::from_pairs(0, 1, Vec::new(), pairs)
+        // Surer the more of the cloud lies on the past one.
+        Match::from_pairs(pairs, a.inlier_fraction)
     }
 }
 
@@ -604,15 +605,13 @@ impl PlaceRecognizer for IcpRecognizer {
         self.next_obs_travel_m = Some(next);
         self.forget_far_cells(&pose);
         let id = self.observations.len();
-        self.observations.push(Observation {
+        self.observations.push(Observation::new(
             id,
-            run: self.run.unwrap_or(0),
+            self.run.unwrap_or(0),
             frame_id,
-            odom_pose: odom,
-            travel_m: self.travel_m,
-            psi: 0.0,
-            lateral_moment: 0.0,
-        });
+            odom,
+            self.travel_m,
+        ));
         self.pending.push(id);
         if self.pending.len() >= self.cfg.region_observations {
             self.close_region()

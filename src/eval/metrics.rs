@@ -44,7 +44,7 @@ use super::pair_set::{PairSet, pack};
 use super::site_tree::{LapSet, Query, Site, sweep};
 use super::tally::{Scope, Tally};
 use super::{GroundTruth, Recognition};
-use crate::recognizer::{Match, ObsId, Observation};
+use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
@@ -670,15 +670,7 @@ pub(crate) mod tests {
                 );
                 let i = obs.len();
                 gt.push_frame(TruePose(pose), OdomPose(pose));
-                obs.push(Observation {
-                    id: i,
-                    run: 0,
-                    frame_id: i,
-                    odom_pose: OdomPose(pose),
-                    travel_m: i as f64 * 0.1,
-                    psi: 0.5,
-                    lateral_moment: 0.0,
-                });
+                obs.push(Observation::new(i, 0, i, OdomPose(pose), i as f64 * 0.1));
             }
         }
         (obs, gt)
@@ -689,7 +681,7 @@ pub(crate) mod tests {
     }
 
     fn one_match(pairs: Vec<AlignedPair>) -> Match {
-        Match::from_pairs(1, 1, vec![], pairs)
+        Match::from_pairs(pairs, 1.0)
     }
 
     /// The oracle: for every observation, its nearest earlier neighbour that makes a revisit.

@@ -24,9 +24,7 @@ pub mod tally;
 
 use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
-use crate::recognizer::{
-    Direction, Match, MatchDiagnostics, ObsId, Observation, RejectedCandidate, Rejection,
-};
+use crate::place::{Diagnostics, Direction, Match, ObsId, Observation, RejectedCandidate};
 use crate::spec::evaluation::EvaluationSpec;
 use std::sync::Arc;
 use std::time::Instant;
@@ -196,7 +194,7 @@ pub struct Recognition {
     /// Truth of every frame fed, by input index (shared by the recognitions of one input).
     pub truth: Arc<GroundTruth>,
     /// What the recognizer saw (to say why nothing matched), when it tells.
-    pub diagnostics: Option<MatchDiagnostics>,
+    pub diagnostics: Option<Arc<dyn Diagnostics>>,
     /// Seconds the recognizer spent on each lap's frames, in the order fed: CPU time of the
     /// thread that fed them (so a loaded machine does not blur how the work grows with history),
     /// wall clock where the thread's CPU time cannot be read; empty when not recorded.
@@ -220,7 +218,8 @@ pub struct RejectedTruth {
     pub query: TruePose,
     pub past: TruePose,
     pub direction: Direction,
-    pub reason: Rejection,
+    /// The check that turned it down ([`Diagnostics::checks`]).
+    pub check: usize,
 }
 
 impl RejectedTruth {
@@ -265,7 +264,7 @@ fn rejected_truth(
                 query: truth.observation_pose(find(r.query)?)?,
                 past: truth.observation_pose(find(r.past)?)?,
                 direction: r.direction,
-                reason: r.reason,
+                check: r.check,
             })
         })
         .collect()
@@ -498,9 +497,9 @@ impl Recording {
             }
             None => rec.observations().to_vec(),
         };
-        let diagnostics = rec.diagnostics();
+        let diagnostics: Option<Arc<dyn Diagnostics>> = rec.diagnostics().map(Arc::from);
         let rejected = diagnostics.as_ref().map_or_else(Vec::new, |d| {
-            rejected_truth(&d.rejected, rec.observations(), truth)
+            rejected_truth(d.rejected(), rec.observations(), truth)
         });
         Ended {
             name: rec.name(),
@@ -515,7 +514,7 @@ impl Recording {
 /// A recording whose recognizer is done ([`Recording::end`]).
 pub struct Ended {
     name: String,
-    diagnostics: Option<MatchDiagnostics>,
+    diagnostics: Option<Arc<dyn Diagnostics>>,
     observations: Vec<Observation>,
     rejected: Vec<RejectedTruth>,
     recording: Recording,

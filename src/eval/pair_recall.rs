@@ -120,11 +120,11 @@ mod tests {
     use super::*;
     use crate::eval::metrics::tests::circle;
     use crate::eval::tally::{Scope, Tally};
-    use crate::recognizer::{Match, Observation};
+    use crate::place::{Match, Observation};
     use crate::spec::evaluation::EvaluationSpec;
 
     fn one_match(_obs: &[Observation], pairs: &[(usize, usize)]) -> Match {
-        Match::from_pairs(1, 1, vec![], pairs.iter().copied())
+        Match::from_pairs(pairs.iter().copied(), 1.0)
     }
 
     /// Pair recall at 1 m of `matches`, over the pairs facing as `facing` says (scored as

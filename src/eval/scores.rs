@@ -36,7 +36,7 @@
 use super::Recognition;
 use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
 use super::sweep::{PrCurve, SweepResult};
-use crate::recognizer::{MatchDiagnostics, Rejection};
+use crate::place::Diagnostics;
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 
@@ -82,9 +82,14 @@ pub struct Scores {
     /// them the truth says were right; `None` when none was turned down.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rejected_candidates: Option<RejectedScores>,
-    /// What the recognizer saw (longest chains, verification counts), when it tells.
+    /// What the recognizer saw, in its own counters (the paper's recognizer: longest chains,
+    /// verification counts), when it tells.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub diagnostics: Option<MatchDiagnostics>,
+    pub diagnostics: Option<serde_json::Value>,
+    /// The recognizer's notes worth showing beside the figures (e.g. inputs it could not use in
+    /// full); empty when it has none.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
 }
 
 impl Scores {
@@ -121,6 +126,7 @@ impl Scores {
             no_pairs_reason: None,
             rejected_candidates: None,
             diagnostics: None,
+            notes: Vec::new(),
         }
     }
 
@@ -143,11 +149,13 @@ impl Scores {
     /// Evaluates `rec` with `spec` and takes its timing.
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
         let e = super::evaluate(rec, spec);
-        let rejected = RejectedScores::of(&rec.rejected, spec);
+        let d = rec.diagnostics.as_deref();
+        let rejected = d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec));
         Scores {
-            no_pairs_reason: no_pairs_reason(&e, rec.diagnostics.as_ref(), rejected.as_ref(), spec),
+            no_pairs_reason: no_pairs_reason(&e, d, rejected.as_ref(), spec),
             rejected_candidates: rejected,
-            diagnostics: rec.diagnostics.clone(),
+            diagnostics: d.map(Diagnostics::to_json),
+            notes: d.map(Diagnostics::notes).unwrap_or_default(),
             ..Scores::new(&e, rec.seconds_per_lap())
         }
     }
@@ -157,7 +165,7 @@ impl Scores {
 /// `None` when there are pairs.
 pub fn no_pairs_reason(
     e: &Evaluation,
-    diagnostics: Option<&MatchDiagnostics>,
+    diagnostics: Option<&dyn Diagnostics>,
     rejected: Option<&RejectedScores>,
     spec: &EvaluationSpec,
 ) -> Option<String> {
@@ -174,11 +182,15 @@ pub fn no_pairs_reason(
     }
     match diagnostics {
         Some(d) => {
-            why.push(recognizer_reason(d));
-            if m.revisits > 0 && d.verification.accepted + d.verification.rejected() == 0 {
-                why.extend(revisit_length_reason(e, d));
+            why.push(d.no_match_reason());
+            let c = d.candidates();
+            if m.revisits > 0 && c.accepted + c.rejected == 0 {
+                why.extend(d.revisit_length_reason(
+                    e.directions.same.longest_revisit_m,
+                    e.directions.opposite.longest_revisit_m,
+                ));
             }
-            if d.verification.accepted == 0 {
+            if c.accepted == 0 {
                 why.extend(rejected.map(|r| r.sentence(spec)));
             }
         }
@@ -188,44 +200,65 @@ pub fn no_pairs_reason(
     Some(why.join("; "))
 }
 
-/// The candidates verification turned down, scored against the truth at their sampled
+/// The candidates a recognizer turned down, scored against the truth at their sampled
 /// observation pairs (`eval::Recognition::rejected`).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 pub struct RejectedScores {
-    /// Rejected candidates sampled (the recognizer keeps the first 10,000).
+    /// Rejected candidates sampled (the paper's recognizer keeps the first 10,000).
     pub sampled: usize,
     /// Of them, those whose pair is correct at `tp_radius_m` (same place, facing as the
     /// candidate's direction claims): true revisits that verification turned down.
     pub correct: usize,
-    /// `correct` per rejection reason.
-    pub correct_travel: usize,
-    pub correct_turn: usize,
-    pub correct_density: usize,
-    pub correct_sides: usize,
-    pub correct_straight: usize,
+    /// `correct` per check that turned them down, in the recognizer's order of checks (every
+    /// check named, 0 included).
+    pub correct_by_check: Vec<CheckCount>,
+}
+
+/// A count for one of a recognizer's checks.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct CheckCount {
+    /// The check's name, as the recognizer calls it ("turn").
+    pub check: String,
+    pub count: usize,
 }
 
 impl RejectedScores {
-    /// The scores of `rejected` with `spec`'s radius and heading tolerance; `None` when empty.
-    pub fn of(rejected: &[super::RejectedTruth], spec: &EvaluationSpec) -> Option<Self> {
+    /// The scores of `rejected` (turned down by the named `checks`) with `spec`'s radius and
+    /// heading tolerance; `None` when empty.
+    pub fn of(
+        rejected: &[super::RejectedTruth],
+        checks: &[String],
+        spec: &EvaluationSpec,
+    ) -> Option<Self> {
         if rejected.is_empty() {
             return None;
         }
         let mut s = RejectedScores {
             sampled: rejected.len(),
-            ..RejectedScores::default()
+            correct: 0,
+            correct_by_check: checks
+                .iter()
+                .map(|c| CheckCount {
+                    check: c.clone(),
+                    count: 0,
+                })
+                .collect(),
         };
         for r in rejected.iter().filter(|r| r.is_right(spec)) {
             s.correct += 1;
-            match r.reason {
-                Rejection::Travel => s.correct_travel += 1,
-                Rejection::Turn => s.correct_turn += 1,
-                Rejection::Density => s.correct_density += 1,
-                Rejection::Sides => s.correct_sides += 1,
-                Rejection::Straight => s.correct_straight += 1,
+            if let Some(c) = s.correct_by_check.get_mut(r.check) {
+                c.count += 1;
             }
         }
         Some(s)
+    }
+
+    /// Correct rejections by the check named `check` (0 when it has no such check).
+    pub fn correct_by(&self, check: &str) -> usize {
+        self.correct_by_check
+            .iter()
+            .find(|c| c.check == check)
+            .map_or(0, |c| c.count)
     }
 
     /// What the truth says of the rejected candidates, in words.
@@ -237,126 +270,20 @@ impl RejectedScores {
                 self.sampled, spec.tp_radius_m
             );
         }
+        let by_check: Vec<String> = self
+            .correct_by_check
+            .iter()
+            .map(|c| format!("{} {}", c.check, c.count))
+            .collect();
         format!(
             "by the ground truth {} of the {} rejected candidates sampled paired the same place \
-             (within {} m; travel {}, turn {}, density {}, sides {}, straight {}): verification \
-             turned down true revisits",
+             (within {} m; {}): verification turned down true revisits",
             self.correct,
             self.sampled,
             spec.tp_radius_m,
-            self.correct_travel,
-            self.correct_turn,
-            self.correct_density,
-            self.correct_sides,
-            self.correct_straight
+            by_check.join(", ")
         )
     }
-}
-
-/// Whether the revisits are long enough for a chain of τ words (the smallest τ; more read
-/// backwards) at the run's mean word length: when they are not, no tolerance on the words can
-/// help; when they are, the words differ between visits.
-fn revisit_length_reason(e: &Evaluation, d: &MatchDiagnostics) -> Option<String> {
-    let tau = *d.min_ngram.first()?;
-    if d.mean_word_m <= 0.0 || tau == 0 {
-        return None;
-    }
-    let backwards = tau + d.reverse_extra_ngram;
-    let (same_need_m, opposite_need_m) =
-        (tau as f64 * d.mean_word_m, backwards as f64 * d.mean_word_m);
-    let (same_m, opposite_m) = (
-        e.directions.same.longest_revisit_m,
-        e.directions.opposite.longest_revisit_m,
-    );
-    let stretch = format!(
-        "the longest stretch along which every observation has a revisit is {same_m:.1} m \
-         driven the same way and {opposite_m:.1} m the other way, and a word spans {:.1} m on \
-         average",
-        d.mean_word_m
-    );
-    let need = if backwards == tau {
-        format!("τ = {tau} words need about {same_need_m:.0} m")
-    } else {
-        format!(
-            "τ = {tau} words need about {same_need_m:.0} m ({backwards} read backwards, about \
-             {opposite_need_m:.0} m)"
-        )
-    };
-    Some(if same_m < same_need_m && opposite_m < opposite_need_m {
-        format!("{stretch}: {need}, so the revisits are too short for a chain")
-    } else {
-        format!(
-            "{stretch}: {need}, so the revisits are long enough and the words differ between visits"
-        )
-    })
-}
-
-/// The recognizer's side of a run without pairs, with a word on steps too long to observe
-/// along their length when there were any.
-fn recognizer_reason(d: &MatchDiagnostics) -> String {
-    let why = matcher_reason(d);
-    match d.long_steps {
-        0 => why,
-        n => format!(
-            "{why}; {} (words break there: raise it)",
-            long_steps_sentence(n)
-        ),
-    }
-}
-
-/// `n` steps between scans too long to observe along their length, in words (the reason of a
-/// run without pairs, and the table's note when there are pairs).
-pub fn long_steps_sentence(n: usize) -> String {
-    format!(
-        "{n} step{} between scans {} longer than max_interpolation_m and observed once where \
-         more observations were due",
-        plural(n),
-        if n == 1 { "was" } else { "were" }
-    )
-}
-
-/// What the matcher saw of a run without pairs.
-fn matcher_reason(d: &MatchDiagnostics) -> String {
-    let v = &d.verification;
-    if v.accepted > 0 {
-        return format!(
-            "{} matches were accepted but none kept an aligned pair beyond the candidate gap",
-            v.accepted
-        );
-    }
-    if v.rejected() > 0 {
-        return format!(
-            "every candidate was rejected by verification: {} (travel {}, turn {}, density {}, sides {}, straight {})",
-            v.rejected(),
-            v.rejected_travel,
-            v.rejected_turn,
-            v.rejected_density,
-            v.rejected_sides,
-            v.rejected_straight
-        );
-    }
-    let chains: Vec<String> = d
-        .longest_chain
-        .iter()
-        .zip(&d.min_ngram)
-        .enumerate()
-        .map(|(k, (l, t))| format!("{l} (τ = {t}) at {} level{}", k + 1, plural(k + 1)))
-        .collect();
-    let chains = chains.join(", ");
-    let short = d.longest_chain.iter().zip(&d.min_ngram).all(|(l, t)| l < t);
-    if short || d.within_gap == 0 {
-        format!("no word sequence long enough: the longest chain of matching words is {chains}")
-    } else {
-        format!(
-            "the {} chains that reached τ all began within the candidate gap of their past \
-             side (a repeat inside one pass); the longest chain of matching words is {chains}",
-            d.within_gap
-        )
-    }
-}
-
-fn plural(n: usize) -> &'static str {
-    if n == 1 { "" } else { "s" }
 }
 
 /// The result of one level configuration of the recognizer.
@@ -545,6 +472,7 @@ pub struct TableReport {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::recognizer::{MatchDiagnostics, Rejection};
 
     /// A run without pairs says why: verification counts when every candidate was rejected,
     /// chain lengths against τ when no chain was long enough, and missing revisits.
@@ -571,7 +499,7 @@ pub(crate) mod tests {
         d.verification.rejected_travel = 3;
         d.verification.rejected_density = 2;
         d.verification.rejected_straight = 1;
-        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(
             why.contains(
                 "rejected by verification: 6 (travel 3, turn 0, density 2, sides 0, straight 1)"
@@ -580,14 +508,14 @@ pub(crate) mod tests {
         );
         d.verification = Default::default();
         d.longest_chain = vec![4, 8];
-        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
             "{why}"
         );
         d.long_steps = 3;
-        let why = no_pairs_reason(&none, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("3 steps between scans were longer than max_interpolation_m"),
@@ -597,7 +525,10 @@ pub(crate) mod tests {
         assert!(why.starts_with("no observation has a revisit"), "{why}");
         let mut some = none.clone();
         some.main.pairs = 1;
-        assert_eq!(no_pairs_reason(&some, Some(&d), None, &spec), None);
+        assert_eq!(
+            no_pairs_reason(&some, Some(&d as &dyn Diagnostics), None, &spec),
+            None
+        );
     }
 
     /// When no chain is long enough, the reason says whether the revisits are shorter than τ
@@ -616,7 +547,7 @@ pub(crate) mod tests {
             mean_word_m: 2.5,
             ..MatchDiagnostics::default()
         };
-        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(why.contains("no word sequence long enough"), "{why}");
         assert!(
             why.contains("is 11.2 m driven the same way and 9.0 m the other way"),
@@ -632,19 +563,19 @@ pub(crate) mod tests {
             ..d
         };
         e.directions.opposite.longest_revisit_m = 16.0;
-        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(
             why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
             "{why}"
         );
         assert!(why.contains("too short for a chain"), "{why}");
         e.directions.same.longest_revisit_m = 16.0;
-        let why = no_pairs_reason(&e, Some(&d), None, &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(why.contains("the words differ between visits"), "{why}");
         // Verification's counts are the reason when candidates were made.
         let mut v = d.clone();
         v.verification.rejected_turn = 2;
-        let why = no_pairs_reason(&e, Some(&v), None, &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&v as &dyn Diagnostics), None, &spec).unwrap();
         assert!(!why.contains("stretch"), "{why}");
     }
 
@@ -658,12 +589,13 @@ pub(crate) mod tests {
         use crate::recognizer::Direction;
         let spec = EvaluationSpec::default();
         let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
-        let r = |q, p, direction, reason| RejectedTruth {
+        let r = |q, p, direction, reason: Rejection| RejectedTruth {
             query: q,
             past: p,
             direction,
-            reason,
+            check: reason.index(),
         };
+        let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
         let rejected = [
             // The same place, facing alike: a true revisit turned down by the turn check.
             r(
@@ -694,13 +626,17 @@ pub(crate) mod tests {
                 Rejection::Travel,
             ),
         ];
-        let s = RejectedScores::of(&rejected, &spec).expect("four sampled");
+        let s = RejectedScores::of(&rejected, &checks, &spec).expect("four sampled");
         assert_eq!((s.sampled, s.correct), (4, 2));
         assert_eq!(
-            (s.correct_turn, s.correct_sides, s.correct_travel),
+            (
+                s.correct_by("turn"),
+                s.correct_by("sides"),
+                s.correct_by("travel")
+            ),
             (1, 1, 0)
         );
-        assert_eq!(RejectedScores::of(&[], &spec), None);
+        assert_eq!(RejectedScores::of(&[], &checks, &spec), None);
         let mut e = Evaluation::default();
         e.main.revisits = 10;
         let d = MatchDiagnostics {
@@ -714,7 +650,7 @@ pub(crate) mod tests {
             },
             ..MatchDiagnostics::default()
         };
-        let why = no_pairs_reason(&e, Some(&d), Some(&s), &spec).unwrap();
+        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), Some(&s), &spec).unwrap();
         assert!(
             why.contains("every candidate was rejected by verification: 4"),
             "{why}"
@@ -724,8 +660,9 @@ pub(crate) mod tests {
             "{why}"
         );
         assert!(why.contains("turned down true revisits"), "{why}");
-        let none_right = RejectedScores::of(&rejected[3..], &spec).unwrap();
-        let why = no_pairs_reason(&e, Some(&d), Some(&none_right), &spec).unwrap();
+        let none_right = RejectedScores::of(&rejected[3..], &checks, &spec).unwrap();
+        let why =
+            no_pairs_reason(&e, Some(&d as &dyn Diagnostics), Some(&none_right), &spec).unwrap();
         assert!(why.contains("turned down look-alikes"), "{why}");
     }
 

@@ -14,7 +14,7 @@ use super::metrics::{Metrics, Scorer, f1};
 use super::tally::{Scope, Tally};
 use super::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs};
 use crate::log::RunLog;
-use crate::recognizer::{Match, Observation};
+use crate::place::{Match, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -296,12 +296,10 @@ mod tests {
             // last threshold, so precision falls as the threshold grows.
             let shift = *p.thresholds.last().unwrap();
             vec![Match::from_pairs(
-                p.levels,
-                1,
-                vec![],
                 (420..obs.len())
                     .step_by(p.levels)
                     .map(|q| (q, q - 400 - shift)),
+                1.0,
             )]
         };
         let spec = EvaluationSpec::default();

@@ -30,7 +30,7 @@ use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Me
 use super::pair_recall::{Facing, PairRecall, count_possible};
 use super::pair_set::pack;
 use super::site_tree::{LapSet, Site};
-use crate::recognizer::{Match, ObsId, Observation};
+use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use std::collections::{HashMap, HashSet};
 
@@ -556,12 +556,7 @@ mod tests {
         let spec = EvaluationSpec::default();
         let pairs: Vec<(usize, usize)> = (400..obs.len()).map(|q| (q, q - 400)).collect();
         let score = |obs: &[Observation], shift: usize| {
-            let m = Match::from_pairs(
-                1,
-                1,
-                vec![],
-                pairs.iter().map(|&(q, p)| (q + shift, p + shift)),
-            );
+            let m = Match::from_pairs(pairs.iter().map(|&(q, p)| (q + shift, p + shift)), 1.0);
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(obs, &gt);
             t.add(&m, &gt);
@@ -569,10 +564,7 @@ mod tests {
         };
         let moved: Vec<Observation> = obs
             .iter()
-            .map(|o| Observation {
-                id: o.id + 1000,
-                ..*o
-            })
+            .map(|o| Observation::new(o.id + 1000, o.run, o.frame_id, o.odom_pose, o.travel_m))
             .collect();
         let (dense, sparse) = (score(&obs, 0), score(&moved, 1000));
         assert!(

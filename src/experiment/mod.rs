@@ -15,12 +15,11 @@ pub mod stress;
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::scores::Report;
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
-use crate::eval::{GroundTruth, PlaceRecognizer, Recognition, recognize_runs_with_progress};
-use crate::geom::OdomPose;
+use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
+use crate::place::Match;
 use crate::recognizer::{
-    DensityFrontEnd, FrameId, Match, Observation, Recognizer, RecognizerConfig, WordMatcher,
+    DensityFrontEnd, DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher,
 };
-use crate::scan::Scan;
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
 use crate::spec::evaluation::EvaluationSpec;
@@ -93,36 +92,7 @@ pub fn config_for_levels(base: &RecognizerConfig, levels: usize) -> RecognizerCo
     }
 }
 
-/// The thresholds a level configuration uses (τ0 .. τ(levels-1)).
-pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
-    cfg.min_ngram.iter().copied().take(cfg.levels).collect()
-}
-
-/// The recognizer as evaluation sees it.
-impl PlaceRecognizer for Recognizer {
-    fn start_run(&mut self) -> Vec<Match> {
-        Recognizer::start_run(self)
-    }
-    fn push(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match> {
-        Recognizer::push_frame(self, frame_id, odom, scan)
-    }
-    fn finish(&mut self) -> Vec<Match> {
-        Recognizer::finish(self)
-    }
-    fn observations(&self) -> &[Observation] {
-        Recognizer::observations(self)
-    }
-    fn query_horizon(&self) -> usize {
-        Recognizer::query_horizon(self)
-    }
-    fn name(&self) -> String {
-        let c = self.config();
-        format!("levels={} {:?}", c.levels, thresholds(c))
-    }
-    fn diagnostics(&self) -> Option<crate::recognizer::MatchDiagnostics> {
-        Some(Recognizer::diagnostics(self))
-    }
-}
+pub use crate::recognizer::thresholds;
 
 /// Simulates a scenario, telling its progress per lap; returns the runs and the wall-clock seconds.
 pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
@@ -266,7 +236,7 @@ fn assemble(
 pub fn observe(
     runs: &[RunLog],
     cfg: &RecognizerConfig,
-) -> Result<(Vec<Observation>, f64), ExperimentError> {
+) -> Result<(Vec<DensityObservation>, f64), ExperimentError> {
     let mut front =
         DensityFrontEnd::new(cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
     let t = Instant::now();
@@ -284,7 +254,7 @@ pub fn observe(
 
 /// The matches the back end finds in `observations` with the levels and thresholds of `point`.
 pub fn back_end_matches(
-    observations: &[Observation],
+    observations: &[DensityObservation],
     base: &RecognizerConfig,
     point: &GridPoint,
 ) -> Result<Vec<Match>, ExperimentError> {
@@ -303,12 +273,12 @@ pub fn back_end_matches(
     };
     let mut back =
         WordMatcher::new(&cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
-    let mut out = Vec::new();
+    let mut out: Vec<WordMatch> = Vec::new();
     for o in observations {
         out.extend(back.push_observation(o));
     }
     out.extend(back.finish_run());
-    Ok(out)
+    Ok(out.iter().map(WordMatch::to_place).collect())
 }
 
 /// The paper's Fig. 8 sweep: observations computed once, then every grid point's back end in
@@ -320,7 +290,8 @@ pub fn sweep(
     grid: &[GridPoint],
     progress: &ProgressSink,
 ) -> Result<Vec<SweepResult>, ExperimentError> {
-    let (observations, _) = observe(runs, base)?;
+    let (densities, _) = observe(runs, base)?;
+    let observations: Vec<_> = densities.iter().map(|d| d.observation).collect();
     let truth = GroundTruth::from_runs(runs);
     // Check every grid point's settings before the parallel part, so errors are reported once.
     for p in grid {
@@ -332,7 +303,7 @@ pub fn sweep(
         &observations,
         &truth,
         evaluation,
-        |p| back_end_matches(&observations, base, p).unwrap_or_default(),
+        |p| back_end_matches(&densities, base, p).unwrap_or_default(),
         &|| progress.step(),
     );
     progress.done();

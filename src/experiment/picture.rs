@@ -8,7 +8,6 @@ use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
 use crate::eval::pair_recall::Facing;
 use crate::log::RunLog;
-use crate::recognizer::Rejection;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
     LegendEntry, MarkOverlay, PathOverlay, RenderOptions, SegmentOverlay, render_world_svg,
@@ -116,7 +115,12 @@ pub fn matches_svg(
             }));
     }
     let right_rejected = rec.rejected.iter().filter(|r| r.is_right(&spec)).count();
-    opts.marks = turned_down_marks(&rec.rejected, &spec, 2 * WORST_CLUSTERS);
+    let checks = rec
+        .diagnostics
+        .as_ref()
+        .map(|d| d.checks())
+        .unwrap_or_default();
+    opts.marks = turned_down_marks(&rec.rejected, &checks, &spec, 2 * WORST_CLUSTERS);
     let clusters = worst_wrong_clusters(&status.wrong_pairs, WORST_CLUSTERS);
     let shown: usize = clusters.iter().map(|c| c.2).sum();
     opts.segments = clusters
@@ -181,15 +185,25 @@ pub fn matches_svg(
     render_world_svg(world, &opts)
 }
 
+/// A check's short label on the picture: its name's first two letters, the first capitalised
+/// ("turn" → "Tu").
+fn check_label(check: Option<&String>) -> String {
+    let mut c = check.map_or("?", |c| c.as_str()).chars().take(2);
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
 /// Marks where verification turned down true revisits: the rejected candidates the truth
 /// calls right, grouped by the 5 m cell of their query, the `k` largest groups, each at its
 /// mean query position with its size and its most frequent check.
 fn turned_down_marks(
     rejected: &[crate::eval::RejectedTruth],
+    checks: &[String],
     spec: &EvaluationSpec,
     k: usize,
 ) -> Vec<MarkOverlay> {
-    type Group = (crate::geom::Vec2, usize, [usize; 5]);
+    type Group = (crate::geom::Vec2, usize, Vec<usize>);
     let mut groups: HashMap<(i64, i64), Group> = HashMap::new();
     for r in rejected.iter().filter(|r| r.is_right(spec)) {
         let at = crate::geom::Vec2::new(r.query.0.x, r.query.0.y);
@@ -199,29 +213,27 @@ fn turned_down_marks(
         );
         let g = groups
             .entry(cell)
-            .or_insert((crate::geom::Vec2::zeros(), 0, [0; 5]));
+            .or_insert_with(|| (crate::geom::Vec2::zeros(), 0, vec![0; checks.len().max(1)]));
         g.0 += at;
         g.1 += 1;
-        let check = match r.reason {
-            Rejection::Travel => 0,
-            Rejection::Turn => 1,
-            Rejection::Density => 2,
-            Rejection::Sides => 3,
-            Rejection::Straight => 4,
-        };
-        g.2[check] += 1;
+        if let Some(n) = g.2.get_mut(r.check) {
+            *n += 1;
+        }
     }
     let mut list: Vec<((i64, i64), Group)> = groups.into_iter().collect();
     // Largest first; ties by cell so the picture does not depend on hash order.
     list.sort_by(|x, y| y.1.1.cmp(&x.1.1).then(x.0.cmp(&y.0)));
-    const CHECKS: [&str; 5] = ["Tr", "Tu", "D", "S", "St"];
+
     list.into_iter()
         .take(k)
         .map(|(_, (sum, n, by_check))| {
-            let check = (0..5).max_by_key(|&c| (by_check[c], 5 - c)).unwrap_or(0);
+            let n_checks = by_check.len();
+            let check = (0..n_checks)
+                .max_by_key(|&c| (by_check[c], n_checks - c))
+                .unwrap_or(0);
             MarkOverlay {
                 at: sum / n as f64,
-                text: format!("{n} {}", CHECKS[check]),
+                text: format!("{n} {}", check_label(checks.get(check))),
                 color: TURNED_DOWN_COLOR.into(),
                 class: "turned-down".into(),
             }
@@ -582,13 +594,15 @@ mod tests {
     fn turned_down_true_revisits_are_marked() {
         use crate::eval::RejectedTruth;
         use crate::recognizer::Direction;
+        use crate::recognizer::Rejection;
         let at = |x: f64| TruePose(Pose2::new(x, 1.0, 0.0));
-        let r = |q: f64, p: f64, reason| RejectedTruth {
+        let r = |q: f64, p: f64, reason: Rejection| RejectedTruth {
             query: at(q),
             past: at(p),
             direction: Direction::Same,
-            reason,
+            check: reason.index(),
         };
+        let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
         let rejected = [
             r(1.0, 1.2, Rejection::Turn),
             r(2.0, 2.3, Rejection::Turn),
@@ -597,12 +611,12 @@ mod tests {
             // A look-alike 20 m away.
             r(30.0, 10.0, Rejection::Turn),
         ];
-        let marks = turned_down_marks(&rejected, &EvaluationSpec::default(), 8);
+        let marks = turned_down_marks(&rejected, &checks, &EvaluationSpec::default(), 8);
         let texts: Vec<&str> = marks.iter().map(|m| m.text.as_str()).collect();
         assert_eq!(texts, ["3 Tu", "1 Tr"]);
         assert_eq!(marks[0].at, crate::geom::Vec2::new(2.0, 1.0));
         assert_eq!(
-            turned_down_marks(&rejected, &EvaluationSpec::default(), 1).len(),
+            turned_down_marks(&rejected, &checks, &EvaluationSpec::default(), 1).len(),
             1
         );
     }

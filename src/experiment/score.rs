@@ -15,8 +15,8 @@ use crate::eval::scores::Report;
 use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
-use crate::io::matches_csv::{MatchDirection, MatchRow, MatchesCsvError};
-use crate::recognizer::{Direction, Match, Observation};
+use crate::io::matches_csv::{MatchRow, MatchesCsvError};
+use crate::place::{Match, Observation};
 use crate::sim::RunLog;
 use crate::sim::logs::Manifest;
 use crate::spec::evaluation::EvaluationSpec;
@@ -104,28 +104,12 @@ pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<Matc
                 query_scan: qs,
                 matched_run: pr,
                 matched_scan: ps,
-                score: Some(m.ngram_len as f64),
-                direction: written(m.direction),
+                score: Some(m.score),
+                direction: m.direction,
             });
         }
     }
     rows
-}
-
-/// The direction a matches-file row claims, as a recognizer's match states it.
-fn claimed(d: MatchDirection) -> Direction {
-    match d {
-        MatchDirection::Same => Direction::Same,
-        MatchDirection::Opposite => Direction::Opposite,
-    }
-}
-
-/// A match's direction as the matches file writes it.
-fn written(d: Direction) -> MatchDirection {
-    match d {
-        Direction::Same => MatchDirection::Same,
-        Direction::Opposite => MatchDirection::Opposite,
-    }
 }
 
 /// Reads `dir/manifest.json` and every run's log in it.
@@ -229,15 +213,13 @@ fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Ve
                 } else {
                     0.0
                 };
-                obs.push(Observation {
-                    id: obs.len(),
-                    run: run_pos,
-                    frame_id: i,
-                    odom_pose: OdomPose(odom[i]),
-                    travel_m: travel,
-                    psi: 0.0,
-                    lateral_moment: 0.0,
-                });
+                obs.push(Observation::new(
+                    obs.len(),
+                    run_pos,
+                    i,
+                    OdomPose(odom[i]),
+                    travel,
+                ));
             }
             of_scan[i] = obs.len() - 1;
         }
@@ -278,8 +260,8 @@ impl LoggedRuns {
             let q = self.obs_of_scan[at(r.query_run, r.query_scan)?];
             let p = self.obs_of_scan[at(r.matched_run, r.matched_scan)?];
             let (qo, po) = (&self.observations[q], &self.observations[p]);
-            let mut m = Match::from_pairs(1, 1, Vec::new(), [(qo.id, po.id)]);
-            m.direction = claimed(r.direction);
+            let mut m = Match::from_pairs([(qo.id, po.id)], r.score.unwrap_or(1.0));
+            m.direction = r.direction;
             matches.push(m);
         }
         Ok(Recognition {
@@ -319,6 +301,7 @@ mod tests {
     use crate::experiment::load_scenario;
     use crate::experiment::{ExperimentOptions, evaluate_runs, recognizer_config};
     use crate::io::matches_csv::{parse_matches, write_matches};
+    use crate::place::Direction;
 
     /// The smoke scenario simulated and written as `simulate` writes it.
     fn smoke_logs() -> (tempfile::TempDir, Vec<RunLog>, crate::experiment::Scenario) {
@@ -366,9 +349,9 @@ mod tests {
         logs: &LoggedRuns,
         spec: &EvaluationSpec,
         shift: usize,
-        claim: MatchDirection,
+        claim: Direction,
     ) -> Vec<MatchRow> {
-        let facing = crate::eval::pair_recall::Facing::of(claimed(claim));
+        let facing = crate::eval::pair_recall::Facing::of(claim);
         let tolerance = spec.heading_tolerance_deg.to_radians();
         let travel = crate::eval::pair_recall::true_travel_m(&logs.truth);
         let pose = |o: &Observation| logs.truth.frames[o.frame_id].pose.0;
@@ -412,12 +395,12 @@ mod tests {
         let (dir, runs, scn) = smoke_logs();
         let logs = load_logged_runs(dir.path()).expect("logs load");
         let spec = EvaluationSpec::default();
-        let text = write_matches(&oracle_rows(&logs, &spec, 0, MatchDirection::Same));
+        let text = write_matches(&oracle_rows(&logs, &spec, 0, Direction::Same));
         let perfect = parse_matches(&text, "perfect.csv").expect("parses");
         let r = score_rows(&logs, &perfect, "perfect.csv", &spec, 1).unwrap();
         let s = &r.levels[0].scores;
         assert_eq!((s.precision, s.recall), (1.0, 1.0), "{s:?}");
-        let shifted = oracle_rows(&logs, &spec, 125, MatchDirection::Same);
+        let shifted = oracle_rows(&logs, &spec, 125, Direction::Same);
         assert!(shifted.len() > perfect.len() / 2);
         let r = score_rows(&logs, &shifted, "shifted.csv", &spec, 1).unwrap();
         let s = &r.levels[0].scores;
@@ -447,7 +430,7 @@ mod tests {
         let (dir, _, _) = reverse_smoke_logs();
         let logs = load_logged_runs(dir.path()).expect("logs load");
         let spec = EvaluationSpec::default();
-        let rows = oracle_rows(&logs, &spec, 0, MatchDirection::Opposite);
+        let rows = oracle_rows(&logs, &spec, 0, Direction::Opposite);
         assert!(rows.len() > 100, "a reverse run revisits: {}", rows.len());
         let text = write_matches(&rows);
         let parsed = parse_matches(&text, "opposite.csv").expect("parses");
@@ -461,7 +444,7 @@ mod tests {
         let as_same: Vec<MatchRow> = rows
             .iter()
             .map(|r| MatchRow {
-                direction: MatchDirection::Same,
+                direction: Direction::Same,
                 ..*r
             })
             .collect();
@@ -480,7 +463,7 @@ mod tests {
             matched_run: 0,
             matched_scan: 0,
             score: None,
-            direction: MatchDirection::Same,
+            direction: Direction::Same,
         };
         let e = score_rows(&logs, &[row], "m.csv", &EvaluationSpec::default(), 1).unwrap_err();
         assert!(

@@ -28,25 +28,7 @@
 
 use crate::spec::diag::Diagnostic;
 
-/// The way the older scan of a pair was driven relative to the newer one, as the tool claims.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum MatchDirection {
-    /// Driven the same way (the default).
-    #[default]
-    Same,
-    /// Driven the other way.
-    Opposite,
-}
-
-impl MatchDirection {
-    /// `same` or `opposite`, as written in the file.
-    pub fn name(self) -> &'static str {
-        match self {
-            MatchDirection::Same => "same",
-            MatchDirection::Opposite => "opposite",
-        }
-    }
-}
+use crate::place::Direction;
 
 /// One matched pair of scans.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,7 +39,7 @@ pub struct MatchRow {
     pub matched_scan: usize,
     pub score: Option<f64>,
     /// The direction the pair claims. Default `Same`.
-    pub direction: MatchDirection,
+    pub direction: Direction,
 }
 
 /// The header line [`write_matches`] writes (every column).
@@ -206,7 +188,7 @@ fn parse_row(text: &str, layout: &[Optional]) -> Result<MatchRow, (usize, String
         matched_run: ints[2],
         matched_scan: ints[3],
         score: None,
-        direction: MatchDirection::Same,
+        direction: Direction::Same,
     };
     for (&(c, f), column) in fields[4..].iter().zip(layout) {
         match column {
@@ -225,10 +207,10 @@ fn parse_score(c: usize, f: &str) -> Result<f64, (usize, String)> {
     ))
 }
 
-fn parse_direction(c: usize, f: &str) -> Result<MatchDirection, (usize, String)> {
+fn parse_direction(c: usize, f: &str) -> Result<Direction, (usize, String)> {
     match f {
-        "same" => Ok(MatchDirection::Same),
-        "opposite" => Ok(MatchDirection::Opposite),
+        "same" => Ok(Direction::Same),
+        "opposite" => Ok(Direction::Opposite),
         _ => Err((
             c,
             format!("direction `{f}` is neither `same` nor `opposite`; leave it empty for `same`"),
@@ -249,7 +231,7 @@ mod tests {
                 matched_run: 0,
                 matched_scan: 3,
                 score: Some(0.5),
-                direction: MatchDirection::Opposite,
+                direction: Direction::Opposite,
             },
             MatchRow {
                 query_run: 0,
@@ -257,7 +239,7 @@ mod tests {
                 matched_run: 0,
                 matched_scan: 1,
                 score: None,
-                direction: MatchDirection::Same,
+                direction: Direction::Same,
             },
         ];
         let text = write_matches(&rows);
@@ -295,12 +277,12 @@ mod tests {
         let old = "query_run,query_scan,matched_run,matched_scan,score\n0,5,0,1,0.5\n0,6,0,2\n";
         let rows = parse_matches(old, "m.csv").unwrap();
         assert_eq!(rows[0].score, Some(0.5));
-        assert!(rows.iter().all(|r| r.direction == MatchDirection::Same));
+        assert!(rows.iter().all(|r| r.direction == Direction::Same));
         let swapped = "query_run,query_scan,matched_run,matched_scan,direction,score\n\
                        0,5,0,1,opposite,0.5\n0,6,0,2,,\n0,7,0,3\n0,8,0,4, opposite\n";
         let rows = parse_matches(swapped, "m.csv").unwrap();
         let dirs: Vec<_> = rows.iter().map(|r| (r.direction, r.score)).collect();
-        use MatchDirection::{Opposite, Same};
+        use Direction::{Opposite, Same};
         assert_eq!(
             dirs,
             [

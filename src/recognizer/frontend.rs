@@ -24,7 +24,7 @@
 use super::config::{RecognizerConfig, RecognizerError};
 use super::density::{DensityKernel, RayDeltas};
 use super::grid::LocalGrid;
-use super::types::{FrameId, Observation};
+use super::types::{DensityObservation, FrameId, Observation};
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
@@ -80,7 +80,7 @@ impl DensityFrontEnd {
     /// Integrates one scan taken at `odom`; returns the observations it made: usually none or
     /// one; after a step longer than the spacing (sparse logs), one per spacing passed, at poses
     /// interpolated along the step (steps longer than `max_interpolation_m` give one).
-    pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Observation> {
+    pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<DensityObservation> {
         self.push_frame(self.inputs, odom, scan)
     }
 
@@ -91,7 +91,7 @@ impl DensityFrontEnd {
         frame_id: FrameId,
         odom: OdomPose,
         scan: &Scan,
-    ) -> Vec<Observation> {
+    ) -> Vec<DensityObservation> {
         self.inputs += 1;
         let previous = self.last_odom.map(|last| (last, self.travel_m));
         if let Some(last) = self.last_odom {
@@ -146,12 +146,8 @@ impl DensityFrontEnd {
                     .grid
                     .density_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
                 let (sin, cos) = pose.0.theta.sin_cos();
-                let obs = Observation {
-                    id: self.next_id,
-                    run: self.run,
-                    frame_id,
-                    odom_pose: pose,
-                    travel_m,
+                let obs = DensityObservation {
+                    observation: Observation::new(self.next_id, self.run, frame_id, pose, travel_m),
                     psi: density.psi,
                     // On the robot's left axis (−sin θ, cos θ) of the odometry heading.
                     lateral_moment: cos * density.moment.1 - sin * density.moment.0,

@@ -83,10 +83,14 @@
 //! pairs whose travel differs by less than `candidate_gap_m` are dropped.
 
 use super::config::{AlignmentMode, RecognizerConfig, RecognizerError};
+use super::diagnostics::{MAX_REJECTED_SAMPLES, MatchDiagnostics, Rejection, VerificationCounts};
 use super::index::recent_candidates;
-use super::types::{AlignedRun, Direction, Match, ObsId, Observation, push_pair, push_run};
+use super::types::{
+    AlignedRun, DensityObservation, Direction, Observation, WordMatch, push_pair, push_run,
+};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::geom::wrap_angle;
+use crate::place::RejectedCandidate;
 use std::cell::RefCell;
 use std::collections::HashMap;
 
@@ -253,7 +257,8 @@ impl WordMatcher {
     /// # Panics
     /// When `obs.travel_m` is less than the previous observation's (or NaN): the candidate search
     /// bisects the occurrence lists by travel, which is only correct if travel never decreases.
-    pub fn push_observation(&mut self, obs: &Observation) -> Vec<Match> {
+    pub fn push_observation(&mut self, density: &DensityObservation) -> Vec<WordMatch> {
+        let obs = &density.observation;
         let last = self.words.observations().last().map_or(0.0, |o| o.travel_m);
         assert!(
             obs.travel_m >= last,
@@ -270,14 +275,14 @@ impl WordMatcher {
             out = self.match_words(&closed);
             self.forget_finished_runs();
         }
-        let closed = self.words.push(obs);
+        let closed = self.words.push(density);
         out.extend(self.match_words(&closed));
         out
     }
 
     /// Closes the current run (its last word is matched) and starts a new one; does nothing
     /// while the current run has no observation.
-    pub fn start_run(&mut self) -> Vec<Match> {
+    pub fn start_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.start_run();
         let out = self.match_words(&closed);
         self.forget_finished_runs();
@@ -300,7 +305,7 @@ impl WordMatcher {
 
     /// Closes the current run's open word and matches it, without starting a new run (call at
     /// the end of the input).
-    pub fn finish_run(&mut self) -> Vec<Match> {
+    pub fn finish_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.finish_run();
         self.match_words(&closed)
     }
@@ -388,7 +393,7 @@ impl WordMatcher {
         d <= self.params.angle_tol_deg + 1e-9
     }
 
-    fn match_words(&mut self, closed: &[WordId]) -> Vec<Match> {
+    fn match_words(&mut self, closed: &[WordId]) -> Vec<WordMatch> {
         let mut out = Vec::new();
         for &c in closed {
             debug_assert_eq!(self.reading_starts.len(), c as usize);
@@ -610,7 +615,7 @@ impl WordMatcher {
         Some((entry.back_word[k], entry.back_idx[k] as usize))
     }
 
-    fn report(&mut self, c: WordId, out: &mut Vec<Match>) {
+    fn report(&mut self, c: WordId, out: &mut Vec<WordMatch>) {
         self.placements.get_mut().clear();
         let mut scratch = std::mem::take(&mut self.scratch);
         for k in 0..self.params.levels {
@@ -752,7 +757,7 @@ impl WordMatcher {
             query: obs[cw.first_obs + i as usize].id,
             past: obs[PastSide::of(pw, dir).index(j)].id,
             direction: dir,
-            reason,
+            check: reason.index(),
         }
     }
 
@@ -799,7 +804,7 @@ impl WordMatcher {
     }
 
     /// Marks a candidate's new pairs reported and makes its match.
-    fn emit(&mut self, c: WordId, k: usize, cand: &Candidate, scr: &mut Scratch) -> Match {
+    fn emit(&mut self, c: WordId, k: usize, cand: &Candidate, scr: &mut Scratch) -> WordMatch {
         let d = cand.dir as usize;
         let chain = &scr.chain[cand.pairs.clone()];
         // Counted now, not when the candidate was found: another candidate of the same word may
@@ -826,7 +831,7 @@ impl WordMatcher {
             self.aligned_pairs(wc, past, cand.dir, placement, &mut scr.runs);
         }
         self.rejections.accepted += 1;
-        Match {
+        WordMatch {
             levels: k + 1,
             ngram_len: self.memo[d][c as usize][cand.idx].len[k] as usize,
             word_pairs: refs,
@@ -909,14 +914,14 @@ impl WordMatcher {
     /// Σ over the pairs of placement `w` of the squared difference of the observations'
     /// `lateral_moment`, the past side's negated when read backwards (its left is then our right).
     fn lateral_squared_error(&self, c: WordId, p: WordId, dir: Direction, w: &Placement) -> f64 {
-        let obs = self.words.observations();
+        let lateral = self.words.lateral_moments();
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);
         let sign = past.step as f64;
         w.r.clone()
             .map(|i| {
-                let q = obs[(s2 + w.a + i) as usize].lateral_moment;
-                let d = q - sign * obs[past.index(w.b + i)].lateral_moment;
+                let q = lateral[(s2 + w.a + i) as usize];
+                let d = q - sign * lateral[past.index(w.b + i)];
                 d * d
             })
             .sum()
@@ -1224,106 +1229,6 @@ impl PastSide {
                 .sum()
         }
     }
-}
-
-/// Rejected candidates sampled at most (the first ones; 24 bytes each).
-const MAX_REJECTED_SAMPLES: usize = 10_000;
-
-/// A candidate n-gram verification turned down, as one observation pair: the middle of its
-/// newest current word and the past observation its shift aligns with it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RejectedCandidate {
-    pub query: ObsId,
-    pub past: ObsId,
-    pub direction: Direction,
-    pub reason: Rejection,
-}
-
-/// Why verification turned a candidate n-gram down.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Rejection {
-    /// Odometric travel between its words differs between the two sides.
-    Travel,
-    /// Odometric heading change between its words differs between the two sides.
-    Turn,
-    /// The aligned raw densities differ too much.
-    Density,
-    /// The free space lies on different sides of the path at the two visits.
-    Sides,
-    /// Read backwards, its current side turns by less than `reverse_min_turn_deg`.
-    Straight,
-}
-
-/// Counts of candidate n-grams (τ reached, candidate gap satisfied) by outcome, summed over
-/// level configurations and directions.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct VerificationCounts {
-    pub accepted: usize,
-    pub rejected_travel: usize,
-    pub rejected_turn: usize,
-    pub rejected_density: usize,
-    /// Free space on different sides of the path (`verify_max_lateral_rms`).
-    #[serde(default)]
-    pub rejected_sides: usize,
-    /// Read backwards along a path that does not turn (`reverse_min_turn_deg`).
-    #[serde(default)]
-    pub rejected_straight: usize,
-}
-
-impl VerificationCounts {
-    /// Candidates verification turned down, for any reason.
-    pub fn rejected(&self) -> usize {
-        self.rejected_travel
-            + self.rejected_turn
-            + self.rejected_density
-            + self.rejected_sides
-            + self.rejected_straight
-    }
-
-    fn add(&mut self, r: Rejection) {
-        match r {
-            Rejection::Travel => self.rejected_travel += 1,
-            Rejection::Turn => self.rejected_turn += 1,
-            Rejection::Density => self.rejected_density += 1,
-            Rejection::Sides => self.rejected_sides += 1,
-            Rejection::Straight => self.rejected_straight += 1,
-        }
-    }
-}
-
-/// What the matcher saw, so that a run without matches can say why.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MatchDiagnostics {
-    /// Per level configuration (index k: k + 1 levels), the longest chain of matching word pairs
-    /// found, in word pairs.
-    pub longest_chain: Vec<usize>,
-    /// Per level configuration, its minimum n-gram size τ.
-    pub min_ngram: Vec<usize>,
-    /// Chains that reached τ but began within the candidate gap of their past side.
-    pub within_gap: usize,
-    /// Candidate n-grams by verification outcome.
-    pub verification: VerificationCounts,
-    /// Steps between scans longer than `max_interpolation_m`, each observed once where one
-    /// observation per spacing was due (filled by [`crate::recognizer::Recognizer`]; written
-    /// only when not 0).
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub long_steps: usize,
-    /// Words a chain read backwards needs beyond τ (`reverse_extra_ngram`; 0 without reverse
-    /// matching).
-    #[serde(default, skip_serializing_if = "is_zero")]
-    pub reverse_extra_ngram: usize,
-    /// The first 10,000 candidates verification turned down, one observation pair each (not
-    /// written: the harness scores them against the truth, see `eval::Recognition::rejected`).
-    #[serde(skip)]
-    pub rejected: Vec<RejectedCandidate>,
-    /// Mean travel a level-0 word spans, metres (0 before the first word closes): a chain of
-    /// τ words needs a revisit about τ times this long.
-    #[serde(default)]
-    pub mean_word_m: f64,
-}
-
-fn is_zero(n: &usize) -> bool {
-    *n == 0
 }
 
 /// Σ (a − b)², four lanes at a time.

@@ -3,13 +3,17 @@
 //! never sees ground truth: its inputs are [`OdomPose`] and [`Scan`] only.
 //!
 //! Two halves, usable apart so that a threshold sweep computes observations once:
-//! - [`DensityFrontEnd`]: scans → local grid → one [`Observation`] (Ψ) per 0.10 m of travel;
-//! - [`WordMatcher`]: observations → words of every level → [`Match`]es with aligned pairs.
+//! - [`DensityFrontEnd`]: scans → local grid → one [`DensityObservation`] (Ψ) per 0.10 m of
+//!   travel;
+//! - [`WordMatcher`]: observations → words of every level → [`WordMatch`]es with aligned pairs.
 //!
-//! [`Recognizer`] composes the two.
+//! [`Recognizer`] composes the two, and is a [`PlaceRecognizer`]: the harness scores the neutral
+//! part of its matches ([`WordMatch::to_place`]) and hears its [`MatchDiagnostics`] through
+//! [`crate::place::Diagnostics`].
 
 pub(crate) mod config;
 pub(crate) mod density;
+pub(crate) mod diagnostics;
 pub(crate) mod frontend;
 pub(crate) mod grid;
 mod index;
@@ -22,15 +26,18 @@ pub(crate) mod words;
 
 pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
+pub use diagnostics::{MatchDiagnostics, Rejection, VerificationCounts, long_steps_sentence};
 pub use frontend::DensityFrontEnd;
 pub use grid::{Density, LocalGrid};
-pub use matcher::{
-    MatchDiagnostics, RejectedCandidate, Rejection, VerificationCounts, WordMatcher,
+pub use matcher::WordMatcher;
+pub use types::{
+    AlignedRun, DensityObservation, Direction, FrameId, ObsId, Observation, WordMatch, WordRef,
+    push_pair,
 };
-pub use types::{AlignedRun, Direction, FrameId, Match, ObsId, Observation, WordRef, push_pair};
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;
+use crate::place::{self, PlaceRecognizer};
 use crate::scan::Scan;
 
 /// The online recognizer: push odometry and scans, get matches as soon as they exist.
@@ -105,7 +112,7 @@ impl Recognizer {
     ///     assert!((q.odom_pose.0.x - p.odom_pose.0.x).abs() < 1.0);
     /// }
     /// ```
-    pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+    pub fn push(&mut self, odom: OdomPose, scan: &Scan) -> Vec<WordMatch> {
         let observations = self.front.push(odom, scan);
         self.match_observations(&observations)
     }
@@ -113,12 +120,12 @@ impl Recognizer {
     /// Like [`push`](Self::push), with the frame's id given by the caller: every observation
     /// the scan makes carries `frame_id` (`Observation::frame_id`), so a harness that tags its
     /// frames can score matches against truth it keeps to itself.
-    pub fn push_frame(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<Match> {
+    pub fn push_frame(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<WordMatch> {
         let observations = self.front.push_frame(frame_id, odom, scan);
         self.match_observations(&observations)
     }
 
-    fn match_observations(&mut self, observations: &[Observation]) -> Vec<Match> {
+    fn match_observations(&mut self, observations: &[DensityObservation]) -> Vec<WordMatch> {
         let mut out = Vec::new();
         for obs in observations {
             out.extend(self.back.push_observation(obs));
@@ -129,14 +136,14 @@ impl Recognizer {
     /// Ends the current run and starts the next: the grid is cleared, the last word of the run
     /// is closed (its matches are returned) and no predecessor links cross the boundary. Does
     /// nothing before the run's first input, so it may be called before every run.
-    pub fn start_run(&mut self) -> Vec<Match> {
+    pub fn start_run(&mut self) -> Vec<WordMatch> {
         self.front.start_run();
         self.back.start_run()
     }
 
     /// Closes the last word of the current run and returns its matches (call after the last
     /// input; pushing more afterwards continues the run with a fresh word).
-    pub fn finish(&mut self) -> Vec<Match> {
+    pub fn finish(&mut self) -> Vec<WordMatch> {
         self.back.finish_run()
     }
 
@@ -179,5 +186,40 @@ impl Recognizer {
             long_steps: self.front.long_steps(),
             ..self.back.diagnostics()
         }
+    }
+}
+
+/// The thresholds a level configuration uses (τ0 .. τ(levels-1)).
+pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
+    cfg.min_ngram.iter().copied().take(cfg.levels).collect()
+}
+
+fn to_place(matches: Vec<WordMatch>) -> Vec<place::Match> {
+    matches.iter().map(WordMatch::to_place).collect()
+}
+
+/// The recognizer as the harness sees it: neutral matches scored by chain length.
+impl PlaceRecognizer for Recognizer {
+    fn start_run(&mut self) -> Vec<place::Match> {
+        to_place(Recognizer::start_run(self))
+    }
+    fn push(&mut self, frame_id: FrameId, odom: OdomPose, scan: &Scan) -> Vec<place::Match> {
+        to_place(Recognizer::push_frame(self, frame_id, odom, scan))
+    }
+    fn finish(&mut self) -> Vec<place::Match> {
+        to_place(Recognizer::finish(self))
+    }
+    fn observations(&self) -> &[Observation] {
+        Recognizer::observations(self)
+    }
+    fn query_horizon(&self) -> usize {
+        Recognizer::query_horizon(self)
+    }
+    fn name(&self) -> String {
+        let c = self.config();
+        format!("levels={} {:?}", c.levels, thresholds(c))
+    }
+    fn diagnostics(&self) -> Option<Box<dyn place::Diagnostics>> {
+        Some(Box::new(Recognizer::diagnostics(self)))
     }
 }

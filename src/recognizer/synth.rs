@@ -2,7 +2,7 @@
 //! observation sequences laid out word by word, analytic scans of a few wall segments, and a
 //! 200 m loop floor with side rooms whose doors open and close.
 
-use super::types::Observation;
+use super::types::{DensityObservation, Observation};
 use crate::geom::{OdomPose, Pose2, Segment, Vec2, wrap_angle};
 use crate::scan::{BeamLayout, Scan};
 
@@ -64,10 +64,13 @@ pub fn observations(
     stretches: &[Stretch],
     spacing_m: f64,
     run: usize,
-    after: Option<&Observation>,
-) -> Vec<Observation> {
+    after: Option<&DensityObservation>,
+) -> Vec<DensityObservation> {
     let (mut pose, mut travel, mut id, mut input) = match after {
-        Some(o) => (o.odom_pose.0, o.travel_m, o.id + 1, o.frame_id + 1),
+        Some(o) => {
+            let o = &o.observation;
+            (o.odom_pose.0, o.travel_m, o.id + 1, o.frame_id + 1)
+        }
         None => (Pose2::IDENTITY, 0.0, 0, 0),
     };
     let mut out = Vec::new();
@@ -83,12 +86,8 @@ pub fn observations(
                 pose.y += spacing_m * pose.theta.sin();
                 travel += spacing_m;
             }
-            out.push(Observation {
-                id,
-                run,
-                frame_id: input,
-                odom_pose: OdomPose(pose),
-                travel_m: travel,
+            out.push(DensityObservation {
+                observation: Observation::new(id, run, input, OdomPose(pose), travel),
                 psi: s.psi,
                 lateral_moment: 0.0,
             });
@@ -372,8 +371,8 @@ impl LoopFloor {
 pub fn procedural_lap(
     floor_seed: u64,
     lap_seed: u64,
-    after: Option<&Observation>,
-) -> Vec<Observation> {
+    after: Option<&DensityObservation>,
+) -> Vec<DensityObservation> {
     let mut floor = SplitMix::new(floor_seed);
     let mut lap = SplitMix::new(lap_seed ^ 0xA5A5_5A5A);
     let mut stretches = Vec::new();
@@ -407,7 +406,12 @@ pub fn procedural_lap(
         ));
         total += len + 15;
     }
-    let mut obs = observations(&stretches, 0.10, after.map_or(0, |o| o.run), after);
+    let mut obs = observations(
+        &stretches,
+        0.10,
+        after.map_or(0, |o| o.observation.run),
+        after,
+    );
     for o in &mut obs {
         o.psi = (o.psi + lap.range(-0.03, 0.03)).clamp(0.0, 1.0);
     }

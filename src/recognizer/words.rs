@@ -28,7 +28,7 @@
 //! level 3, so each level adds the words of deeper bumps that lower levels cannot correct.
 
 use super::config::MultiLevelRule;
-use super::types::{Observation, WordRef};
+use super::types::{DensityObservation, Observation, WordRef};
 use crate::geom::wrap_angle;
 
 /// Arena index of a word (across levels).
@@ -112,6 +112,8 @@ pub struct WordLevels {
     observations: Vec<Observation>,
     /// Ψ of each observation, contiguous for the alignment.
     psi: Vec<f64>,
+    /// Lateral moment of each observation ([`DensityObservation::lateral_moment`]).
+    lateral_moments: Vec<f64>,
     /// Index of the first observation of each run.
     run_starts: Vec<usize>,
     obs_class: Vec<u8>,
@@ -147,6 +149,7 @@ impl WordLevels {
             rule,
             observations: Vec::new(),
             psi: Vec::new(),
+            lateral_moments: Vec::new(),
             run_starts: vec![0],
             obs_class: Vec::new(),
             words: Vec::new(),
@@ -166,11 +169,12 @@ impl WordLevels {
     }
 
     /// Adds one observation; returns the ids of the words it closed (level 0 first).
-    pub fn push(&mut self, obs: &Observation) -> Vec<WordId> {
+    pub fn push(&mut self, obs: &DensityObservation) -> Vec<WordId> {
         let i = self.observations.len();
         let q = self.class_of(obs.psi);
-        self.observations.push(*obs);
+        self.observations.push(obs.observation);
         self.psi.push(obs.psi);
+        self.lateral_moments.push(obs.lateral_moment);
         self.obs_class.push(q);
         let Some(mut open) = self.open else {
             self.open = Some(Run {
@@ -360,6 +364,11 @@ impl WordLevels {
     /// Ψ of each observation.
     pub fn psi(&self) -> &[f64] {
         &self.psi
+    }
+
+    /// Lateral moment of every observation, in order ([`DensityObservation::lateral_moment`]).
+    pub fn lateral_moments(&self) -> &[f64] {
+        &self.lateral_moments
     }
 
     /// Observation indices of run `run` (so far).

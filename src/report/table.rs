@@ -133,17 +133,18 @@ pub fn text_table(report: &Report) -> String {
         }
     }
     // Every configuration sees the same scans; say it once, where the reason did not.
-    let long_steps = rows(report)
-        .into_iter()
-        .filter(|(_, s)| s.no_pairs_reason.is_none())
-        .find_map(|(_, s)| s.diagnostics.as_ref().map(|d| d.long_steps))
-        .filter(|&n| n > 0);
-    if let Some(n) = long_steps {
-        let _ = writeln!(
-            out,
-            "note: {} (raise it to observe them along their length)",
-            crate::eval::scores::long_steps_sentence(n)
-        );
+    let mut notes: Vec<&String> = Vec::new();
+    for (_, s) in rows(report) {
+        if s.no_pairs_reason.is_none() {
+            for n in &s.notes {
+                if !notes.contains(&n) {
+                    notes.push(n);
+                }
+            }
+        }
+    }
+    for n in notes {
+        let _ = writeln!(out, "note: {n}");
     }
     // Where there are pairs (the reason says it otherwise): what verification turned down.
     for (label, s) in rows(report) {
@@ -406,10 +407,11 @@ mod tests {
         let mut rep = sample("A", [0.9; 3], [0.2; 3]);
         assert!(!text_table(&rep).contains("max_interpolation_m"));
         for l in &mut rep.levels {
-            l.scores.diagnostics = Some(crate::recognizer::MatchDiagnostics {
+            let d = crate::recognizer::MatchDiagnostics {
                 long_steps: 2,
                 ..Default::default()
-            });
+            };
+            l.scores.notes = crate::place::Diagnostics::notes(&d);
         }
         let t = text_table(&rep);
         assert_eq!(t.matches("max_interpolation_m").count(), 1, "{t}");

@@ -13,11 +13,11 @@ const LAYERS: &[&[&str]] = &[
     &["report"],
     &["eval"],
     &["baseline", "sim"],
-    &["place"],
     &["recognizer"],
     &["world", "io"],
     &["spec"],
     &["log"],
+    &["place"],
     &["scan"],
     &["geom"],
 ];

@@ -7,7 +7,7 @@ use placewords::eval::scores::Report;
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
 use placewords::log::{Frame, LapLog, RunLog};
-use placewords::recognizer::{Match, Observation};
+use placewords::place::{Match, Observation};
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
 use placewords::spec::evaluation::{EvaluationSpec, ExpectSpec, Expectation, LevelExpectation};
@@ -173,18 +173,16 @@ impl PlaceRecognizer for LapBack {
     }
     fn push(&mut self, frame_id: usize, odom: OdomPose, _scan: &Scan) -> Vec<Match> {
         let id = self.obs.len();
-        self.obs.push(Observation {
+        self.obs.push(Observation::new(
             id,
-            run: self.runs_started - 1,
+            self.runs_started - 1,
             frame_id,
-            odom_pose: odom,
-            travel_m: id as f64 * 0.04,
-            psi: 0.0,
-            lateral_moment: 0.0,
-        });
+            odom,
+            id as f64 * 0.04,
+        ));
         if id >= self.per_lap {
             let p = id - self.per_lap;
-            vec![Match::from_pairs(1, 1, vec![], [(id, p)])]
+            vec![Match::from_pairs([(id, p)], 1.0)]
         } else {
             vec![]
         }

@@ -5,9 +5,10 @@ use placewords::io::carmen::{
     CarmenError, LaserRecord, LogRecord, OdomRecord, ReadOptions, TruePosRecord, parse_log_str,
     read_log, read_log_from, write_record,
 };
-use placewords::io::matches_csv::{MatchDirection, MatchRow, parse_matches, write_matches};
+use placewords::io::matches_csv::{MatchRow, parse_matches, write_matches};
 use placewords::io::mobilesim::{import_mobilesim, world_to_toml};
 use placewords::io::real_log::{TruthSource, log_to_run, noise_free};
+use placewords::place::Direction;
 use placewords::spec::diag::Diagnostic;
 use proptest::prelude::*;
 use std::io::Write;
@@ -645,9 +646,9 @@ fn match_row() -> impl Strategy<Value = MatchRow> {
             matched_scan: ms,
             score,
             direction: if opposite {
-                MatchDirection::Opposite
+                Direction::Opposite
             } else {
-                MatchDirection::Same
+                Direction::Same
             },
         })
 }

@@ -24,7 +24,8 @@ fn without_timings(v: &mut serde_json::Value) {
 /// 3,375 → 3,374 matches with the side cue as a moment of the reached tree nodes), and for
 /// added keys only (eighth: `longest_revisit_m`, `rejected_candidates`,
 /// `diagnostics.mean_word_m` and `diagnostics.reverse_extra_ngram`; every other value
-/// identical).
+/// identical), and for the neutral place types of issue 24 (ninth: `rejected_candidates`'
+/// per-check counts became `correct_by_check`, a list named by check; every value identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]

@@ -4,8 +4,9 @@
 use placewords::geom::{OdomPose, Pose2};
 use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::recognizer::{
-    CellState, DenseGrid, DensityFrontEnd, DensityKernel, Direction, Match, MultiLevelRule,
-    Observation, Recognizer, RecognizerConfig, WordLevels, WordMatcher, WordRef,
+    CellState, DenseGrid, DensityFrontEnd, DensityKernel, DensityObservation, Direction,
+    MatchDiagnostics, MultiLevelRule, Observation, Recognizer, RecognizerConfig, Rejection,
+    WordLevels, WordMatch, WordMatcher, WordRef,
 };
 use placewords::scan::BeamLayout;
 use proptest::prelude::*;
@@ -82,7 +83,10 @@ fn config(f: impl FnOnce(&mut RecognizerConfig)) -> RecognizerConfig {
 }
 
 /// Feeds observations (closing the run at the end) and collects every match.
-fn run_matcher(cfg: &RecognizerConfig, obs: &[Observation]) -> (WordMatcher, Vec<Match>) {
+fn run_matcher(
+    cfg: &RecognizerConfig,
+    obs: &[DensityObservation],
+) -> (WordMatcher, Vec<WordMatch>) {
     let mut m = WordMatcher::new(cfg).unwrap();
     let mut out = Vec::new();
     for o in obs {
@@ -90,6 +94,12 @@ fn run_matcher(cfg: &RecognizerConfig, obs: &[Observation]) -> (WordMatcher, Vec
     }
     out.extend(m.finish_run());
     (m, out)
+}
+
+/// The paper recognizer's diagnostics of a scored run, read back from the report.
+fn diagnostics(scores: &placewords::eval::scores::Scores) -> MatchDiagnostics {
+    let json = scores.diagnostics.clone().expect("diagnostics");
+    serde_json::from_value(json).expect("the word matcher's diagnostics")
 }
 
 fn summary(words: &WordLevels, level: usize) -> Vec<(u8, usize)> {
@@ -368,7 +378,7 @@ fn random_stretches(seed: u64, n: usize) -> Vec<Stretch> {
     out
 }
 
-fn with_noise(mut obs: Vec<Observation>, seed: u64) -> Vec<Observation> {
+fn with_noise(mut obs: Vec<DensityObservation>, seed: u64) -> Vec<DensityObservation> {
     let mut r = SplitMix::new(seed);
     for o in &mut obs {
         o.psi += r.range(-0.04, 0.04);
@@ -383,9 +393,9 @@ fn repeated_sequence_matches_and_shuffled_does_not() {
     let first = with_noise(synth::observations(&lap, 0.1, 0, None), 1);
     let lap_len = first.len();
     let second = with_noise(synth::observations(&lap, 0.1, 0, first.last()), 2);
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&cfg, &all);
-    let one_level: Vec<&Match> = matches.iter().filter(|m| m.levels == 1).collect();
+    let one_level: Vec<&WordMatch> = matches.iter().filter(|m| m.levels == 1).collect();
     assert!(!one_level.is_empty(), "the repeated lap is recognized");
     let pairs: Vec<_> = one_level.iter().flat_map(|m| m.pairs()).collect();
     assert!(
@@ -424,7 +434,7 @@ fn repeated_sequence_matches_and_shuffled_does_not() {
         shuffled.swap(i, r.int(0, i));
     }
     let second = with_noise(synth::observations(&shuffled, 0.1, 0, first.last()), 2);
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&cfg, &all);
     assert!(
         matches.is_empty(),
@@ -453,12 +463,12 @@ fn reversed_lap_matches_in_the_opposite_direction() {
         synth::observations(&reversed(&lap), 0.1, 0, first.last()),
         2,
     );
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
     let pairs: Vec<_> = matches
         .iter()
         .filter(|m| m.levels == 1)
-        .flat_map(Match::pairs)
+        .flat_map(WordMatch::pairs)
         .collect();
     assert!(
         pairs.len() > n / 3,
@@ -496,8 +506,8 @@ fn side_profile(i: usize) -> f64 {
 /// Whether `second` (observations after `first`) matches, with the first lap's free space on
 /// the side `side_profile` gives and the second's on the side `side_of(k)` gives; and why not.
 fn matches_with_sides(
-    first: &[Observation],
-    mut second: Vec<Observation>,
+    first: &[DensityObservation],
+    mut second: Vec<DensityObservation>,
     side_of: impl Fn(usize) -> f64,
 ) -> (bool, placewords::recognizer::VerificationCounts) {
     let mut first = first.to_vec();
@@ -507,7 +517,7 @@ fn matches_with_sides(
     for (k, o) in second.iter_mut().enumerate() {
         o.lateral_moment = side_of(k);
     }
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (m, matches) = run_matcher(&RecognizerConfig::default(), &all);
     (!matches.is_empty(), m.verification())
 }
@@ -556,7 +566,7 @@ fn the_side_of_the_free_space_flips_with_the_direction_of_travel() {
     let layout = synth::lms200();
     let walls = synth::corridor_with_branch(30.0, 2.0, 15.0, 3.0);
     let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
-    let drive = |fe: &mut DensityFrontEnd, from: f64, heading: f64| -> Vec<Observation> {
+    let drive = |fe: &mut DensityFrontEnd, from: f64, heading: f64| -> Vec<DensityObservation> {
         fe.start_run();
         (0..650)
             .flat_map(|i| {
@@ -571,7 +581,7 @@ fn the_side_of_the_free_space_flips_with_the_direction_of_travel() {
     };
     let east = drive(&mut fe, 1.0, 0.0);
     let west = drive(&mut fe, 28.0, std::f64::consts::PI);
-    let at = |obs: &[Observation], x: f64| nearest_to_x(obs, x).lateral_moment;
+    let at = |obs: &[DensityObservation], x: f64| nearest_to_x(obs, x).lateral_moment;
     let (e, w) = (at(&east, 15.0), at(&west, 15.0));
     eprintln!("lateral moment at the side corridor: east {e:.3}, west {w:.3}");
     assert!(e > 0.05, "side corridor on the left driving east: {e}");
@@ -619,7 +629,7 @@ fn runs_break_predecessor_chains() {
     }
 }
 
-/// Replaying a stored observation stream splits runs by `Observation::run` by itself, and gives
+/// Replaying a stored observation stream splits runs by `DensityObservation::run` by itself, and gives
 /// the same words and matches as explicit `start_run` calls.
 #[test]
 fn replay_splits_runs_by_observation_run() {
@@ -637,7 +647,7 @@ fn replay_splits_runs_by_observation_run() {
         a.extend(explicit.push_observation(o));
     }
     a.extend(explicit.finish_run());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (replayed, b) = run_matcher(&cfg, &all);
     assert!(!a.is_empty());
     assert_eq!(a, b);
@@ -664,10 +674,10 @@ fn alignment_recovers_a_shift() {
     for (i, o) in second.iter_mut().enumerate() {
         o.psi += 0.05 * ((i as f64) * 0.7).sin();
     }
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, matches) = run_matcher(&cfg, &all);
     assert!(!matches.is_empty());
-    for (query, past) in matches.iter().flat_map(Match::pairs) {
+    for (query, past) in matches.iter().flat_map(WordMatch::pairs) {
         assert_eq!(query - n, past);
     }
 }
@@ -781,7 +791,7 @@ fn corridor_inputs(layout: &BeamLayout) -> Vec<(OdomPose, placewords::scan::Scan
 }
 
 /// The observation whose odometry x is nearest `x` (the corridor runs along x).
-fn nearest_to_x(obs: &[Observation], x: f64) -> &Observation {
+fn nearest_to_x(obs: &[DensityObservation], x: f64) -> &DensityObservation {
     obs.iter()
         .min_by(|a, b| {
             (a.odom_pose.0.x - x)
@@ -791,7 +801,7 @@ fn nearest_to_x(obs: &[Observation], x: f64) -> &Observation {
         .unwrap()
 }
 
-fn front_end_psi(layout: &BeamLayout) -> Vec<Observation> {
+fn front_end_psi(layout: &BeamLayout) -> Vec<DensityObservation> {
     let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
     corridor_inputs(layout)
         .iter()
@@ -847,7 +857,7 @@ fn front_end_corridor_and_bifurcation_with_any_layout() {
     for w in reference.windows(2) {
         assert!((w[1].travel_m - w[0].travel_m - 0.1).abs() < 0.041);
     }
-    let at = |obs: &[Observation], x: f64| nearest_to_x(obs, x).psi;
+    let at = |obs: &[DensityObservation], x: f64| nearest_to_x(obs, x).psi;
     let corridor = at(&reference, 8.0);
     let branch = at(&reference, 15.0);
     assert!(
@@ -948,7 +958,7 @@ fn whole_recognizer_recognizes_a_second_lap() {
     matches.extend(rec.finish());
     let obs = rec.observations();
     let lap_obs = obs.len() / 2;
-    let pairs: Vec<_> = matches.iter().flat_map(Match::pairs).collect();
+    let pairs: Vec<_> = matches.iter().flat_map(WordMatch::pairs).collect();
     let correct = pairs
         .iter()
         .filter(|&&(q, p)| obs[q].odom_pose.0.distance(&obs[p].odom_pose.0) <= 1.0)
@@ -1296,12 +1306,12 @@ fn too_long_steps_are_named_when_nothing_matches() {
         return;
     };
     assert_eq!(scores.pairs, 0, "the old limit gave no pair");
-    let why = scores.no_pairs_reason.expect("a reason");
+    let why = scores.no_pairs_reason.clone().expect("a reason");
     assert!(
         why.contains("steps between scans were longer than max_interpolation_m"),
         "{why}"
     );
-    let long_steps = scores.diagnostics.expect("diagnostics").long_steps;
+    let long_steps = diagnostics(&scores).long_steps;
     assert!(long_steps > 10, "{long_steps} long steps");
 }
 
@@ -1321,8 +1331,8 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
             return;
         };
         assert_eq!(scores.pairs, 0, "τ = {tau}: no chain is that long");
-        let why = scores.no_pairs_reason.expect("a reason");
-        let d = scores.diagnostics.expect("diagnostics");
+        let why = scores.no_pairs_reason.clone().expect("a reason");
+        let d = diagnostics(&scores);
         assert!((1.0..5.0).contains(&d.mean_word_m), "{}", d.mean_word_m);
         let (same_m, opposite_m) = (
             scores.directions.same.longest_revisit_m,
@@ -1353,20 +1363,30 @@ fn rejected_candidates_are_counted_against_the_truth() {
     let Some(scores) = real_log_scores_at("intel", 1, 1) else {
         return;
     };
-    let v = scores.diagnostics.expect("diagnostics").verification;
+    let v = diagnostics(&scores).verification;
     assert!(v.rejected() > 0, "Intel has rejected candidates");
     let r = scores.rejected_candidates.expect("scored rejections");
     assert_eq!(r.sampled, v.rejected());
     assert!(r.correct <= r.sampled);
+    let names: Vec<&str> = r
+        .correct_by_check
+        .iter()
+        .map(|c| c.check.as_str())
+        .collect();
+    let every_check: Vec<&str> = Rejection::ALL.iter().map(|c| c.name()).collect();
     assert_eq!(
-        r.correct,
-        r.correct_travel
-            + r.correct_turn
-            + r.correct_density
-            + r.correct_sides
-            + r.correct_straight
+        names, every_check,
+        "every check named, in the recognizer's order"
     );
-    assert!(r.correct_travel <= v.rejected_travel && r.correct_turn <= v.rejected_turn);
+    let by_check: usize = r.correct_by_check.iter().map(|c| c.count).sum();
+    assert_eq!(r.correct, by_check);
+    for check in Rejection::ALL {
+        assert!(
+            r.correct_by(check.name()) <= v.of(check),
+            "{}",
+            check.name()
+        );
+    }
 }
 
 /// fhw (a building nothing was developed on, with turns between scans) gives correct pairs
@@ -1414,7 +1434,7 @@ fn long_steps_keep_psi_close_to_dense_scans() {
     let inputs = corridor_inputs(&layout);
     for every in [38, 73] {
         let mut fe = DensityFrontEnd::new(&RecognizerConfig::default()).unwrap();
-        let sparse: Vec<Observation> = inputs
+        let sparse: Vec<DensityObservation> = inputs
             .iter()
             .step_by(every)
             .flat_map(|(o, s)| fe.push(*o, s))
@@ -1424,7 +1444,7 @@ fn long_steps_keep_psi_close_to_dense_scans() {
             let near = dense
                 .iter()
                 .min_by(|a, b| {
-                    let d = |x: &Observation| x.odom_pose.0.distance(&o.odom_pose.0);
+                    let d = |x: &DensityObservation| x.odom_pose.0.distance(&o.odom_pose.0);
                     d(a).total_cmp(&d(b))
                 })
                 .unwrap();
@@ -1452,7 +1472,7 @@ fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
     let count = |max_interpolation_m: f64| {
         let cfg = config(|c| c.max_interpolation_m = max_interpolation_m);
         let mut fe = DensityFrontEnd::new(&cfg).unwrap();
-        let obs: Vec<Observation> = inputs
+        let obs: Vec<DensityObservation> = inputs
             .iter()
             .step_by(110)
             .flat_map(|(o, s)| fe.push(*o, s))
@@ -1505,12 +1525,8 @@ fn one_scan_per_step_bounds_psi_against_every_scan() {
 #[should_panic(expected = "non-decreasing travel")]
 fn decreasing_travel_is_refused() {
     let mut m = WordMatcher::new(&RecognizerConfig::default()).unwrap();
-    let mut o = Observation {
-        id: 0,
-        run: 0,
-        frame_id: 0,
-        odom_pose: OdomPose(Pose2::IDENTITY),
-        travel_m: 5.0,
+    let mut o = DensityObservation {
+        observation: Observation::new(0, 0, 0, OdomPose(Pose2::IDENTITY), 5.0),
         psi: 0.5,
         lateral_moment: 0.0,
     };
@@ -1549,7 +1565,7 @@ fn verification_rejects_a_density_mismatch_and_counts_it() {
         for o in &mut second {
             o.psi += shift;
         }
-        let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+        let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
         let (m, matches) = run_matcher(&cfg, &all);
         let counts = m.verification();
         assert_eq!(
@@ -1613,7 +1629,7 @@ fn a_substituted_word_is_bridged_only_with_substitutions() {
     let (lap, changed, base) = substituted_laps(28); // the size syllable fails, travel does not
     let first = synth::observations(&lap, 0.1, 0, None);
     let second = synth::observations(&changed, 0.1, 0, first.last());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, plain) = run_matcher(&base, &all);
     assert!(plain.is_empty(), "5-word chains must not reach τ = 6");
     let bridged = RecognizerConfig {
@@ -1624,7 +1640,7 @@ fn a_substituted_word_is_bridged_only_with_substitutions() {
     assert!(!matches.is_empty(), "the bridged chain reaches τ");
     let n = first.len();
     let grown = (changed[5].size - lap[5].size) as i64;
-    for (query, past) in matches.iter().flat_map(Match::pairs) {
+    for (query, past) in matches.iter().flat_map(WordMatch::pairs) {
         let offset = (query - n) as i64 - past as i64;
         assert!(
             offset == 0 || offset == grown,
@@ -1641,7 +1657,7 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
     let (lap, changed, base) = substituted_laps(32);
     let first = synth::observations(&lap, 0.1, 0, None);
     let second = synth::observations(&changed, 0.1, 0, first.last());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let bridged = RecognizerConfig {
         substitutions: true,
         ..base.clone()
@@ -1664,7 +1680,7 @@ fn corridor_of_long_words(
     size: usize,
     back: bool,
     turn_deg: f64,
-) -> (usize, Vec<Observation>, RecognizerConfig) {
+) -> (usize, Vec<DensityObservation>, RecognizerConfig) {
     let turn = |i: usize| match i % 4 {
         1 => turn_deg,
         3 => -turn_deg,
@@ -1678,7 +1694,7 @@ fn corridor_of_long_words(
     let first = synth::observations(&lap, 0.1, 0, None);
     let again = if back { reversed(&lap) } else { lap };
     let second = synth::observations(&again, 0.1, 0, first.last());
-    let all: Vec<Observation> = first.iter().chain(&second).copied().collect();
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let base = config(|c| {
         c.levels = 1;
         c.candidate_gap_m = 5.0;
@@ -1701,7 +1717,7 @@ fn long_words_match_by_travel_when_asked() {
     let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.ngram_len >= 4));
-    for (query, past) in matches.iter().flat_map(Match::pairs) {
+    for (query, past) in matches.iter().flat_map(WordMatch::pairs) {
         assert_eq!(query - n, past);
     }
 }
@@ -1733,7 +1749,7 @@ fn long_words_driven_back_match_by_travel_when_asked() {
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.direction == Direction::Opposite));
     assert!(matches.iter().all(|m| m.ngram_len >= 6));
-    for (query, past) in matches.iter().flat_map(Match::pairs) {
+    for (query, past) in matches.iter().flat_map(WordMatch::pairs) {
         let at = (query - n) as i64 + past as i64 + 1 - n as i64;
         assert!(
             at.abs() <= 2,
