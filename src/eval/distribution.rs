@@ -7,8 +7,8 @@
 //! with `--seed`. A seed whose recognizer made no pair has no precision ("no matches"): it is
 //! left out of the precision figures and listed in `no_match_seeds`; its recall (0) counts.
 
-use crate::eval::scores::{Report, Scores};
-use crate::recognizer::Direction;
+use crate::eval::scores::{Report, Scores, SubjectKind};
+use crate::place::Direction;
 use serde::{Deserialize, Serialize};
 
 /// The quantile the `p10` figures use.
@@ -112,9 +112,10 @@ impl Spread {
 /// One recognizer configuration over seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ConfigSpread {
-    /// `levels=3` or `icp`.
+    /// The subject's name (`words-3`, `icp`).
     pub subject: String,
-    /// Level count (none for ICP).
+    pub kind: SubjectKind,
+    /// Level count (words subjects only).
     pub levels: Option<usize>,
     pub thresholds: Vec<usize>,
     /// `None` when no seed matched anything.
@@ -141,17 +142,9 @@ impl ConfigSpread {
     }
 }
 
-/// The scores of configuration `subject` (`levels=N` or `icp`) in `report`.
+/// The scores of subject `subject` (`words-3`, `icp`) in `report`.
 pub fn scores_of<'a>(report: &'a Report, subject: &str) -> Option<&'a Scores> {
-    match subject.strip_prefix("levels=") {
-        Some(n) => n
-            .parse()
-            .ok()
-            .and_then(|n| report.level(n))
-            .map(|l| &l.scores),
-        None if subject == "icp" => report.icp.as_ref().map(|i| &i.scores),
-        None => None,
-    }
+    report.subject(subject).map(|s| &s.scores)
 }
 
 /// (seed, value) of `metric` for `subject` in every report that has one.
@@ -177,25 +170,21 @@ pub fn samples_of(
         .collect()
 }
 
-/// Per configuration found in any of `reports` (levels in increasing order, then ICP), the
-/// spread of every metric over the reports (one per seed).
+/// Per subject found in any of `reports` (words subjects by levels, then the others in the
+/// order first seen), the spread of every metric over the reports (one per seed).
 pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
-    let mut subjects: Vec<(String, Option<usize>, Vec<usize>)> = Vec::new();
+    let mut subjects: Vec<(String, SubjectKind, Option<usize>, Vec<usize>)> = Vec::new();
     for r in reports {
-        for l in &r.levels {
-            let s = format!("levels={}", l.levels);
-            if !subjects.iter().any(|x| x.0 == s) {
-                subjects.push((s, Some(l.levels), l.thresholds.clone()));
+        for s in &r.subjects {
+            if !subjects.iter().any(|x| x.0 == s.name) {
+                subjects.push((s.name.clone(), s.kind, s.levels, s.thresholds.clone()));
             }
         }
     }
-    subjects.sort_by_key(|s| s.1);
-    if reports.iter().any(|r| r.icp.is_some()) {
-        subjects.push(("icp".into(), None, Vec::new()));
-    }
+    subjects.sort_by_key(|s| (s.1 != SubjectKind::Words, s.2.unwrap_or(0)));
     subjects
         .into_iter()
-        .map(|(subject, levels, thresholds)| {
+        .map(|(subject, kind, levels, thresholds)| {
             let spread =
                 |m: Metric| Spread::of(&samples(reports, &subject, m), m.higher_is_better());
             let no_match_seeds = reports
@@ -209,6 +198,7 @@ pub fn summarize(reports: &[Report]) -> Vec<ConfigSpread> {
             let seconds_per_lap = spread(Metric::SecondsPerLap);
             ConfigSpread {
                 subject,
+                kind,
                 levels,
                 thresholds,
                 precision,
@@ -245,13 +235,13 @@ mod tests {
         let mut a = sample("B", [0.9; 3], [0.5; 3]);
         let mut b = sample("B", [0.8; 3], [0.4; 3]);
         b.seed = 8;
-        b.levels[2].scores.no_pairs = true;
-        b.levels[2].scores.precision = 0.0;
-        b.levels[2].scores.recall = 0.0;
-        a.icp = None;
-        b.icp = None;
+        b.subjects[2].scores.no_pairs = true;
+        b.subjects[2].scores.precision = 0.0;
+        b.subjects[2].scores.recall = 0.0;
+        a.subjects.retain(|s| s.kind != SubjectKind::Icp);
+        b.subjects.retain(|s| s.kind != SubjectKind::Icp);
         let sum = summarize(&[a, b]);
-        let l3 = sum.iter().find(|c| c.subject == "levels=3").unwrap();
+        let l3 = sum.iter().find(|c| c.subject == "words-3").unwrap();
         assert_eq!(l3.no_match_seeds, vec![8]);
         assert_eq!(l3.get(Metric::Precision).unwrap().seeds, 1);
         assert_eq!(l3.get(Metric::Recall).unwrap().worst_seed, 8);

@@ -2,19 +2,20 @@
 //!
 //! Every bound of an expectation is checked on its own and gives one [`Outcome`] (one JUnit
 //! testcase): `min_precision`, `min_recall`, `min_visit_recall`, `min_pair_recall` and
-//! `max_seconds_per_lap` of each `[[expect.levels]]` entry and of `[expect.icp]`, then the bounds
-//! of the entry's `[expect.levels.same]` and `[expect.levels.opposite]` sub-tables, checked on
-//! that direction's figures alone (`Scores::of_direction`); their outcomes name the direction
-//! (`reverse/levels=3/opposite/precision`, `FAIL reverse levels=3 opposite precision …`). A bound applies
+//! `max_seconds_per_lap` of each `[[expect.subjects]]` entry, then the bounds of the entry's
+//! `[expect.subjects.same]` and `[expect.subjects.opposite]` sub-tables, checked on that
+//! direction's figures alone (`Scores::of_direction`); their outcomes name the subject and the
+//! direction (`reverse/words-3/opposite/precision`, `FAIL reverse words-3 opposite precision …`).
+//! A bound applies
 //! to the worst seed, or with `quantile = q` to the q-quantile from the worst end
-//! (`eval::distribution`). A bound on a configuration no report holds fails ("not in the
+//! (`eval::distribution`). A bound on a subject no report holds fails ("not in the
 //! report"), and so does a precision bound when no seed matched anything ("no matches"). Exit
 //! decision ([`gate_exit_code`], the one rule the CLI uses): 2 when a scenario or seed could not
 //! be run (an error), else 1 when any outcome missed, else 0.
 
 use crate::eval::distribution::{self, Metric};
 use crate::eval::scores::Report;
-use crate::recognizer::Direction;
+use crate::place::Direction;
 use crate::spec::evaluation::{ExpectSpec, Expectation};
 use serde::{Deserialize, Serialize};
 
@@ -47,7 +48,7 @@ impl Bound {
 pub struct Outcome {
     /// Scenario label (its name; with its file when two scenarios share a name).
     pub scenario: String,
-    /// "levels=3" or "icp".
+    /// The subject's name: `words-3`, `icp`.
     pub subject: String,
     /// The direction whose figures alone the bound is on; `None`: both directions.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -73,8 +74,8 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// The testcase name, the same whatever the bound: `B/levels=3/precision`, or with a
-    /// direction `reverse/levels=3/opposite/precision`.
+    /// The testcase name, the same whatever the bound: `B/words-3/precision`, or with a
+    /// direction `reverse/words-3/opposite/precision`.
     pub fn name(&self) -> String {
         let subject = match self.direction {
             None => self.subject.clone(),
@@ -83,7 +84,7 @@ impl Outcome {
         format!("{}/{subject}/{}", self.scenario, self.bound.metric().name())
     }
 
-    /// The configuration, and the direction if the bound is on one: `levels=3 opposite`.
+    /// The configuration, and the direction if the bound is on one: `words-3 opposite`.
     fn target(&self) -> String {
         match self.direction {
             None => self.subject.clone(),
@@ -109,7 +110,7 @@ impl Outcome {
         }
     }
 
-    /// The line printed for people: `PASS B levels=3 precision worst 0.930 >= 0.900 (seed 7 of
+    /// The line printed for people: `PASS B words-3 precision worst 0.930 >= 0.900 (seed 7 of
     /// 20)`.
     pub fn line(&self) -> String {
         let status = if self.passed { "PASS" } else { "FAIL" };
@@ -170,12 +171,12 @@ pub fn check(report: &Report, expect: &ExpectSpec) -> Vec<Outcome> {
 }
 
 /// Checks the reports of a scenario's seeds against `expect`: one outcome per bound, in file
-/// order (levels entries, each followed by its same- and opposite-direction bounds, then ICP;
+/// order (subject entries, each followed by its same- and opposite-direction bounds;
 /// precision, recall, time within each).
 pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> Vec<Outcome> {
     let mut entries: Vec<(String, Option<Direction>, Expectation)> = Vec::new();
-    for e in &expect.levels {
-        let subject = format!("levels={}", e.levels);
+    for e in &expect.subjects {
+        let subject = e.subject.clone();
         entries.push((subject.clone(), None, e.expectation()));
         for (d, de) in [
             (Direction::Same, &e.same),
@@ -185,9 +186,6 @@ pub fn check_seeds(scenario: &str, reports: &[Report], expect: &ExpectSpec) -> V
                 entries.push((subject.clone(), Some(d), de.expectation()));
             }
         }
-    }
-    if let Some(e) = &expect.icp {
-        entries.push(("icp".into(), None, e.clone()));
     }
     let mut out = Vec::new();
     for (subject, direction, e) in entries {
@@ -305,11 +303,11 @@ pub fn gate_exit_code<'a>(errors: usize, outcomes: impl IntoIterator<Item = &'a 
 mod tests {
     use super::*;
     use crate::eval::scores::tests::sample;
-    use crate::spec::evaluation::LevelExpectation;
+    use crate::spec::evaluation::SubjectExpectation;
 
-    fn expect(levels: usize, p: f64, r: f64, s: Option<f64>) -> LevelExpectation {
-        LevelExpectation {
-            levels,
+    fn expect(levels: usize, p: f64, r: f64, s: Option<f64>) -> SubjectExpectation {
+        SubjectExpectation {
+            subject: format!("words-{levels}"),
             min_precision: Some(p),
             min_recall: Some(r),
             min_visit_recall: None,
@@ -320,12 +318,24 @@ mod tests {
         }
     }
 
+    fn icp(min_precision: Option<f64>, min_recall: Option<f64>) -> SubjectExpectation {
+        SubjectExpectation {
+            subject: "icp".into(),
+            min_precision,
+            min_recall,
+            min_visit_recall: None,
+            min_pair_recall: None,
+            max_seconds_per_lap: None,
+            same: None,
+            opposite: None,
+        }
+    }
+
     #[test]
     fn all_pass_gives_zero() {
         let rep = sample("B", [0.93, 0.91, 0.9], [0.1, 0.25, 0.33]);
         let spec = ExpectSpec {
-            levels: vec![expect(3, 0.9, 0.3, Some(2.0)), expect(1, 0.9, 0.1, None)],
-            icp: None,
+            subjects: vec![expect(3, 0.9, 0.3, Some(2.0)), expect(1, 0.9, 0.1, None)],
             quantile: None,
         };
         let o = check(&rep, &spec);
@@ -333,12 +343,12 @@ mod tests {
         assert_eq!(exit_code(&o), 0);
         assert_eq!(
             o[0].line(),
-            "PASS B levels=3 precision worst 0.900 >= 0.900 (seed 7, over 1 seed)"
+            "PASS B words-3 precision worst 0.900 >= 0.900 (seed 7, over 1 seed)"
         );
-        assert_eq!(o[0].name(), "B/levels=3/precision");
+        assert_eq!(o[0].name(), "B/words-3/precision");
         assert_eq!(
             o[2].line(),
-            "PASS B levels=3 s/lap worst 1.50s <= 2.00s (seed 7, over 1 seed)"
+            "PASS B words-3 s/lap worst 1.50s <= 2.00s (seed 7, over 1 seed)"
         );
     }
 
@@ -346,18 +356,14 @@ mod tests {
     fn a_miss_gives_one_with_a_failing_line() {
         let rep = sample("C", [0.93, 0.91, 0.9], [0.1, 0.25, 0.33]);
         let spec = ExpectSpec {
-            levels: vec![expect(2, 0.95, 0.2, None)],
-            icp: Some(Expectation {
-                min_precision: Some(0.01),
-                ..Expectation::default()
-            }),
+            subjects: vec![expect(2, 0.95, 0.2, None), icp(Some(0.01), None)],
             quantile: None,
         };
         let o = check(&rep, &spec);
         assert_eq!(exit_code(&o), 1);
         assert_eq!(
             o[0].line(),
-            "FAIL C levels=2 precision worst 0.910 < 0.950 (seed 7, over 1 seed)"
+            "FAIL C words-2 precision worst 0.910 < 0.950 (seed 7, over 1 seed)"
         );
         assert!(o[1].passed && o[2].passed);
         assert_eq!(o[2].subject, "icp");
@@ -366,14 +372,9 @@ mod tests {
     #[test]
     fn missing_configuration_fails() {
         let mut rep = sample("A", [0.93, 0.91, 0.9], [0.1, 0.25, 0.33]);
-        rep.levels.truncate(1);
-        rep.icp = None;
+        rep.subjects.truncate(1);
         let spec = ExpectSpec {
-            levels: vec![expect(3, 0.5, 0.1, None)],
-            icp: Some(Expectation {
-                min_recall: Some(0.0),
-                ..Expectation::default()
-            }),
+            subjects: vec![expect(3, 0.5, 0.1, None), icp(None, Some(0.0))],
             quantile: None,
         };
         let o = check(&rep, &spec);
@@ -399,13 +400,12 @@ mod tests {
             .map(|seed| {
                 let mut r = sample("A", [0.9; 3], [0.5; 3]);
                 r.seed = seed;
-                r.levels[2].scores.precision = if seed == 4 { 0.6 } else { 0.9 };
+                r.subjects[2].scores.precision = if seed == 4 { 0.6 } else { 0.9 };
                 r
             })
             .collect();
         let mut spec = ExpectSpec {
-            levels: vec![expect(3, 0.8, 0.0, None)],
-            icp: None,
+            subjects: vec![expect(3, 0.8, 0.0, None)],
             quantile: None,
         };
         let worst = check_seeds("A", &reports, &spec);
@@ -424,10 +424,9 @@ mod tests {
     #[test]
     fn no_matches_at_any_seed_fails_a_precision_bound_by_name() {
         let mut rep = sample("A", [0.9; 3], [0.0; 3]);
-        rep.levels[0].scores.no_pairs = true;
+        rep.subjects[0].scores.no_pairs = true;
         let spec = ExpectSpec {
-            levels: vec![expect(1, 0.5, 0.0, None)],
-            icp: None,
+            subjects: vec![expect(1, 0.5, 0.0, None)],
             quantile: None,
         };
         let o = check(&rep, &spec);
@@ -440,14 +439,14 @@ mod tests {
         assert!(o[1].passed, "recall 0 >= 0");
     }
 
-    /// Three seeds whose levels=3 directions are set: same precision 0.95; opposite precision
+    /// Three seeds whose words-3 directions are set: same precision 0.95; opposite precision
     /// 0.99 (0.8 at seed 2), recall 0.3.
     fn reports_with_directions() -> Vec<Report> {
         (1..=3)
             .map(|seed| {
                 let mut r = sample("R", [0.9; 3], [0.5; 3]);
                 r.seed = seed;
-                let d = &mut r.levels[2].scores.directions;
+                let d = &mut r.subjects[2].scores.directions;
                 (d.same.precision, d.same.pairs) = (0.95, 50);
                 (d.opposite.precision, d.opposite.pairs) = (0.99, 40);
                 d.opposite.recall = 0.3;
@@ -459,7 +458,7 @@ mod tests {
             .collect()
     }
 
-    /// levels=3 with precision >= 0.9 for `same`, and precision >= 0.9, recall >= 0.2 for
+    /// words-3 with precision >= 0.9 for `same`, and precision >= 0.9, recall >= 0.2 for
     /// `opposite`.
     fn direction_spec() -> ExpectSpec {
         use crate::spec::evaluation::DirectionExpectation;
@@ -474,26 +473,25 @@ mod tests {
             ..p
         });
         ExpectSpec {
-            levels: vec![entry],
-            icp: None,
+            subjects: vec![entry],
             quantile: None,
         }
     }
 
-    /// Bounds in `[expect.levels.same]` / `[expect.levels.opposite]` apply to that direction's
+    /// Bounds in `[expect.subjects.same]` / `[expect.subjects.opposite]` apply to that direction's
     /// figures alone and their outcomes name the direction.
     #[test]
     fn direction_bounds_check_one_direction_and_name_it() {
         let o = check_seeds("R", &reports_with_directions(), &direction_spec());
         assert_eq!(o.len(), 5, "{o:?}");
         assert!(o[0].passed && o[1].passed && o[2].passed && o[4].passed);
-        assert_eq!(o[2].name(), "R/levels=3/same/precision");
+        assert_eq!(o[2].name(), "R/words-3/same/precision");
         assert_eq!(o[3].direction, Some(Direction::Opposite));
         assert_eq!(
             o[3].line(),
-            "FAIL R levels=3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
+            "FAIL R words-3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
         );
-        assert_eq!(o[3].name(), "R/levels=3/opposite/precision");
+        assert_eq!(o[3].name(), "R/words-3/opposite/precision");
         assert_eq!(exit_code(&o), 1);
     }
 
@@ -501,7 +499,7 @@ mod tests {
     fn a_direction_without_matches_fails_its_precision_bound_by_name() {
         let mut reports = reports_with_directions();
         for r in &mut reports {
-            r.levels[2].scores.directions.opposite.no_pairs = true;
+            r.subjects[2].scores.directions.opposite.no_pairs = true;
         }
         let o = check_seeds("R", &reports, &direction_spec());
         assert!(!o[3].passed);

@@ -286,12 +286,47 @@ impl RejectedScores {
     }
 }
 
-/// The result of one level configuration of the recognizer.
+/// What kind of recognizer a subject is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SubjectKind {
+    /// The paper's recognizer at one level configuration (multi-level words of densities).
+    Words,
+    /// The ICP scan-matching baseline.
+    Icp,
+    /// A Scan Context-style polar descriptor baseline.
+    ScanContext,
+    /// A recognizer outside the harness (a program speaking the plug-in protocol).
+    External,
+}
+
+impl SubjectKind {
+    /// Its name in reports: `words`, `icp`, `scan-context`, `external`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SubjectKind::Words => "words",
+            SubjectKind::Icp => "icp",
+            SubjectKind::ScanContext => "scan-context",
+            SubjectKind::External => "external",
+        }
+    }
+}
+
+pub use crate::spec::evaluation::{words_subject_levels, words_subject_name};
+
+/// The result of one subject: a recognizer under test (one level configuration of the paper's
+/// recognizer, a baseline, or an external program), scored on the same runs as the others.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct LevelReport {
-    /// 1 = level 0 only, 2 = levels 0-1, 3 = levels 0-2.
-    pub levels: usize,
-    /// Minimum n-gram size per level.
+pub struct SubjectReport {
+    /// Its name, unique in the report: what `[[expect.subjects]]`, tables and JUnit call it
+    /// (`words-3`, `icp`, or the name an external subject was given).
+    pub name: String,
+    pub kind: SubjectKind,
+    /// Words subjects: 1 = level 0 only, 2 = levels 0-1, 3 = levels 0-2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub levels: Option<usize>,
+    /// Words subjects: minimum n-gram size τ per level.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub thresholds: Vec<usize>,
     #[serde(flatten)]
     pub scores: Scores,
@@ -300,10 +335,43 @@ pub struct LevelReport {
     /// when not recorded.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub recognize_seconds_by_lap: Vec<f64>,
-    /// The distinct pairs this configuration found that the configuration with one level fewer
-    /// did not (`None` when that one was not run).
-    #[serde(default)]
+    /// Words subjects: the distinct pairs this configuration found that the configuration with
+    /// one level fewer did not (`None` when that one was not run).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub only_here: Option<LevelGain>,
+}
+
+impl SubjectReport {
+    /// A subject `name` of `kind` with `scores` (no per-lap times, no level gain).
+    pub fn new(name: &str, kind: SubjectKind, scores: Scores) -> Self {
+        SubjectReport {
+            name: name.to_string(),
+            kind,
+            levels: None,
+            thresholds: Vec::new(),
+            scores,
+            recognize_seconds_by_lap: Vec::new(),
+            only_here: None,
+        }
+    }
+
+    /// The paper recognizer's subject with `levels` levels and τ per level `thresholds`.
+    pub fn words(levels: usize, thresholds: &[usize], scores: Scores) -> Self {
+        SubjectReport {
+            levels: Some(levels),
+            thresholds: thresholds.to_vec(),
+            ..SubjectReport::new(&words_subject_name(levels), SubjectKind::Words, scores)
+        }
+    }
+
+    /// How tables label it: `words-3 [6, 9, 12]` (its τ per level), or its name.
+    pub fn label(&self) -> String {
+        if self.thresholds.is_empty() {
+            return self.name.clone();
+        }
+        let th: Vec<String> = self.thresholds.iter().map(|t| t.to_string()).collect();
+        format!("{} [{}]", self.name, th.join(", "))
+    }
 }
 
 /// What a level configuration adds over the one with one level fewer.
@@ -317,13 +385,6 @@ pub struct LevelGain {
     pub correct_pairs: usize,
 }
 
-/// The result of the ICP baseline.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct IcpReport {
-    #[serde(flatten)]
-    pub scores: Scores,
-}
-
 /// The report of one scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Report {
@@ -332,58 +393,63 @@ pub struct Report {
     pub seed: u64,
     /// Laps driven in all runs.
     pub laps: usize,
-    /// Observations with a revisit at `tp_radius_m` (those of the first level configuration
-    /// reported, or of ICP when there is none).
+    /// Observations with a revisit at `tp_radius_m` (those of the first subject reported).
     pub revisits: usize,
-    pub levels: Vec<LevelReport>,
-    pub icp: Option<IcpReport>,
+    /// Every recognizer scored on these runs: the paper's level configurations first, by
+    /// levels, then the others in the order they were run.
+    pub subjects: Vec<SubjectReport>,
     pub simulate_seconds_per_lap: f64,
     /// How the scores were computed.
     pub evaluation: EvaluationSpec,
 }
 
 impl Report {
-    /// An empty report; push level results and set `icp`, then call [`Report::finish`].
+    /// An empty report; add subjects, then call [`Report::finish`].
     pub fn new(scenario: &str, seed: u64, laps: usize, evaluation: EvaluationSpec) -> Self {
         Report {
             scenario: scenario.to_string(),
             seed,
             laps,
             revisits: 0,
-            levels: Vec::new(),
-            icp: None,
+            subjects: Vec::new(),
             simulate_seconds_per_lap: 0.0,
             evaluation,
         }
     }
 
-    /// Sets the top-level `revisits` from the parts and sorts levels by number of levels.
+    /// Sets the top-level `revisits` from the first subject and puts the words subjects first,
+    /// by levels (the others keep their order).
     pub fn finish(&mut self) {
-        self.levels.sort_by_key(|l| l.levels);
-        self.revisits = self
-            .levels
-            .first()
-            .map(|l| l.scores.revisits)
-            .or(self.icp.as_ref().map(|i| i.scores.revisits))
-            .unwrap_or(0);
+        self.subjects
+            .sort_by_key(|s| (s.kind != SubjectKind::Words, s.levels.unwrap_or(0)));
+        self.revisits = self.subjects.first().map_or(0, |s| s.scores.revisits);
     }
 
-    /// Scores `rec` (a recognizer run with `levels` levels and `thresholds`) and adds it.
+    /// Scores `rec` (the paper's recognizer run with `levels` levels and `thresholds`) and adds
+    /// it as subject `words-<levels>`.
     pub fn add_level(
         &mut self,
         levels: usize,
         thresholds: &[usize],
         rec: &Recognition,
-    ) -> &LevelReport {
-        let scores = Scores::of(rec, &self.evaluation);
-        self.levels.push(LevelReport {
-            levels,
-            thresholds: thresholds.to_vec(),
-            scores,
-            recognize_seconds_by_lap: rec.lap_seconds.clone(),
-            only_here: None,
-        });
-        self.levels.last().expect("just pushed")
+    ) -> &SubjectReport {
+        let added = self.add_subject(&words_subject_name(levels), SubjectKind::Words, rec);
+        added.levels = Some(levels);
+        added.thresholds = thresholds.to_vec();
+        added
+    }
+
+    /// Scores `rec` and adds it as the subject `name` of `kind`.
+    pub fn add_subject(
+        &mut self,
+        name: &str,
+        kind: SubjectKind,
+        rec: &Recognition,
+    ) -> &mut SubjectReport {
+        let mut added = SubjectReport::new(name, kind, Scores::of(rec, &self.evaluation));
+        added.recognize_seconds_by_lap = rec.lap_seconds.clone();
+        self.subjects.push(added);
+        self.subjects.last_mut().expect("just pushed")
     }
 
     /// Sets each level configuration's `only_here` from the recognitions of every configuration
@@ -396,9 +462,10 @@ impl Report {
                 .find(|(l, _)| *l == levels)
                 .map(|(_, rec)| rec)
         };
-        for lr in &mut self.levels {
-            let below = lr.levels.saturating_sub(1);
-            let (Some(here), Some(fewer)) = (rec_of(lr.levels), rec_of(below)) else {
+        for lr in &mut self.subjects {
+            let Some(levels) = lr.levels else { continue };
+            let below = levels.saturating_sub(1);
+            let (Some(here), Some(fewer)) = (rec_of(levels), rec_of(below)) else {
                 continue;
             };
             // Counted as the matches arrived when they were scored so (the two configurations
@@ -416,16 +483,19 @@ impl Report {
         }
     }
 
-    /// Scores `rec` (an ICP baseline run) and sets it as the report's ICP result.
-    pub fn set_icp(&mut self, rec: &Recognition) {
-        self.icp = Some(IcpReport {
-            scores: Scores::of(rec, &self.evaluation),
-        });
+    /// The subject called `name`.
+    pub fn subject(&self, name: &str) -> Option<&SubjectReport> {
+        self.subjects.iter().find(|s| s.name == name)
     }
 
-    /// The result of the configuration with `levels` levels.
-    pub fn level(&self, levels: usize) -> Option<&LevelReport> {
-        self.levels.iter().find(|l| l.levels == levels)
+    /// The paper recognizer's subject with `levels` levels.
+    pub fn level(&self, levels: usize) -> Option<&SubjectReport> {
+        self.subjects.iter().find(|s| s.levels == Some(levels))
+    }
+
+    /// The paper recognizer's subjects, by levels.
+    pub fn words(&self) -> impl Iterator<Item = &SubjectReport> {
+        self.subjects.iter().filter(|s| s.levels.is_some())
     }
 }
 
@@ -670,30 +740,28 @@ pub(crate) mod tests {
         let mut rep = Report::new(scenario, 7, 40, EvaluationSpec::default());
         let th = [vec![6], vec![6, 9], vec![6, 9, 12]];
         for l in 0..3 {
-            rep.levels.push(LevelReport {
-                levels: l + 1,
-                thresholds: th[l].clone(),
-                scores: Scores {
-                    precision: p[l],
-                    recall: r[l],
-                    pairs: 100 * (l + 1),
-                    revisits: 5000,
-                    recognize_seconds_per_lap: 0.5 * (l + 1) as f64,
-                    ..Scores::default()
-                },
-                recognize_seconds_by_lap: Vec::new(),
-                only_here: None,
-            });
+            let scores = Scores {
+                precision: p[l],
+                recall: r[l],
+                pairs: 100 * (l + 1),
+                revisits: 5000,
+                recognize_seconds_per_lap: 0.5 * (l + 1) as f64,
+                ..Scores::default()
+            };
+            rep.subjects
+                .push(SubjectReport::words(l + 1, &th[l], scores));
         }
-        rep.icp = Some(IcpReport {
-            scores: Scores {
+        rep.subjects.push(SubjectReport::new(
+            "icp",
+            SubjectKind::Icp,
+            Scores {
                 precision: 0.05,
                 recall: 0.04,
                 revisits: 4900,
                 recognize_seconds_per_lap: 9.0,
                 ..Scores::default()
             },
-        });
+        ));
         rep.simulate_seconds_per_lap = 0.25;
         rep.finish();
         rep

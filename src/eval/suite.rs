@@ -312,7 +312,7 @@ fn same_plan(a: &SuiteReport, b: &SuiteReport) -> bool {
 mod tests {
     use super::*;
     use crate::eval::scores::tests::sample;
-    use crate::spec::evaluation::LevelExpectation;
+    use crate::spec::evaluation::SubjectExpectation;
 
     fn scenario(seeds: &[u64]) -> ScenarioResult {
         ScenarioResult {
@@ -321,8 +321,8 @@ mod tests {
             file: "scenarios/B.toml".into(),
             seeds: SeedRange { first: 1, last: 4 },
             expect: ExpectSpec {
-                levels: vec![LevelExpectation {
-                    levels: 3,
+                subjects: vec![SubjectExpectation {
+                    subject: "words-3".into(),
                     min_precision: Some(0.5),
                     min_recall: None,
                     min_visit_recall: None,
@@ -331,7 +331,6 @@ mod tests {
                     same: None,
                     opposite: None,
                 }],
-                icp: None,
                 quantile: None,
             },
             error: None,
@@ -340,7 +339,7 @@ mod tests {
                 .map(|&seed| {
                     let mut r = sample("B", [0.9; 3], [0.5; 3]);
                     r.seed = seed;
-                    r.levels[2].scores.precision = 0.5 + seed as f64 / 10.0;
+                    r.subjects[2].scores.precision = 0.5 + seed as f64 / 10.0;
                     SeedResult {
                         seed,
                         seconds: 1.0,

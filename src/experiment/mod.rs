@@ -13,7 +13,7 @@ pub(crate) mod stream;
 pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
-use crate::eval::scores::Report;
+use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
 use crate::place::Match;
@@ -213,7 +213,7 @@ fn assemble(
         _ => None,
     };
     if let Some(r) = &icp {
-        report.set_icp(r);
+        report.add_subject("icp", SubjectKind::Icp, r);
     }
     let mut recognitions = Vec::new();
     for (levels, r) in results {

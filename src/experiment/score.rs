@@ -398,12 +398,12 @@ mod tests {
         let text = write_matches(&oracle_rows(&logs, &spec, 0, Direction::Same));
         let perfect = parse_matches(&text, "perfect.csv").expect("parses");
         let r = score_rows(&logs, &perfect, "perfect.csv", &spec, 1).unwrap();
-        let s = &r.levels[0].scores;
+        let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.recall), (1.0, 1.0), "{s:?}");
         let shifted = oracle_rows(&logs, &spec, 125, Direction::Same);
         assert!(shifted.len() > perfect.len() / 2);
         let r = score_rows(&logs, &shifted, "shifted.csv", &spec, 1).unwrap();
-        let s = &r.levels[0].scores;
+        let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.recall), (0.0, 0.0), "{s:?}");
 
         let opts = ExperimentOptions {
@@ -415,7 +415,7 @@ mod tests {
         let (_, rec) = &exp.recognitions[0];
         let rows = export_rows(rec, &run_frames(&exp.runs));
         let scored = score_rows(&logs, &rows, "run.csv", &spec, 3).unwrap();
-        let (a, b) = (&exp.report.levels[0].scores, &scored.levels[0].scores);
+        let (a, b) = (&exp.report.subjects[0].scores, &scored.subjects[0].scores);
         assert!(a.pairs > 100, "smoke should match: {a:?}");
         assert!((a.precision - b.precision).abs() <= 0.01, "{a:?} vs {b:?}");
         assert!((a.recall - b.recall).abs() <= 0.02, "{a:?} vs {b:?}");
@@ -435,7 +435,7 @@ mod tests {
         let text = write_matches(&rows);
         let parsed = parse_matches(&text, "opposite.csv").expect("parses");
         let r = score_rows(&logs, &parsed, "opposite.csv", &spec, 1).unwrap();
-        let s = &r.levels[0].scores;
+        let s = &r.subjects[0].scores;
         let opp = s.of_direction(Direction::Opposite);
         assert_eq!((opp.precision, opp.recall), (1.0, 1.0), "{opp:?}");
         assert_eq!(s.precision, 1.0);
@@ -449,7 +449,7 @@ mod tests {
             })
             .collect();
         let r = score_rows(&logs, &as_same, "same.csv", &spec, 1).unwrap();
-        let s = &r.levels[0].scores;
+        let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.correct_pairs), (0.0, 0), "{s:?}");
     }
 

@@ -61,7 +61,7 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
             let scenario = match (scenario, &options) {
                 (Ok(_), None) if opts.gate && !opts.allow_no_expect => Err(format!(
                     "{file}: no [expect] block, so `check` would test nothing; add \
-                     [[expect.levels]] bounds, or pass --allow-no-expect to skip it"
+                     [[expect.subjects]] bounds, or pass --allow-no-expect to skip it"
                 )),
                 (s, _) => s,
             };
@@ -83,12 +83,9 @@ fn options_for(scn: &Scenario, opts: &StressOptions) -> Option<ExperimentOptions
     if scn.expect.is_empty() {
         return None;
     }
-    let mut levels: Vec<usize> = scn.expect.levels.iter().map(|e| e.levels).collect();
-    levels.sort_unstable();
-    levels.dedup();
     Some(ExperimentOptions {
-        levels,
-        icp: scn.expect.icp.is_some(),
+        levels: scn.expect.word_levels(),
+        icp: scn.expect.names("icp"),
         ..opts.experiment.clone()
     })
 }

@@ -30,13 +30,14 @@ mod tests {
             "seed",
             "laps",
             "revisits",
-            "levels",
-            "icp",
+            "subjects",
             "simulate_seconds_per_lap",
         ] {
             assert!(v.get(k).is_some(), "missing {k}");
         }
         for k in [
+            "name",
+            "kind",
             "levels",
             "thresholds",
             "precision",
@@ -47,11 +48,19 @@ mod tests {
             "sensitivity",
             "door_configs",
         ] {
-            assert!(v["levels"][0].get(k).is_some(), "missing levels[].{k}");
+            assert!(v["subjects"][0].get(k).is_some(), "missing subjects[0].{k}");
         }
+        assert_eq!(v["subjects"][0]["name"], "words-1");
+        assert_eq!(v["subjects"][0]["kind"], "words");
+        let icp = &v["subjects"][3];
+        assert_eq!((&icp["name"], &icp["kind"]), (&"icp".into(), &"icp".into()));
         for k in ["precision", "recall", "pairs", "recognize_seconds_per_lap"] {
-            assert!(v["icp"].get(k).is_some(), "missing icp.{k}");
+            assert!(icp.get(k).is_some(), "missing the icp subject's {k}");
         }
+        assert!(
+            icp.get("levels").is_none(),
+            "levels belong to words subjects"
+        );
         assert_eq!(v["revisits"], 5000);
         assert_eq!(report_from_json(&json).unwrap(), rep);
     }

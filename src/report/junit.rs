@@ -3,7 +3,7 @@
 //! seed that could not run. The dialect is the common one Jenkins, GitLab and GitHub test
 //! reporters read.
 //!
-//! Test case names do not change when a bound does (`B/levels=3/precision`); the class name
+//! Test case names do not change when a bound does (`B/words-3/precision`); the class name
 //! is the scenario file, so two scenarios of one name stay apart. Each test case carries the
 //! measured value, the bound, the statistic (worst or a quantile), the seed it came from and
 //! the command reproducing it as `<properties>`, and its `time` is the seconds its
@@ -165,7 +165,7 @@ mod tests {
     use super::*;
     use crate::eval::gate::{Bound, check};
     use crate::eval::scores::tests::sample;
-    use crate::spec::evaluation::{ExpectSpec, LevelExpectation};
+    use crate::spec::evaluation::{ExpectSpec, SubjectExpectation};
 
     #[test]
     fn escapes_markup_and_control_characters() {
@@ -179,8 +179,8 @@ mod tests {
     fn parses_and_reports_a_failure() {
         let rep = sample("B<&>", [0.93, 0.91, 0.9], [0.1, 0.25, 0.33]);
         let spec = ExpectSpec {
-            levels: vec![LevelExpectation {
-                levels: 3,
+            subjects: vec![SubjectExpectation {
+                subject: "words-3".into(),
                 min_precision: Some(0.95),
                 min_recall: Some(0.3),
                 min_visit_recall: None,
@@ -189,7 +189,6 @@ mod tests {
                 same: None,
                 opposite: None,
             }],
-            icp: None,
             quantile: None,
         };
         let outcomes = check(&rep, &spec);
@@ -230,9 +229,9 @@ mod tests {
             .expect("a failure element");
         assert_eq!(
             failure.attribute("message"),
-            Some("FAIL B<&> levels=3 precision worst 0.900 < 0.950 (seed 7, over 1 seed)")
+            Some("FAIL B<&> words-3 precision worst 0.900 < 0.950 (seed 7, over 1 seed)")
         );
-        assert_eq!(cases[0].attribute("name"), Some("B<&>/levels=3/precision"));
+        assert_eq!(cases[0].attribute("name"), Some("B<&>/words-3/precision"));
         assert!(
             failure
                 .text()

@@ -21,12 +21,12 @@ fn worst(s: Option<&Spread>, decimals: usize) -> String {
     })
 }
 
-/// Row label: `3 [6, 9, 12]` or `ICP`.
+/// Row label: the subject with its τ per level, `words-3 [6, 9, 12]`, or its name, `icp`.
 fn label(c: &ConfigSpread) -> String {
-    match c.levels {
-        Some(n) => format!("{n} {:?}", c.thresholds),
-        None => "ICP".into(),
+    if c.thresholds.is_empty() {
+        return c.subject.clone();
     }
+    format!("{} {:?}", c.subject, c.thresholds)
 }
 
 /// The header line of a scenario: label, file, seeds and how many ran.
@@ -62,7 +62,7 @@ pub fn text_table(suite: &SuiteReport) -> String {
         let body: Vec<Vec<String>> = sc.summary.iter().map(text_row).collect();
         out.push_str(&super::table::render(
             &[
-                "levels [τ]",
+                "subject [τ]",
                 "precision mean",
                 "worst",
                 "recall mean",
@@ -170,7 +170,7 @@ fn md_scenario(sc: &ScenarioResult) -> String {
         let _ = writeln!(out, "- error: {}", e.replace('\n', " "));
     }
     if !sc.summary.is_empty() {
-        out.push_str("| levels | metric | mean | p10 | worst | worst seed |\n");
+        out.push_str("| subject | metric | mean | p10 | worst | worst seed |\n");
         out.push_str("|---|---|---|---|---|---|\n");
     }
     for c in &sc.summary {
@@ -276,7 +276,7 @@ mod tests {
     use super::*;
     use crate::eval::scores::tests::sample;
     use crate::eval::suite::SeedResult;
-    use crate::spec::evaluation::{ExpectSpec, LevelExpectation};
+    use crate::spec::evaluation::{ExpectSpec, SubjectExpectation};
     use crate::spec::seeds::SeedRange;
 
     fn suite() -> SuiteReport {
@@ -284,10 +284,10 @@ mod tests {
             .map(|seed| {
                 let mut r = sample("B", [0.9; 3], [0.5; 3]);
                 r.seed = seed;
-                r.icp = None;
+                r.subjects.retain(|s| s.name != "icp");
                 if seed == 2 {
-                    r.levels[0].scores.no_pairs = true;
-                    r.levels[2].scores.recall = 0.1;
+                    r.subjects[0].scores.no_pairs = true;
+                    r.subjects[2].scores.recall = 0.1;
                 }
                 SeedResult {
                     seed,
@@ -303,8 +303,8 @@ mod tests {
             file: "scenarios/B.toml".into(),
             seeds: SeedRange { first: 1, last: 3 },
             expect: ExpectSpec {
-                levels: vec![LevelExpectation {
-                    levels: 3,
+                subjects: vec![SubjectExpectation {
+                    subject: "words-3".into(),
                     min_precision: None,
                     min_recall: Some(0.2),
                     min_visit_recall: None,
@@ -328,7 +328,7 @@ mod tests {
         let t = text_table(&suite());
         assert!(t.contains("0.367") && t.contains("0.100 (seed 2)"), "{t}");
         assert!(
-            t.contains("worst recall at levels=3: placewords run scenarios/B.toml --seed 2"),
+            t.contains("worst recall at words-3: placewords run scenarios/B.toml --seed 2"),
             "{t}"
         );
         assert!(t.contains("no matches at seed(s) [2]"), "{t}");
@@ -339,7 +339,7 @@ mod tests {
         let s = suite();
         let md = markdown(&s);
         assert!(
-            md.contains("| `B/levels=3/recall` | worst | 0.100 | 0.200 | 2 | **FAIL** |"),
+            md.contains("| `B/words-3/recall` | worst | 0.100 | 0.200 | 2 | **FAIL** |"),
             "{md}"
         );
         assert!(md.ends_with("0 passed, 1 failed\n"), "{md}");

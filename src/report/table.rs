@@ -1,23 +1,16 @@
 //! Tables from reports: a plain-text table for the terminal, and the paper's Table I in Markdown.
 
-use crate::eval::scores::{Report, Scores};
-use crate::recognizer::Direction;
+use crate::eval::scores::{Report, Scores, SubjectReport};
+use crate::place::Direction;
 use std::fmt::Write;
 
-/// Rows of a terminal table: (label, scores).
+/// Rows of a terminal table, one per subject: (label, scores).
 fn rows(report: &Report) -> Vec<(String, &Scores)> {
-    let mut rows: Vec<(String, &Scores)> = report
-        .levels
+    report
+        .subjects
         .iter()
-        .map(|l| {
-            let th: Vec<String> = l.thresholds.iter().map(|t| t.to_string()).collect();
-            (format!("{} [{}]", l.levels, th.join(", ")), &l.scores)
-        })
-        .collect();
-    if let Some(icp) = &report.icp {
-        rows.push(("ICP".to_string(), &icp.scores));
-    }
-    rows
+        .map(|s| (s.label(), &s.scores))
+        .collect()
 }
 
 /// `rows` with, under each row that has opposite revisits or matches, a row per direction.
@@ -105,7 +98,7 @@ pub fn text_table(report: &Report) -> String {
         .collect();
     out.push_str(&render(
         &[
-            "levels [τ]",
+            "subject [τ]",
             "precision",
             "recall",
             "visit R",
@@ -118,12 +111,12 @@ pub fn text_table(report: &Report) -> String {
         ],
         &body,
     ));
-    for l in &report.levels {
-        if let Some(g) = &l.only_here {
+    for l in &report.subjects {
+        if let (Some(g), Some(levels)) = (&l.only_here, l.levels) {
             let _ = writeln!(
                 out,
                 "{} levels found {} pair(s) that {} level(s) did not ({} correct)",
-                l.levels, g.pairs, g.than_levels, g.correct_pairs
+                levels, g.pairs, g.than_levels, g.correct_pairs
             );
         }
     }
@@ -212,7 +205,8 @@ fn fmt_p(s: &Scores) -> String {
     }
 }
 
-/// The paper's Table I for several scenarios, in Markdown: rows 1, 2 and 3 levels and ICP
+/// The paper's Table I for several scenarios, in Markdown: a row per subject (words-1, words-2,
+/// words-3, icp, …)
 /// (those present in any report), per scenario a "P – R" column and an "s/lap" column.
 pub fn markdown_table_i(reports: &[Report]) -> String {
     markdown_by_level(reports, &["P – R", "s/lap"], |s| {
@@ -234,20 +228,15 @@ pub fn markdown_visit_recall(reports: &[Report]) -> String {
     })
 }
 
-/// A Markdown table with a row per level configuration (and ICP when any report has it) and,
-/// per scenario, one column per entry of `columns`, filled by `cells`.
+/// A Markdown table with a row per subject found in any report (words subjects by levels, then
+/// the others) and, per scenario, one column per entry of `columns`, filled by `cells`.
 fn markdown_by_level(
     reports: &[Report],
     columns: &[&str],
     cells: impl Fn(&Scores) -> Vec<String>,
 ) -> String {
-    let mut rows: Vec<usize> = reports
-        .iter()
-        .flat_map(|r| r.levels.iter().map(|l| l.levels))
-        .collect();
-    rows.sort_unstable();
-    rows.dedup();
-    let mut out = String::from("| levels |");
+    let rows = subject_names(reports);
+    let mut out = String::from("| subject |");
     for r in reports {
         for c in columns {
             let _ = write!(out, " {} {c} |", r.scenario);
@@ -268,45 +257,58 @@ fn markdown_by_level(
         }
         out.push('\n');
     };
-    for lv in rows {
-        line(lv.to_string(), &|r| r.level(lv).map(|l| l.scores.clone()));
-        fn level(r: &Report, lv: usize) -> Option<&Scores> {
-            r.level(lv).map(|l| &l.scores)
+    for name in rows {
+        fn of<'r>(r: &'r Report, name: &str) -> Option<&'r Scores> {
+            r.subject(name).map(|s| &s.scores)
         }
+        line(name.clone(), &|r| of(r, &name).cloned());
         if reports
             .iter()
-            .any(|r| level(r, lv).is_some_and(Scores::has_opposite))
+            .any(|r| of(r, &name).is_some_and(Scores::has_opposite))
         {
             for d in Direction::BOTH {
-                line(format!("{lv} {}", d.name()), &|r| {
-                    level(r, lv).map(|s| s.of_direction(d))
+                line(format!("{name} {}", d.name()), &|r| {
+                    of(r, &name).map(|s| s.of_direction(d))
                 });
             }
         }
     }
-    if reports.iter().any(|r| r.icp.is_some()) {
-        line("ICP".into(), &|r| r.icp.as_ref().map(|i| i.scores.clone()));
-    }
     out
 }
 
-/// Thresholds per level row of Table I, as a Markdown note (`1 level: [6]; 2 levels: [6, 9]`) taken
-/// from the first report that has each row.
-pub fn thresholds_note(reports: &[Report]) -> String {
-    let mut seen: Vec<(usize, Vec<usize>)> = Vec::new();
-    for r in reports {
-        for l in &r.levels {
-            if !seen.iter().any(|(lv, _)| *lv == l.levels) {
-                seen.push((l.levels, l.thresholds.clone()));
-            }
+/// The subjects of any of `reports`, words subjects by levels first, then the others in the
+/// order first seen.
+fn subject_names(reports: &[Report]) -> Vec<String> {
+    let mut seen: Vec<&SubjectReport> = Vec::new();
+    for s in reports.iter().flat_map(|r| &r.subjects) {
+        if !seen.iter().any(|x| x.name == s.name) {
+            seen.push(s);
         }
     }
-    seen.sort();
+    seen.sort_by_key(|s| (s.levels.is_none(), s.levels.unwrap_or(0)));
+    seen.into_iter().map(|s| s.name.clone()).collect()
+}
+
+/// Thresholds per words subject of Table I, as a Markdown note (`words-1: [6]; words-2: [6,
+/// 9]`) taken from the first report that has each.
+pub fn thresholds_note(reports: &[Report]) -> String {
+    let mut seen: Vec<(usize, &str, &[usize])> = Vec::new();
+    for s in reports.iter().flat_map(|r| &r.subjects) {
+        if let Some(lv) = s.levels
+            && !seen.iter().any(|x| x.0 == lv)
+        {
+            seen.push((lv, &s.name, &s.thresholds));
+        }
+    }
+    seen.sort_by_key(|x| x.0);
     let parts: Vec<String> = seen
         .iter()
-        .map(|(lv, th)| format!("{lv} level{}: {th:?}", if *lv == 1 { "" } else { "s" }))
+        .map(|(_, name, th)| format!("{name}: {th:?}"))
         .collect();
-    format!("Minimum n-gram sizes per level: {}.", parts.join("; "))
+    format!(
+        "Minimum n-gram sizes τ per level (words-N: the paper's recognizer with N levels): {}.",
+        parts.join("; ")
+    )
 }
 
 /// One line per PR curve: its max-F1 point and its best recall at precision ≥ 0.9.
@@ -347,13 +349,13 @@ mod tests {
         assert_eq!(lines.len(), 6, "{md}");
         assert_eq!(
             lines[0],
-            "| levels | A P – R | A s/lap | B P – R | B s/lap |"
+            "| subject | A P – R | A s/lap | B P – R | B s/lap |"
         );
         assert_eq!(
             lines[2],
-            "| 1 | 0.935 – 0.103 | 0.50 | 0.931 – 0.106 | 0.50 |"
+            "| words-1 | 0.935 – 0.103 | 0.50 | 0.931 – 0.106 | 0.50 |"
         );
-        assert!(lines[5].starts_with("| ICP | 0.050 – 0.040 | 9.00 |"));
+        assert!(lines[5].starts_with("| icp | 0.050 – 0.040 | 9.00 |"));
     }
 
     #[test]
@@ -386,14 +388,14 @@ mod tests {
     fn turned_down_candidates_are_told_per_level() {
         let mut rep = sample("A", [0.9; 3], [0.2; 3]);
         assert!(!text_table(&rep).contains("verification turned down"));
-        for l in &mut rep.levels {
+        for l in rep.subjects.iter_mut().filter(|s| s.levels.is_some()) {
             l.scores.rejected_candidates = Some(crate::eval::scores::RejectedScores {
                 sampled: 25,
                 correct: 22,
                 ..Default::default()
             });
         }
-        rep.levels[0].scores.no_pairs_reason = Some("every candidate was rejected".into());
+        rep.subjects[0].scores.no_pairs_reason = Some("every candidate was rejected".into());
         let t = text_table(&rep);
         assert_eq!(t.matches("verification turned down").count(), 2, "{t}");
         assert!(
@@ -406,7 +408,7 @@ mod tests {
     fn long_steps_are_noted_once() {
         let mut rep = sample("A", [0.9; 3], [0.2; 3]);
         assert!(!text_table(&rep).contains("max_interpolation_m"));
-        for l in &mut rep.levels {
+        for l in &mut rep.subjects {
             let d = crate::recognizer::MatchDiagnostics {
                 long_steps: 2,
                 ..Default::default()
@@ -424,7 +426,7 @@ mod tests {
         assert!(!text_table(&plain).contains("opposite"));
         assert!(!markdown_table_i(std::slice::from_ref(&plain)).contains("opposite"));
         let mut both = plain.clone();
-        let s = &mut both.levels[2].scores;
+        let s = &mut both.subjects[2].scores;
         s.directions.same.precision = 0.97;
         s.directions.opposite.revisits = 100;
         s.directions.opposite.pairs = 10;
@@ -438,8 +440,8 @@ mod tests {
             "{t}"
         );
         let md = markdown_table_i(&[both]);
-        assert!(md.contains("| 3 same | 0.970 – "), "{md}");
-        assert!(md.contains("| 3 opposite | 0.800 – "), "{md}");
+        assert!(md.contains("| words-3 same | 0.970 – "), "{md}");
+        assert!(md.contains("| words-3 opposite | 0.800 – "), "{md}");
     }
 
     #[test]
@@ -448,7 +450,13 @@ mod tests {
         if std::env::var_os("PLACEWORDS_SHOW_TABLE").is_some() {
             eprintln!("{t}");
         }
-        for needle in ["1 [6]", "2 [6, 9]", "3 [6, 9, 12]", "ICP", "revisits 5000"] {
+        for needle in [
+            "words-1 [6]",
+            "words-2 [6, 9]",
+            "words-3 [6, 9, 12]",
+            "icp",
+            "revisits 5000",
+        ] {
             assert!(t.contains(needle), "{needle} missing in\n{t}");
         }
     }

@@ -2,7 +2,7 @@
 //! CI gate a scenario must pass.
 
 use crate::spec::diag::Diags;
-use crate::spec::read::{Val, get, integer, number, table, table_array, unknown_keys};
+use crate::spec::read::{Val, get, number, table, table_array, unknown_keys};
 use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
 
@@ -31,16 +31,17 @@ impl Default for EvaluationSpec {
     }
 }
 
-/// The CI gate: `[[expect.levels]]` entries and an optional `[expect.icp]`, checked over the
-/// seeds run: each bound applies to the worst seed, or with `quantile = q` to the q-quantile
-/// (nearest rank, counted from the worst seed; `quantile = 0.1` lets the worst tenth miss).
-/// A levels entry may also bound the figures of one direction alone in its sub-tables
-/// `[expect.levels.same]` and `[expect.levels.opposite]` (the report's `directions`).
+/// The CI gate: `[[expect.subjects]]` entries, each naming a subject (`words-3`, `icp`),
+/// checked over the seeds run: each bound applies to the worst seed, or with `quantile = q` to
+/// the q-quantile (nearest rank, counted from the worst seed; `quantile = 0.1` lets the worst
+/// tenth miss).
+///
+/// An entry may also bound the figures of one direction alone in its sub-tables
+/// `[expect.subjects.same]` and `[expect.subjects.opposite]` (the report's `directions`).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExpectSpec {
-    pub levels: Vec<LevelExpectation>,
-    pub icp: Option<Expectation>,
+    pub subjects: Vec<SubjectExpectation>,
     /// Bounds apply to this quantile of the seeds instead of the worst seed, in [0, 1).
     /// Default: none (the worst seed).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -50,16 +51,48 @@ pub struct ExpectSpec {
 impl ExpectSpec {
     /// Whether the block sets no bound at all.
     pub fn is_empty(&self) -> bool {
-        self.levels.is_empty() && self.icp.is_none()
+        self.subjects.is_empty()
+    }
+
+    /// The levels of the paper recognizer's subjects the block bounds, in increasing order.
+    pub fn word_levels(&self) -> Vec<usize> {
+        let mut levels: Vec<usize> = self
+            .subjects
+            .iter()
+            .filter_map(|e| words_subject_levels(&e.subject))
+            .collect();
+        levels.sort_unstable();
+        levels.dedup();
+        levels
+    }
+
+    /// Whether the block bounds the subject `name`.
+    pub fn names(&self, name: &str) -> bool {
+        self.subjects.iter().any(|e| e.subject == name)
     }
 }
 
-/// What one level configuration must achieve.
+/// The name of the paper recognizer's subject with `levels` levels: `words-3`.
+pub fn words_subject_name(levels: usize) -> String {
+    format!("words-{levels}")
+}
+
+/// The levels of a words subject's name (`words-3` → 3), if it is one.
+pub fn words_subject_levels(name: &str) -> Option<usize> {
+    name.strip_prefix("words-")?.parse().ok()
+}
+
+/// The subjects a scenario's `[expect]` may name today: the paper's recognizer at 1, 2 or 3
+/// levels, and the ICP baseline.
+pub const KNOWN_SUBJECTS: &[&str] = &["words-1", "words-2", "words-3", "icp"];
+
+/// What one subject must achieve.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct LevelExpectation {
-    /// Level configuration: 1, 2 or 3 levels of words.
-    pub levels: usize,
+pub struct SubjectExpectation {
+    /// The subject bounded: `words-1`, `words-2`, `words-3` (the paper's recognizer at that
+    /// many levels) or `icp`.
+    pub subject: String,
     /// Minimum pair precision in [0, 1].
     #[serde(default)]
     pub min_precision: Option<f64>,
@@ -75,11 +108,11 @@ pub struct LevelExpectation {
     /// Maximum recognition time per lap, seconds.
     #[serde(default)]
     pub max_seconds_per_lap: Option<f64>,
-    /// Bounds on the same-direction figures alone (`[expect.levels.same]`): the matches that
+    /// Bounds on the same-direction figures alone (`[expect.subjects.same]`): the matches that
     /// claim the same direction against the same-direction revisits. Default: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub same: Option<DirectionExpectation>,
-    /// Bounds on the opposite-direction figures alone (`[expect.levels.opposite]`). Default:
+    /// Bounds on the opposite-direction figures alone (`[expect.subjects.opposite]`). Default:
     /// none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub opposite: Option<DirectionExpectation>,
@@ -113,7 +146,7 @@ impl DirectionExpectation {
     }
 }
 
-impl LevelExpectation {
+impl SubjectExpectation {
     /// The thresholds alone.
     pub fn expectation(&self) -> Expectation {
         Expectation {
@@ -150,10 +183,10 @@ pub const EVALUATION_KEYS: &[&str] = &[
     "sensitivity_radii_m",
 ];
 /// Keys of `[expect]`.
-pub const EXPECT_KEYS: &[&str] = &["levels", "icp", "quantile"];
-/// Keys of an `[[expect.levels]]` entry.
-pub const EXPECT_LEVEL_KEYS: &[&str] = &[
-    "levels",
+pub const EXPECT_KEYS: &[&str] = &["subjects", "quantile"];
+/// Keys of an `[[expect.subjects]]` entry.
+pub const EXPECT_SUBJECT_KEYS: &[&str] = &[
+    "subject",
     "min_precision",
     "min_recall",
     "max_seconds_per_lap",
@@ -162,22 +195,13 @@ pub const EXPECT_LEVEL_KEYS: &[&str] = &[
     "same",
     "opposite",
 ];
-/// Keys of an `[expect.levels.same]` or `[expect.levels.opposite]` sub-table.
+/// Keys of an `[expect.subjects.same]` or `[expect.subjects.opposite]` sub-table.
 pub const EXPECT_DIRECTION_KEYS: &[&str] = &[
     "min_precision",
     "min_recall",
     "min_visit_recall",
     "min_pair_recall",
 ];
-/// Keys of `[expect.icp]`.
-pub const EXPECT_ICP_KEYS: &[&str] = &[
-    "min_precision",
-    "min_recall",
-    "max_seconds_per_lap",
-    "min_visit_recall",
-    "min_pair_recall",
-];
-
 /// A key, its slot, the rule it must meet and the rule in words.
 type Check<'a> = (&'a str, &'a mut f64, fn(f64) -> bool, &'a str);
 
@@ -228,36 +252,65 @@ fn numbers(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<Vec<f64>>
     a.iter().map(|x| number(x, key, ctx, d)).collect()
 }
 
-/// `[expect]`: `[[expect.levels]]` entries and an optional `[expect.icp]`.
+/// `[expect]`: `[[expect.subjects]]` entries and `quantile`. The form before subjects
+/// (`[[expect.levels]]` with `levels = N`, `[expect.icp]`) is refused with how to update it.
 pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
     let mut ex = ExpectSpec::default();
     let Some((_, t)) = table(top, "expect", d) else {
         return ex;
     };
-    unknown_keys(t, EXPECT_KEYS, "[expect]", d);
-    for (i, (_, lt)) in table_array(t, "levels", d).into_iter().enumerate() {
-        let ctx = format!("[[expect.levels]] #{}", i + 1);
-        unknown_keys(lt, EXPECT_LEVEL_KEYS, &ctx, d);
-        let levels = match get(lt, "levels") {
+    old_expect_form(t, d);
+    let known: Vec<&str> = [EXPECT_KEYS, &["levels", "icp"]].concat();
+    unknown_keys(t, &known, "[expect]", d);
+    for (i, (_, lt)) in table_array(t, "subjects", d).into_iter().enumerate() {
+        let ctx = format!("[[expect.subjects]] #{i}");
+        unknown_keys(lt, EXPECT_SUBJECT_KEYS, &ctx, d);
+        let subject = match get(lt, "subject") {
             None => {
                 d.at(
                     0,
-                    format!("missing key `levels` in {ctx}; add `levels = 1`, 2 or 3"),
+                    format!(
+                        "missing key `subject` in {ctx}; add e.g. `subject = \"words-3\"` \
+                         (one of {})",
+                        KNOWN_SUBJECTS.join(", ")
+                    ),
                 );
-                0
+                String::new()
             }
-            Some((_, v)) => match integer(v, "levels", &ctx, d) {
-                Some(n @ 1..=3) => n as usize,
-                Some(n) => {
-                    d.at(v.span().start, format!("levels = {n}; use 1, 2 or 3"));
-                    0
+            Some((_, v)) => match v.get_ref() {
+                DeValue::String(name) if KNOWN_SUBJECTS.contains(&name.as_ref()) => {
+                    name.to_string()
                 }
-                None => 0,
+                DeValue::String(name) => {
+                    let hint =
+                        match crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().copied()) {
+                            Some(k) => format!("did you mean `{k}`? "),
+                            None => String::new(),
+                        };
+                    d.at(
+                        v.span().start,
+                        format!(
+                            "unknown subject `{name}` in {ctx}; {hint}the subjects are {}",
+                            KNOWN_SUBJECTS.join(", ")
+                        ),
+                    );
+                    String::new()
+                }
+                _ => {
+                    d.at(
+                        v.span().start,
+                        format!(
+                            "`subject` in {ctx} must be a name in quotes, e.g. \
+                             `subject = \"words-3\"`"
+                        ),
+                    );
+                    String::new()
+                }
             },
         };
         let e = expectation(lt, &ctx, d);
-        ex.levels.push(LevelExpectation {
-            levels,
+        ex.subjects.push(SubjectExpectation {
+            subject,
             min_precision: e.min_precision,
             min_recall: e.min_recall,
             max_seconds_per_lap: e.max_seconds_per_lap,
@@ -266,10 +319,6 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
             same: direction_expectation(lt, "same", &ctx, d),
             opposite: direction_expectation(lt, "opposite", &ctx, d),
         });
-    }
-    if let Some((_, it)) = table(t, "icp", d) {
-        unknown_keys(it, EXPECT_ICP_KEYS, "[expect.icp]", d);
-        ex.icp = Some(expectation(it, "[expect.icp]", d));
     }
     if let Some((_, v)) = get(t, "quantile")
         && let Some(q) = number(v, "quantile", "[expect]", d)
@@ -286,7 +335,45 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
     ex
 }
 
-/// The `[expect.levels.<dir>]` sub-table of a levels entry (`dir` is `same` or `opposite`).
+/// Refuses the `[expect]` form before subjects, at each old key, saying what to write instead.
+fn old_expect_form(t: &DeTable<'_>, d: &mut Diags) {
+    if let Some((kat, v)) = get(t, "levels") {
+        let entries: Vec<String> = match v.get_ref() {
+            DeValue::Array(a) => a
+                .iter()
+                .filter_map(|e| match e.get_ref() {
+                    DeValue::Table(lt) => get(lt, "levels").and_then(|(_, n)| match n.get_ref() {
+                        DeValue::Integer(i) => Some(i.as_str().to_string()),
+                        _ => None,
+                    }),
+                    _ => None,
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        let example = entries.first().map_or("3".to_string(), |n| n.clone());
+        d.at(
+            kat,
+            format!(
+                "`[[expect.levels]]` is the form before subjects; each entry is now \
+                 `[[expect.subjects]]` with `subject = \"words-{example}\"` in place of \
+                 `levels = {example}` (and `[expect.levels.same]` becomes \
+                 `[expect.subjects.same]`); the other keys stay as they are"
+            ),
+        );
+    }
+    if let Some((kat, _)) = get(t, "icp") {
+        d.at(
+            kat,
+            "`[expect.icp]` is the form before subjects; write it as `[[expect.subjects]]` \
+             with `subject = \"icp\"` and the same bounds"
+                .to_string(),
+        );
+    }
+}
+
+/// The `[expect.subjects.<dir>]` sub-table of a subject entry (`dir` is `same` or
+/// `opposite`).
 fn direction_expectation(
     lt: &DeTable<'_>,
     dir: &str,
@@ -299,18 +386,18 @@ fn direction_expectation(
             kat,
             format!(
                 "`{dir}` in {entry} must be a table of bounds on the {dir}-direction figures; \
-                 write a `[expect.levels.{dir}]` section with e.g. `min_precision = 0.9`"
+                 write a `[expect.subjects.{dir}]` section with e.g. `min_precision = 0.9`"
             ),
         );
         return None;
     };
-    let ctx = format!("[expect.levels.{dir}] of {entry}");
+    let ctx = format!("[expect.subjects.{dir}] of {entry}");
     if let Some((kat, _)) = get(t, "max_seconds_per_lap") {
         d.at(
             kat,
             format!(
                 "`max_seconds_per_lap` in {ctx}: time is not counted per direction; \
-                 bound it in the levels entry itself"
+                 bound it in the subject entry itself"
             ),
         );
     }

@@ -48,15 +48,16 @@ fn smoke_scenario_runs_end_to_end_within_its_golden_band() {
         "seed",
         "laps",
         "revisits",
-        "levels",
-        "icp",
+        "subjects",
         "simulate_seconds_per_lap",
     ] {
         assert!(r.get(key).is_some(), "report lacks `{key}`");
     }
-    let levels = r["levels"].as_array().unwrap();
-    assert_eq!(levels.len(), 3, "run fills 1, 2 and 3 levels");
-    for l in levels {
+    let levels = r["subjects"].as_array().unwrap();
+    assert_eq!(levels.len(), 3, "run fills words-1, words-2 and words-3");
+    for (i, l) in levels.iter().enumerate() {
+        assert_eq!(l["name"], format!("words-{}", i + 1));
+        assert_eq!(l["kind"], "words");
         for key in [
             "levels",
             "thresholds",
@@ -66,7 +67,7 @@ fn smoke_scenario_runs_end_to_end_within_its_golden_band() {
             "pairs",
             "recognize_seconds_per_lap",
         ] {
-            assert!(l.get(key).is_some(), "level entry lacks `{key}`");
+            assert!(l.get(key).is_some(), "subject entry lacks `{key}`");
         }
     }
     assert!(svg.join("trajectory.svg").exists() && svg.join("matches-levels3.svg").exists());
@@ -105,7 +106,7 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     let easy = smoke_variant(
         dir.path(),
         "easy",
-        "[[expect.levels]]\nlevels = 1\nmin_precision = 0.0\nmin_recall = 0.0\n",
+        "[[expect.subjects]]\nsubject = \"words-1\"\nmin_precision = 0.0\nmin_recall = 0.0\n",
     );
     let o = placewords(&["check", "-q", "--seed", "42", easy.to_str().unwrap()]);
     assert_eq!(
@@ -119,7 +120,7 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     let hard = smoke_variant(
         dir.path(),
         "hard",
-        "[[expect.levels]]\nlevels = 1\nmin_recall = 0.999\n",
+        "[[expect.subjects]]\nsubject = \"words-1\"\nmin_recall = 0.999\n",
     );
     let junit = dir.path().join("junit.xml");
     let o = placewords(&[
@@ -151,7 +152,7 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     );
 }
 
-/// Bounds on one direction (`[expect.levels.same]`, `[expect.levels.opposite]`): one that holds
+/// Bounds on one direction (`[expect.subjects.same]`, `[expect.subjects.opposite]`): one that holds
 /// passes; one that does not exits 1, and the line and the JUnit test case name the direction.
 #[test]
 fn check_gates_one_direction_and_names_it() {
@@ -159,8 +160,8 @@ fn check_gates_one_direction_and_names_it() {
     let scenario = smoke_variant(
         dir.path(),
         "directions",
-        "[[expect.levels]]\nlevels = 3\n\n[expect.levels.same]\nmin_precision = 0.5\n\n\
-         [expect.levels.opposite]\nmin_recall = 0.999\n",
+        "[[expect.subjects]]\nsubject = \"words-3\"\n\n[expect.subjects.same]\nmin_precision = 0.5\n\n\
+         [expect.subjects.opposite]\nmin_recall = 0.999\n",
     );
     let junit = dir.path().join("junit.xml");
     let args = ["check", "-q", "--seed", "42", scenario.to_str().unwrap()];
@@ -168,16 +169,16 @@ fn check_gates_one_direction_and_names_it() {
     let out = String::from_utf8_lossy(&o.stdout);
     assert_eq!(o.status.code(), Some(1), "{out}");
     assert!(
-        out.contains("PASS smoke levels=3 same precision worst"),
+        out.contains("PASS smoke words-3 same precision worst"),
         "{out}"
     );
     assert!(
-        out.contains("FAIL smoke levels=3 opposite recall worst"),
+        out.contains("FAIL smoke words-3 opposite recall worst"),
         "{out}"
     );
     let xml = std::fs::read_to_string(&junit).unwrap();
     assert!(
-        xml.contains("name=\"smoke/levels=3/opposite/recall\""),
+        xml.contains("name=\"smoke/words-3/opposite/recall\""),
         "{xml}"
     );
     assert!(
@@ -205,7 +206,7 @@ fn recognize_reads_a_real_log_and_writes_the_run_schema() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let r = report_of(&out);
-    assert_eq!(r["levels"].as_array().unwrap().len(), 3);
+    assert_eq!(r["subjects"].as_array().unwrap().len(), 3);
     assert!(r["revisits"].as_u64().unwrap() > 0);
 }
 
@@ -299,8 +300,7 @@ fn sharded_check_then_merge_equals_the_unsharded_run() {
     std::fs::create_dir_all(&a).unwrap();
     std::fs::create_dir_all(&b).unwrap();
     // the same name twice; one bound that always holds, one that no seed meets
-    let gate =
-        "[expect]\nlevels = [{ levels = 1, min_recall = 0.0 }, { levels = 3, min_recall = 1.0 }]\n";
+    let gate = "[expect]\nsubjects = [{ subject = \"words-1\", min_recall = 0.0 }, { subject = \"words-3\", min_recall = 1.0 }]\n";
     let s1 = smoke_variant(&a, "smoke", gate);
     let s2 = smoke_variant(&b, "smoke", gate);
     let (s1, s2) = (s1.to_str().unwrap(), s2.to_str().unwrap());
@@ -379,7 +379,7 @@ fn sharded_check_then_merge_equals_the_unsharded_run() {
     );
     assert_eq!(
         cases[1].1,
-        format!("{}/levels=3/recall", cases[1].0),
+        format!("{}/words-3/recall", cases[1].0),
         "no bound in a name"
     );
     let props: Vec<&str> = cases[1].3.iter().map(|p| p.0.as_str()).collect();
@@ -505,5 +505,5 @@ fn a_closed_stdout_ends_quietly_with_exit_0() {
         assert_eq!(out.status.code(), Some(0), "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
-    assert!(report_of(&report)["levels"].is_array());
+    assert!(report_of(&report)["subjects"].is_array());
 }

@@ -3,14 +3,14 @@
 
 use placewords::baseline::{IcpConfig, IcpRecognizer};
 use placewords::eval::gate::{check, exit_code};
-use placewords::eval::scores::Report;
+use placewords::eval::scores::{Report, SubjectKind};
 use placewords::eval::{PlaceRecognizer, evaluate, recognize_runs};
 use placewords::geom::{OdomPose, Pose2, Segment, TruePose, Vec2};
 use placewords::log::{Frame, LapLog, RunLog};
 use placewords::place::{Match, Observation};
 use placewords::report::junit::{Suite, junit_xml};
 use placewords::scan::{BeamLayout, Scan};
-use placewords::spec::evaluation::{EvaluationSpec, ExpectSpec, Expectation, LevelExpectation};
+use placewords::spec::evaluation::{EvaluationSpec, ExpectSpec, SubjectExpectation};
 
 /// A corridor loop 20 × 8 m around a 16 × 4 m block, with niches and pillars so that ICP has
 /// something to hold on to.
@@ -259,32 +259,40 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
 
     let mut report = Report::new("loop", 1, r.laps, spec.clone());
     report.add_level(1, &[6], &r);
-    report.set_icp(&r);
+    report.add_subject("icp", SubjectKind::Icp, &r);
     report.finish();
     assert_eq!(report.revisits, e.main.revisits);
-    assert_eq!(report.icp.as_ref().unwrap().scores.pairs, e.main.pairs);
+    assert_eq!(report.subject("icp").unwrap().scores.pairs, e.main.pairs);
     let pass = ExpectSpec {
-        levels: vec![LevelExpectation {
-            levels: 1,
-            min_precision: Some(0.5),
-            min_recall: Some(0.5),
-            min_visit_recall: None,
-            min_pair_recall: None,
-            max_seconds_per_lap: None,
-            same: None,
-            opposite: None,
-        }],
-        icp: Some(Expectation {
-            min_precision: Some(0.5),
-            ..Expectation::default()
-        }),
+        subjects: vec![
+            SubjectExpectation {
+                subject: "words-1".into(),
+                min_precision: Some(0.5),
+                min_recall: Some(0.5),
+                min_visit_recall: None,
+                min_pair_recall: None,
+                max_seconds_per_lap: None,
+                same: None,
+                opposite: None,
+            },
+            SubjectExpectation {
+                subject: "icp".into(),
+                min_precision: Some(0.5),
+                min_recall: None,
+                min_visit_recall: None,
+                min_pair_recall: None,
+                max_seconds_per_lap: None,
+                same: None,
+                opposite: None,
+            },
+        ],
         quantile: None,
     };
     let outcomes = check(&report, &pass);
     assert_eq!(exit_code(&outcomes), 0, "{outcomes:?}");
     let too_high = ExpectSpec {
-        levels: vec![LevelExpectation {
-            levels: 1,
+        subjects: vec![SubjectExpectation {
+            subject: "words-1".into(),
             min_precision: Some(1.01),
             min_recall: None,
             min_visit_recall: None,
@@ -293,7 +301,6 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             same: None,
             opposite: None,
         }],
-        icp: None,
         quantile: None,
     };
     let outcomes = check(&report, &too_high);
@@ -306,7 +313,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
         seconds: r.seconds,
     }]);
     assert!(
-        xml.contains("<failure message=\"FAIL loop levels=1 precision"),
+        xml.contains("<failure message=\"FAIL loop words-1 precision"),
         "{xml}"
     );
 }

@@ -612,7 +612,7 @@ fn a_log_read_as_a_stream_gives_the_report_of_the_log_loaded_whole() {
         };
         let streamed = report(false);
         let pairs = |l: &serde_json::Value| l["pairs"].as_u64().unwrap_or(0);
-        let levels = streamed["levels"].as_array().unwrap();
+        let levels = streamed["subjects"].as_array().unwrap();
         assert!(levels.iter().any(|l| pairs(l) > 0), "something matched");
         assert_eq!(streamed, report(true), "{truth:?}, every {scan_step}");
     }

@@ -25,7 +25,8 @@ fn without_timings(v: &mut serde_json::Value) {
 /// added keys only (eighth: `longest_revisit_m`, `rejected_candidates`,
 /// `diagnostics.mean_word_m` and `diagnostics.reverse_extra_ngram`; every other value
 /// identical), and for the neutral place types of issue 24 (ninth: `rejected_candidates`'
-/// per-check counts became `correct_by_check`, a list named by check; every value identical).
+/// per-check counts became `correct_by_check`, a list named by check; then `levels` + `icp`
+/// became `subjects`, each with `name` and `kind`; every value identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]
@@ -87,8 +88,13 @@ fn scoring_as_matches_arrive_gives_the_report_of_scoring_them_at_the_end() {
         v
     };
     let (streamed, kept) = (report(false), report(true));
-    let levels = streamed["levels"].as_array().unwrap();
+    let subjects = streamed["subjects"].as_array().unwrap();
+    let levels: Vec<_> = subjects.iter().filter(|s| s["kind"] == "words").collect();
     assert_eq!(levels.len(), 3);
+    assert!(
+        subjects.iter().any(|s| s["name"] == "icp"),
+        "ICP scored too"
+    );
     assert!(levels[2]["only_here"].is_object(), "level gains reported");
     assert!(levels[2]["pairs"].as_u64().unwrap() > 100, "smoke matches");
     assert!(streamed == kept, "streamed and kept reports differ");

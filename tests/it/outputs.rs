@@ -45,7 +45,7 @@ fn blocked_scenario(dir: &Path) -> PathBuf {
          [pedestrians]\ncount = 1\npaths_m = [[[8.0, 0.0], [8.0, 0.0]]]\n\
          speed_min_m_s = 0.001\nspeed_max_m_s = 0.001\nradius_m = 0.5\n\
          [robot]\nblocked_timeout_s = 2\n\
-         [expect]\nlevels = [{{ levels = 1, min_precision = 0.5 }}]\n",
+         [expect]\nsubjects = [{{ subject = \"words-1\", min_precision = 0.5 }}]\n",
         world.display().to_string()
     );
     std::fs::write(&path, src).unwrap();

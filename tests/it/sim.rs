@@ -738,8 +738,8 @@ levels = 3
 min_word_size = 4
 [evaluation]
 tp_radius_m = 1.5
-[[expect.levels]]
-levels = 2
+[[expect.subjects]]
+subject = "words-2"
 min_precision = 0.9
 "#,
     )
@@ -773,7 +773,7 @@ min_precision = 0.9
     assert_eq!(scn.recognizer.levels, 3);
     assert_eq!(scn.recognizer.min_word_size, 4);
     assert_eq!(scn.evaluation.tp_radius_m, 1.5);
-    assert_eq!(scn.expect.levels[0].min_precision, Some(0.9));
+    assert_eq!(scn.expect.subjects[0].min_precision, Some(0.9));
     // Door states per lap follow the plan.
     let (name, st) = placewords::sim::runner::door_states(&scn.sim, 0, 4);
     assert_eq!(
@@ -871,7 +871,7 @@ fn a_run_without_pairs_says_why() {
         ..Default::default()
     };
     let exp = evaluate_runs("tiny", 1, runs, &scn.recognizer, &scn.evaluation, &opts).unwrap();
-    let s = &exp.report.levels[0].scores;
+    let s = &exp.report.subjects[0].scores;
     assert_eq!(s.pairs, 0);
     let why = s.no_pairs_reason.as_deref().unwrap_or_default();
     assert!(why.contains("no observation has a revisit"), "{why}");
