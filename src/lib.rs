@@ -12,6 +12,7 @@ pub mod authoring;
 pub mod baseline;
 pub mod eval;
 pub mod experiment;
+pub mod external;
 pub mod geom;
 pub mod io;
 pub mod log;

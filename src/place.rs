@@ -333,4 +333,15 @@ pub trait PlaceRecognizer {
     fn diagnostics(&self) -> Option<Box<dyn Diagnostics>> {
         None
     }
+    /// Why the recognizer could not go on (an external program that crashed, hung or printed
+    /// garbage), in words; the harness checks it when the input ends and then fails the run
+    /// instead of scoring it. `None`, the default: it never fails.
+    fn failure(&self) -> Option<String> {
+        None
+    }
+    /// Whether its work happens in another process, so that the harness's thread CPU clock
+    /// does not see it and its time per lap is taken from the wall clock. Default false.
+    fn runs_out_of_process(&self) -> bool {
+        false
+    }
 }

@@ -21,6 +21,8 @@ pub struct CheckArgs {
     pub scenarios: Vec<PathBuf>,
     #[command(flatten)]
     pub seeds: SeedsArg,
+    #[command(flatten)]
+    pub external: super::common::ExternalArg,
     /// Run only part K of N of the (scenario × seed) work and write it with --report, for
     /// `placewords merge`. `auto`: K from JOB_COMPLETION_INDEX (Kubernetes Indexed Job, 0-based),
     /// N from --shard-count or PLACEWORDS_SHARD_COUNT.
@@ -68,6 +70,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         allow_no_expect: args.allow_no_expect,
         experiment: ExperimentOptions {
             progress: super::progress::bar(args.quiet),
+            external: args.external.specs(),
             ..ExperimentOptions::default()
         },
     };

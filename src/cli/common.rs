@@ -21,6 +21,35 @@ impl LevelsArg {
     }
 }
 
+/// `--recognizer NAME=exec:COMMAND`: recognizers in other processes, scored beside the
+/// built-in subjects (docs/plugin.md).
+#[derive(Debug, Args)]
+pub struct ExternalArg {
+    /// Also score a recognizer in any language: a program (run by `sh -c`) that speaks the
+    /// JSON-lines protocol of docs/plugin.md, as subject NAME. Repeatable.
+    /// Example: --recognizer mine=exec:"python3 examples/plugin_recognizer.py"
+    #[arg(long = "recognizer", value_name = "NAME=exec:COMMAND", value_parser = parse_external)]
+    pub external: Vec<placewords::external::ExternalSpec>,
+    /// Time an external recognizer may take to answer one line before it is stopped, seconds.
+    #[arg(long, value_name = "S", default_value_t = placewords::external::DEFAULT_TIMEOUT_S)]
+    pub recognizer_timeout_s: f64,
+}
+
+impl ExternalArg {
+    /// The external recognizers, each with the timeout.
+    pub fn specs(&self) -> Vec<placewords::external::ExternalSpec> {
+        let mut out = self.external.clone();
+        for s in &mut out {
+            s.timeout_s = self.recognizer_timeout_s;
+        }
+        out
+    }
+}
+
+fn parse_external(text: &str) -> Result<placewords::external::ExternalSpec, String> {
+    placewords::external::ExternalSpec::parse(text)
+}
+
 /// Writes a file atomically, naming it in the error.
 pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
     placewords::io::atomic::write_atomic(path, bytes)

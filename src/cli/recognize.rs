@@ -42,6 +42,8 @@ pub struct RecognizeArgs {
     pub config: Option<PathBuf>,
     #[command(flatten)]
     pub levels: LevelsArg,
+    #[command(flatten)]
+    pub external: super::common::ExternalArg,
     /// Also run the ICP baseline.
     #[arg(long)]
     pub icp: bool,
@@ -109,6 +111,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
+        external: args.external.specs(),
         laps: None,
         progress: super::progress::bar(args.quiet),
     };

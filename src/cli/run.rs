@@ -1,7 +1,7 @@
 //! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report; over
 //! a range of seeds with `--seeds A..B` (mean and worst per configuration).
 
-use super::common::{LevelsArg, SeedsArg, print_and_write, write_file};
+use super::common::{ExternalArg, LevelsArg, SeedsArg, print_and_write, write_file};
 use clap::Args;
 use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::{self, ExperimentOptions};
@@ -16,6 +16,8 @@ pub struct RunArgs {
     pub levels: LevelsArg,
     #[command(flatten)]
     pub seeds: SeedsArg,
+    #[command(flatten)]
+    pub external: ExternalArg,
     /// Also run the ICP baseline (slow: every region is aligned with every past region).
     #[arg(long)]
     pub icp: bool,
@@ -46,6 +48,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
+        external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
     };

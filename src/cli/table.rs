@@ -24,6 +24,8 @@ pub struct TableArgs {
     /// Replace every run's lap count (for a quick look).
     #[arg(long, value_name = "N")]
     pub laps: Option<usize>,
+    #[command(flatten)]
+    pub external: super::common::ExternalArg,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -34,6 +36,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,
+        external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
     };

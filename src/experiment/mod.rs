@@ -16,7 +16,8 @@ use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
-use crate::place::Match;
+use crate::external::{ExternalRecognizer, ExternalSpec};
+use crate::place::{Match, PlaceRecognizer};
 use crate::recognizer::{
     DensityFrontEnd, DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher,
 };
@@ -44,6 +45,8 @@ pub enum ExperimentError {
     Write(#[from] std::io::Error),
     #[error(transparent)]
     RealLog(#[from] crate::io::real_log::RealLogError),
+    #[error("{0}")]
+    External(String),
 }
 
 /// What to run.
@@ -53,6 +56,9 @@ pub struct ExperimentOptions {
     pub levels: Vec<usize>,
     /// Also run the ICP baseline. Default false (it is slow: every region against every past one).
     pub icp: bool,
+    /// Recognizers in other processes to score beside the built-in ones (`--recognizer
+    /// NAME=exec:COMMAND`). Default none.
+    pub external: Vec<ExternalSpec>,
     /// Replace every run's lap count. Default: the scenario's.
     pub laps: Option<usize>,
     /// Where progress goes. Default: nowhere.
@@ -64,6 +70,7 @@ impl Default for ExperimentOptions {
         ExperimentOptions {
             levels: vec![1, 2, 3],
             icp: false,
+            external: Vec::new(),
             laps: None,
             progress: ProgressSink::none(),
         }
@@ -77,6 +84,48 @@ pub struct Experiment {
     /// One recognition per level configuration, in the order of `ExperimentOptions::levels`.
     pub recognitions: Vec<(usize, Recognition)>,
     pub icp: Option<Recognition>,
+    /// The external subjects' recognitions, by name, in the order of
+    /// `ExperimentOptions::external`.
+    pub external: Vec<(String, Recognition)>,
+}
+
+/// Which subject a recognition belongs to while an experiment runs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SubjectId {
+    /// The paper's recognizer with this many levels.
+    Words(usize),
+    /// The ICP baseline.
+    Icp,
+    /// An external recognizer, by name.
+    External(String),
+}
+
+impl SubjectId {
+    /// The levels of a words subject.
+    pub fn levels(&self) -> Option<usize> {
+        match self {
+            SubjectId::Words(l) => Some(*l),
+            _ => None,
+        }
+    }
+}
+
+/// Starts the external recognizers of `specs`.
+fn start_external(specs: &[ExternalSpec]) -> Result<Vec<ExternalRecognizer>, ExperimentError> {
+    specs
+        .iter()
+        .map(|s| ExternalRecognizer::start(s).map_err(|e| ExperimentError::External(e.to_string())))
+        .collect()
+}
+
+/// The first failure of a recognizer that can fail (an external program), as an error.
+fn failed<'a>(
+    recs: impl IntoIterator<Item = &'a dyn PlaceRecognizer>,
+) -> Result<(), ExperimentError> {
+    match recs.into_iter().find_map(|r| r.failure()) {
+        Some(why) => Err(ExperimentError::External(why)),
+        None => Ok(()),
+    }
 }
 
 /// The recognizer settings of a scenario (checked when the scenario was loaded).
@@ -142,10 +191,12 @@ pub fn evaluate_runs(
 ) -> Result<Experiment, ExperimentError> {
     let laps: usize = runs.iter().map(|r| r.laps.len()).sum();
     let configs = level_configs(base, &opts.levels)?;
+    let external = start_external(&opts.external)?;
     let jobs = configs.len() + usize::from(opts.icp);
-    opts.progress.start("recognizing", (jobs * laps) as u64);
+    opts.progress
+        .start("recognizing", ((jobs + external.len()) * laps) as u64);
     // Each task is single-threaded and timed on its own; the tasks share the cores.
-    let results: Result<Vec<(Option<usize>, Recognition)>, _> = (0..jobs)
+    let results: Result<Vec<(SubjectId, Recognition)>, _> = (0..jobs)
         .into_par_iter()
         .map(|j| {
             let mut on_lap = |_: usize| opts.progress.step();
@@ -154,7 +205,7 @@ pub fn evaluate_runs(
                 let mut rec = Recognizer::new(cfg.clone())
                     .map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
                 Ok((
-                    Some(cfg.levels),
+                    SubjectId::Words(cfg.levels),
                     recognize_runs_with_progress(&mut rec, &runs, &mut on_lap),
                 ))
             } else {
@@ -163,15 +214,22 @@ pub fn evaluate_runs(
                     ..IcpConfig::default()
                 });
                 Ok((
-                    None,
+                    SubjectId::Icp,
                     recognize_runs_with_progress(&mut icp, &runs, &mut on_lap),
                 ))
             }
         })
         .collect::<Result<_, ExperimentError>>();
+    let mut results = results?;
+    for mut rec in external {
+        let mut on_lap = |_: usize| opts.progress.step();
+        let recognition = recognize_runs_with_progress(&mut rec, &runs, &mut on_lap);
+        failed([&rec as &dyn PlaceRecognizer])?;
+        results.push((SubjectId::External(rec.name()), recognition));
+    }
     opts.progress.done();
     Ok(assemble(
-        name, seed, laps, evaluation, &configs, results?, runs,
+        name, seed, laps, evaluation, &configs, results, runs,
     ))
 }
 
@@ -204,22 +262,26 @@ fn assemble(
     laps: usize,
     evaluation: &EvaluationSpec,
     configs: &[RecognizerConfig],
-    mut results: Vec<(Option<usize>, Recognition)>,
+    results: Vec<(SubjectId, Recognition)>,
     runs: Vec<RunLog>,
 ) -> Experiment {
     let mut report = Report::new(name, seed, laps, evaluation.clone());
-    let icp = match results.last() {
-        Some((None, _)) => results.pop().map(|(_, r)| r),
-        _ => None,
-    };
-    if let Some(r) = &icp {
-        report.add_subject("icp", SubjectKind::Icp, r);
-    }
-    let mut recognitions = Vec::new();
-    for (levels, r) in results {
-        let levels = levels.unwrap_or(1);
-        report.add_level(levels, &thresholds(&configs[recognitions.len()]), &r);
-        recognitions.push((levels, r));
+    let (mut icp, mut recognitions, mut external) = (None, Vec::new(), Vec::new());
+    for (id, r) in results {
+        match id {
+            SubjectId::Words(levels) => {
+                report.add_level(levels, &thresholds(&configs[recognitions.len()]), &r);
+                recognitions.push((levels, r));
+            }
+            SubjectId::Icp => {
+                report.add_subject("icp", SubjectKind::Icp, &r);
+                icp = Some(r);
+            }
+            SubjectId::External(name) => {
+                report.add_subject(&name, SubjectKind::External, &r);
+                external.push((name, r));
+            }
+        }
     }
     report.set_level_gains(&recognitions);
     report.finish();
@@ -228,6 +290,7 @@ fn assemble(
         runs,
         recognitions,
         icp,
+        external,
     }
 }
 

@@ -198,7 +198,7 @@ pub fn recognize_log_streamed(
     opts: &ExperimentOptions,
 ) -> Result<(Experiment, usize), ExperimentError> {
     let configs = level_configs(base, &opts.levels)?;
-    let mut jobs = jobs(&configs, evaluation, opts.icp)?;
+    let mut jobs = jobs(&configs, evaluation, opts)?;
     let read = ReadOptions {
         lenient: log.lenient,
     };
@@ -215,7 +215,7 @@ pub fn recognize_log_streamed(
     });
     opts.progress.done();
     read?;
-    let results = finish_jobs(jobs, truth);
+    let results = finish_jobs(jobs, truth)?;
     let exp = assemble(name, log.seed, 1, evaluation, &configs, results, Vec::new());
     Ok((exp, survey.counts.skipped_lines))
 }

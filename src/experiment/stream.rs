@@ -12,9 +12,10 @@
 //!
 //! The lap producer ([`with_laps`]) also feeds `simulate`'s log writer (`super::output`).
 
-use super::{ExperimentError, ExperimentOptions, ProgressSink, assemble, level_configs};
+use super::{ExperimentError, ExperimentOptions, ProgressSink, SubjectId, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::{GroundTruth, LapInfo, PlaceRecognizer, Recognition, Recording};
+use crate::external::ExternalRecognizer;
 use crate::log::LapLog;
 use crate::recognizer::{Recognizer, RecognizerConfig};
 use crate::sim::runner::RunSim;
@@ -30,8 +31,8 @@ use super::{Experiment, Scenario, recognizer_config};
 /// Laps simulated ahead of the recognizers at most (each holds one lap of scans).
 const LAPS_AHEAD: usize = 2;
 
-/// A recognizer with its recording; `levels` is `None` for ICP.
-pub(super) type Job = (Option<usize>, Box<dyn PlaceRecognizer + Send>, Recording);
+/// A recognizer with its recording, and which subject it is.
+pub(super) type Job = (SubjectId, Box<dyn PlaceRecognizer + Send>, Recording);
 
 /// Simulates `scn` and evaluates it lap by lap (see the module doc).
 pub fn run_scenario_streamed(
@@ -39,7 +40,7 @@ pub fn run_scenario_streamed(
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
-    let mut jobs = jobs(&configs, &scn.evaluation, opts.icp)?;
+    let mut jobs = jobs(&configs, &scn.evaluation, opts)?;
     let plan = &scn.sim;
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
@@ -50,7 +51,7 @@ pub fn run_scenario_streamed(
     });
     opts.progress.done();
     let sim_s = sim_s?;
-    let results = finish_jobs(jobs, truth);
+    let results = finish_jobs(jobs, truth)?;
     let mut exp = assemble(
         &plan.name,
         plan.seed,
@@ -107,20 +108,20 @@ fn simulate_laps(
 }
 
 /// One job per level configuration, in order, then ICP's if asked (with the evaluation's
-/// `min_gap_m`). Each scores its matches as they arrive ([`Recording::streaming`]); a
+/// `min_gap_m`), then one per external recognizer (started here). Each scores its matches as they arrive ([`Recording::streaming`]); a
 /// configuration with one level fewer than another keeps what it forgets, to count the other's
 /// gain ([`settle`]).
 pub(super) fn jobs(
     configs: &[RecognizerConfig],
     evaluation: &EvaluationSpec,
-    icp: bool,
+    opts: &ExperimentOptions,
 ) -> Result<Vec<Job>, ExperimentError> {
     let mut jobs: Vec<Job> = Vec::new();
     for cfg in configs {
         let rec =
             Recognizer::new(cfg.clone()).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
         jobs.push((
-            Some(cfg.levels),
+            SubjectId::Words(cfg.levels),
             Box::new(rec),
             Recording::streaming(evaluation),
         ));
@@ -129,19 +130,32 @@ pub(super) fn jobs(
         jobs[here].2.keep_forgotten();
         jobs[fewer].2.keep_forgotten();
     }
-    if icp {
+    if opts.icp {
         let icp = IcpRecognizer::new(IcpConfig {
             min_gap_m: evaluation.min_gap_m,
             ..IcpConfig::default()
         });
-        jobs.push((None, Box::new(icp), Recording::streaming(evaluation)));
+        jobs.push((
+            SubjectId::Icp,
+            Box::new(icp),
+            Recording::streaming(evaluation),
+        ));
+    }
+    for spec in &opts.external {
+        let rec = ExternalRecognizer::start(spec)
+            .map_err(|e| ExperimentError::External(e.to_string()))?;
+        jobs.push((
+            SubjectId::External(spec.name.clone()),
+            Box::new(rec),
+            Recording::streaming(evaluation),
+        ));
     }
     Ok(jobs)
 }
 
 /// `(job, job with one level fewer)` for every level configuration whose gain is reported.
 fn gain_pairs(jobs: &[Job]) -> Vec<(usize, usize)> {
-    let levels: Vec<Option<usize>> = jobs.iter().map(|j| j.0).collect();
+    let levels: Vec<Option<usize>> = jobs.iter().map(|j| j.0.levels()).collect();
     let mut out = Vec::new();
     for (i, l) in levels.iter().enumerate() {
         let Some(l) = l else { continue };
@@ -159,12 +173,12 @@ fn gain_pairs(jobs: &[Job]) -> Vec<(usize, usize)> {
 pub(super) fn settle(jobs: &mut [Job], last: bool) {
     let common = jobs
         .iter()
-        .filter(|j| j.0.is_some())
+        .filter(|j| j.0.levels().is_some())
         .map(|j| j.1.query_horizon())
         .min()
         .unwrap_or(0);
-    for (levels, rec, recording) in jobs.iter_mut() {
-        let h = match (last, levels.is_some()) {
+    for (id, rec, recording) in jobs.iter_mut() {
+        let h = match (last, id.levels().is_some()) {
             (true, _) => usize::MAX,
             (false, true) => common,
             (false, false) => rec.query_horizon(),
@@ -216,26 +230,30 @@ fn feed(
 }
 
 /// Ends every job's input and hands its recording and recognizer over as the scored
-/// recognition; `truth` is the truth of every frame fed, shared by the recognitions.
+/// recognition; `truth` is the truth of every frame fed, shared by the recognitions. A
+/// recognizer that failed (an external program) fails the whole experiment.
 pub(super) fn finish_jobs(
     mut jobs: Vec<Job>,
     truth: GroundTruth,
-) -> Vec<(Option<usize>, Recognition)> {
+) -> Result<Vec<(SubjectId, Recognition)>, ExperimentError> {
     for (_, rec, recording) in &mut jobs {
         recording.close(rec.as_mut(), &truth);
+    }
+    if let Some(why) = jobs.iter().find_map(|j| j.1.failure()) {
+        return Err(ExperimentError::External(why));
     }
     settle(&mut jobs, true);
     // Each recognizer is dropped as soon as its recording has taken what it needs, before any
     // tally makes its last count: the peak memory of a long log is the end of recognition.
-    let ended: Vec<(Option<usize>, crate::eval::Ended)> = jobs
+    let ended: Vec<(SubjectId, crate::eval::Ended)> = jobs
         .into_iter()
         .map(|(levels, mut rec, recording)| (levels, recording.end(rec.as_mut(), &truth)))
         .collect();
     let truth = Arc::new(truth);
-    ended
+    Ok(ended
         .into_iter()
         .map(|(levels, e)| (levels, e.finish(truth.clone())))
-        .collect()
+        .collect())
 }
 
 /// "12.3 laps/s, 456 MB (peak 789 MB)": the rate so far and the process's resident memory.
@@ -282,7 +300,7 @@ mod tests {
         let mut base = recognizer_config(&scn).unwrap();
         base.max_candidates = 8;
         let configs = level_configs(&base, &[2, 3]).unwrap();
-        let mut jobs = jobs(&configs, &scn.evaluation, false).unwrap();
+        let mut jobs = jobs(&configs, &scn.evaluation, &ExperimentOptions::default()).unwrap();
         let laps_of = |run: usize| [30, 10][run];
         let mut held_at = Vec::new();
         let mut truth = GroundTruth::default();
@@ -306,7 +324,7 @@ mod tests {
         });
         sim.expect("simulates");
         let late: Vec<usize> = jobs.iter().map(|j| j.2.pairs_held().unwrap().1).collect();
-        let results = finish_jobs(jobs, truth);
+        let results = finish_jobs(jobs, truth).unwrap();
         let (_, e) = results[1].1.evaluation.as_ref().expect("scored as it went");
         assert!(results[1].1.matches.is_empty(), "no match is kept");
         // Held pairs flatten out: laps 30–40 hold at most a third more than laps 15–20 did,

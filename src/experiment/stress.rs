@@ -11,6 +11,7 @@
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
 use crate::experiment::{ExperimentOptions, ProgressSink, run_scenario};
+use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -42,6 +43,19 @@ struct Planned {
     options: Option<ExperimentOptions>,
 }
 
+/// A subject `expect` names that `opts` does not run (an external one not given).
+fn unrun_subject(expect: &ExpectSpec, opts: &ExperimentOptions) -> Option<String> {
+    expect
+        .subjects
+        .iter()
+        .map(|e| &e.subject)
+        .find(|name| {
+            !crate::spec::evaluation::KNOWN_SUBJECTS.contains(&name.as_str())
+                && !opts.external.iter().any(|x| &x.name == *name)
+        })
+        .cloned()
+}
+
 /// Loads and plans every scenario of `paths`.
 fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
     paths
@@ -63,6 +77,14 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
                     "{file}: no [expect] block, so `check` would test nothing; add \
                      [[expect.subjects]] bounds, or pass --allow-no-expect to skip it"
                 )),
+                (Ok(scn), Some(o)) => match unrun_subject(&scn.expect, o) {
+                    Some(name) => Err(format!(
+                        "{file}: [expect] names subject `{name}`, which is neither built in \
+                     ({}) nor given with --recognizer {name}=exec:COMMAND",
+                        crate::spec::evaluation::KNOWN_SUBJECTS.join(", ")
+                    )),
+                    None => Ok(scn),
+                },
                 (s, _) => s,
             };
             Planned {
@@ -86,6 +108,7 @@ fn options_for(scn: &Scenario, opts: &StressOptions) -> Option<ExperimentOptions
     Some(ExperimentOptions {
         levels: scn.expect.word_levels(),
         icp: scn.expect.names("icp"),
+        external: opts.experiment.external.clone(),
         ..opts.experiment.clone()
     })
 }

@@ -91,7 +91,8 @@ pub const KNOWN_SUBJECTS: &[&str] = &["words-1", "words-2", "words-3", "icp"];
 #[serde(deny_unknown_fields)]
 pub struct SubjectExpectation {
     /// The subject bounded: `words-1`, `words-2`, `words-3` (the paper's recognizer at that
-    /// many levels) or `icp`.
+    /// many levels), `icp`, or the name of an external recognizer given to `check` with
+    /// `--recognizer NAME=exec:COMMAND`.
     pub subject: String,
     /// Minimum pair precision in [0, 1].
     #[serde(default)]
@@ -282,19 +283,32 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
                     name.to_string()
                 }
                 DeValue::String(name) => {
-                    let hint =
-                        match crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().copied()) {
+                    // Any other name is an external subject's (`--recognizer NAME=…`), unless
+                    // it looks like a built-in one mistyped.
+                    let near = crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().copied());
+                    let valid = |c: char| c.is_ascii_alphanumeric() || c == '-' || c == '_';
+                    if near.is_some()
+                        || name.starts_with("words-")
+                        || name.is_empty()
+                        || !name.chars().all(valid)
+                    {
+                        let hint = match near {
                             Some(k) => format!("did you mean `{k}`? "),
                             None => String::new(),
                         };
-                    d.at(
-                        v.span().start,
-                        format!(
-                            "unknown subject `{name}` in {ctx}; {hint}the subjects are {}",
-                            KNOWN_SUBJECTS.join(", ")
-                        ),
-                    );
-                    String::new()
+                        d.at(
+                            v.span().start,
+                            format!(
+                                "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
+                                 are {} (an external recognizer's name is made of letters, \
+                                 digits, `-` and `_`)",
+                                KNOWN_SUBJECTS.join(", ")
+                            ),
+                        );
+                        String::new()
+                    } else {
+                        name.to_string()
+                    }
                 }
                 _ => {
                     d.at(

@@ -12,7 +12,7 @@ const LAYERS: &[&[&str]] = &[
     &["experiment", "authoring"],
     &["report"],
     &["eval"],
-    &["baseline", "sim"],
+    &["baseline", "sim", "external"],
     &["recognizer"],
     &["world", "io"],
     &["spec"],

@@ -1,25 +1,8 @@
 //! The commands end to end, as CI pipelines and people call them: `run`, `check`, `recognize`.
 
-use super::common::{placewords, root};
-use std::path::{Path, PathBuf};
+use super::common::{placewords, root, smoke_variant};
+use std::path::Path;
 use std::process::Command;
-
-/// The smoke scenario with its world path made absolute and `extra` appended, in `dir`.
-fn smoke_variant(dir: &Path, name: &str, extra: &str) -> PathBuf {
-    let src = std::fs::read_to_string(root().join("scenarios/smoke.toml")).unwrap();
-    let world = root().join("worlds/loop-small.toml");
-    let src = src.replace(
-        "\"../worlds/loop-small.toml\"",
-        &format!("{:?}", world.display().to_string()),
-    );
-    let src = match src.find("[expect]") {
-        Some(i) => src[..i].to_string(),
-        None => src,
-    };
-    let path = dir.join(format!("{name}.toml"));
-    std::fs::write(&path, format!("{src}\n{extra}")).unwrap();
-    path
-}
 
 fn report_of(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

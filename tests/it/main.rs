@@ -8,6 +8,7 @@ mod eval;
 mod io;
 mod longterm;
 mod outputs;
+mod plugin;
 mod recognizer;
 mod sim;
 mod spec;
