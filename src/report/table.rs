@@ -11,7 +11,13 @@ fn rows(report: &Report) -> Vec<(String, &Scores)> {
         .iter()
         .map(|l| {
             let th: Vec<String> = l.thresholds.iter().map(|t| t.to_string()).collect();
-            (format!("{} [{}]", l.levels, th.join(", ")), &l.scores)
+            // `score` knows no thresholds: its row is labelled by `--levels` alone.
+            let label = if th.is_empty() {
+                l.levels.to_string()
+            } else {
+                format!("{} [{}]", l.levels, th.join(", "))
+            };
+            (label, &l.scores)
         })
         .collect();
     if let Some(icp) = &report.icp {
