@@ -16,7 +16,7 @@ use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
 use crate::io::matches_csv::{MatchDirection, MatchRow, MatchesCsvError};
-use crate::recognizer::{Direction, Match, ObservationClock, Observation};
+use crate::recognizer::{Direction, Match, Observation, ObservationClock};
 use crate::sim::RunLog;
 use crate::sim::logs::Manifest;
 use crate::spec::evaluation::EvaluationSpec;
@@ -209,15 +209,10 @@ fn read_run(path: &Path) -> Result<(Vec<Pose2>, Vec<Pose2>), ScoreError> {
 /// its default spacing and interpolation limit): a scan makes as many observations as the
 /// recognizer would make there. For every scan, the observation at or before it in its run
 /// (before a run's first observation, that one); `None` in a run without observations.
-fn thin(
-    odom: &[Pose2],
-    runs: &[(usize, usize, usize)],
-) -> (Vec<Observation>, Vec<Option<usize>>) {
+fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Vec<Option<usize>>) {
     let defaults = crate::recognizer::RecognizerConfig::default();
-    let mut clock = ObservationClock::new(
-        defaults.observation_spacing_m,
-        defaults.max_interpolation_m,
-    );
+    let mut clock =
+        ObservationClock::new(defaults.observation_spacing_m, defaults.max_interpolation_m);
     let mut obs: Vec<Observation> = Vec::new();
     let mut of_scan = vec![None; odom.len()];
     for (run_pos, &(_, start, n)) in runs.iter().enumerate() {

@@ -161,10 +161,7 @@ impl DensityFrontEnd {
         );
         let kernel = DensityKernel::new(config.kernel_radius_cells(), config.ray_step_deg);
         Ok(DensityFrontEnd {
-            clock: ObservationClock::new(
-                config.observation_spacing_m,
-                config.max_interpolation_m,
-            ),
+            clock: ObservationClock::new(config.observation_spacing_m, config.max_interpolation_m),
             kernel_cells: config.kernel_radius_cells(),
             integrate_every_scan: config.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),

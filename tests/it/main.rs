@@ -11,4 +11,5 @@ mod outputs;
 mod recognizer;
 mod sim;
 mod spec;
+mod tour;
 mod world;
