@@ -9,6 +9,7 @@ mod io;
 mod longterm;
 mod outputs;
 mod recognizer;
+mod settings;
 mod sim;
 mod spec;
 mod tour;
