@@ -52,7 +52,8 @@ pub struct RecognizeArgs {
     /// A pair is correct when its true positions are within this distance, metres.
     #[arg(long, default_value_t = 1.0, value_name = "M")]
     pub tp_radius_m: f64,
-    /// Minimum odometric travel between revisiting observations (evaluation), metres.
+    /// Minimum true travel (from the corrected poses) between revisiting observations
+    /// (evaluation), metres.
     #[arg(long, default_value_t = 20.0, value_name = "M")]
     pub min_gap_m: f64,
     /// Write the JSON report here.

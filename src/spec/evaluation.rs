@@ -12,7 +12,8 @@ use toml::de::{DeTable, DeValue};
 pub struct EvaluationSpec {
     /// A pair is correct when its two true positions are within this distance, metres. Default 1.0.
     pub tp_radius_m: f64,
-    /// Observations closer than this in odometric travel are never a revisit, metres. Default 20.
+    /// Observations closer than this in true travel (the harness's, not the odometry) are never
+    /// a revisit, metres. Default 20.
     pub min_gap_m: f64,
     /// A revisit must face the same way within this angle, degrees. Default 45.
     pub heading_tolerance_deg: f64,
