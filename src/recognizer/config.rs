@@ -1,5 +1,5 @@
 //! The recognizer's settings: one struct, readable from a scenario's `[recognizer]` table.
-//! Every field has a default (DESIGN.md §5) and a unit.
+//! Every field has a default (docs/design.md, Recognizer choices) and a unit.
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

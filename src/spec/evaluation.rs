@@ -6,7 +6,7 @@ use crate::spec::read::{Val, get, integer, number, table, table_array, unknown_k
 use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
 
-/// How matches are scored against ground truth (DESIGN.md §6).
+/// How matches are scored against ground truth (docs/design.md, Evaluation).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EvaluationSpec {
