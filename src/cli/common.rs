@@ -31,6 +31,10 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
 /// Refuses an output file whose extension says another format than the one written
 /// (`world render -o out.png` would be SVG in a `.png`).
 pub fn check_extension(path: &Path, ext: &str) -> anyhow::Result<()> {
+    // A device or pipe (`-o /dev/null`) has no format to contradict.
+    if path.exists() && !path.is_file() && !path.is_dir() {
+        return Ok(());
+    }
     match path.extension().and_then(|e| e.to_str()) {
         Some(e) if e.eq_ignore_ascii_case(ext) => Ok(()),
         _ => anyhow::bail!(
