@@ -11,7 +11,15 @@ fn main() -> ExitCode {
     match cli::dispatch(args) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            // The causes after the message, each once: `{e:#}` repeats one that the message
+            // already quotes ("cannot read: No such file or directory: No such file …").
+            let mut text = e.to_string();
+            for cause in e.chain().skip(1).map(|c| c.to_string()) {
+                if !text.contains(&cause) {
+                    text = format!("{text}: {cause}");
+                }
+            }
+            eprintln!("error: {text}");
             ExitCode::from(placewords::eval::gate::EXIT_ERROR)
         }
     }

@@ -23,6 +23,10 @@ pub struct CheckArgs {
     pub seeds: SeedsArg,
     #[command(flatten)]
     pub external: super::common::ExternalArg,
+    /// Replace every run's lap count (for a quick look: the bounds were set at the scenario's
+    /// own laps, so fewer laps may miss them, exit 1).
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
+    pub laps: Option<usize>,
     /// Run only part K of N of the (scenario × seed) work and write it with --report, for
     /// `placewords merge`. `auto`: K from JOB_COMPLETION_INDEX (Kubernetes Indexed Job, 0-based),
     /// N from --shard-count or PLACEWORDS_SHARD_COUNT.
@@ -71,6 +75,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         experiment: ExperimentOptions {
             progress: super::progress::bar(args.quiet),
             external: args.external.specs(),
+            laps: args.laps,
             ..ExperimentOptions::default()
         },
     };

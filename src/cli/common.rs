@@ -50,10 +50,27 @@ fn parse_external(text: &str) -> Result<placewords::external::ExternalSpec, Stri
     placewords::external::ExternalSpec::parse(text)
 }
 
-/// Writes a file atomically, naming it in the error.
+/// Writes a file the user named, atomically, naming it in the error; its folder must exist.
 pub fn write_file(path: &Path, bytes: &[u8]) -> anyhow::Result<()> {
-    placewords::io::atomic::write_atomic(path, bytes)
+    placewords::io::atomic::check_parent(path)
+        .and_then(|()| placewords::io::atomic::write_atomic(path, bytes))
         .with_context(|| format!("{}: cannot write", path.display()))
+}
+
+/// Refuses an output file whose extension says another format than the one written
+/// (`world render -o out.png` would be SVG in a `.png`).
+pub fn check_extension(path: &Path, ext: &str) -> anyhow::Result<()> {
+    // A device or pipe (`-o /dev/null`) has no format to contradict.
+    if path.exists() && !path.is_file() && !path.is_dir() {
+        return Ok(());
+    }
+    match path.extension().and_then(|e| e.to_str()) {
+        Some(e) if e.eq_ignore_ascii_case(ext) => Ok(()),
+        _ => anyhow::bail!(
+            "{}: this command writes .{ext}; give a file name ending in .{ext}",
+            path.display()
+        ),
+    }
 }
 
 /// Checks, before any work starts, that each output file can be written (exit 2 naming it).

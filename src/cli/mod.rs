@@ -40,27 +40,47 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Check, render, describe and import world layouts.
+    /// Check, render, describe, import and generate world layouts; density and ambiguity maps.
     #[command(subcommand)]
     World(world::WorldCommand),
     /// Check scenario files without running them.
     #[command(subcommand)]
     Scenario(scenario::ScenarioCommand),
     /// Drive the simulated robot through a scenario and write CARMEN logs.
+    #[command(after_help = "Example:\n  placewords simulate scenarios/smoke.toml -o logs/ --svg")]
     Simulate(simulate::SimulateArgs),
     /// Simulate a scenario, recognize places at 1, 2 and 3 levels, evaluate and report.
+    #[command(
+        after_help = "Example:\n  placewords run scenarios/A.toml --report a.json --svg pics/\n  placewords run scenarios/B.toml --laps 2 --levels 3   # a quick look"
+    )]
     Run(run::RunArgs),
     /// Run scenarios and compare them with their [expect] blocks (the CI gate).
+    #[command(
+        after_help = "Example:\n  placewords check scenarios/*.toml --junit junit.xml\n  placewords check scenarios/smoke.toml --seed 1   # one seed"
+    )]
     Check(check::CheckArgs),
     /// Join the parts of a sharded `check` into one report, table and JUnit file.
+    #[command(
+        after_help = "Example:\n  placewords check scenarios/B.toml --shard 1/2 --report part-1.json\n  placewords check scenarios/B.toml --shard 2/2 --report part-2.json\n  placewords merge part-1.json part-2.json -o gate/"
+    )]
     Merge(merge::MergeArgs),
     /// The paper's Table I for one or more scenarios, as Markdown and JSON.
+    #[command(
+        after_help = "Example:\n  placewords table scenarios/A.toml scenarios/B.toml scenarios/C.toml -o table/\n  placewords table scenarios/A.toml -o table/ --laps 1 --no-icp   # a quick look"
+    )]
     Table(table::TableArgs),
     /// The paper's Fig. 8: precision/recall over the n-gram thresholds.
+    #[command(after_help = "Example:\n  placewords sweep scenarios/B.toml -o sweep/ --laps 2")]
     Sweep(sweep::SweepArgs),
     /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
+    #[command(
+        after_help = "Example:\n  placewords recognize ../shared/data/carmen/intel-corrected.log.gz --report r.json\n  placewords recognize LOG --scan-step 2 --config docs/recognizer.toml --seed 3"
+    )]
     Recognize(recognize::RecognizeArgs),
     /// Score any recognizer's matches file against the logs `simulate` wrote.
+    #[command(
+        after_help = "Example:\n  placewords simulate scenarios/smoke.toml -o logs/\n  placewords run scenarios/smoke.toml --export-matches m.csv\n  placewords score logs/ --matches m.csv --report s.json"
+    )]
     Score(score::ScoreArgs),
 }
 

@@ -2,7 +2,7 @@
 //! definitions and report schema as `run`.
 
 use super::common::{LevelsArg, print_and_write};
-use anyhow::{Context, bail};
+use anyhow::bail;
 use clap::{Args, ValueEnum};
 use placewords::experiment::{self, ExperimentOptions, picture};
 use placewords::io::real_log::TruthSource;
@@ -37,7 +37,8 @@ pub struct RecognizeArgs {
     /// Use every K-th scan only (K = 2 halves the scan rate), to test a recognizer on sparse logs.
     #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     pub scan_step: u64,
-    /// Recognizer settings: a TOML file whose `[recognizer]` table is read as in a scenario.
+    /// Recognizer settings: a TOML file holding a `[recognizer]` table, read as in a scenario
+    /// (docs/scenario-format.md; `levels` is chosen with --levels).
     #[arg(long, value_name = "FILE.toml")]
     pub config: Option<PathBuf>,
     #[command(flatten)]
@@ -53,7 +54,8 @@ pub struct RecognizeArgs {
     /// A pair is correct when its true positions are within this distance, metres.
     #[arg(long, default_value_t = 1.0, value_name = "M")]
     pub tp_radius_m: f64,
-    /// Minimum odometric travel between revisiting observations (evaluation), metres.
+    /// Minimum true travel (from the corrected poses) between revisiting observations
+    /// (evaluation), metres.
     #[arg(long, default_value_t = 20.0, value_name = "M")]
     pub min_gap_m: f64,
     /// Write the JSON report here.
@@ -85,12 +87,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         TruthArg::Truepos => TruthSource::TruePos,
     };
     let base = match &args.config {
-        Some(path) => {
-            let src = std::fs::read_to_string(path)
-                .with_context(|| format!("{}: cannot read", path.display()))?;
-            RecognizerConfig::from_toml_str(&src)
-                .map_err(|e| anyhow::anyhow!("{}:{e}", path.display()))?
-        }
+        Some(path) => experiment::load_recognizer_config(path)?,
         None => RecognizerConfig::default(),
     };
     let name = args

@@ -9,6 +9,7 @@ use std::process::ExitCode;
 #[derive(Debug, Subcommand)]
 pub enum ScenarioCommand {
     /// Check scenario files; every problem is printed as file:line:col on stderr (exit 2).
+    #[command(after_help = "Example:\n  placewords scenario check scenarios/*.toml")]
     Check(CheckArgs),
 }
 

@@ -20,7 +20,8 @@ pub struct ScoreArgs {
     /// Write the JSON report here (the schema of `run`'s).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
-    /// Label the result as this level configuration in the table and report.
+    /// Label the result as this level configuration in the table and report (the row reads `N`:
+    /// the tool's thresholds are unknown).
     #[arg(long, value_name = "N", default_value_t = 1)]
     pub levels: usize,
 }

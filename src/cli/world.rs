@@ -11,19 +11,49 @@ use std::process::ExitCode;
 #[derive(Debug, Subcommand)]
 pub enum WorldCommand {
     /// Validate world files; every problem is printed as file:line:col on stderr (exit 2).
+    #[command(after_help = "Example:\n  placewords world check worlds/*.toml")]
     Check(CheckArgs),
     /// Draw a world as SVG: walls, doors, routes, home pose, scale bar, legend.
+    #[command(
+        after_help = "Example:\n  placewords world render worlds/institute-floor.toml -o floor.svg --open s-04,n-01 --waypoints"
+    )]
     Render(RenderArgs),
     /// Print a world's size, wall length, doors and routes (lengths, corners).
+    #[command(after_help = "Example:\n  placewords world info worlds/institute-floor.toml --json")]
     Info(InfoArgs),
     /// Import a MobileSim line map (.map) as a world file, with a generated lap route.
+    #[command(
+        after_help = "Example:\n  placewords world import ../shared/data/mobilesim/office.map -o office.toml"
+    )]
     Import(super::import::ImportArgs),
     /// Colour every free cell by the density class the recognizer gives it (paper Fig. 2a).
+    #[command(
+        after_help = "Example:\n  placewords world density worlds/institute-floor.toml -o d.svg"
+    )]
     Density(DensityArgs),
     /// Drive a route once without noise and mark the stretches the recognizer will confuse.
+    #[command(
+        after_help = "Example:\n  placewords world ambiguity worlds/institute-floor.toml --route lap -o a.svg --json"
+    )]
     Ambiguity(AmbiguityArgs),
     /// Write a random valid floor (corridor loop, offices with doors, niches, a lap route).
+    #[command(
+        after_help = "Example:\n  placewords world generate --seed 1 -o floor.toml\n  placewords world generate --seed 2 --size-m 60,40 --doors 20 -o big.toml"
+    )]
     Generate(GenerateArgs),
+}
+
+/// `--size-m W,H`: two numbers, separated by a comma or spaces.
+fn size_m(text: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|p| !p.is_empty())
+        .collect();
+    let numbers: Vec<f64> = parts.iter().filter_map(|p| p.parse().ok()).collect();
+    match numbers[..] {
+        [w, h] if parts.len() == 2 => Ok((w, h)),
+        _ => Err("two numbers, width and height in metres: 50,40 or \"50 40\"".to_string()),
+    }
 }
 
 #[derive(Debug, Args)]
@@ -31,9 +61,9 @@ pub struct GenerateArgs {
     /// Seed: the same seed and options give the same file.
     #[arg(long)]
     pub seed: u64,
-    /// Floor size in metres, x and y (each 24-2000).
-    #[arg(long = "size-m", value_name = "W,H", value_delimiter = ',', default_values_t = [40.0, 30.0])]
-    pub size_m: Vec<f64>,
+    /// Floor size in metres, x and y (each 24-2000): `50,40` or `"50 40"`.
+    #[arg(long = "size-m", value_name = "W,H", default_value = "40,30", value_parser = size_m)]
+    pub size_m: (f64, f64),
     /// Number of offices, each with one door.
     #[arg(long, default_value_t = 12)]
     pub doors: usize,
@@ -41,7 +71,7 @@ pub struct GenerateArgs {
     #[arg(long, default_value_t = 4)]
     pub corridors: usize,
     /// Output world file (TOML).
-    #[arg(short = 'o', long = "output", value_name = "WORLD.toml")]
+    #[arg(short = 'o', long = "out", alias = "output", value_name = "WORLD.toml")]
     pub output: PathBuf,
 }
 
@@ -50,7 +80,7 @@ pub struct DensityArgs {
     /// World file (TOML).
     pub file: PathBuf,
     /// Output SVG file.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    #[arg(short = 'o', long = "out", alias = "output", value_name = "OUT.svg")]
     pub output: PathBuf,
     /// Doors open, by id (comma-separated or repeated); the others are closed.
     #[arg(long, value_name = "ID,...", value_delimiter = ',')]
@@ -65,7 +95,7 @@ pub struct AmbiguityArgs {
     #[arg(long, default_value = "lap")]
     pub route: String,
     /// Output SVG file.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    #[arg(short = 'o', long = "out", alias = "output", value_name = "OUT.svg")]
     pub output: PathBuf,
     /// Doors open during the drive, by id (comma-separated or repeated).
     #[arg(long, value_name = "ID,...", value_delimiter = ',')]
@@ -92,7 +122,7 @@ pub struct RenderArgs {
     /// World file (TOML).
     pub file: PathBuf,
     /// Output SVG file.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    #[arg(short = 'o', long = "out", alias = "output", value_name = "OUT.svg")]
     pub output: PathBuf,
     /// Doors to draw open, by id (comma-separated or repeated).
     #[arg(long, value_name = "ID,...", value_delimiter = ',')]
@@ -106,7 +136,7 @@ pub struct RenderArgs {
     /// Draw a coordinate grid with labelled metres.
     #[arg(long)]
     pub grid: bool,
-    /// Number the route waypoints (from 1, as messages count them).
+    /// Number the route waypoints (from 0, as messages count them).
     #[arg(long)]
     pub waypoints: bool,
 }
@@ -201,6 +231,7 @@ fn door_states(world: &World, open: &[String], all_open: bool) -> anyhow::Result
 /// Renders a world; an invalid one is drawn as far as it could be read with its problems
 /// marked (numbered in the order they are printed), and exits 2.
 fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_extension(&args.output, "svg")?;
     let src = std::fs::read_to_string(&args.file)
         .with_context(|| format!("{}: cannot read", args.file.display()))?;
     let path = args.file.display().to_string();
@@ -247,6 +278,7 @@ fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_extension(&args.output, "svg")?;
     let Some(world) = load(&args.file) else {
         return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
@@ -258,6 +290,7 @@ fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
 }
 
 fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
+    super::common::check_extension(&args.output, "svg")?;
     let Some(world) = load(&args.file) else {
         return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
@@ -288,12 +321,10 @@ fn print_quietly(text: &str) -> anyhow::Result<()> {
 
 fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
     use placewords::authoring::generate::{GenerateOptions, generate_toml};
-    let [w, h] = args.size_m[..] else {
-        bail!("--size-m takes two numbers, W,H (e.g. --size-m 40,30)");
-    };
+    super::common::check_extension(&args.output, "toml")?;
     let opts = GenerateOptions {
         seed: args.seed,
-        size_m: (w, h),
+        size_m: args.size_m,
         doors: args.doors,
         corridors: args.corridors,
     };

@@ -1,4 +1,4 @@
-//! Ground truth scoring of matches (DESIGN.md §6).
+//! Ground truth scoring of matches (docs/design.md, Evaluation).
 //!
 //! Definitions, all at one radius `r` (`tp_radius_m`, or a sensitivity radius):
 //!
@@ -140,7 +140,7 @@ pub struct DirectionMetrics {
     pub opposite: Metrics,
 }
 
-/// Scores `rec` as DESIGN.md §6 says: at `tp_radius_m`, at every sensitivity radius, per door
+/// Scores `rec` as docs/design.md, Evaluation says: at `tp_radius_m`, at every sensitivity radius, per door
 /// configuration and per direction. A recognition scored while it was recognized
 /// ([`super::Recording::streaming`]) carries its evaluation; any other is scored now by feeding
 /// its matches, in order, to a [`Tally`] (the one implementation of the rules).

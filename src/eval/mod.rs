@@ -3,7 +3,7 @@
 //! The flow is: [`recognize_runs`] feeds the frames of simulated (or logged) runs to a
 //! [`PlaceRecognizer`] in order, keeping the ground truth of every frame to itself
 //! ([`GroundTruth`]); [`metrics::evaluate`] turns the recognizer's matches into observation pairs
-//! and scores them (DESIGN.md §6) through a [`tally::Tally`], which counts each match as it
+//! and scores them (docs/design.md, Evaluation) through a [`tally::Tally`], which counts each match as it
 //! arrives: a [`Recording::streaming`] feeds it while the recognizer runs and keeps no match,
 //! forgetting the pairs behind the recognizer's query horizon, so a thousand-lap run is scored
 //! in memory that grows with its observations, not its pairs; [`sweep`] repeats this over a

@@ -1,5 +1,5 @@
 //! Scoring as matches arrive: the one implementation of the counting rules of
-//! [`super::metrics`] (DESIGN.md §6), fed one match at a time.
+//! [`super::metrics`] (docs/design.md, Evaluation), fed one match at a time.
 //!
 //! A [`Tally`] learns the truth and the observations as they are made ([`Tally::sync`]), counts
 //! each match's pairs the moment it arrives ([`Tally::add`]) and keeps of them only what the

@@ -399,14 +399,53 @@ fn robot_cross_checks(s: &Settings, r: &RobotConfig, d: &mut Diags) {
     }
 }
 
+/// `RecognizerConfig` fields the harness sets itself, never a file: `levels` (each level
+/// configuration is run; `--levels` and `[[expect.subjects]]` (`subject = "words-N"`) choose).
+const HARNESS_KEYS: &[&str] = &["levels"];
+
+/// Recognizer settings from a file holding a `[recognizer]` table alone (`recognize --config`),
+/// read and checked as a scenario's `[recognizer]`: every problem at its `file:line:col`, unknown
+/// keys with "did you mean".
+pub fn load_recognizer_config(path: &Path) -> Result<RecognizerConfig, SpecError> {
+    let src = read_text(path)?;
+    parse_recognizer_config(&src, path)
+}
+
+/// [`load_recognizer_config`] on text; `path` names the file in messages.
+pub fn parse_recognizer_config(src: &str, path: &Path) -> Result<RecognizerConfig, SpecError> {
+    let file = path.display().to_string();
+    let mut d = Diags::new(src, &file);
+    let cfg = crate::spec::scenario::read_recognizer_file(src, &mut d)
+        .map(|entries| recognizer(&entries, &mut d));
+    match cfg {
+        Some(cfg) if !d.has_errors() => Ok(cfg),
+        _ => Err(SpecError::Invalid(d.into_sorted())),
+    }
+}
+
 /// The `[recognizer]` keys over [`RecognizerConfig::default`]; each problem at its key.
 fn recognizer(entries: &[(S<String>, toml::Value)], d: &mut Diags) -> RecognizerConfig {
     let defaults = toml::Table::try_from(RecognizerConfig::default()).unwrap_or_default();
-    let known: Vec<&str> = defaults.keys().map(String::as_str).collect();
+    let known: Vec<&str> = defaults
+        .keys()
+        .map(String::as_str)
+        .filter(|k| !HARNESS_KEYS.contains(k))
+        .collect();
     let mut table = defaults.clone();
     let mut ok = true;
     for (key, v) in entries {
         let k = key.get_ref();
+        if k == "levels" {
+            d.at(
+                key.span().start,
+                "`levels` in [recognizer] is not read: `run` and `recognize` search 1, 2 and 3 \
+                 levels each time (the table's rows); run one with `--levels N` (1-4), and gate \
+                 one in `check` with [[expect.subjects]] `subject = \"words-N\"`"
+                    .to_string(),
+            );
+            ok = false;
+            continue;
+        }
         if !known.contains(&k.as_str()) {
             let h = hint(k, known.iter().copied(), "keys here");
             d.at(

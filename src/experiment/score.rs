@@ -5,11 +5,11 @@
 //! The harness holds the truth: the `TRUEPOS` of every laser line and the laps (door
 //! configurations) from the manifest. Placewords' recognizer scores *observations*, one per
 //! 0.10 m of odometric travel; a tool's matches name *scans*. To score both on the same footing,
-//! the scans are thinned the same way: a run's first scan and every scan after at least
-//! [`OBSERVATION_SPACING_M`] of odometric travel since the last one kept are the observations,
-//! and a matched scan counts as the observation at or before it in its run. The remaining
-//! differences with `run` (the recognizer's observations are interpolated between scans, so
-//! they fall on slightly different scans) are small: see the test beside `score`.
+//! the scans are thinned by the recognizer's own rule ([`ObservationClock`]: an observation
+//! each time the odometric travel passes a multiple of 0.10 m, counted from the run's start), so
+//! the observations fall on the scans the recognizer's fall on, and a matched scan counts as the
+//! observation at or before it in its run. `score` on `run`'s exported matches therefore gives
+//! `run`'s figures (the test beside `score_rows`).
 
 use crate::eval::scores::Report;
 use crate::eval::{GroundTruth, LapInfo, Recognition};
@@ -17,14 +17,12 @@ use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
 use crate::io::matches_csv::{MatchRow, MatchesCsvError};
 use crate::place::{Match, Observation};
+use crate::recognizer::ObservationClock;
 use crate::sim::RunLog;
 use crate::sim::logs::Manifest;
 use crate::spec::evaluation::EvaluationSpec;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
-
-/// Odometric travel between two observations, metres (as the recognizer's default).
-pub const OBSERVATION_SPACING_M: f64 = 0.10;
 
 /// Why a log folder or matches file could not be scored.
 #[derive(Debug, thiserror::Error)]
@@ -56,12 +54,13 @@ pub struct LoggedRuns {
     pub laps: usize,
     /// Truth of every laser line, runs in manifest order.
     pub truth: GroundTruth,
-    /// Observations (thinned scans, see the module docs).
+    /// Observations (scans thinned as the recognizer thins them, see the module docs).
     pub observations: Vec<Observation>,
     /// Per run (manifest order): run number, index of its first scan in `truth.frames`, scans.
     pub runs: Vec<(usize, usize, usize)>,
-    /// Global scan index → observation index (the observation at or before it).
-    obs_of_scan: Vec<usize>,
+    /// Global scan index → observation index (the observation at or before it; `None` in a run
+    /// too short for one).
+    obs_of_scan: Vec<Option<usize>>,
 }
 
 /// `(run number, frames)` of simulated runs, to map observations back to scans.
@@ -191,37 +190,42 @@ fn read_run(path: &Path) -> Result<(Vec<Pose2>, Vec<Pose2>), ScoreError> {
     Ok((odom, truth))
 }
 
-/// Observations from scans: each run's first scan, then one each `OBSERVATION_SPACING_M` of
-/// odometric travel; and for every scan, the observation at or before it.
-fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Vec<usize>) {
+/// Observations from scans, placed by the recognizer's own rule ([`ObservationClock`], with
+/// its default spacing and interpolation limit): a scan makes as many observations as the
+/// recognizer would make there. For every scan, the observation at or before it in its run
+/// (before a run's first observation, that one); `None` in a run without observations.
+fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Vec<Option<usize>>) {
+    let defaults = crate::recognizer::RecognizerConfig::default();
+    let mut clock =
+        ObservationClock::new(defaults.observation_spacing_m, defaults.max_interpolation_m);
     let mut obs: Vec<Observation> = Vec::new();
-    let mut of_scan = vec![0; odom.len()];
-    let mut travel = 0.0;
+    let mut of_scan = vec![None; odom.len()];
     for (run_pos, &(_, start, n)) in runs.iter().enumerate() {
-        let mut since = f64::INFINITY;
+        clock.start_run();
+        let first = obs.len();
         for i in start..start + n {
-            if i > start {
-                let d = odom[i - 1].distance(&odom[i]);
-                travel += d;
-                since += d;
-            }
-            if since >= OBSERVATION_SPACING_M {
-                // Keep the remainder, so observations average one per spacing as the
-                // recognizer's (interpolated) ones do.
-                since = if since.is_finite() {
-                    since - OBSERVATION_SPACING_M
-                } else {
-                    0.0
-                };
+            let due = clock.step(OdomPose(odom[i]));
+            for _ in 0..due.observations() {
                 obs.push(Observation::new(
                     obs.len(),
                     run_pos,
                     i,
                     OdomPose(odom[i]),
-                    travel,
+                    clock.travel_m(),
                 ));
             }
-            of_scan[i] = obs.len() - 1;
+            if obs.len() > first {
+                of_scan[i] = Some(obs.len() - 1);
+            }
+        }
+        // Scans before the run's first observation count as that one.
+        if obs.len() > first {
+            for slot in &mut of_scan[start..start + n] {
+                if slot.is_some() {
+                    break;
+                }
+                *slot = Some(first);
+            }
         }
     }
     (obs, of_scan)
@@ -257,8 +261,18 @@ impl LoggedRuns {
                         what,
                     })
             };
-            let q = self.obs_of_scan[at(r.query_run, r.query_scan)?];
-            let p = self.obs_of_scan[at(r.matched_run, r.matched_scan)?];
+            let observed = |run: usize, scan: usize| {
+                let i = at(run, scan)?;
+                self.obs_of_scan[i].ok_or_else(|| ScoreError::UnknownScan {
+                    path: path.to_string(),
+                    row: k + 1,
+                    run,
+                    scan,
+                    what: format!("run {run} is too short to make an observation"),
+                })
+            };
+            let q = observed(r.query_run, r.query_scan)?;
+            let p = observed(r.matched_run, r.matched_scan)?;
             let (qo, po) = (&self.observations[q], &self.observations[p]);
             let mut m = Match::from_pairs([(qo.id, po.id)], r.score.unwrap_or(1.0));
             m.direction = r.direction;
@@ -388,8 +402,8 @@ mod tests {
 
     /// A matches file written from the truth scores 1; the same file with every matched scan
     /// moved 5 m along the path (125 scans at 0.4 m/s and 10 Hz) scores 0. And `score` on
-    /// `run`'s own exported matches gives `run`'s figures: precision within 0.01, recall within
-    /// 0.02 (scans are thinned to observations, which fall on nearly the same scans).
+    /// `run`'s own exported matches gives `run`'s figures: scans are thinned to observations by the recognizer's own rule, so
+    /// they fall on the same scans and count the same revisits.
     #[test]
     fn score_reads_logs_and_matches_files_like_run() {
         let (dir, runs, scn) = smoke_logs();
@@ -417,8 +431,10 @@ mod tests {
         let scored = score_rows(&logs, &rows, "run.csv", &spec, 3).unwrap();
         let (a, b) = (&exp.report.subjects[0].scores, &scored.subjects[0].scores);
         assert!(a.pairs > 100, "smoke should match: {a:?}");
-        assert!((a.precision - b.precision).abs() <= 0.01, "{a:?} vs {b:?}");
-        assert!((a.recall - b.recall).abs() <= 0.02, "{a:?} vs {b:?}");
+        assert_eq!(exp.report.revisits, scored.revisits);
+        assert_eq!(a.revisits, b.revisits, "{a:?} vs {b:?}");
+        assert_eq!((a.pairs, a.correct_pairs), (b.pairs, b.correct_pairs));
+        assert_eq!((a.precision, a.recall), (b.precision, b.recall));
     }
 
     /// A matches file's `direction` column is scored by the evaluation's heading rule: the

@@ -61,6 +61,22 @@ fn create_parent(path: &Path) -> std::io::Result<()> {
     }
 }
 
+/// Refuses a file whose folder does not exist: a misspelt folder is a mistake to report, not a
+/// tree to create (output *folders*, `--svg DIR` and `-o DIR`, are created).
+pub fn check_parent(path: &Path) -> std::io::Result<()> {
+    match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(parent) if !parent.is_dir() => Err(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            format!(
+                "folder {} does not exist; create it first (output files are written into \
+                 existing folders)",
+                parent.display()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Writes `bytes` to `path` atomically, creating parent folders.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     create_parent(path)?;
@@ -190,13 +206,14 @@ impl Drop for ScratchFile {
     }
 }
 
-/// Checks, before any work, that a file can be written at `path`: creates its parent folders
-/// and a temporary file beside it (removed again). An existing folder at `path` is an error.
+/// Checks, before any work, that a file can be written at `path`: its folder exists
+/// ([`check_parent`]) and takes a temporary file (removed again). An existing folder at `path`
+/// is an error.
 pub fn check_writable(path: &Path) -> std::io::Result<()> {
     if path.is_dir() {
         return Err(std::io::Error::other("it is a folder; give a file name"));
     }
-    create_parent(path)?;
+    check_parent(path)?;
     let tmp = temp_path(path);
     std::fs::File::create(&tmp)?;
     std::fs::remove_file(&tmp)

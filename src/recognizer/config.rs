@@ -1,5 +1,5 @@
 //! The recognizer's settings: one struct, readable from a scenario's `[recognizer]` table.
-//! Every field has a default (DESIGN.md §5) and a unit.
+//! Every field has a default (docs/design.md, Recognizer choices) and a unit.
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -49,7 +49,8 @@ pub struct RecognizerConfig {
     /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
     pub angle_tolerance_deg: f64,
     /// Number of level configurations searched: 1 = level 0 only, 2 = levels 0-1, 3 = levels 0-2,
-    /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3.
+    /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3. The harness sets it
+    /// per level configuration (`--levels`); a scenario or `--config` file may not.
     pub levels: usize,
     /// How upper-level ("corrected") words are built: `paper` (Algorithm 2 as written: a level-l
     /// word fuses l + 2 level-0 words whose first and last share a class) or `boundaries` (a
@@ -501,39 +502,6 @@ impl RecognizerConfig {
         } else {
             Err(RecognizerError::InvalidConfig(problems))
         }
-    }
-
-    /// Settings from a TOML document whose `[recognizer]` table holds them (a scenario file, or a
-    /// file with only that table); other tables are ignored, missing keys take their defaults.
-    /// Errors read `line:col: what; what to try`.
-    pub fn from_toml_str(src: &str) -> Result<Self, String> {
-        #[derive(Deserialize)]
-        struct File {
-            #[serde(default)]
-            recognizer: Option<toml::Spanned<toml::Table>>,
-        }
-        let at = |span: Option<std::ops::Range<usize>>| {
-            let offset = span.map_or(0, |r| r.start).min(src.len());
-            let line = src[..offset].matches('\n').count() + 1;
-            let col = offset - src[..offset].rfind('\n').map_or(0, |i| i + 1) + 1;
-            format!("{line}:{col}")
-        };
-        let file: File =
-            toml::from_str(src).map_err(|e| format!("{}: {}", at(e.span()), e.message()))?;
-        let Some(table) = file.recognizer else {
-            return Err("1:1: no [recognizer] table; put the settings under [recognizer]".into());
-        };
-        let span = table.span();
-        let cfg: RecognizerConfig =
-            table
-                .into_inner()
-                .try_into()
-                .map_err(|e: toml::de::Error| {
-                    format!("{}: [recognizer]: {}", at(Some(span.clone())), e.message())
-                })?;
-        cfg.validate()
-            .map_err(|e| format!("{}: {e}", at(Some(span))))?;
-        Ok(cfg)
     }
 
     /// Kernel radius in grid cells (rounded).

@@ -28,20 +28,121 @@ use super::types::{DensityObservation, FrameId, Observation};
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
+/// When observations are due: each time the odometric travel passes the next multiple of the
+/// spacing, counted from the start of each run (a run's first scan is not one). The one rule
+/// for where observations fall: the front end follows it, and so does `score`, which thins a
+/// tool's scans to observations (`experiment::score`).
+#[derive(Clone, Debug)]
+pub struct ObservationClock {
+    spacing_m: f64,
+    max_interpolation_m: f64,
+    last_odom: Option<OdomPose>,
+    travel_m: f64,
+    next_obs_travel_m: f64,
+}
+
+/// What one scan's step made due ([`ObservationClock::step`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Due {
+    /// The previous scan's pose and travel (`None` at a run's first scan).
+    pub previous: Option<(OdomPose, f64)>,
+    /// Spacing multiples the step passed (0: no observation is due).
+    pub passed: usize,
+    /// Travel of the first multiple passed, metres.
+    pub first_travel_m: f64,
+    /// Whether the `passed` observations are made along the step (it is at most
+    /// `max_interpolation_m` long); otherwise one is made at the new pose.
+    pub along_step: bool,
+}
+
+impl Due {
+    /// The number of observations this step makes.
+    pub fn observations(&self) -> usize {
+        if self.along_step {
+            self.passed
+        } else {
+            self.passed.min(1)
+        }
+    }
+}
+
+impl ObservationClock {
+    /// A clock with observations every `spacing_m` of odometric travel, interpolated along steps
+    /// up to `max_interpolation_m`.
+    pub fn new(spacing_m: f64, max_interpolation_m: f64) -> Self {
+        ObservationClock {
+            spacing_m,
+            max_interpolation_m,
+            last_odom: None,
+            travel_m: 0.0,
+            next_obs_travel_m: spacing_m,
+        }
+    }
+
+    /// Moves to the next scan, taken at `odom`.
+    pub fn step(&mut self, odom: OdomPose) -> Due {
+        let previous = self.last_odom.map(|last| (last, self.travel_m));
+        if let Some(last) = self.last_odom {
+            let step = last.0.distance(&odom.0);
+            if step.is_finite() {
+                self.travel_m += step;
+            }
+        }
+        self.last_odom = Some(odom);
+        let first_travel_m = self.next_obs_travel_m;
+        if self.travel_m + 1e-9 < self.next_obs_travel_m {
+            return Due {
+                previous,
+                passed: 0,
+                first_travel_m,
+                along_step: false,
+            };
+        }
+        let passed =
+            ((self.travel_m + 1e-9 - self.next_obs_travel_m) / self.spacing_m).floor() as usize + 1;
+        self.next_obs_travel_m += passed as f64 * self.spacing_m;
+        let along_step = previous.is_some_and(|(_, last_travel)| {
+            passed > 1 && self.travel_m - last_travel <= self.max_interpolation_m + 1e-9
+        });
+        Due {
+            previous,
+            passed,
+            first_travel_m,
+            along_step,
+        }
+    }
+
+    /// Starts a new run: the jump to the new start is not travel. Returns false (and does
+    /// nothing) while the current run has had no scan.
+    pub fn start_run(&mut self) -> bool {
+        if self.last_odom.is_none() {
+            return false;
+        }
+        self.last_odom = None;
+        self.next_obs_travel_m = self.travel_m + self.spacing_m;
+        true
+    }
+
+    /// Odometric travel so far, metres.
+    pub fn travel_m(&self) -> f64 {
+        self.travel_m
+    }
+
+    /// Spacing between observations, metres.
+    pub fn spacing_m(&self) -> f64 {
+        self.spacing_m
+    }
+}
+
 /// Local grid + density: makes observations from odometry and scans.
 #[derive(Clone, Debug)]
 pub struct DensityFrontEnd {
-    spacing_m: f64,
-    /// Longest step observed along its length, metres.
-    max_interpolation_m: f64,
+    clock: ObservationClock,
     kernel_cells: usize,
     integrate_every_scan: bool,
     grid: LocalGrid,
     kernel: DensityKernel,
     deltas: RayDeltas,
-    last_odom: Option<OdomPose>,
-    travel_m: f64,
-    next_obs_travel_m: f64,
     run: usize,
     inputs: usize,
     next_id: usize,
@@ -60,16 +161,12 @@ impl DensityFrontEnd {
         );
         let kernel = DensityKernel::new(config.kernel_radius_cells(), config.ray_step_deg);
         Ok(DensityFrontEnd {
-            spacing_m: config.observation_spacing_m,
-            max_interpolation_m: config.max_interpolation_m,
+            clock: ObservationClock::new(config.observation_spacing_m, config.max_interpolation_m),
             kernel_cells: config.kernel_radius_cells(),
             integrate_every_scan: config.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),
             grid,
             kernel,
-            last_odom: None,
-            travel_m: 0.0,
-            next_obs_travel_m: config.observation_spacing_m,
             run: 0,
             inputs: 0,
             next_id: 0,
@@ -93,34 +190,22 @@ impl DensityFrontEnd {
         scan: &Scan,
     ) -> Vec<DensityObservation> {
         self.inputs += 1;
-        let previous = self.last_odom.map(|last| (last, self.travel_m));
-        if let Some(last) = self.last_odom {
-            let step = last.0.distance(&odom.0);
-            if step.is_finite() {
-                self.travel_m += step;
-            }
-        }
-        self.last_odom = Some(odom);
-        let due = self.travel_m + 1e-9 >= self.next_obs_travel_m;
+        let due = self.clock.step(odom);
         // The authors' code updates the grid once per observation step (0.10 m), not on every
         // scan: the same map at a fraction of the cost (a scan every 2.5 cm adds little).
-        if self.integrate_every_scan || due || previous.is_none() {
+        if self.integrate_every_scan || due.passed > 0 || due.previous.is_none() {
             self.grid.integrate(&odom, scan);
         }
-        if !due {
+        if due.passed == 0 {
             return Vec::new();
         }
-        let passed =
-            ((self.travel_m + 1e-9 - self.next_obs_travel_m) / self.spacing_m).floor() + 1.0;
+        let travel_now = self.clock.travel_m();
         let mut at: Vec<(OdomPose, f64)> = Vec::new();
-        match previous {
-            Some((last, last_travel))
-                if passed > 1.0
-                    && self.travel_m - last_travel <= self.max_interpolation_m + 1e-9 =>
-            {
-                let span = (self.travel_m - last_travel).max(1e-12);
-                for k in 0..passed as usize {
-                    let travel = self.next_obs_travel_m + k as f64 * self.spacing_m;
+        match due.previous {
+            Some((last, last_travel)) if due.along_step => {
+                let span = (travel_now - last_travel).max(1e-12);
+                for k in 0..due.passed {
+                    let travel = due.first_travel_m + k as f64 * self.clock.spacing_m();
                     let f = ((travel - last_travel) / span).clamp(0.0, 1.0);
                     let (a, b) = (last.0, odom.0);
                     let pose = crate::geom::Pose2::new(
@@ -130,15 +215,14 @@ impl DensityFrontEnd {
                             a.theta + crate::geom::wrap_angle(b.theta - a.theta) * f,
                         ),
                     );
-                    at.push((OdomPose(pose), travel.min(self.travel_m)));
+                    at.push((OdomPose(pose), travel.min(travel_now)));
                 }
             }
             _ => {
-                self.long_steps += usize::from(passed > 1.0 && previous.is_some());
-                at.push((odom, self.travel_m))
+                self.long_steps += usize::from(due.passed > 1 && due.previous.is_some());
+                at.push((odom, travel_now))
             }
         }
-        self.next_obs_travel_m += passed * self.spacing_m;
         at.into_iter()
             .map(|(pose, travel_m)| {
                 debug_assert!(self.grid.kernel_fits(self.kernel_cells, pose.0.x, pose.0.y));
@@ -162,13 +246,10 @@ impl DensityFrontEnd {
     /// nothing while the current run has had no input (so calling it before every run, the first
     /// included, is fine).
     pub fn start_run(&mut self) {
-        if self.last_odom.is_none() {
-            return;
+        if self.clock.start_run() {
+            self.run += 1;
+            self.grid.clear();
         }
-        self.run += 1;
-        self.grid.clear();
-        self.last_odom = None;
-        self.next_obs_travel_m = self.travel_m + self.spacing_m;
     }
 
     /// The local grid (for plots and tests).
@@ -189,7 +270,7 @@ impl DensityFrontEnd {
 
     /// Odometric travel so far, metres.
     pub fn travel_m(&self) -> f64 {
-        self.travel_m
+        self.clock.travel_m()
     }
 
     /// Index of the current run (0 for the first).

@@ -27,7 +27,7 @@ pub(crate) mod words;
 pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use diagnostics::{MatchDiagnostics, Rejection, VerificationCounts, long_steps_sentence};
-pub use frontend::DensityFrontEnd;
+pub use frontend::{DensityFrontEnd, Due, ObservationClock};
 pub use grid::{Density, LocalGrid};
 pub use matcher::WordMatcher;
 pub use types::{

@@ -1,6 +1,6 @@
-//! The SICK LMS200 model (DESIGN.md §4): 181 beams over 180° at 1°, 10 Hz, uniform ±5 mm range
-//! noise, a fixed angle error per beam (uniform ±0.0007 rad, drawn once per robot), no return =
-//! maximum range; mounted 0.021 m ahead of the robot centre.
+//! The SICK LMS200 model (docs/design.md, Simulation defaults): 181 beams over 180° at 1°,
+//! 10 Hz, uniform ±5 mm range noise, a fixed angle error per beam (uniform ±0.0007 rad, drawn
+//! once per robot), no return = maximum range; mounted 0.021 m ahead of the robot centre.
 
 use crate::geom::{Pose2, Vec2};
 use crate::scan::{BeamLayout, Scan};

@@ -6,13 +6,14 @@ use crate::spec::read::{Val, get, number, table, table_array, unknown_keys};
 use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
 
-/// How matches are scored against ground truth (DESIGN.md §6).
+/// How matches are scored against ground truth (docs/design.md, Evaluation).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EvaluationSpec {
     /// A pair is correct when its two true positions are within this distance, metres. Default 1.0.
     pub tp_radius_m: f64,
-    /// Observations closer than this in odometric travel are never a revisit, metres. Default 20.
+    /// Observations closer than this in true travel (the harness's, not the odometry) are never
+    /// a revisit, metres. Default 20.
     pub min_gap_m: f64,
     /// A revisit must face the same way within this angle, degrees. Default 45.
     pub heading_tolerance_deg: f64,

@@ -647,6 +647,27 @@ fn check_robot_limits(robot: &Settings, d: &mut Diags) {
     }
 }
 
+/// A recognizer settings file (`recognize --config`): a `[recognizer]` table, read as a
+/// scenario's, and nothing else (any other key would be silently unused). `None` when the
+/// text is not TOML.
+pub fn read_recognizer_file(src: &str, d: &mut Diags) -> Option<Vec<(S<String>, toml::Value)>> {
+    let doc = crate::spec::read::parse_document(src, d)?;
+    let top = doc.get_ref();
+    unknown_keys(
+        top,
+        &["recognizer"],
+        "a recognizer settings file (it holds a [recognizer] table only)",
+        d,
+    );
+    if get(top, "recognizer").is_none() {
+        d.at(
+            0,
+            "no [recognizer] table; put the settings under [recognizer]".to_string(),
+        );
+    }
+    Some(read_recognizer(top, d))
+}
+
 /// `[recognizer]` as plain keys and values; the recognizer's model checks them.
 fn read_recognizer(top: &DeTable<'_>, d: &mut Diags) -> Vec<(S<String>, toml::Value)> {
     let Some((_, t)) = table(top, "recognizer", d) else {

@@ -56,7 +56,12 @@ pub fn route_corners(route: &Route) -> usize {
         .count()
 }
 
-/// Summarises `world`.
+/// `x` to the millimetre: sums of segment lengths print as `984.1`, not `984.1000000000001`.
+fn mm(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}
+
+/// Summarises `world` (lengths to the millimetre).
 pub fn world_info(world: &World) -> WorldInfo {
     let (lo, hi) = world.bounds();
     let segs = world.wall_segments();
@@ -65,15 +70,15 @@ pub fn world_info(world: &World) -> WorldInfo {
         doors: world.doors.len(),
         walls: world.walls.len(),
         wall_segments: segs.len(),
-        wall_length_m: segs.iter().map(|s| s.length()).sum(),
-        bounds_m: [hi.x - lo.x, hi.y - lo.y],
-        origin_m: [lo.x, lo.y],
+        wall_length_m: mm(segs.iter().map(|s| s.length()).sum()),
+        bounds_m: [mm(hi.x - lo.x), mm(hi.y - lo.y)],
+        origin_m: [mm(lo.x), mm(lo.y)],
         routes: world
             .routes
             .iter()
             .map(|r| RouteInfo {
                 id: r.id.clone(),
-                length_m: r.length_m(),
+                length_m: mm(r.length_m()),
                 corners: route_corners(r),
                 waypoints: r.waypoints.len(),
             })

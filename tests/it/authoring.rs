@@ -129,6 +129,9 @@ fn ambiguity_cli_writes_a_picture_and_json_with_the_stretches() {
 
 #[test]
 fn unknown_route_is_an_error_naming_the_routes() {
+    // Not `-o /dev/null`: an atomic write renames its temporary file onto the target.
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("a.svg");
     let out = placewords(&[
         "world",
         "ambiguity",
@@ -136,7 +139,7 @@ fn unknown_route_is_an_error_naming_the_routes() {
         "--route",
         "lapp",
         "-o",
-        "/dev/null",
+        svg.to_str().unwrap(),
     ]);
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);

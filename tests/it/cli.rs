@@ -125,12 +125,12 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     let xml = std::fs::read_to_string(&junit).unwrap();
     assert!(xml.contains("<failure"), "{xml}");
 
-    let broken = smoke_variant(dir.path(), "broken", "[recognizer]\nlevles = 2\n");
+    let broken = smoke_variant(dir.path(), "broken", "[recognizer]\nclases = 6\n");
     let o = placewords(&["check", "-q", broken.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        err.contains("broken.toml:") && err.contains("did you mean `levels`"),
+        err.contains("broken.toml:") && err.contains("did you mean `classes`"),
         "{err}"
     );
 }
@@ -489,4 +489,113 @@ fn a_closed_stdout_ends_quietly_with_exit_0() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
     assert!(report_of(&report)["subjects"].is_array());
+}
+
+/// Help that matches behaviour: every subcommand's help shows an example; `-o/--out` is one
+/// spelling (`--output` still read); `--size-m` takes the form its default shows; an output's
+/// extension must name the format written; an output file's missing folder is an error, not
+/// created; a missing input is reported once; `world info` rounds to the millimetre.
+#[test]
+fn help_and_small_behaviours_match() {
+    let commands: &[&[&str]] = &[
+        &["world", "check"],
+        &["world", "render"],
+        &["world", "info"],
+        &["world", "import"],
+        &["world", "density"],
+        &["world", "ambiguity"],
+        &["world", "generate"],
+        &["scenario", "check"],
+        &["simulate"],
+        &["run"],
+        &["check"],
+        &["merge"],
+        &["table"],
+        &["sweep"],
+        &["recognize"],
+        &["score"],
+    ];
+    for c in commands {
+        let mut args = c.to_vec();
+        args.push("--help");
+        let o = placewords(&args);
+        let help = String::from_utf8_lossy(&o.stdout);
+        assert!(help.contains("Example:\n  placewords "), "{c:?}: {help}");
+        assert!(
+            !help.contains("--output"),
+            "{c:?} spells -o as --out: {help}"
+        );
+        assert!(!help.contains("from 1"), "{c:?} counts from 0: {help}");
+    }
+    let world = placewords(&["world", "--help"]);
+    let help = String::from_utf8_lossy(&world.stdout);
+    for sub in ["density", "ambiguity", "generate"] {
+        assert!(help.contains(sub), "{help}");
+    }
+
+    let dir = tempfile::tempdir().unwrap();
+    let at = |name: &str| dir.path().join(name).display().to_string();
+    let floor = "worlds/institute-floor.toml";
+    let o = placewords(&["world", "render", floor, "-o", &at("floor.png")]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains(".svg"));
+    assert!(!dir.path().join("floor.png").exists());
+    let o = placewords(&["world", "render", floor, "--output", &at("floor.svg")]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for size in ["50 40", "50,40"] {
+        let o = placewords(&[
+            "world",
+            "generate",
+            "--seed",
+            "1",
+            "--size-m",
+            size,
+            "-o",
+            &at("g.toml"),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{size}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let o = placewords(&[
+        "world",
+        "generate",
+        "--seed",
+        "1",
+        "--size-m",
+        "50",
+        "-o",
+        &at("g.toml"),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+
+    let missing = dir.path().join("no/such/dir/r.json");
+    let o = placewords(&[
+        "run",
+        "scenarios/smoke.toml",
+        "--laps",
+        "1",
+        "--report",
+        missing.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("does not exist"));
+    assert!(!dir.path().join("no").exists(), "no folder is created");
+
+    let o = placewords(&["run", "scenarios/no-such.toml"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.matches("No such file").count(), 1, "{err}");
+
+    let o = placewords(&["world", "info", floor, "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let len = v["wall_length_m"].as_f64().unwrap();
+    assert_eq!(len, (len * 1000.0).round() / 1000.0, "{len}");
 }

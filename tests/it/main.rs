@@ -10,6 +10,8 @@ mod longterm;
 mod outputs;
 mod plugin;
 mod recognizer;
+mod settings;
 mod sim;
 mod spec;
+mod tour;
 mod world;

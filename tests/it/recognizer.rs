@@ -1536,23 +1536,6 @@ fn decreasing_travel_is_refused() {
     m.push_observation(&o);
 }
 
-/// `recognize --config` reads the `[recognizer]` table of a TOML file, as a scenario does, and
-/// names the place of a bad key.
-#[test]
-fn settings_from_a_toml_file() {
-    let c = RecognizerConfig::from_toml_str(
-        "[recognizer]\nlevels = 2\nalignment = \"paper\"\nverify = false\n",
-    )
-    .unwrap();
-    assert_eq!(c.levels, 2);
-    assert_eq!(c.alignment, placewords::recognizer::AlignmentMode::Paper);
-    assert!(!c.verify);
-    let e = RecognizerConfig::from_toml_str("x = 1\n\n[recognizer]\nlevles = 2\n").unwrap_err();
-    assert!(e.starts_with("3:1") && e.contains("levles"), "{e}");
-    let e = RecognizerConfig::from_toml_str("[recognizer]\nlevels = 9\n").unwrap_err();
-    assert!(e.contains("levels"), "{e}");
-}
-
 /// Verification turns down an n-gram whose words agree but whose raw densities do not (a second
 /// pass with Ψ shifted within every class), and says why; the same pass unshifted is accepted.
 #[test]

@@ -459,6 +459,8 @@ fn cli_info_json_has_the_promised_fields() {
 #[test]
 fn cli_render_writes_svg_and_suggests_door_ids() {
     let dir = tempfile::tempdir().unwrap();
+    // An output file's folder must exist (it is not created).
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
     let out_svg = dir.path().join("sub/floor.svg");
     let o = out_svg.to_str().unwrap();
     let out = placewords(&[
