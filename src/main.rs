@@ -11,7 +11,7 @@ fn main() -> ExitCode {
     match cli::dispatch(args) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            cli::out::write_err(format_args!("error: {e:#}\n"));
             ExitCode::from(placewords::eval::gate::EXIT_ERROR)
         }
     }

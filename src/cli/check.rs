@@ -99,7 +99,7 @@ pub fn finish(
         stress::write_file(path, xml.as_bytes())?;
     }
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
-        eprintln!("error: {e}");
+        errln!("error: {e}");
     }
     if json {
         outln!("{}", format::summary_json(suite))?;

@@ -56,6 +56,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
         &args.out.join("pr-curves.svg"),
         pr_curves_svg(&report.curves, &title).as_bytes(),
     )?;
-    eprintln!("sweep: {}", args.out.display());
+    errln!("sweep: {}", args.out.display());
     Ok(ExitCode::SUCCESS)
 }

@@ -45,7 +45,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         .collect::<Result<Vec<_>, _>>()?;
     let mut reports = Vec::new();
     for scn in &scenarios {
-        eprintln!("scenario {}", scn.sim.name);
+        errln!("scenario {}", scn.sim.name);
         let exp = experiment::run_scenario(scn, &opts)?;
         write_file(
             &args.out.join(format!("report-{}.json", scn.sim.name)),
@@ -63,6 +63,6 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     write_file(&args.out.join("table.md"), md.as_bytes())?;
     let json = placewords::report::json::to_json(&TableReport { reports });
     write_file(&args.out.join("table.json"), json.as_bytes())?;
-    eprintln!("table: {}", args.out.join("table.md").display());
+    errln!("table: {}", args.out.join("table.md").display());
     Ok(ExitCode::SUCCESS)
 }

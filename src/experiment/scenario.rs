@@ -57,7 +57,7 @@ use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
 use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 use crate::sim::robot::RobotConfig;
 use crate::sim::variation::LapVariationConfig;
-use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
+use crate::spec::diag::{Diagnostic, Diags, echo, fmt_number, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
 use crate::spec::seeds::SeedRange;
@@ -230,7 +230,10 @@ fn value(d: &mut Diags, s: &Settings, key: &str, default: f64, rule: Rule) -> f6
     }
     d.at(
         x.span().start,
-        format!("{key} = {v} is out of range; use a {what} number (default {default})"),
+        format!(
+            "{key} = {} is out of range; use a {what} number (default {default})",
+            fmt_number(v)
+        ),
     );
     default
 }
