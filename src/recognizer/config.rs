@@ -556,8 +556,24 @@ impl RecognizerConfig {
                 .map_err(|e: toml::de::Error| {
                     format!("{}: [recognizer]: {}", at(Some(span.clone())), e.message())
                 })?;
-        cfg.validate()
-            .map_err(|e| format!("{}: {e}", at(Some(span))))?;
+        // A problem is shown at its key's line (the first problem's), else at the table.
+        let key_at = |field: &str| {
+            let mut offset = 0;
+            for line in src.split_inclusive('\n') {
+                let t = line.trim_start();
+                let rest = t.strip_prefix(field).unwrap_or("-");
+                if rest.trim_start().starts_with('=') {
+                    return Some(offset + line.len() - t.len()..offset + line.len());
+                }
+                offset += line.len();
+            }
+            None
+        };
+        cfg.validate().map_err(|e| {
+            let RecognizerError::InvalidConfig(problems) = &e;
+            let first = problems.first().and_then(|p| key_at(p.field));
+            format!("{}: {e}", at(first.or(Some(span))))
+        })?;
         Ok(cfg)
     }
 
