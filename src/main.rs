@@ -19,7 +19,7 @@ fn main() -> ExitCode {
                     text = format!("{text}: {cause}");
                 }
             }
-            eprintln!("error: {text}");
+            cli::out::write_err(format_args!("error: {text}\n"));
             ExitCode::from(placewords::eval::gate::EXIT_ERROR)
         }
     }

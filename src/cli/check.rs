@@ -66,7 +66,10 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("--shard writes a part for `merge`; add --report PART.json");
     }
     super::common::check_outputs([args.report.as_deref(), args.junit.as_deref()])?;
-    super::common::check_output_dirs([args.out.as_deref()])?;
+    if let Some(dir) = &args.out {
+        // Refused now (another output there, or a live writer) rather than after the work.
+        drop(stress::stage_dir(dir)?);
+    }
     let opts = StressOptions {
         seeds: args.seeds.range(),
         shard,
@@ -107,7 +110,7 @@ pub fn finish(
         stress::write_file(path, xml.as_bytes())?;
     }
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
-        eprintln!("error: {e}");
+        errln!("error: {e}");
     }
     if json {
         outln!("{}", format::summary_json(suite))?;

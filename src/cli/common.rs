@@ -108,11 +108,11 @@ pub fn print_and_write(
             path,
             placewords::report::json::to_json(&exp.report).as_bytes(),
         )?;
-        eprintln!("report: {}", path.display());
+        errln!("report: {}", path.display());
     }
     if let Some(dir) = svg_dir {
         placewords::experiment::picture::write_pictures(exp, world, radius_m, dir)?;
-        eprintln!("pictures: {}", dir.display());
+        errln!("pictures: {}", dir.display());
     }
     Ok(())
 }

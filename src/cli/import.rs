@@ -20,7 +20,7 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
     let src = match placewords::spec::diag::read_text(&args.map) {
         Ok(src) => src,
         Err(e) => {
-            super::print_problems(&e, Default::default());
+            super::print_problems(&e, Default::default())?;
             return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
     };
@@ -36,15 +36,15 @@ pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
                 mobilesim::world_to_toml(&partial, &name).context("cannot serialise the world")?;
             placewords::io::atomic::write_atomic(&args.out, text.as_bytes())
                 .with_context(|| format!("{}: cannot write", args.out.display()))?;
-            eprintln!("{path}: {message}");
-            eprintln!(
+            errln!("{path}: {message}");
+            errln!(
                 "{}: written with walls and home but no route; add the [[routes]] block there",
                 args.out.display()
             );
             return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
     };

@@ -11,6 +11,11 @@ macro_rules! outln {
     ($($arg:tt)*) => { crate::cli::out::write(format_args!("{}\n", format_args!($($arg)*))) };
 }
 
+/// `eprintln!` that never panics on a closed stderr (see [`out`]).
+macro_rules! errln {
+    ($($arg:tt)*) => { crate::cli::out::write_err(format_args!("{}\n", format_args!($($arg)*))) };
+}
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -111,11 +116,12 @@ pub struct MessageFormatArg {
 pub fn print_problems(
     e: &placewords::spec::SpecError,
     format: placewords::spec::diag::MessageFormat,
-) {
+) -> std::io::Result<()> {
     for line in e.render(format) {
         match format {
-            placewords::spec::diag::MessageFormat::Human => eprintln!("{line}"),
-            placewords::spec::diag::MessageFormat::Json => println!("{line}"),
+            placewords::spec::diag::MessageFormat::Human => errln!("{line}"),
+            placewords::spec::diag::MessageFormat::Json => outln!("{line}")?,
         }
     }
+    Ok(())
 }

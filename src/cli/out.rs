@@ -1,6 +1,8 @@
-//! Standard output for the commands. A closed stdout (the reader left: `placewords run … | head`)
-//! is not an error: output stops quietly and the command finishes its other work and exits 0,
-//! as ripgrep does. Any other write error is returned.
+//! Standard output and standard error for every command: the one writer. A closed stdout (the
+//! reader left: `placewords run … | head`) is not an error: output stops quietly and the command
+//! finishes its other work and exits with its own code, as ripgrep does. Any other write error
+//! is returned. Messages on a closed stderr are dropped (there is nowhere left to say so); the
+//! exit code still tells.
 
 use std::io::{ErrorKind, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -21,4 +23,11 @@ pub fn write(args: std::fmt::Arguments) -> std::io::Result<()> {
         }
         r => r,
     }
+}
+
+/// Writes `args` to stderr, dropping them when stderr is closed or full (use through `errln!`):
+/// `eprintln!` would panic.
+pub fn write_err(args: std::fmt::Arguments) {
+    let mut stderr = std::io::stderr().lock();
+    let _ = stderr.write_fmt(args).and_then(|()| stderr.flush());
 }

@@ -130,7 +130,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         keep_runs,
     )?;
     if skipped > 0 {
-        eprintln!(
+        errln!(
             "{}: skipped {skipped} malformed line(s)",
             args.log.display()
         );

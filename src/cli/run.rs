@@ -62,7 +62,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         out!("{}", placewords::report::suite::text_table(&suite))?;
         if let Some(path) = &args.report {
             write_file(path, suite.to_json().as_bytes())?;
-            eprintln!("report: {}", path.display());
+            errln!("report: {}", path.display());
         }
         if let Some(e) = suite.scenarios.iter().flat_map(|s| s.errors()).next() {
             anyhow::bail!("{e}");

@@ -28,18 +28,16 @@ pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
     let mut failed = false;
     for f in &args.files {
         match placewords::experiment::load_scenario(f) {
-            Ok(s) if format == MessageFormat::Human => {
-                println!(
-                    "{}: ok ({} runs, world {})",
-                    f.display(),
-                    s.sim.runs.len(),
-                    s.sim.world.name
-                )
-            }
+            Ok(s) if format == MessageFormat::Human => outln!(
+                "{}: ok ({} runs, world {})",
+                f.display(),
+                s.sim.runs.len(),
+                s.sim.world.name
+            )?,
             Ok(_) => {}
             Err(e) => {
                 failed = true;
-                super::print_problems(&e, format);
+                super::print_problems(&e, format)?;
             }
         }
     }

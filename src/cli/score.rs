@@ -34,10 +34,10 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
         std::fs::read_to_string(&args.matches).with_context(|| format!("{name}: cannot read"))?;
     let rows = matches_csv::parse_matches(&text, &name)?;
     let report = score::score_rows(&logs, &rows, &name, &EvaluationSpec::default(), args.levels)?;
-    print!("{}", placewords::report::table::text_table(&report));
+    out!("{}", placewords::report::table::text_table(&report))?;
     if let Some(path) = &args.report {
         write_file(path, placewords::report::json::to_json(&report).as_bytes())?;
-        eprintln!("report: {}", path.display());
+        errln!("report: {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -50,6 +50,6 @@ pub fn export(
 ) -> anyhow::Result<()> {
     let rows = score::export_rows(rec, &score::run_frames(runs));
     write_file(path, matches_csv::write_matches(&rows).as_bytes())?;
-    eprintln!("matches: {} ({} pairs)", path.display(), rows.len());
+    errln!("matches: {} ({} pairs)", path.display(), rows.len());
     Ok(())
 }

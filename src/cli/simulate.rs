@@ -41,13 +41,13 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         &super::progress::bar(args.quiet),
     )?;
     if !args.quiet {
-        eprintln!(
+        errln!(
             "simulated {total} laps and wrote {} files in {:.2} s",
             files.len(),
             started.elapsed().as_secs_f64()
         );
         for f in &files {
-            eprintln!("wrote {}", f.display());
+            errln!("wrote {}", f.display());
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -3,6 +3,7 @@
 //! writes PR curves as SVG and JSON.
 
 use super::common::write_file;
+use anyhow::Context;
 use clap::Args;
 use placewords::eval::scores::SweepReport;
 use placewords::eval::sweep::fig8_grid;
@@ -28,7 +29,10 @@ pub struct SweepArgs {
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
-    super::common::check_output_dirs([Some(args.out.as_path())])?;
+    // Staged whole and put in place at the end: the folder holds the old sweep or the new one.
+    let stage = placewords::io::atomic::StagedDir::begin(&args.out, &|d| {
+        placewords::io::atomic::holds_only(d, &|n| matches!(n, "sweep.json" | "pr-curves.svg"))
+    })?;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let base = experiment::recognizer_config(&scn)?;
     let opts = ExperimentOptions {
@@ -48,14 +52,17 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     );
     out!("{}", curves_table(&report.curves))?;
     write_file(
-        &args.out.join("sweep.json"),
+        &stage.path().join("sweep.json"),
         placewords::report::json::to_json(&report).as_bytes(),
     )?;
     let title = format!("{}: precision / recall (Fig. 8)", scn.sim.name);
     write_file(
-        &args.out.join("pr-curves.svg"),
+        &stage.path().join("pr-curves.svg"),
         pr_curves_svg(&report.curves, &title).as_bytes(),
     )?;
-    eprintln!("sweep: {}", args.out.display());
+    stage
+        .commit()
+        .with_context(|| format!("{}: cannot write", args.out.display()))?;
+    errln!("sweep: {}", args.out.display());
     Ok(ExitCode::SUCCESS)
 }

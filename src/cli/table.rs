@@ -3,6 +3,7 @@
 //! JSON.
 
 use super::common::write_file;
+use anyhow::Context;
 use clap::Args;
 use placewords::eval::scores::TableReport;
 use placewords::experiment::{self, ExperimentOptions};
@@ -32,7 +33,13 @@ pub struct TableArgs {
 }
 
 pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
-    super::common::check_output_dirs([Some(args.out.as_path())])?;
+    // Staged whole and put in place at the end: the folder holds the old table or the new one.
+    let stage = placewords::io::atomic::StagedDir::begin(&args.out, &|d| {
+        placewords::io::atomic::holds_only(d, &|n| {
+            matches!(n, "table.md" | "table.json")
+                || (n.starts_with("report-") && n.ends_with(".json"))
+        })
+    })?;
     let opts = ExperimentOptions {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,
@@ -48,10 +55,10 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         .collect::<Result<Vec<_>, _>>()?;
     let mut reports = Vec::new();
     for scn in &scenarios {
-        eprintln!("scenario {}", scn.sim.name);
+        errln!("scenario {}", scn.sim.name);
         let exp = experiment::run_scenario(scn, &opts)?;
         write_file(
-            &args.out.join(format!("report-{}.json", scn.sim.name)),
+            &stage.path().join(format!("report-{}.json", scn.sim.name)),
             placewords::report::json::to_json(&exp.report).as_bytes(),
         )?;
         reports.push(exp.report);
@@ -63,9 +70,12 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         markdown_visit_recall(&reports)
     );
     out!("{md}")?;
-    write_file(&args.out.join("table.md"), md.as_bytes())?;
+    write_file(&stage.path().join("table.md"), md.as_bytes())?;
     let json = placewords::report::json::to_json(&TableReport { reports });
-    write_file(&args.out.join("table.json"), json.as_bytes())?;
-    eprintln!("table: {}", args.out.join("table.md").display());
+    write_file(&stage.path().join("table.json"), json.as_bytes())?;
+    stage
+        .commit()
+        .with_context(|| format!("{}: cannot write", args.out.display()))?;
+    errln!("table: {}", args.out.join("table.md").display());
     Ok(ExitCode::SUCCESS)
 }

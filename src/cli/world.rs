@@ -172,7 +172,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 for line in
                     placewords::spec::diag::SpecError::Invalid(warnings.clone()).render(format)
                 {
-                    eprintln!("{line}");
+                    errln!("{line}");
                 }
                 outln!(
                     "{}: ok ({} walls, {} doors, {} routes{})",
@@ -187,7 +187,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
                 )?
             }
             Err(e) => {
-                super::print_problems(&e, format);
+                super::print_problems(&e, format)?;
                 failed = true;
             }
         }
@@ -204,7 +204,7 @@ fn load(path: &std::path::Path) -> Option<World> {
     match placewords::world::load_world(path) {
         Ok(w) => Some(w),
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             None
         }
     }
@@ -245,10 +245,10 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
         Ok(w) => w,
         Err(_) => {
             let (svg, diags) = placewords::authoring::problems::problems_svg(&src, &path, &base);
-            diags.iter().for_each(|d| eprintln!("{d}"));
+            diags.iter().for_each(|d| errln!("{d}"));
             if let Some(svg) = svg {
                 super::common::write_file(&args.output, svg.as_bytes())?;
-                eprintln!(
+                errln!(
                     "wrote {} with the problems above marked 1..",
                     args.output.display()
                 );
@@ -260,7 +260,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
     let opts = RenderOptions { doors, ..base };
     let svg = render_world_svg(&world, &opts);
     super::common::write_file(&args.output, svg.as_bytes())?;
-    eprintln!("wrote {}", args.output.display());
+    errln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -285,7 +285,7 @@ fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
     let doors = door_states(&world, &args.open, false)?;
     let svg = placewords::authoring::density::density_picture(&world, &doors);
     super::common::write_file(&args.output, svg.as_bytes())?;
-    eprintln!("wrote {}", args.output.display());
+    errln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -306,17 +306,13 @@ fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
         report.summary()
     };
     print_quietly(&text)?;
-    eprintln!("wrote {}", args.output.display());
+    errln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }
 
 /// Writes to stdout; a closed pipe (`| head`) ends quietly.
 fn print_quietly(text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    match std::io::stdout().write_all(text.as_bytes()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(e.into()),
-        _ => Ok(()),
-    }
+    Ok(out!("{text}")?)
 }
 
 fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
@@ -330,6 +326,6 @@ fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
     };
     let text = generate_toml(&opts)?;
     super::common::write_file(&args.output, text.as_bytes())?;
-    eprintln!("wrote {}", args.output.display());
+    errln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
 }

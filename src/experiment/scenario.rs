@@ -57,7 +57,7 @@ use crate::sim::pedestrians::{PedestrianConfig, WalkSource};
 use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 use crate::sim::robot::RobotConfig;
 use crate::sim::variation::LapVariationConfig;
-use crate::spec::diag::{Diagnostic, Diags, echo, read_text};
+use crate::spec::diag::{Diagnostic, Diags, echo, fmt_number, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
 use crate::spec::seeds::SeedRange;
@@ -230,7 +230,10 @@ fn value(d: &mut Diags, s: &Settings, key: &str, default: f64, rule: Rule) -> f6
     }
     d.at(
         x.span().start,
-        format!("{key} = {v} is out of range; use a {what} number (default {default})"),
+        format!(
+            "{key} = {} is out of range; use a {what} number (default {default})",
+            fmt_number(v)
+        ),
     );
     default
 }
@@ -519,7 +522,76 @@ fn plan(
         robot: models.robot,
         world,
     };
+    work_budget(spec, &sim, &models.recognizer, d);
     Some((sim, models.recognizer))
+}
+
+/// Most simulation steps one scenario may take (about ten minutes at 100,000 steps a second).
+pub const MAX_SIM_STEPS: f64 = 5e7;
+/// Most observations one scenario may make (each holds a local-grid summary until evaluated).
+pub const MAX_OBSERVATIONS: f64 = 1e7;
+
+/// The work the validated numbers imply, estimated before any run: simulation steps (travel
+/// at the slowest cruise speed a lap may draw, plus its stops, over `step_s`) and observations
+/// (travel over `observation_spacing_m`). `--laps` on the command line is not counted here. Beyond [`MAX_SIM_STEPS`] or [`MAX_OBSERVATIONS`] the
+/// file is refused at the key that sets the work, with a value that fits.
+fn work_budget(spec: &ScenarioSpec, sim: &SimPlan, rec: &RecognizerConfig, d: &mut Diags) {
+    if d.has_errors() {
+        // An estimate from numbers already refused would only repeat them.
+        return;
+    }
+    let r = &sim.robot;
+    let v = &r.variation;
+    let laps: usize = sim.runs.iter().map(|run| run.laps).sum();
+    let travel_m = laps as f64 * sim.route.length_m();
+    // The slowest lap's cruise speed; the speed wave averages out along a lap.
+    let slowest_m_s = r.cruise_speed_m_s * (1.0 - v.lap_speed_spread_ratio);
+    let stops_s = if v.stop_spacing_m > 0.0 {
+        travel_m / v.stop_spacing_m * v.stop_duration_s
+    } else {
+        0.0
+    };
+    let seconds = travel_m / slowest_m_s.max(1e-9) + stops_s;
+    let steps = seconds / r.step_s;
+    let laps_at = spec.runs.first().map_or(0, |run| run.laps.span().start);
+    if steps > MAX_SIM_STEPS {
+        let at = spec.robot.get("step_s").map_or(laps_at, |s| s.span().start);
+        let fits = seconds / MAX_SIM_STEPS;
+        d.at(
+            at,
+            format!(
+                "{laps} lap{} of {:.0} m at step_s = {} take about {steps:.1e} simulation steps, \
+                 more than {} (about ten minutes); use step_s = {} or more, or fewer laps",
+                if laps == 1 { "" } else { "s" },
+                sim.route.length_m(),
+                fmt_number(r.step_s),
+                fmt_number(MAX_SIM_STEPS),
+                fmt_number((fits * 1000.0).ceil() / 1000.0)
+            ),
+        );
+    }
+    let observations = travel_m / rec.observation_spacing_m;
+    if observations > MAX_OBSERVATIONS {
+        let key = spec
+            .recognizer
+            .iter()
+            .find(|(k, _)| k.get_ref() == "observation_spacing_m");
+        let at = key.map_or(laps_at, |(k, _)| k.span().start);
+        let fits = travel_m / MAX_OBSERVATIONS;
+        d.at(
+            at,
+            format!(
+                "{laps} lap{} of {:.0} m at observation_spacing_m = {} make about \
+                 {observations:.1e} observations, more than {} held in memory; use \
+                 observation_spacing_m = {} or more, or fewer laps",
+                if laps == 1 { "" } else { "s" },
+                sim.route.length_m(),
+                fmt_number(rec.observation_spacing_m),
+                fmt_number(MAX_OBSERVATIONS),
+                fmt_number((fits * 1000.0).ceil() / 1000.0)
+            ),
+        );
+    }
 }
 
 fn route(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> Option<Route> {

@@ -11,6 +11,7 @@
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
 use crate::experiment::{ExperimentOptions, ProgressSink, run_scenario};
+use crate::io::atomic::{StagedDir, holds_only};
 use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
 use rayon::prelude::*;
@@ -233,6 +234,8 @@ pub enum StressError {
         path: String,
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Output(#[from] crate::io::atomic::StageError),
 }
 
 /// Reads the parts at `paths` and merges them into the whole run's report.
@@ -264,11 +267,30 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StressError> {
     })
 }
 
-/// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`.
+/// The files [`write_dir`] writes.
+pub const DIR_FILES: [&str; 3] = ["report.json", "table.md", "junit.xml"];
+
+/// Stages output folder `dir` for [`write_dir`]: it must be new, empty or an earlier output of
+/// it, and no other live process may be writing it. Dropping the stage leaves `dir` as it was,
+/// so this also checks the folder before the work starts.
+pub fn stage_dir(dir: &Path) -> Result<StagedDir, StressError> {
+    Ok(StagedDir::begin(dir, &|d| {
+        holds_only(d, &|n| DIR_FILES.contains(&n))
+    })?)
+}
+
+/// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`, staged and
+/// put in place in one step: `DIR` holds the old three or the new three, never a mix.
 pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
     use crate::report::{junit, suite as format};
-    write_file(&dir.join("report.json"), suite.to_json().as_bytes())?;
-    write_file(&dir.join("table.md"), format::markdown(suite).as_bytes())?;
+    let stage = stage_dir(dir)?;
+    let at = stage.path().to_path_buf();
+    write_file(&at.join(DIR_FILES[0]), suite.to_json().as_bytes())?;
+    write_file(&at.join(DIR_FILES[1]), format::markdown(suite).as_bytes())?;
     let xml = junit::junit_xml(&junit::suites(suite));
-    write_file(&dir.join("junit.xml"), xml.as_bytes())
+    write_file(&at.join(DIR_FILES[2]), xml.as_bytes())?;
+    stage.commit().map_err(|source| StressError::Write {
+        path: dir.display().to_string(),
+        source,
+    })
 }

@@ -6,9 +6,67 @@
 //! error path removes them. A process killed outright (`kill -9`, a file-size limit) cannot, so
 //! the next write of `NAME` in that folder removes the `.NAME.tmpPID` of any process that no
 //! longer runs (on systems with `/proc`; elsewhere they stay, hidden, and nothing reads them).
+//!
+//! A staged folder replaces an existing one by exchanging the two in one `renameat2`
+//! (`RENAME_EXCHANGE`, Linux), so a kill at any instant leaves the old folder or the new one
+//! whole; where the exchange is not available it falls back to two renames (old aside, new in).
+//! While a process writes a folder, `.DIR.lock` beside it holds its pid; another process asked
+//! to write the same folder refuses, naming that pid.
+//!
+//! Every rename goes through one function, so a test can kill the process at the n-th one:
+//! `PLACEWORDS_TEST_KILL_AT=n` (test-only; nothing sets it in normal use) aborts the process
+//! just before its n-th rename.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The test-only hook's environment variable: abort just before the n-th rename (1-based).
+pub const TEST_KILL_AT_ENV: &str = "PLACEWORDS_TEST_KILL_AT";
+
+/// Renames done by this process so far (for [`TEST_KILL_AT_ENV`]).
+static RENAMES: AtomicUsize = AtomicUsize::new(0);
+
+/// Aborts the process when this is the rename [`TEST_KILL_AT_ENV`] names.
+fn kill_point() {
+    let n = RENAMES.fetch_add(1, Ordering::SeqCst) + 1;
+    let at = std::env::var(TEST_KILL_AT_ENV).ok();
+    if at.and_then(|v| v.parse::<usize>().ok()) == Some(n) {
+        std::process::abort();
+    }
+}
+
+/// `std::fs::rename`, the one place every output is renamed.
+fn rename(from: &Path, to: &Path) -> std::io::Result<()> {
+    kill_point();
+    std::fs::rename(from, to)
+}
+
+/// Swaps two existing paths in one atomic step; `Ok(false)` where the system or file system
+/// cannot (then nothing was changed).
+fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
+    kill_point();
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::fs::{CWD, RenameFlags, renameat_with};
+        match renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE) {
+            Ok(()) => Ok(true),
+            Err(e)
+                if e == rustix::io::Errno::INVAL
+                    || e == rustix::io::Errno::NOSYS
+                    || e == rustix::io::Errno::OPNOTSUPP =>
+            {
+                Ok(false)
+            }
+            Err(e) => Err(e.into()),
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        let _ = (a, b);
+        Ok(false)
+    }
+}
 
 /// `.NAME.tmpPID` beside `path`, for this process.
 fn temp_path(path: &Path) -> PathBuf {
@@ -86,7 +144,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        rename(&tmp, path)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -129,7 +187,7 @@ impl AtomicFile {
         let out = self.out.take().expect("an uncommitted file has its writer");
         let file = out.into_inner().map_err(|e| e.into_error())?;
         file.sync_all()?;
-        std::fs::rename(&self.tmp, &self.path)
+        rename(&self.tmp, &self.path)
     }
 }
 
@@ -225,12 +283,14 @@ pub fn check_writable_dir(dir: &Path) -> std::io::Result<()> {
     check_writable(&dir.join(".placewords-probe"))
 }
 
-/// An output folder written in full beside its final place (`.DIR.tmpPID`), then renamed onto
-/// it by [`StagedDir::commit`]; dropped without a commit, the staging folder is removed.
+/// An output folder written in full beside its final place (`.DIR.tmpPID`), then put in its
+/// place by [`StagedDir::commit`] in one atomic exchange; dropped without a commit, the staging
+/// folder is removed. While it lives, `.DIR.lock` beside the folder holds this process's pid.
 #[derive(Debug)]
 pub struct StagedDir {
     target: PathBuf,
     staging: PathBuf,
+    lock: PathBuf,
     committed: bool,
 }
 
@@ -242,6 +302,15 @@ pub enum StageError {
          choose an empty or new folder"
     )]
     Foreign(String),
+    #[error(
+        "{path}: another placewords (pid {pid}) is writing this folder; wait for it to finish \
+         or choose another folder (if no such process runs, remove {lock})"
+    )]
+    Busy {
+        path: String,
+        pid: u32,
+        lock: String,
+    },
     #[error("{path}: cannot write: {source}")]
     Io {
         path: String,
@@ -249,16 +318,57 @@ pub enum StageError {
     },
 }
 
+/// `.DIR.lock` beside `dir`.
+fn lock_path(dir: &Path) -> PathBuf {
+    dir.with_file_name(format!(".{}.lock", file_name(dir)))
+}
+
+/// Takes `.DIR.lock` for this process: `Ok(Some(pid))` when a live process holds it. A lock
+/// whose process is gone is taken over.
+fn take_lock(lock: &Path) -> std::io::Result<Option<u32>> {
+    for _ in 0..2 {
+        match std::fs::File::options()
+            .write(true)
+            .create_new(true)
+            .open(lock)
+        {
+            Ok(mut f) => {
+                write!(f, "{}", std::process::id())?;
+                return Ok(None);
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                let text = std::fs::read_to_string(lock).unwrap_or_default();
+                match text.trim().parse::<u32>() {
+                    Ok(pid) if may_be_running(pid) && pid != std::process::id() => {
+                        return Ok(Some(pid));
+                    }
+                    // Stale (its process is gone) or half-written: take it over.
+                    _ => {
+                        let _ = std::fs::remove_file(lock);
+                    }
+                }
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Err(std::io::Error::other("the lock file could not be taken"))
+}
+
 impl StagedDir {
     /// Stages output for `dir`. An existing `dir` must be empty or, by `replaceable`, an earlier
     /// output of the same kind (it is then replaced whole on commit); otherwise an error, before
-    /// anything is written.
+    /// anything is written. A folder another live process is staging is refused
+    /// ([`StageError::Busy`]).
     pub fn begin(dir: &Path, replaceable: &dyn Fn(&Path) -> bool) -> Result<StagedDir, StageError> {
         let io = |path: &Path, source| StageError::Io {
             path: path.display().to_string(),
             source,
         };
         if dir.exists() {
+            if !dir.is_dir() {
+                let e = std::io::Error::other("it is a file; give a folder name");
+                return Err(io(dir, e));
+            }
             let empty = std::fs::read_dir(dir)
                 .map_err(|e| io(dir, e))?
                 .next()
@@ -268,15 +378,28 @@ impl StagedDir {
             }
         }
         create_parent(dir).map_err(|e| io(dir, e))?;
-        remove_stale_temps(dir);
-        let staging = temp_path(dir);
-        let _ = std::fs::remove_dir_all(&staging);
-        std::fs::create_dir(&staging).map_err(|e| io(dir, e))?;
-        Ok(StagedDir {
+        let lock = lock_path(dir);
+        if let Some(pid) = take_lock(&lock).map_err(|e| io(&lock, e))? {
+            return Err(StageError::Busy {
+                path: dir.display().to_string(),
+                pid,
+                lock: lock.display().to_string(),
+            });
+        }
+        // From here the lock is ours: the value below releases it on every path.
+        let mut staged = StagedDir {
             target: dir.to_path_buf(),
-            staging,
+            staging: temp_path(dir),
+            lock,
             committed: false,
-        })
+        };
+        remove_stale_temps(dir);
+        let _ = std::fs::remove_dir_all(&staged.staging);
+        if let Err(e) = std::fs::create_dir(&staged.staging) {
+            staged.committed = true; // nothing staged to remove
+            return Err(io(dir, e));
+        }
+        Ok(staged)
     }
 
     /// The folder to write into now.
@@ -289,26 +412,34 @@ impl StagedDir {
         &self.target
     }
 
-    /// Moves the staged folder onto the target: an old target is first moved aside (to
-    /// `.DIR.tmpPID-old`) and removed after, so the target is never a mix of two runs.
+    /// Puts the staged folder in the target's place. An old target is exchanged with it in one
+    /// atomic step and then removed; where the exchange is not available, the old target is
+    /// first moved aside (to `.DIR.tmpPID-old`) and removed after, so the target is never a mix
+    /// of two runs (though a kill between those two renames leaves it missing).
     pub fn commit(mut self) -> std::io::Result<()> {
+        let result = self.put_in_place();
+        self.committed = result.is_ok();
+        result
+    }
+
+    fn put_in_place(&self) -> std::io::Result<()> {
+        if !self.target.exists() {
+            return rename(&self.staging, &self.target);
+        }
+        if exchange(&self.staging, &self.target)? {
+            // The staging path now holds the old output.
+            let _ = std::fs::remove_dir_all(&self.staging);
+            return Ok(());
+        }
         let old = self
             .staging
             .with_file_name(format!("{}-old", file_name(&self.staging)));
-        let moved_aside = self.target.exists();
-        if moved_aside {
-            std::fs::rename(&self.target, &old)?;
-        }
-        if let Err(e) = std::fs::rename(&self.staging, &self.target) {
-            if moved_aside {
-                let _ = std::fs::rename(&old, &self.target);
-            }
+        rename(&self.target, &old)?;
+        if let Err(e) = rename(&self.staging, &self.target) {
+            let _ = std::fs::rename(&old, &self.target);
             return Err(e);
         }
-        self.committed = true;
-        if moved_aside {
-            let _ = std::fs::remove_dir_all(&old);
-        }
+        let _ = std::fs::remove_dir_all(&old);
         Ok(())
     }
 }
@@ -318,5 +449,26 @@ impl Drop for StagedDir {
         if !self.committed {
             let _ = std::fs::remove_dir_all(&self.staging);
         }
+        let _ = std::fs::remove_file(&self.lock);
     }
+}
+
+/// Whether `dir` holds at least one file `named` accepts and nothing else but hidden files: an
+/// earlier output of a command that writes those names, which a new output may replace whole.
+pub fn holds_only(dir: &Path, named: &dyn Fn(&str) -> bool) -> bool {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    let mut any = false;
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name.starts_with('.') {
+            continue;
+        }
+        if !named(&name) || !e.file_type().is_ok_and(|t| t.is_file()) {
+            return false;
+        }
+        any = true;
+    }
+    any
 }

@@ -262,6 +262,13 @@ impl fmt::Display for ConfigProblem {
     }
 }
 
+/// Smallest `observation_spacing_m`, metres: the observations (and their memory) grow as
+/// travel / spacing, and a real log at 1e-4 m runs for minutes.
+pub const MIN_OBSERVATION_SPACING_M: f64 = 0.01;
+/// Largest `max_alignment_offset` and `chain_alignment_offset`, observations: each shift is
+/// tried for every matched pair (1e9 never finishes).
+pub const MAX_ALIGNMENT_OFFSET: usize = 1000;
+
 /// Largest local grid the recognizer accepts, cells from the centre to the edge.
 pub const MAX_GRID_HALF_CELLS: f64 = 1000.0;
 
@@ -272,14 +279,32 @@ impl RecognizerConfig {
         let mut bad =
             |field: &'static str, problem: String| out.push(ConfigProblem { field, problem });
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        if !positive(self.observation_spacing_m) {
+        if !(self.observation_spacing_m.is_finite()
+            && self.observation_spacing_m >= MIN_OBSERVATION_SPACING_M)
+        {
             bad(
                 "observation_spacing_m",
                 format!(
-                    "must be a positive distance, got {}; the default is 0.10",
-                    self.observation_spacing_m
+                    "must be a distance of at least {MIN_OBSERVATION_SPACING_M} m (finer spacing \
+                     multiplies the observations and the memory they take), got {}; the default \
+                     is 0.10",
+                    crate::spec::diag::fmt_number(self.observation_spacing_m)
                 ),
             );
+        }
+        for (field, v) in [
+            ("max_alignment_offset", self.max_alignment_offset),
+            ("chain_alignment_offset", self.chain_alignment_offset),
+        ] {
+            if v > MAX_ALIGNMENT_OFFSET {
+                bad(
+                    field,
+                    format!(
+                        "must be at most {MAX_ALIGNMENT_OFFSET} observations (every shift is \
+                         tried for every matched pair), got {v}; the default is 10 or 5"
+                    ),
+                );
+            }
         }
         if !positive(self.grid_cell_m) {
             bad(

@@ -183,6 +183,8 @@ impl Laser {
     pub fn add_noise(&self, ranges: &mut [f64], rng: &mut SimRng) {
         let max = self.config.max_range_m;
         let n = self.config.range_noise_m;
+        // The scenario's size limit keeps ±n (and so the uniform draw's width) finite.
+        debug_assert!((0.0..=1e300).contains(&n), "range_noise_m = {n}");
         for r in ranges.iter_mut() {
             if *r >= max || !r.is_finite() {
                 *r = max;

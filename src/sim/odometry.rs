@@ -104,6 +104,8 @@ fn proportional_error(
 ) -> (f64, f64) {
     match form {
         ProportionalError::EachUpdate => {
+            // The scenario's size limit keeps each draw's width -r..r finite.
+            debug_assert!(t_ratio.abs() <= 1e300 && r_ratio.abs() <= 1e300);
             let mut fraction = |r: f64| {
                 if r > 0.0 {
                     rng.random_range(-r..r)

@@ -203,6 +203,8 @@ pub fn draw(cfg: &PedestrianConfig, rng: &mut SimRng) -> Vec<Pedestrian> {
             };
             let p = Pedestrian::new(path, speed, 0.0, r);
             let cycle = 2.0 * p.length_m();
+            // The scenario's coordinate limit keeps the path's length finite.
+            debug_assert!(cycle.is_finite(), "walking path of length {cycle}");
             let phase = if cycle > 0.0 {
                 rng.random_range(0.0..cycle)
             } else {

@@ -263,6 +263,8 @@ fn events(spacing_m: f64, (start_m, length_m): (f64, f64), rng: &mut SimRng) -> 
     if spacing_m <= 0.0 || !spacing_m.is_finite() {
         return out;
     }
+    // The scenario's limits (0 or at least 1 m) bound the events per lap to its length.
+    debug_assert!(spacing_m >= 1e-3, "event spacing {spacing_m} m");
     let mut s = start_m;
     loop {
         let u: f64 = rng.random_range(f64::EPSILON..1.0);

@@ -51,6 +51,16 @@ impl Diagnostic {
 /// Longest piece of a file echoed in a message, characters: a 10 MB key is not printed back.
 pub const MAX_ECHO_CHARS: usize = 60;
 
+/// A number as a person writes it: `1e308` and `1e-9` in exponent form rather than as a
+/// 300-digit expansion, others as Rust prints them (`0.25`, `1000`).
+pub fn fmt_number(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// `text` cut to [`MAX_ECHO_CHARS`] characters, with `...` when cut.
 pub fn echo(text: &str) -> String {
     match text.char_indices().nth(MAX_ECHO_CHARS) {

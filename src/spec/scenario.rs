@@ -6,13 +6,14 @@
 //! The reference, with every key, its unit, default and limits, is `docs/scenario-format.md`;
 //! the key tables below are what the reader accepts (a test holds the two together).
 
-use crate::spec::diag::{Diags, echo};
+use crate::spec::diag::{Diags, echo, fmt_number};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::read::{
     Val, get, integer, missing, number, parse_int, plain, points, string, strings, table,
     table_array, type_name, unknown_keys,
 };
 use crate::spec::seeds::SeedRange;
+use crate::spec::world::MAX_ABS_COORD_M;
 use toml::Spanned;
 use toml::de::{DeTable, DeValue};
 
@@ -28,6 +29,172 @@ pub const MIN_STEP_S: f64 = 0.001;
 pub const MAX_STEP_S: f64 = 0.5;
 /// Longest the robot may wait for a blocked route before the run fails, seconds.
 pub const MAX_BLOCKED_TIMEOUT_S: f64 = 600.0;
+
+/// How large one number of a model table may be: what keeps the simulator's arithmetic finite
+/// (a uniform draw of ±1e308 overflows) and a lap's work bounded (stops every nanometre). The
+/// sign and finiteness are the model's own rule (`experiment::scenario`); this is the size.
+#[derive(Clone, Copy, Debug)]
+pub struct NumberLimit {
+    /// The table, without brackets: `laser`, `odometry`, `robot`, `pedestrians`.
+    pub table: &'static str,
+    pub key: &'static str,
+    /// Largest magnitude accepted.
+    pub max: f64,
+    /// Smallest magnitude accepted besides 0 (0: no such bound).
+    pub min_nonzero: f64,
+    /// 0 turns the feature off (said in the message).
+    pub off_at_zero: bool,
+    /// Unit as the docs write it.
+    pub unit: &'static str,
+    /// A value that fits, for the message.
+    pub typical: &'static str,
+}
+
+const fn lim(
+    table: &'static str,
+    key: &'static str,
+    (min_nonzero, max): (f64, f64),
+    unit: &'static str,
+    typical: &'static str,
+) -> NumberLimit {
+    NumberLimit {
+        table,
+        key,
+        max,
+        min_nonzero,
+        off_at_zero: false,
+        unit,
+        typical,
+    }
+}
+
+/// [`lim`] of a feature 0 turns off.
+const fn off(
+    table: &'static str,
+    key: &'static str,
+    range: (f64, f64),
+    unit: &'static str,
+    typical: &'static str,
+) -> NumberLimit {
+    NumberLimit {
+        off_at_zero: true,
+        ..lim(table, key, range, unit, typical)
+    }
+}
+
+/// Every size limit of a model number; `docs/scenario-format.md` shows each beside its key (a
+/// test holds the two together).
+pub const NUMBER_LIMITS: &[NumberLimit] = &[
+    lim("laser", "max_range_m", (0.0, 1000.0), "m", "32.767"),
+    lim("laser", "range_noise_m", (0.0, 1.0), "m", "0.005"),
+    lim("laser", "angle_error_deg", (0.0, 10.0), "deg", "0.04"),
+    lim("laser", "rate_hz", (0.1, 100.0), "Hz", "10"),
+    lim("laser", "mount_x_m", (0.0, 1.0), "m", "0.021"),
+    lim(
+        "odometry",
+        "translation_error_ratio",
+        (0.0, 1.0),
+        "",
+        "0.0075",
+    ),
+    lim("odometry", "rotation_error_ratio", (0.0, 1.0), "", "0.0075"),
+    lim("odometry", "alpha1", (0.0, 1.0), "", "0.01"),
+    lim("odometry", "alpha2", (0.0, 1.0), "", "0.01"),
+    lim("odometry", "alpha3", (0.0, 1.0), "", "0.01"),
+    lim("odometry", "alpha4", (0.0, 1.0), "", "0.01"),
+    lim(
+        "odometry",
+        "wheel_radius_bias_ratio",
+        (0.0, 0.5),
+        "",
+        "0.01",
+    ),
+    lim(
+        "odometry",
+        "wheel_radius_mismatch_ratio",
+        (0.0, 0.5),
+        "",
+        "0.01",
+    ),
+    lim("robot", "radius_m", (0.0, 2.0), "m", "0.25"),
+    lim("robot", "axle_track_m", (0.0, 4.0), "m", "0.357"),
+    lim("robot", "cruise_speed_m_s", (0.05, 5.0), "m/s", "0.4"),
+    lim("robot", "max_speed_m_s", (0.05, 5.0), "m/s", "1.0"),
+    lim(
+        "robot",
+        "max_turn_rate_deg_s",
+        (1.0, 1000.0),
+        "deg/s",
+        "100",
+    ),
+    lim("robot", "accel_m_s2", (0.01, 100.0), "m/s²", "0.3"),
+    lim(
+        "robot",
+        "turn_accel_deg_s2",
+        (1.0, 10000.0),
+        "deg/s²",
+        "100",
+    ),
+    lim("robot", "lookahead_m", (0.05, 10.0), "m", "0.8"),
+    lim("robot", "stop_distance_m", (0.0, 10.0), "m", "0.6"),
+    lim("robot", "slow_distance_m", (0.0, 20.0), "m", "1.2"),
+    lim("robot", "lane_margin_m", (0.0, 5.0), "m", "0.25"),
+    off("robot", "stop_spacing_m", (1.0, 1e6), "m", "10"),
+    lim("robot", "stop_duration_s", (0.0, 60.0), "s", "4"),
+    off("robot", "spin_spacing_m", (1.0, 1e6), "m", "50"),
+    lim("pedestrians", "speed_min_m_s", (0.0, 5.0), "m/s", "0.5"),
+    lim("pedestrians", "speed_max_m_s", (0.0, 5.0), "m/s", "1.2"),
+    lim("pedestrians", "radius_m", (0.01, 1.0), "m", "0.2"),
+];
+
+/// The limit of `key` in `[table]`, if it has one.
+pub fn number_limit(table: &str, key: &str) -> Option<&'static NumberLimit> {
+    NUMBER_LIMITS
+        .iter()
+        .find(|l| l.table == table && l.key == key)
+}
+
+/// Reports each number of `[table]` whose size is beyond its [`NumberLimit`].
+fn check_number_limits(table: &str, s: &Settings, d: &mut Diags) {
+    for (key, v) in &s.numbers {
+        let (Some(l), x) = (number_limit(table, key), *v.get_ref()) else {
+            continue;
+        };
+        let a = x.abs();
+        // Non-finite values and signs are the model's checks; one message per value.
+        if !a.is_finite() || (a <= l.max && (a == 0.0 || a >= l.min_nonzero)) {
+            continue;
+        }
+        let unit = if l.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", l.unit)
+        };
+        let what = if x > l.max {
+            format!("more than {}{unit}, the most", fmt_number(l.max))
+        } else if x < -l.max {
+            format!("less than -{}{unit}, the least", fmt_number(l.max))
+        } else {
+            let off = if l.off_at_zero {
+                " (0 turns it off)"
+            } else {
+                ""
+            };
+            format!(
+                "less than {}{unit}{off}, the finest",
+                fmt_number(l.min_nonzero)
+            )
+        };
+        d.at(
+            v.span().start,
+            format!(
+                "{key} = {} in [{table}] is {what} the simulator takes; use {}",
+                fmt_number(x),
+                l.typical
+            ),
+        );
+    }
+}
 
 /// Keys of the top level.
 pub const TOP_KEYS: &[&str] = &[
@@ -213,6 +380,16 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
     let odometry = read_settings(top, "odometry", ODOMETRY_KEYS, "model", d);
     let robot = read_settings(top, "robot", ROBOT_KEYS, "", d);
     check_robot_limits(&robot, d);
+    for (table, s) in [
+        ("laser", &laser),
+        ("odometry", &odometry),
+        ("robot", &robot),
+    ] {
+        check_number_limits(table, s, d);
+    }
+    if let Some(p) = &pedestrians {
+        check_number_limits("pedestrians", &p.settings, d);
+    }
     let recognizer = read_recognizer(top, d);
     let evaluation = crate::spec::evaluation::read_evaluation(top, d);
     let expect = crate::spec::evaluation::read_expect(top, d);
@@ -570,11 +747,28 @@ fn walk_paths(v: &Val<'_>, d: &mut Diags) -> Vec<S<Vec<[f64; 2]>>> {
     for p in a.iter() {
         let mut spans = Vec::new();
         if let Some(pts) = points(p, "paths_m", "[pedestrians]", d, &mut spans) {
+            let far = pts
+                .iter()
+                .zip(&spans[spans.len() - pts.len()..])
+                .find(|(q, _)| q[0].abs() > MAX_ABS_COORD_M || q[1].abs() > MAX_ABS_COORD_M);
             if pts.len() < 2 {
                 d.at(
                     p.span().start,
                     "a path needs at least two finite points [x, y]".into(),
                 );
+            } else if let Some((q, &at)) = far {
+                d.at(
+                    at,
+                    format!(
+                        "the walking point [{}, {}] is more than {:.0} km from the origin; paths \
+                         are metres in the world's frame: use points inside the world",
+                        fmt_number(q[0]),
+                        fmt_number(q[1]),
+                        MAX_ABS_COORD_M / 1000.0
+                    ),
+                );
+                // Kept, so the file does not also read as having nowhere to walk.
+                out.push(Spanned::new(p.span(), pts));
             } else {
                 out.push(Spanned::new(p.span(), pts));
             }
@@ -631,7 +825,7 @@ fn check_robot_limits(robot: &Settings, d: &mut Diags) {
     {
         d.at(s.span().start, format!(
             "step_s = {} is outside {MIN_STEP_S}..{MAX_STEP_S} s (a lap takes lap time / step_s \
-             steps); use 0.05", s.get_ref()));
+             steps); use 0.05", fmt_number(*s.get_ref())));
     }
     if let Some(s) = robot.get("blocked_timeout_s")
         && !(*s.get_ref() > 0.0 && *s.get_ref() <= MAX_BLOCKED_TIMEOUT_S)
@@ -641,7 +835,7 @@ fn check_robot_limits(robot: &Settings, d: &mut Diags) {
             format!(
                 "blocked_timeout_s = {} is outside (0, {MAX_BLOCKED_TIMEOUT_S}] s; a robot blocked \
              longer is stuck: use 10",
-                s.get_ref()
+                fmt_number(*s.get_ref())
             ),
         );
     }

@@ -234,6 +234,9 @@ pub struct AreaLoc {
 /// lap grows faster than linearly with the segment count (20,000 segments take about 10 s a lap
 /// on one core), so the limit keeps a lap within seconds.
 pub const MAX_SEGMENTS: usize = 10_000;
+/// Largest absolute coordinate, metres, of a world or a scenario's walking path: keeps every
+/// number the geometry squares or converts far from overflow.
+pub const MAX_ABS_COORD_M: f64 = 1_000_000.0;
 
 /// Reads a world file's text into its file structures and the offsets of its values, reporting
 /// every syntax, key and type problem to `d`. `None` when the text is not TOML (or the problem

@@ -9,7 +9,7 @@
 //! checked with all doors closed and with all doors open.
 
 use crate::geom::{Segment, Vec2, wrap_angle};
-use crate::spec::diag::Diags;
+use crate::spec::diag::{Diags, fmt_number};
 use crate::spec::world::{WorldLoc, WorldSpec};
 use crate::world::geometry::{SegmentIndex, ThickSegment};
 use std::collections::HashMap;
@@ -37,9 +37,8 @@ pub const WAYPOINT_MARGIN_M: f64 = 0.05;
 pub const DOOR_GAP_TOLERANCE_M: f64 = 0.05;
 /// Largest world extent, metres.
 pub const MAX_EXTENT_M: f64 = 10_000.0;
-/// Largest absolute coordinate, metres: keeps every number the geometry squares or converts
-/// far from overflow.
-pub const MAX_ABS_COORD_M: f64 = 1_000_000.0;
+/// Largest absolute coordinate, metres (see [`crate::spec::world::MAX_ABS_COORD_M`]).
+pub const MAX_ABS_COORD_M: f64 = crate::spec::world::MAX_ABS_COORD_M;
 /// Most wall segments, door panels and route legs a world may hold.
 pub const MAX_SEGMENTS: usize = crate::spec::world::MAX_SEGMENTS;
 /// Half the width of a walking person, metres (scenario A's pedestrians are about 0.3 m across).
@@ -57,14 +56,6 @@ fn v(p: &[f64; 2]) -> Vec2 {
 }
 
 /// A coordinate for a message: plain when ordinary, in exponent form when huge.
-fn fmt_coord(x: f64) -> String {
-    if x.abs() >= 1e7 {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
-}
-
 fn fmt_m(x: f64) -> String {
     if x < 0.0 {
         "inside".to_string()
@@ -368,8 +359,8 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             *at,
             format!(
                 "the point [{}, {}] is more than {:.0} km from the origin; coordinates are metres: check this value or move the world near [0, 0]",
-                fmt_coord(p[0]),
-                fmt_coord(p[1]),
+                fmt_number(p[0]),
+                fmt_number(p[1]),
                 MAX_ABS_COORD_M / 1000.0
             ),
         );
@@ -398,8 +389,8 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
                     "the world is {:.0} m across in {} (limit {MAX_EXTENT_M:.0} m), because of the point [{}, {}]; coordinates are metres: check this value",
                     hi - lo,
                     if axis == 0 { "x" } else { "y" },
-                    fmt_coord(p[0]),
-                    fmt_coord(p[1])
+                    fmt_number(p[0]),
+                    fmt_number(p[1])
                 ),
             );
             return false;

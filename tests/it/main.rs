@@ -5,6 +5,7 @@ mod authoring;
 mod cli;
 mod common;
 mod eval;
+mod fuzz;
 mod io;
 mod longterm;
 mod outputs;

@@ -197,3 +197,126 @@ fn simulate_with_laps(out: &Path, laps: &str) -> Output {
         out.to_str().unwrap(),
     ])
 }
+
+/// The visible files of `dir` and their bytes (empty when `dir` is missing).
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Default::default();
+    };
+    entries
+        .map(|e| e.unwrap())
+        .filter(|e| !e.file_name().to_string_lossy().starts_with('.'))
+        .map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            (name, std::fs::read(e.path()).unwrap())
+        })
+        .collect()
+}
+
+/// Runs `new_args` (with `-o DIR` appended) over an earlier output of `old_args`, killing it
+/// at its first rename, then its second, and so on until a run goes through: after every kill
+/// `DIR` must be the old output byte for byte, and the run that goes through must leave the new
+/// output, no staging folder and no lock.
+fn kill_at_every_rename(old_args: &[&str], new_args: &[&str]) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("out");
+    let dir_s = dir.to_str().unwrap();
+    let with_out = |args: &[&str]| {
+        let mut v: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+        v.extend(["-q".into(), "-o".into(), dir_s.into()]);
+        v
+    };
+    let run = |args: &[String], kill_at: Option<usize>| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"));
+        c.args(args).current_dir(root());
+        if let Some(n) = kill_at {
+            c.env(placewords::io::atomic::TEST_KILL_AT_ENV, n.to_string());
+        }
+        c.output().unwrap()
+    };
+    let o = run(&with_out(old_args), None);
+    assert!(o.status.code().is_some_and(|c| c < 2), "{}", stderr(&o));
+    let old = snapshot(&dir);
+    assert!(!old.is_empty());
+    let mut kills = 0;
+    for n in 1..100 {
+        let o = run(&with_out(new_args), Some(n));
+        if o.status.code().is_some() {
+            assert!(o.status.code().unwrap() < 2, "{}", stderr(&o));
+            break;
+        }
+        kills += 1;
+        assert!(
+            snapshot(&dir) == old,
+            "{new_args:?} killed at rename {n}: {dir_s} is not the old output whole (files {:?})",
+            snapshot(&dir).keys().collect::<Vec<_>>()
+        );
+    }
+    assert!(kills >= 1, "{new_args:?} renamed nothing");
+    let new = snapshot(&dir);
+    assert!(new != old && new.keys().eq(old.keys()), "{new_args:?}");
+    let leftovers: Vec<String> = names(tmp.path())
+        .into_iter()
+        .filter(|n| n != "out")
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+/// Issue 31 point 3: every multi-file writer puts its folder in place in one step.
+#[test]
+fn a_kill_at_any_rename_leaves_the_old_output_or_the_new_one_whole() {
+    let smoke = "scenarios/smoke.toml";
+    kill_at_every_rename(
+        &["simulate", smoke, "--laps", "1"],
+        &["simulate", smoke, "--laps", "2"],
+    );
+    kill_at_every_rename(
+        &["check", smoke, "--seed", "1"],
+        &["check", smoke, "--seed", "2"],
+    );
+    kill_at_every_rename(
+        &["table", smoke, "--no-icp", "--laps", "1"],
+        &["table", smoke, "--no-icp", "--laps", "2"],
+    );
+    kill_at_every_rename(
+        &["sweep", smoke, "--laps", "1"],
+        &["sweep", smoke, "--laps", "2"],
+    );
+}
+
+/// Two writers of one folder: while one holds it, the other is refused, naming its pid.
+#[test]
+fn a_folder_another_live_process_writes_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("out");
+    // This test process is alive: its pid in the lock stands for a running writer.
+    std::fs::write(tmp.path().join(".out.lock"), std::process::id().to_string()).unwrap();
+    for args in [
+        vec!["simulate", "scenarios/smoke.toml", "--laps", "1"],
+        vec!["check", "scenarios/smoke.toml", "--seed", "1"],
+        vec!["sweep", "scenarios/smoke.toml", "--laps", "1"],
+        vec!["table", "scenarios/smoke.toml", "--laps", "1", "--no-icp"],
+    ] {
+        let mut a = args.clone();
+        a.extend(["-q", "-o", dir.to_str().unwrap()]);
+        let o = placewords(&a);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        let pid = format!("pid {}", std::process::id());
+        assert!(e.contains("another placewords") && e.contains(&pid), "{e}");
+        assert!(!dir.exists(), "{args:?} created the folder it was refused");
+    }
+    // A lock whose process is gone is taken over.
+    std::fs::write(tmp.path().join(".out.lock"), DEAD_PID).unwrap();
+    let o = placewords(&[
+        "simulate",
+        "scenarios/smoke.toml",
+        "--laps",
+        "1",
+        "-q",
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!tmp.path().join(".out.lock").exists());
+}

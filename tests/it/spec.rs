@@ -11,7 +11,12 @@ use std::path::{Path, PathBuf};
 /// The lines a file's check prints; `None` when the file is accepted.
 fn problems(shown: &Path) -> Option<String> {
     let name = shown.to_string_lossy();
-    let lines = if name.ends_with(".map") {
+    let lines = if name.ends_with(".recognizer.toml") {
+        let src = std::fs::read_to_string(shown).unwrap();
+        placewords::experiment::parse_recognizer_config(&src, shown)
+            .err()?
+            .render(MessageFormat::Human)
+    } else if name.ends_with(".map") {
         let e = match read_text(shown) {
             Err(e) => return Some(e.render(MessageFormat::Human).join("\n")),
             Ok(src) => placewords::io::mobilesim::import_mobilesim(&src, &name).err()?,
@@ -50,7 +55,8 @@ fn check_folder(folder: &str, at_least: usize) {
         let expected_path = PathBuf::from(
             expected_path
                 .to_string_lossy()
-                .replace(".world.expected", ".expected"),
+                .replace(".world.expected", ".expected")
+                .replace(".recognizer.expected", ".expected"),
         );
         let Some(got) = problems(&f) else {
             failures.push(format!(
@@ -87,6 +93,13 @@ fn invalid_scenarios_give_their_messages() {
 #[test]
 fn fuzz_finds_give_located_messages() {
     check_folder("tests/fixtures/fuzz", 10);
+}
+
+/// The 2026-12-02 fuzz finds (`../shared/fuzz-finds/2026-12-02/`): numbers that passed the
+/// checks and then panicked, aborted or never ended in the simulator or the recognizer.
+#[test]
+fn fuzz_finds_of_december_give_located_messages() {
+    check_folder("tests/fixtures/fuzz-finds", 9);
 }
 
 /// Fuzz find 8: a world of 99,000 wall segments passed the checks, then a lap never ended.
@@ -239,4 +252,68 @@ fn the_format_reference_names_every_key() {
         "keys the parser accepts but the reference lacks:\n{}",
         missing.join("\n")
     );
+}
+
+/// Runs `args` with stdout and stderr pipes whose reading ends are closed at once: every
+/// command that prints must end with its own exit code, never a panic (101).
+fn exit_into_closed_pipes(args: &[&str]) -> Option<i32> {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(args)
+        .current_dir(root())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    child.wait().unwrap().code()
+}
+
+/// Fuzz find `MIN-pipe-world-check-json`: `world check --message-format json` (and `scenario
+/// check`) into a closed pipe panicked with "failed printing to stdout". 500 problems are more
+/// than a pipe holds, so the write meets the closed end every time.
+#[test]
+fn checks_into_a_closed_pipe_exit_2_without_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut src = String::from("format_version = 2\n");
+    for i in 0..600 {
+        src.push_str(&format!("unknown_key_number_{i} = 1\n"));
+    }
+    let file = dir.path().join("many-problems.toml");
+    std::fs::write(&file, &src).unwrap();
+    let file = file.to_str().unwrap();
+    for format in ["json", "human"] {
+        for command in ["world", "scenario"] {
+            let code =
+                exit_into_closed_pipes(&[command, "check", "--message-format", format, file]);
+            assert_eq!(code, Some(2), "{command} check --message-format {format}");
+        }
+    }
+}
+
+/// Every size limit of a model number is in the reference, in its key's row of its table's
+/// section: the limits column shows the largest (and smallest non-zero) value accepted.
+#[test]
+fn the_format_reference_shows_every_number_limit() {
+    use placewords::spec::diag::fmt_number;
+    let text = std::fs::read_to_string(root().join("docs/scenario-format.md")).unwrap();
+    let mut wrong = Vec::new();
+    for l in placewords::spec::scenario::NUMBER_LIMITS {
+        let heading = format!("## `[{}]`", l.table);
+        let section = text.split(&heading).nth(1).unwrap_or("");
+        let section = section.split("\n## ").next().unwrap_or("");
+        let row = section
+            .lines()
+            .find(|r| r.starts_with(&format!("| `{}` |", l.key)));
+        let limits = row.and_then(|r| r.split('|').nth(4)).unwrap_or("").trim();
+        let shown = |x: f64| {
+            limits
+                .split(|c: char| !(c.is_ascii_digit() || c == '.' || c == 'e'))
+                .any(|n| n == fmt_number(x))
+        };
+        if !shown(l.max) || (l.min_nonzero > 0.0 && !shown(l.min_nonzero)) {
+            wrong.push(format!("[{}] {}: limits column `{limits}`", l.table, l.key));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
