@@ -233,6 +233,17 @@ pub enum MergeError {
     OtherPlan { file: String, first: String },
     #[error("{label} seed {seed} is in {n} parts; run every shard with the same arguments")]
     SeedTwice { label: String, seed: u64, n: usize },
+    #[error(
+        "{file} (part {shard}) holds {label} seeds {got}, but part {shard} of its plan runs \
+         seeds {want}; run every shard with the same arguments"
+    )]
+    OtherSeeds {
+        file: String,
+        shard: Shard,
+        label: String,
+        got: String,
+        want: String,
+    },
 }
 
 /// Joins parts (with the files they came from, for messages) into the whole run's suite.
@@ -288,6 +299,7 @@ fn check_parts(parts: &[(String, SuiteReport)]) -> Result<(), MergeError> {
                 first: first_file.clone(),
             });
         }
+        check_seeds(file, shard, part)?;
     }
     match seen.iter().position(Option::is_none) {
         Some(i) => Err(MergeError::Missing {
@@ -296,6 +308,55 @@ fn check_parts(parts: &[(String, SuiteReport)]) -> Result<(), MergeError> {
         }),
         None => Ok(()),
     }
+}
+
+/// Checks that a part holds exactly the seeds its shard owns in its plan: the plan's work
+/// items are every runnable scenario's seeds in order, dealt round-robin (`Shard::owns`).
+fn check_seeds(file: &str, shard: Shard, part: &SuiteReport) -> Result<(), MergeError> {
+    let mut item = 0;
+    for sc in &part.scenarios {
+        let runnable = sc.error.is_none() && (!part.gated || !sc.expect.is_empty());
+        let want: Vec<u64> = if runnable {
+            let seeds: Vec<u64> = sc.seeds.seeds().collect();
+            let owned = seeds
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| shard.owns(item + k))
+                .map(|(_, &s)| s)
+                .collect();
+            item += seeds.len();
+            owned
+        } else {
+            Vec::new()
+        };
+        let got: Vec<u64> = sc.results.iter().map(|r| r.seed).collect();
+        if got != want {
+            return Err(MergeError::OtherSeeds {
+                file: file.to_string(),
+                shard,
+                label: sc.label.clone(),
+                got: seed_list(&got),
+                want: seed_list(&want),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// `[1, 5, 9]`, cut after a few seeds, or `none`.
+fn seed_list(seeds: &[u64]) -> String {
+    const SHOWN: usize = 8;
+    if seeds.is_empty() {
+        return "none".into();
+    }
+    let head: Vec<String> = seeds.iter().take(SHOWN).map(u64::to_string).collect();
+    let more = seeds.len().saturating_sub(SHOWN);
+    let tail = if more > 0 {
+        format!(", … {more} more")
+    } else {
+        String::new()
+    };
+    format!("[{}{tail}]", head.join(", "))
 }
 
 /// Whether two parts were planned alike: same scenarios, seeds, expectations and errors.
@@ -382,6 +443,18 @@ mod tests {
         other.1.scenarios[0].seeds.last = 9;
         let e = merge(vec![part(1, &[1, 3]), other]).unwrap_err();
         assert!(e.to_string().contains("same arguments"), "{e}");
+    }
+
+    #[test]
+    fn merge_refuses_a_part_holding_other_seeds_than_its_shard_runs() {
+        let e = merge(vec![part(1, &[1, 2]), part(2, &[3, 4])]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p1.json (part 1/2) holds B seeds [1, 2], but part 1/2 of its plan runs seeds \
+             [1, 3]; run every shard with the same arguments"
+        );
+        let e = merge(vec![part(1, &[1, 3]), part(2, &[2])]).unwrap_err();
+        assert!(e.to_string().contains("holds B seeds [2]"), "{e}");
     }
 
     #[test]

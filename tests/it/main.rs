@@ -7,6 +7,7 @@ mod common;
 mod eval;
 mod io;
 mod longterm;
+mod merge;
 mod outputs;
 mod recognizer;
 mod sim;
