@@ -70,6 +70,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             progress: super::progress::bar(args.quiet),
             ..ExperimentOptions::default()
         },
+        command_line: super::common::command_line(),
     };
     let suite = stress::run_stress(&args.scenarios, &opts);
     if let Some(path) = &args.report {
@@ -95,7 +96,7 @@ pub fn finish(
         stress::write_dir(suite, dir).with_context(|| "writing the outputs")?;
     }
     if let Some(path) = junit_path {
-        let xml = junit::junit_xml(&junit::suites(suite));
+        let xml = junit::document(suite);
         stress::write_file(path, xml.as_bytes())?;
     }
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {

@@ -294,6 +294,7 @@ mod tests {
                     seconds: 2.0,
                     report: Some(r),
                     error: None,
+                    simulation_key: String::new(),
                 }
             })
             .collect();

@@ -9,6 +9,7 @@ mod io;
 mod longterm;
 mod merge;
 mod outputs;
+mod provenance;
 mod recognizer;
 mod sim;
 mod spec;
