@@ -107,5 +107,20 @@ pub fn finish(
     } else {
         out!("{}", format::check_text(suite))?;
     }
+    if std::env::var("GITHUB_ACTIONS").is_ok_and(|v| v == "true") {
+        // The runner reads workflow commands from stdout and stderr; keep --json's stdout JSON.
+        for a in stress::github_annotations(suite) {
+            if json {
+                eprintln!("{a}");
+            } else {
+                outln!("{a}")?;
+            }
+        }
+        let summary = std::env::var_os("GITHUB_STEP_SUMMARY").filter(|p| !p.is_empty());
+        // A part has no verdict to show: the merge writes the summary.
+        if let Some(path) = summary.filter(|_| suite.shard.is_none()) {
+            stress::append_step_summary(suite, Path::new(&path))?;
+        }
+    }
     Ok(ExitCode::from(suite.exit_code()))
 }

@@ -588,6 +588,26 @@ mod tests {
     }
 
     #[test]
+    fn bounds_of_a_scenario_whose_every_seed_failed_say_why() {
+        let mut sc = scenario(&[1, 2]);
+        for r in &mut sc.results {
+            r.report = None;
+            r.error = Some("simulation failed: robot blocked at (3.0, 1.0) for 20 s".into());
+        }
+        let s = SuiteReport::new(None, true, vec![sc]);
+        let o = &s.scenarios[0].outcomes[0];
+        assert!(!o.passed);
+        assert_eq!(
+            o.missing.as_deref(),
+            Some(
+                "every seed failed: simulation failed: robot blocked at (3.0, 1.0) for 20 s, \
+                 see the error test cases"
+            )
+        );
+        assert!(o.line().contains("every seed failed"), "{}", o.line());
+    }
+
+    #[test]
     fn merge_refuses_a_part_holding_other_seeds_than_its_shard_runs() {
         let e = merge(vec![part(1, &[1, 2]), part(2, &[3, 4])]).unwrap_err();
         assert_eq!(

@@ -274,6 +274,31 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StressError> {
     })
 }
 
+/// GitHub Actions `::error` annotations for the run's missed bounds (on each scenario's
+/// `[expect]` line, read from the file again) and failed runs.
+pub fn github_annotations(suite: &SuiteReport) -> Vec<String> {
+    crate::report::suite::github_annotations(suite, |file| {
+        let src = std::fs::read_to_string(file).ok()?;
+        crate::spec::scenario::expect_line(&src)
+    })
+}
+
+/// Appends the Markdown table (`table.md`) to GitHub's step summary file: appended, not
+/// replaced, since every step of a job shares the file.
+pub fn append_step_summary(suite: &SuiteReport, path: &Path) -> Result<(), StressError> {
+    use std::io::Write;
+    let md = crate::report::suite::markdown(suite);
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .and_then(|mut f| f.write_all(format!("{md}\n").as_bytes()))
+        .map_err(|source| StressError::Write {
+            path: path.display().to_string(),
+            source,
+        })
+}
+
 /// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`.
 pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
     use crate::report::{junit, suite as format};

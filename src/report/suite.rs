@@ -218,6 +218,54 @@ fn md_outcome(o: &Outcome) -> String {
     )
 }
 
+/// GitHub Actions workflow commands for a stress run: an `::error file=…,line=…::` per missed
+/// bound, on the line of its scenario's `[expect]` (`expect_line(file)`, `None` when not
+/// found: the annotation is then on the file), and one per scenario or seed that failed to run.
+pub fn github_annotations(
+    suite: &SuiteReport,
+    expect_line: impl Fn(&str) -> Option<usize>,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for sc in &suite.scenarios {
+        let at = match expect_line(&sc.file) {
+            Some(line) => format!("file={},line={line}", gh_property(&sc.file)),
+            None => format!("file={}", gh_property(&sc.file)),
+        };
+        for o in sc.outcomes.iter().filter(|o| !o.passed) {
+            let mut text = o.line();
+            if let Some(seed) = o.seed {
+                let _ = write!(text, "; reproduce: {}", sc.reproduce(seed));
+            }
+            out.push(format!(
+                "::error {at},title={}::{}",
+                gh_property(&o.name()),
+                gh_data(&text)
+            ));
+        }
+        for e in sc.errors() {
+            out.push(format!(
+                "::error file={},title={}::{}",
+                gh_property(&sc.file),
+                gh_property(&format!("{}/run", sc.label)),
+                gh_data(&e)
+            ));
+        }
+    }
+    out
+}
+
+/// A workflow command's message, escaped as GitHub's runner reads it.
+fn gh_data(s: &str) -> String {
+    s.replace('%', "%25")
+        .replace('\r', "%0D")
+        .replace('\n', "%0A")
+}
+
+/// A workflow command's property value (also `:` and `,` escaped).
+fn gh_property(s: &str) -> String {
+    gh_data(s).replace(':', "%3A").replace(',', "%2C")
+}
+
 /// One outcome in the `--json` summary.
 #[derive(Serialize)]
 struct JsonOutcome<'a> {
@@ -351,5 +399,22 @@ mod tests {
             v["outcomes"][0]["reproduce"],
             "placewords run scenarios/B.toml --seed 2"
         );
+    }
+
+    #[test]
+    fn a_missed_bound_is_a_github_annotation_on_the_expect_line() {
+        let s = suite();
+        let a = github_annotations(&s, |f| (f == "scenarios/B.toml").then_some(12));
+        assert_eq!(a.len(), 1, "{a:?}");
+        assert!(
+            a[0].starts_with(
+                "::error file=scenarios/B.toml,line=12,title=B/levels=3/recall::FAIL B levels=3 recall"
+            ),
+            "{}",
+            a[0]
+        );
+        assert!(a[0].ends_with("reproduce: placewords run scenarios/B.toml --seed 2"));
+        assert_eq!(gh_data("50%\nx"), "50%25%0Ax");
+        assert_eq!(gh_property("a:b,c"), "a%3Ab%2Cc");
     }
 }
