@@ -284,7 +284,7 @@ struct JsonOutcome<'a> {
     line: String,
 }
 
-/// The `--json` summary: tally, exit code, every outcome and every error.
+/// The `--json` summary: tally, exit code, every outcome and every error, and the provenance.
 pub fn summary_json(suite: &SuiteReport) -> String {
     let t = suite.tally();
     let outcomes: Vec<JsonOutcome> = suite
@@ -315,6 +315,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
         "shard": suite.shard.map(|s| s.to_string()),
         "outcomes": outcomes,
         "error_messages": errors,
+        "provenance": suite.provenance,
     });
     serde_json::to_string_pretty(&v).expect("a summary always serializes")
 }
@@ -394,6 +395,10 @@ mod tests {
         assert!(md.ends_with("0 passed, 1 failed\n"), "{md}");
         let v: serde_json::Value = serde_json::from_str(&summary_json(&s)).unwrap();
         assert_eq!(v["failed"], 1);
+        assert_eq!(
+            v["provenance"]["report_version"], 0,
+            "the suite's, here a default one"
+        );
         assert_eq!(v["exit_code"], 1);
         assert_eq!(
             v["outcomes"][0]["reproduce"],
