@@ -81,6 +81,7 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             laps: args.laps,
             ..ExperimentOptions::default()
         },
+        command_line: super::common::command_line(),
     };
     let suite = stress::run_stress(&args.scenarios, &opts);
     if let Some(path) = &args.report {
@@ -106,7 +107,7 @@ pub fn finish(
         stress::write_dir(suite, dir).with_context(|| "writing the outputs")?;
     }
     if let Some(path) = junit_path {
-        let xml = junit::junit_xml(&junit::suites(suite));
+        let xml = junit::document(suite);
         stress::write_file(path, xml.as_bytes())?;
     }
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
@@ -116,6 +117,21 @@ pub fn finish(
         outln!("{}", format::summary_json(suite))?;
     } else {
         out!("{}", format::check_text(suite))?;
+    }
+    if std::env::var("GITHUB_ACTIONS").is_ok_and(|v| v == "true") {
+        // The runner reads workflow commands from stdout and stderr; keep --json's stdout JSON.
+        for a in stress::github_annotations(suite) {
+            if json {
+                eprintln!("{a}");
+            } else {
+                outln!("{a}")?;
+            }
+        }
+        let summary = std::env::var_os("GITHUB_STEP_SUMMARY").filter(|p| !p.is_empty());
+        // A part has no verdict to show: the merge writes the summary.
+        if let Some(path) = summary.filter(|_| suite.shard.is_none()) {
+            stress::append_step_summary(suite, Path::new(&path))?;
+        }
     }
     Ok(ExitCode::from(suite.exit_code()))
 }

@@ -93,20 +93,29 @@ pub fn check_output_dirs<'a>(
     Ok(())
 }
 
-/// Prints the experiment's table, then writes its JSON report and pictures where asked: the
-/// true and odometry paths, and the matched pairs of each level configuration (and ICP).
+/// The command line as given (program name first), for the reports' provenance; an argument
+/// that is not UTF-8 is kept with its bad bytes replaced rather than refused.
+pub fn command_line() -> Vec<String> {
+    std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect()
+}
+
+/// Prints the experiment's table, then writes its JSON report (with `provenance`) and pictures
+/// where asked: the true and odometry paths, and the matched pairs of each level configuration
+/// (and ICP).
 pub fn print_and_write(
     exp: &placewords::experiment::Experiment,
     world: &placewords::world::World,
     radius_m: f64,
-    report: Option<&Path>,
+    report: Option<(&Path, &placewords::eval::provenance::Provenance)>,
     svg_dir: Option<&Path>,
 ) -> anyhow::Result<()> {
     out!("{}", placewords::report::table::text_table(&exp.report))?;
-    if let Some(path) = report {
+    if let Some((path, provenance)) = report {
         write_file(
             path,
-            placewords::report::json::to_json(&exp.report).as_bytes(),
+            placewords::report::json::to_json_with(&exp.report, provenance).as_bytes(),
         )?;
         errln!("report: {}", path.display());
     }

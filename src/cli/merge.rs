@@ -21,6 +21,7 @@ pub struct MergeArgs {
 
 pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
     super::common::check_output_dirs([Some(args.out.as_path())])?;
-    let suite = placewords::experiment::stress::merge_files(&args.parts)?;
+    let suite =
+        placewords::experiment::stress::merge_files(&args.parts, super::common::command_line())?;
     super::check::finish(&suite, Some(&args.out), None, args.json)
 }

@@ -136,11 +136,30 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let world = picture::empty_world(&exp.runs, &name);
+    let provenance = {
+        use placewords::eval::provenance::{self as p, Input};
+        let mut prov = p::Provenance::new(super::common::command_line());
+        prov.add_seeds([args.seed]);
+        let log_name = args.log.display().to_string();
+        prov.add_inputs([p::file_input("real_log", &args.log)]);
+        prov.add_inputs(args.config.iter().map(|c| p::file_input("config", c)));
+        prov.add_inputs([
+            Input::new("recognizer", &log_name, p::hash_settings(&base)),
+            Input::new("evaluation", &log_name, p::hash_settings(&evaluation)),
+            // How the log is read (truth source, added odometry noise and its seed, scan step).
+            Input::new(
+                "log_options",
+                &log_name,
+                p::hash_bytes(format!("{log:?}").as_bytes()),
+            ),
+        ]);
+        prov
+    };
     print_and_write(
         &exp,
         &world,
         args.tp_radius_m,
-        args.report.as_deref(),
+        args.report.as_deref().map(|p| (p, &provenance)),
         args.svg.as_deref(),
     )?;
     Ok(ExitCode::SUCCESS)

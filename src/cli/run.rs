@@ -56,6 +56,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         let stress_opts = StressOptions {
             seeds: Some(seeds),
             experiment: opts,
+            command_line: super::common::command_line(),
             ..StressOptions::default()
         };
         let suite = stress::run_stress(std::slice::from_ref(&args.scenario), &stress_opts);
@@ -82,11 +83,13 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
         super::score::export(path, rec, &exp.runs)?;
     }
+    let provenance =
+        experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line());
     print_and_write(
         &exp,
         &scn.sim.world,
         scn.evaluation.tp_radius_m,
-        args.report.as_deref(),
+        args.report.as_deref().map(|p| (p, &provenance)),
         args.svg.as_deref(),
     )?;
     Ok(ExitCode::SUCCESS)

@@ -36,7 +36,29 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     let report = score::score_rows(&logs, &rows, &name, &EvaluationSpec::default(), args.levels)?;
     out!("{}", placewords::report::table::text_table(&report))?;
     if let Some(path) = &args.report {
-        write_file(path, placewords::report::json::to_json(&report).as_bytes())?;
+        use placewords::eval::provenance::{self as p, Input};
+        let mut prov = p::Provenance::new(super::common::command_line());
+        // The logs: the manifest and every log beside it, in name order.
+        let mut logs = vec![args.logdir.join("manifest.json")];
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&args.logdir)
+            .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+            .unwrap_or_default();
+        files.retain(|f| f.extension().is_some_and(|e| e == "log"));
+        files.sort();
+        logs.extend(files);
+        prov.add_inputs(logs.iter().map(|f| p::file_input("logs", f)));
+        prov.add_inputs([
+            p::file_input("matches", &args.matches),
+            Input::new(
+                "evaluation",
+                &name,
+                p::hash_settings(&EvaluationSpec::default()),
+            ),
+        ]);
+        write_file(
+            path,
+            placewords::report::json::to_json_with(&report, &prov).as_bytes(),
+        )?;
         errln!("report: {}", path.display());
     }
     Ok(ExitCode::SUCCESS)

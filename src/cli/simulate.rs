@@ -13,6 +13,9 @@ pub struct SimulateArgs {
     /// are made, so memory does not grow with them).
     #[arg(long, value_parser = super::scenario::streamed_laps_flag)]
     pub laps: Option<usize>,
+    /// Simulate this seed instead of the scenario's `seed` (to reproduce one seed of `check`).
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
     /// Output folder for the logs and manifest.
     #[arg(short, long)]
     pub out: PathBuf,
@@ -25,7 +28,10 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
-    let scn = placewords::experiment::load_scenario(&args.scenario)?;
+    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
+    if let Some(seed) = args.seed {
+        scn.sim.seed = seed;
+    }
     let total: usize = scn
         .sim
         .runs

@@ -53,7 +53,11 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     out!("{}", curves_table(&report.curves))?;
     write_file(
         &stage.path().join("sweep.json"),
-        placewords::report::json::to_json(&report).as_bytes(),
+        placewords::report::json::to_json_with(
+            &report,
+            &experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line()),
+        )
+        .as_bytes(),
     )?;
     let title = format!("{}: precision / recall (Fig. 8)", scn.sim.name);
     write_file(

@@ -54,12 +54,14 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         .map(|p| placewords::experiment::load_scenario(p))
         .collect::<Result<Vec<_>, _>>()?;
     let mut reports = Vec::new();
+    let command_line = super::common::command_line();
     for scn in &scenarios {
         errln!("scenario {}", scn.sim.name);
         let exp = experiment::run_scenario(scn, &opts)?;
+        let provenance = experiment::scenario_provenance(&[scn], args.laps, command_line.clone());
         write_file(
             &stage.path().join(format!("report-{}.json", scn.sim.name)),
-            placewords::report::json::to_json(&exp.report).as_bytes(),
+            placewords::report::json::to_json_with(&exp.report, &provenance).as_bytes(),
         )?;
         reports.push(exp.report);
     }
@@ -71,7 +73,9 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     );
     out!("{md}")?;
     write_file(&stage.path().join("table.md"), md.as_bytes())?;
-    let json = placewords::report::json::to_json(&TableReport { reports });
+    let all: Vec<_> = scenarios.iter().collect();
+    let provenance = experiment::scenario_provenance(&all, args.laps, command_line);
+    let json = placewords::report::json::to_json_with(&TableReport { reports }, &provenance);
     write_file(&stage.path().join("table.json"), json.as_bytes())?;
     stage
         .commit()

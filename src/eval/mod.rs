@@ -16,6 +16,7 @@ pub mod gate;
 pub mod metrics;
 pub mod pair_recall;
 pub mod pair_set;
+pub mod provenance;
 pub mod scores;
 pub mod site_tree;
 pub mod suite;

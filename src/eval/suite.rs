@@ -8,6 +8,7 @@
 
 use crate::eval::distribution::{self, ConfigSpread};
 use crate::eval::gate::{self, Outcome};
+use crate::eval::provenance::{self, Provenance, REPORT_VERSION};
 use crate::eval::scores::Report;
 use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
@@ -25,6 +26,10 @@ pub struct SeedResult {
     /// The report, or `None` when the seed failed (see `error`).
     pub report: Option<Report>,
     pub error: Option<String>,
+    /// The seed's simulation key (`eval::provenance`): equal keys, equal laps. Empty when read
+    /// from a report older than provenance.
+    #[serde(default)]
+    pub simulation_key: String,
 }
 
 /// One scenario over its seeds.
@@ -99,6 +104,13 @@ pub struct SuiteReport {
     /// Whether the `[expect]` blocks are checked (`check`, `merge`) or not (`run`).
     pub gated: bool,
     pub scenarios: Vec<ScenarioResult>,
+    /// Wall-clock seconds of the whole run, start to end (for a merge, its longest part's:
+    /// parts run side by side). 0 when read from an older report.
+    #[serde(default)]
+    pub wall_seconds: f64,
+    /// What made it (`eval::provenance`); `report_version` 0 when read from an older report.
+    #[serde(default)]
+    pub provenance: Provenance,
 }
 
 /// What a suite amounts to.
@@ -133,6 +145,8 @@ impl SuiteReport {
             shard,
             gated,
             scenarios,
+            wall_seconds: 0.0,
+            provenance: Provenance::default(),
         };
         s.finish();
         s
@@ -155,6 +169,17 @@ impl SuiteReport {
             } else {
                 Vec::new()
             };
+            // No seed ran to the end: each bound says why instead of "not in the report".
+            if reports.is_empty()
+                && let Some(why) = sc.results.iter().find_map(|r| r.error.as_deref())
+            {
+                let why = why.lines().next().unwrap_or(why);
+                for o in &mut sc.outcomes {
+                    o.missing = Some(format!(
+                        "every seed failed: {why}, see the error test cases"
+                    ));
+                }
+            }
         }
     }
 
@@ -233,6 +258,46 @@ pub enum MergeError {
     OtherPlan { file: String, first: String },
     #[error("{label} seed {seed} is in {n} parts; run every shard with the same arguments")]
     SeedTwice { label: String, seed: u64, n: usize },
+    #[error(
+        "{file} was written with report_version {found}, this placewords reads \
+         {REPORT_VERSION}; make every part with one placewords"
+    )]
+    OtherReportVersion { file: String, found: u32 },
+    #[error(
+        "{file} (part {shard}) was made by placewords {build}, but {first} by {first_build}; \
+         make every part with one build"
+    )]
+    OtherBuild {
+        file: String,
+        shard: Shard,
+        /// `0.1.0 at commit …`.
+        build: String,
+        first: String,
+        first_build: String,
+    },
+    #[error(
+        "{file} (part {shard}) was made from other inputs than {first}: {input} differs \
+         ({hashes}); the input changed between the shards, run every shard on the same files"
+    )]
+    OtherInputs {
+        file: String,
+        shard: Shard,
+        first: String,
+        input: String,
+        /// `blake3 1a2b… against 3c4d…`.
+        hashes: String,
+    },
+    #[error(
+        "{file} (part {shard}) holds {label} seeds {got}, but part {shard} of its plan runs \
+         seeds {want}; run every shard with the same arguments"
+    )]
+    OtherSeeds {
+        file: String,
+        shard: Shard,
+        label: String,
+        got: String,
+        want: String,
+    },
 }
 
 /// Joins parts (with the files they came from, for messages) into the whole run's suite.
@@ -255,7 +320,24 @@ pub fn merge(parts: Vec<(String, SuiteReport)>) -> Result<SuiteReport, MergeErro
             });
         }
     }
-    Ok(SuiteReport::new(None, first.gated, scenarios))
+    let mut whole = SuiteReport::new(None, first.gated, scenarios);
+    whole.wall_seconds = parts
+        .iter()
+        .map(|(_, p)| p.wall_seconds)
+        .fold(0.0, f64::max);
+    // The figures are the parts' (one build, one set of inputs, checked above): their
+    // version, commit and inputs; the caller adds its command line and the part files.
+    whole.provenance = Provenance {
+        command_line: Vec::new(),
+        seeds: Vec::new(),
+        ..first.provenance.clone()
+    };
+    for (_, p) in &parts {
+        whole
+            .provenance
+            .add_seeds(p.provenance.seeds.iter().copied());
+    }
+    Ok(whole)
 }
 
 /// Checks that `parts` are parts 1..N of one plan, each once.
@@ -288,6 +370,8 @@ fn check_parts(parts: &[(String, SuiteReport)]) -> Result<(), MergeError> {
                 first: first_file.clone(),
             });
         }
+        check_seeds(file, shard, part)?;
+        check_provenance(file, shard, part, first_file, first)?;
     }
     match seen.iter().position(Option::is_none) {
         Some(i) => Err(MergeError::Missing {
@@ -296,6 +380,92 @@ fn check_parts(parts: &[(String, SuiteReport)]) -> Result<(), MergeError> {
         }),
         None => Ok(()),
     }
+}
+
+/// Checks that a part holds exactly the seeds its shard owns in its plan: the plan's work
+/// items are every runnable scenario's seeds in order, dealt round-robin (`Shard::owns`).
+fn check_seeds(file: &str, shard: Shard, part: &SuiteReport) -> Result<(), MergeError> {
+    let mut item = 0;
+    for sc in &part.scenarios {
+        let runnable = sc.error.is_none() && (!part.gated || !sc.expect.is_empty());
+        let want: Vec<u64> = if runnable {
+            let seeds: Vec<u64> = sc.seeds.seeds().collect();
+            let owned = seeds
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| shard.owns(item + k))
+                .map(|(_, &s)| s)
+                .collect();
+            item += seeds.len();
+            owned
+        } else {
+            Vec::new()
+        };
+        let got: Vec<u64> = sc.results.iter().map(|r| r.seed).collect();
+        if got != want {
+            return Err(MergeError::OtherSeeds {
+                file: file.to_string(),
+                shard,
+                label: sc.label.clone(),
+                got: seed_list(&got),
+                want: seed_list(&want),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks that a part was made by the build and from the inputs of the first part.
+fn check_provenance(
+    file: &str,
+    shard: Shard,
+    part: &SuiteReport,
+    first_file: &str,
+    first: &SuiteReport,
+) -> Result<(), MergeError> {
+    let (p, f) = (&part.provenance, &first.provenance);
+    if p.report_version != REPORT_VERSION {
+        return Err(MergeError::OtherReportVersion {
+            file: file.to_string(),
+            found: p.report_version,
+        });
+    }
+    if (&p.version, &p.commit) != (&f.version, &f.commit) {
+        let build = |p: &Provenance| format!("{} at commit {}", p.version, p.commit);
+        return Err(MergeError::OtherBuild {
+            file: file.to_string(),
+            shard,
+            build: build(p),
+            first: first_file.to_string(),
+            first_build: build(f),
+        });
+    }
+    match provenance::first_difference(&p.inputs, &f.inputs) {
+        Some((input, this, other)) => Err(MergeError::OtherInputs {
+            file: file.to_string(),
+            shard,
+            first: first_file.to_string(),
+            input,
+            hashes: format!("blake3 {this} against {other}"),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// `[1, 5, 9]`, cut after a few seeds, or `none`.
+fn seed_list(seeds: &[u64]) -> String {
+    const SHOWN: usize = 8;
+    if seeds.is_empty() {
+        return "none".into();
+    }
+    let head: Vec<String> = seeds.iter().take(SHOWN).map(u64::to_string).collect();
+    let more = seeds.len().saturating_sub(SHOWN);
+    let tail = if more > 0 {
+        format!(", … {more} more")
+    } else {
+        String::new()
+    };
+    format!("[{}{tail}]", head.join(", "))
 }
 
 /// Whether two parts were planned alike: same scenarios, seeds, expectations and errors.
@@ -345,6 +515,7 @@ mod tests {
                         seconds: 1.0,
                         report: Some(r),
                         error: None,
+                        simulation_key: format!("key{seed}"),
                     }
                 })
                 .collect(),
@@ -355,16 +526,20 @@ mod tests {
 
     fn part(k: usize, seeds: &[u64]) -> (String, SuiteReport) {
         let shard = Shard::new(k, 2).unwrap();
-        (
-            format!("p{k}.json"),
-            SuiteReport::new(Some(shard), true, vec![scenario(seeds)]),
-        )
+        let mut p = SuiteReport::new(Some(shard), true, vec![scenario(seeds)]);
+        p.provenance = Provenance::new(vec!["placewords".into(), "check".into()]);
+        p.provenance.add_seeds(seeds.iter().copied());
+        p.provenance.inputs = vec![provenance::Input::new("world", "w.toml", "a".repeat(64))];
+        (format!("p{k}.json"), p)
     }
 
     #[test]
     fn merged_parts_equal_the_whole_run() {
         let whole = SuiteReport::new(None, true, vec![scenario(&[1, 2, 3, 4])]);
-        let merged = merge(vec![part(2, &[2, 4]), part(1, &[1, 3])]).unwrap();
+        let mut merged = merge(vec![part(2, &[2, 4]), part(1, &[1, 3])]).unwrap();
+        assert_eq!(merged.provenance.seeds, [1, 2, 3, 4]);
+        assert_eq!(merged.provenance.inputs, part(1, &[1]).1.provenance.inputs);
+        merged.provenance = Provenance::default();
         assert_eq!(merged, whole);
         assert_eq!(whole.scenarios[0].outcomes[0].seed, Some(1));
         assert_eq!(whole.tally().line(), "1 passed, 0 failed");
@@ -381,6 +556,66 @@ mod tests {
         other.1.scenarios[0].seeds.last = 9;
         let e = merge(vec![part(1, &[1, 3]), other]).unwrap_err();
         assert!(e.to_string().contains("same arguments"), "{e}");
+    }
+
+    #[test]
+    fn merge_refuses_parts_of_other_inputs_builds_or_report_versions() {
+        let mut other = part(2, &[2, 4]);
+        other.1.provenance.inputs[0].blake3 = "b".repeat(64);
+        let e = merge(vec![part(1, &[1, 3]), other])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(
+                "p2.json (part 2/2) was made from other inputs than p1.json: world w.toml differs"
+            ),
+            "{e}"
+        );
+        let mut other = part(2, &[2, 4]);
+        other.1.provenance.commit = "0123abc".into();
+        let e = merge(vec![part(1, &[1, 3]), other])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("at commit 0123abc") && e.contains("one build"),
+            "{e}"
+        );
+        let mut old = part(2, &[2, 4]);
+        old.1.provenance = Provenance::default();
+        let e = merge(vec![part(1, &[1, 3]), old]).unwrap_err().to_string();
+        assert!(e.contains("report_version 0"), "{e}");
+    }
+
+    #[test]
+    fn bounds_of_a_scenario_whose_every_seed_failed_say_why() {
+        let mut sc = scenario(&[1, 2]);
+        for r in &mut sc.results {
+            r.report = None;
+            r.error = Some("simulation failed: robot blocked at (3.0, 1.0) for 20 s".into());
+        }
+        let s = SuiteReport::new(None, true, vec![sc]);
+        let o = &s.scenarios[0].outcomes[0];
+        assert!(!o.passed);
+        assert_eq!(
+            o.missing.as_deref(),
+            Some(
+                "every seed failed: simulation failed: robot blocked at (3.0, 1.0) for 20 s, \
+                 see the error test cases"
+            )
+        );
+        assert!(o.line().contains("every seed failed"), "{}", o.line());
+    }
+
+    #[test]
+    fn merge_refuses_a_part_holding_other_seeds_than_its_shard_runs() {
+        let e = merge(vec![part(1, &[1, 2]), part(2, &[3, 4])]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "p1.json (part 1/2) holds B seeds [1, 2], but part 1/2 of its plan runs seeds \
+             [1, 3]; run every shard with the same arguments"
+        );
+        let e = merge(vec![part(1, &[1, 3]), part(2, &[2])]).unwrap_err();
+        assert!(e.to_string().contains("holds B seeds [2]"), "{e}");
     }
 
     #[test]

@@ -79,6 +79,29 @@ impl Default for ExperimentOptions {
     }
 }
 
+/// The provenance of results made from `scenarios`, each simulated at its own seed with
+/// `laps` (`--laps`) replacing the lap counts when given: each one's inputs, simulation key and
+/// seed (`eval::provenance`).
+pub fn scenario_provenance(
+    scenarios: &[&Scenario],
+    laps: Option<usize>,
+    command_line: Vec<String>,
+) -> crate::eval::provenance::Provenance {
+    use crate::eval::provenance::{self, Provenance};
+    let mut p = Provenance::new(command_line);
+    for scn in scenarios {
+        p.add_inputs(provenance::scenario_inputs(
+            &scn.sim,
+            &scn.recognizer,
+            &scn.evaluation,
+            &scn.expect,
+        ));
+        p.add_inputs([provenance::simulation_input(&scn.sim, scn.sim.seed, laps)]);
+        p.add_seeds([scn.sim.seed]);
+    }
+    p
+}
+
 /// Everything an experiment produced: the report, and the data behind it for pictures.
 pub struct Experiment {
     pub report: Report,

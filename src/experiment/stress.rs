@@ -8,6 +8,7 @@
 //! gathered in plan order, so a report is the same whatever the thread count or the sharding
 //! (timings apart).
 
+use crate::eval::provenance::{self, Provenance};
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
 use crate::experiment::{ExperimentOptions, ProgressSink, run_scenario};
@@ -33,6 +34,8 @@ pub struct StressOptions {
     /// Without `gate`: the level configurations and whether ICP runs (`levels`, `icp`), laps
     /// override (`laps`); progress goes to `progress` (one step per seed).
     pub experiment: ExperimentOptions,
+    /// The command line, for the report's provenance. Default empty.
+    pub command_line: Vec<String>,
 }
 
 /// A scenario as planned: loaded (or why not), its seeds and what to run.
@@ -116,6 +119,7 @@ fn options_for(scn: &Scenario, opts: &StressOptions) -> Option<ExperimentOptions
 
 /// Runs every scenario of `paths` over its seeds (or this shard's share of them).
 pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
+    let started = Instant::now();
     let planned = plan(paths, opts);
     let mut items: Vec<(usize, u64)> = Vec::new();
     for (i, p) in planned.iter().enumerate() {
@@ -144,7 +148,23 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
         })
         .collect();
     progress.done();
-    SuiteReport::new(opts.shard, opts.gate, assemble(planned, items, results))
+    let mut prov = Provenance::new(opts.command_line.clone());
+    for p in &planned {
+        match &p.scenario {
+            Ok(scn) => prov.add_inputs(provenance::scenario_inputs(
+                &scn.sim,
+                &scn.recognizer,
+                &scn.evaluation,
+                &scn.expect,
+            )),
+            Err(_) => prov.add_inputs([provenance::file_input("scenario", Path::new(&p.file))]),
+        }
+    }
+    prov.add_seeds(results.iter().map(|r| r.seed));
+    let mut suite = SuiteReport::new(opts.shard, opts.gate, assemble(planned, items, results));
+    suite.provenance = prov;
+    suite.wall_seconds = started.elapsed().as_secs_f64();
+    suite
 }
 
 /// Runs `scn` at `seed`, timing it.
@@ -165,6 +185,7 @@ pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedR
         seconds: t.elapsed().as_secs_f64(),
         report,
         error,
+        simulation_key: provenance::simulation_key(&scn.sim, options.laps),
     }
 }
 
@@ -238,8 +259,12 @@ pub enum StressError {
     Output(#[from] crate::io::atomic::StageError),
 }
 
-/// Reads the parts at `paths` and merges them into the whole run's report.
-pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
+/// Reads the parts at `paths` and merges them into the whole run's report; its provenance is
+/// the parts' (build, inputs, seeds) with `command_line` and every part file's hash.
+pub fn merge_files(
+    paths: &[PathBuf],
+    command_line: Vec<String>,
+) -> Result<SuiteReport, StressError> {
     let mut parts = Vec::new();
     for path in paths {
         let file = path.display().to_string();
@@ -256,7 +281,12 @@ pub fn merge_files(paths: &[PathBuf]) -> Result<SuiteReport, StressError> {
         })?;
         parts.push((file, part));
     }
-    Ok(crate::eval::suite::merge(parts)?)
+    let mut whole = crate::eval::suite::merge(parts)?;
+    whole.provenance.command_line = command_line;
+    whole
+        .provenance
+        .add_inputs(paths.iter().map(|p| provenance::file_input("part", p)));
+    Ok(whole)
 }
 
 /// Writes `file` atomically, naming it in the error.
@@ -265,6 +295,31 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), StressError> {
         path: path.display().to_string(),
         source,
     })
+}
+
+/// GitHub Actions `::error` annotations for the run's missed bounds (on each scenario's
+/// `[expect]` line, read from the file again) and failed runs.
+pub fn github_annotations(suite: &SuiteReport) -> Vec<String> {
+    crate::report::suite::github_annotations(suite, |file| {
+        let src = std::fs::read_to_string(file).ok()?;
+        crate::spec::scenario::expect_line(&src)
+    })
+}
+
+/// Appends the Markdown table (`table.md`) to GitHub's step summary file: appended, not
+/// replaced, since every step of a job shares the file.
+pub fn append_step_summary(suite: &SuiteReport, path: &Path) -> Result<(), StressError> {
+    use std::io::Write;
+    let md = crate::report::suite::markdown(suite);
+    std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)
+        .and_then(|mut f| f.write_all(format!("{md}\n").as_bytes()))
+        .map_err(|source| StressError::Write {
+            path: path.display().to_string(),
+            source,
+        })
 }
 
 /// The files [`write_dir`] writes.
@@ -287,7 +342,7 @@ pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
     let at = stage.path().to_path_buf();
     write_file(&at.join(DIR_FILES[0]), suite.to_json().as_bytes())?;
     write_file(&at.join(DIR_FILES[1]), format::markdown(suite).as_bytes())?;
-    let xml = junit::junit_xml(&junit::suites(suite));
+    let xml = junit::document(suite);
     write_file(&at.join(DIR_FILES[2]), xml.as_bytes())?;
     stage.commit().map_err(|source| StressError::Write {
         path: dir.display().to_string(),

@@ -6,11 +6,15 @@
 //! Test case names do not change when a bound does (`B/words-3/precision`); the class name
 //! is the scenario file, so two scenarios of one name stay apart. Each test case carries the
 //! measured value, the bound, the statistic (worst or a quantile), the seed it came from and
-//! the command reproducing it as `<properties>`, and its `time` is the seconds its
-//! configuration spent recognizing over all seeds.
+//! the command reproducing it as `<properties>` (`seeds`: every seed the scenario ran, failed
+//! ones included), and its `time` is the seconds its configuration spent recognizing over all
+//! seeds. Each `<testsuite>` names the placewords version and commit that made it as
+//! properties (`placewords_version`, `placewords_commit`); the top-level `time` is the run's
+//! wall time (for a merge, the longest part's), never negative.
 
 pub use super::xml::escape;
 use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::provenance::{GIT_COMMIT, TOOL_VERSION};
 use crate::eval::suite::{SuiteReport, reproduce_command};
 use std::fmt::Write;
 
@@ -27,6 +31,53 @@ pub struct Suite {
     pub error: Option<String>,
     /// Wall-clock seconds the scenario took, over all seeds.
     pub seconds: f64,
+    /// Seeds the scenario ran, failed ones included.
+    pub seeds_run: usize,
+}
+
+/// What the document says about the whole run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunInfo {
+    /// The placewords version and commit that made the results.
+    pub version: String,
+    pub commit: String,
+    /// The run's wall time; `None`: the suites' seconds added up.
+    pub wall_seconds: Option<f64>,
+}
+
+impl Default for RunInfo {
+    /// This binary's version and commit, no wall time.
+    fn default() -> Self {
+        RunInfo {
+            version: TOOL_VERSION.into(),
+            commit: GIT_COMMIT.into(),
+            wall_seconds: None,
+        }
+    }
+}
+
+/// The JUnit document of a stress run (or a merge): its suites, version, commit, wall time.
+pub fn document(report: &SuiteReport) -> String {
+    let p = &report.provenance;
+    let known = |s: &str| {
+        if s.is_empty() {
+            "unknown".to_string()
+        } else {
+            s.to_string()
+        }
+    };
+    let run = RunInfo {
+        version: known(&p.version),
+        commit: known(&p.commit),
+        wall_seconds: Some(report.wall_seconds),
+    };
+    junit_xml_of(&suites(report), &run)
+}
+
+/// Seconds as JUnit writes them: three decimals, never `-0.000` or a negative time.
+fn secs(s: f64) -> String {
+    let s = if s.is_finite() && s > 0.0 { s } else { 0.0 };
+    format!("{s:.3}")
 }
 
 /// The JUnit suites of a stress run.
@@ -42,41 +93,57 @@ pub fn suites(report: &SuiteReport) -> Vec<Suite> {
                 outcomes: sc.outcomes.clone(),
                 error: (!errors.is_empty()).then(|| errors.join("\n")),
                 seconds: sc.seconds(),
+                seeds_run: sc.results.len(),
             }
         })
         .collect()
 }
 
-/// The JUnit XML document of `suites`.
+/// The JUnit XML document of `suites`, made by this binary (see [`document`]).
 pub fn junit_xml(suites: &[Suite]) -> String {
+    junit_xml_of(suites, &RunInfo::default())
+}
+
+/// The JUnit XML document of `suites` with `run`'s version, commit and wall time.
+pub fn junit_xml_of(suites: &[Suite], run: &RunInfo) -> String {
     let count = |s: &Suite| s.outcomes.len() + s.error.is_some() as usize;
     let fails = |s: &Suite| s.outcomes.iter().filter(|o| !o.passed).count();
     let tests: usize = suites.iter().map(count).sum();
     let failures: usize = suites.iter().map(fails).sum();
     let errors = suites.iter().filter(|s| s.error.is_some()).count();
-    let time: f64 = suites.iter().map(|s| s.seconds).sum();
+    let time = run
+        .wall_seconds
+        .unwrap_or_else(|| suites.iter().map(|s| s.seconds).sum());
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
         "<testsuites name=\"placewords check\" tests=\"{tests}\" failures=\"{failures}\" \
-         errors=\"{errors}\" time=\"{time:.3}\">"
+         errors=\"{errors}\" time=\"{}\">",
+        secs(time)
     );
     for s in suites {
         let _ = writeln!(
             x,
             "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"{}\" \
-             skipped=\"0\" time=\"{:.3}\">",
+             skipped=\"0\" time=\"{}\">",
             escape(&s.scenario),
             count(s),
             fails(s),
             s.error.is_some() as usize,
-            s.seconds
+            secs(s.seconds)
+        );
+        let _ = writeln!(
+            x,
+            "    <properties>\n      <property name=\"placewords_version\" value=\"{}\"/>\n      \
+             <property name=\"placewords_commit\" value=\"{}\"/>\n    </properties>",
+            escape(&run.version),
+            escape(&run.commit)
         );
         if let Some(err) = &s.error {
             x.push_str(&error_case(s, err));
         }
         for o in &s.outcomes {
-            x.push_str(&testcase(o, &s.file));
+            x.push_str(&testcase(o, &s.file, s.seeds_run));
         }
         x.push_str("  </testsuite>\n");
     }
@@ -87,22 +154,22 @@ pub fn junit_xml(suites: &[Suite]) -> String {
 /// The `<testcase>` of a scenario (or some of its seeds) that could not run.
 fn error_case(s: &Suite, err: &str) -> String {
     format!(
-        "    <testcase name=\"{}/run\" classname=\"{}\" time=\"{:.3}\">\n      \
+        "    <testcase name=\"{}/run\" classname=\"{}\" time=\"{}\">\n      \
          <error message=\"{}\" type=\"error\">{}</error>\n    </testcase>\n",
         escape(&s.scenario),
         escape(&s.file),
-        s.seconds,
+        secs(s.seconds),
         escape(first_line(err)),
         escape(rest_lines(err))
     )
 }
 
-/// The properties of a test case: measured value, statistic, bound, seeds, seed, command.
-fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
+/// The properties of a test case: measured value, statistic, bound, seeds run, seed, command.
+fn properties(o: &Outcome, file: &str, seeds_run: usize) -> Vec<(&'static str, String)> {
     let mut props = vec![
         ("statistic", o.statistic()),
         ("bound", fmt_value(o.bound, o.limit)),
-        ("seeds", o.seeds.to_string()),
+        ("seeds", seeds_run.to_string()),
     ];
     if let Some(a) = o.actual {
         props.insert(0, ("value", fmt_value(o.bound, a)));
@@ -118,15 +185,15 @@ fn properties(o: &Outcome, file: &str) -> Vec<(&'static str, String)> {
 }
 
 /// One `<testcase>` with its properties and, if missed, its failure.
-fn testcase(o: &Outcome, file: &str) -> String {
+fn testcase(o: &Outcome, file: &str, seeds_run: usize) -> String {
     let mut x = format!(
-        "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"{:.3}\">\n      <properties>\n",
+        "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"{}\">\n      <properties>\n",
         escape(&o.name()),
         escape(file),
         escape(file),
-        o.seconds
+        secs(o.seconds)
     );
-    for (k, v) in properties(o, file) {
+    for (k, v) in properties(o, file, seeds_run) {
         let _ = writeln!(
             x,
             "        <property name=\"{k}\" value=\"{}\"/>",
@@ -200,15 +267,22 @@ mod tests {
                 outcomes,
                 error: None,
                 seconds: 1.5,
+                seeds_run: 1,
             },
             Suite {
                 scenario: "broken".into(),
                 file: "x.toml".into(),
                 outcomes: vec![],
                 error: Some("scenarios/x.toml:3:1: unknown field `lapz`\n\"hint\"".into()),
-                seconds: 0.0,
+                seconds: -0.0,
+                seeds_run: 0,
             },
         ]);
+        assert!(!xml.contains("-0.000"), "{xml}");
+        assert!(
+            xml.contains("<property name=\"placewords_commit\""),
+            "{xml}"
+        );
         let doc = roxmltree::Document::parse(&xml).expect("valid XML");
         let root = doc.root_element();
         assert_eq!(root.tag_name().name(), "testsuites");

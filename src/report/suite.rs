@@ -218,6 +218,54 @@ fn md_outcome(o: &Outcome) -> String {
     )
 }
 
+/// GitHub Actions workflow commands for a stress run: an `::error file=…,line=…::` per missed
+/// bound, on the line of its scenario's `[expect]` (`expect_line(file)`, `None` when not
+/// found: the annotation is then on the file), and one per scenario or seed that failed to run.
+pub fn github_annotations(
+    suite: &SuiteReport,
+    expect_line: impl Fn(&str) -> Option<usize>,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    for sc in &suite.scenarios {
+        let at = match expect_line(&sc.file) {
+            Some(line) => format!("file={},line={line}", gh_property(&sc.file)),
+            None => format!("file={}", gh_property(&sc.file)),
+        };
+        for o in sc.outcomes.iter().filter(|o| !o.passed) {
+            let mut text = o.line();
+            if let Some(seed) = o.seed {
+                let _ = write!(text, "; reproduce: {}", sc.reproduce(seed));
+            }
+            out.push(format!(
+                "::error {at},title={}::{}",
+                gh_property(&o.name()),
+                gh_data(&text)
+            ));
+        }
+        for e in sc.errors() {
+            out.push(format!(
+                "::error file={},title={}::{}",
+                gh_property(&sc.file),
+                gh_property(&format!("{}/run", sc.label)),
+                gh_data(&e)
+            ));
+        }
+    }
+    out
+}
+
+/// A workflow command's message, escaped as GitHub's runner reads it.
+fn gh_data(s: &str) -> String {
+    s.replace('%', "%25")
+        .replace('\r', "%0D")
+        .replace('\n', "%0A")
+}
+
+/// A workflow command's property value (also `:` and `,` escaped).
+fn gh_property(s: &str) -> String {
+    gh_data(s).replace(':', "%3A").replace(',', "%2C")
+}
+
 /// One outcome in the `--json` summary.
 #[derive(Serialize)]
 struct JsonOutcome<'a> {
@@ -236,7 +284,7 @@ struct JsonOutcome<'a> {
     line: String,
 }
 
-/// The `--json` summary: tally, exit code, every outcome and every error.
+/// The `--json` summary: tally, exit code, every outcome and every error, and the provenance.
 pub fn summary_json(suite: &SuiteReport) -> String {
     let t = suite.tally();
     let outcomes: Vec<JsonOutcome> = suite
@@ -267,6 +315,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
         "shard": suite.shard.map(|s| s.to_string()),
         "outcomes": outcomes,
         "error_messages": errors,
+        "provenance": suite.provenance,
     });
     serde_json::to_string_pretty(&v).expect("a summary always serializes")
 }
@@ -294,6 +343,7 @@ mod tests {
                     seconds: 2.0,
                     report: Some(r),
                     error: None,
+                    simulation_key: String::new(),
                 }
             })
             .collect();
@@ -345,10 +395,31 @@ mod tests {
         assert!(md.ends_with("0 passed, 1 failed\n"), "{md}");
         let v: serde_json::Value = serde_json::from_str(&summary_json(&s)).unwrap();
         assert_eq!(v["failed"], 1);
+        assert_eq!(
+            v["provenance"]["report_version"], 0,
+            "the suite's, here a default one"
+        );
         assert_eq!(v["exit_code"], 1);
         assert_eq!(
             v["outcomes"][0]["reproduce"],
             "placewords run scenarios/B.toml --seed 2"
         );
+    }
+
+    #[test]
+    fn a_missed_bound_is_a_github_annotation_on_the_expect_line() {
+        let s = suite();
+        let a = github_annotations(&s, |f| (f == "scenarios/B.toml").then_some(12));
+        assert_eq!(a.len(), 1, "{a:?}");
+        assert!(
+            a[0].starts_with(
+                "::error file=scenarios/B.toml,line=12,title=B/words-3/recall::FAIL B words-3 recall"
+            ),
+            "{}",
+            a[0]
+        );
+        assert!(a[0].ends_with("reproduce: placewords run scenarios/B.toml --seed 2"));
+        assert_eq!(gh_data("50%\nx"), "50%25%0Ax");
+        assert_eq!(gh_property("a:b,c"), "a%3Ab%2Cc");
     }
 }

@@ -880,3 +880,43 @@ fn read_recognizer(top: &DeTable<'_>, d: &mut Diags) -> Vec<(S<String>, toml::Va
         })
         .collect()
 }
+
+/// The line (1-based) of the scenario text's `[expect]` table, or of its first `[expect.…]` /
+/// `[[expect.…]]` header when it has no plain one; `None` without either. CI annotations point
+/// there.
+pub fn expect_line(src: &str) -> Option<usize> {
+    let header = |l: &str| {
+        let l = l.trim_start().trim_start_matches('[').trim_start();
+        l.starts_with("expect]") || l.starts_with("expect.")
+    };
+    let lines: Vec<&str> = src.lines().collect();
+    let plain = lines
+        .iter()
+        .position(|l| l.trim_start().starts_with("[expect]"));
+    plain
+        .or_else(|| {
+            lines
+                .iter()
+                .position(|l| l.trim_start().starts_with('[') && header(l))
+        })
+        .map(|i| i + 1)
+}
+
+#[cfg(test)]
+mod expect_line_tests {
+    use super::expect_line;
+
+    #[test]
+    fn finds_the_expect_table_or_its_first_sub_table() {
+        assert_eq!(
+            expect_line("seed = 1\n\n[expect]\nquantile = 0.1\n"),
+            Some(3)
+        );
+        assert_eq!(
+            expect_line("a = 1\n[[expect.levels]]\nlevels = 3\n"),
+            Some(2)
+        );
+        assert_eq!(expect_line("a = 1\n[expectation]\n"), None);
+        assert_eq!(expect_line("# [expect]\n"), None);
+    }
+}

@@ -87,10 +87,32 @@ impl FromStr for SeedRange {
 }
 
 /// Part `index` (1-based) of `count` disjoint parts of a run's (scenario × seed) work.
+///
+/// Read back from a part file through [`Shard::new`], so a part with index 0, an index above
+/// its count, or a count of 0 or above [`MAX_SHARDS`] is refused where it is read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "RawShard")]
 pub struct Shard {
     pub index: usize,
     pub count: usize,
+}
+
+/// A shard as a file writes it, before [`Shard::new`] checks it.
+#[derive(serde::Deserialize)]
+struct RawShard {
+    index: u64,
+    count: u64,
+}
+
+impl TryFrom<RawShard> for Shard {
+    type Error = String;
+
+    fn try_from(raw: RawShard) -> Result<Self, String> {
+        // u64 first: on a 32-bit target a huge count must be refused, not wrapped.
+        let fit = |n: u64| usize::try_from(n).unwrap_or(usize::MAX);
+        Shard::new(fit(raw.index), fit(raw.count))
+            .map_err(|e| format!("shard {}/{}: {e}", raw.index, raw.count))
+    }
 }
 
 impl Shard {
@@ -202,5 +224,24 @@ mod tests {
         assert!("0/3".parse::<Shard>().is_err());
         assert!("4/3".parse::<Shard>().is_err());
         assert!("x".parse::<Shard>().unwrap_err().contains("K/N"));
+    }
+
+    #[test]
+    fn a_shard_read_from_a_file_is_checked() {
+        let read = |s: &str| serde_json::from_str::<Shard>(s);
+        assert_eq!(
+            read(r#"{"index":2,"count":4}"#).unwrap(),
+            Shard::new(2, 4).unwrap()
+        );
+        for bad in [
+            r#"{"index":0,"count":1}"#,
+            r#"{"index":1,"count":0}"#,
+            r#"{"index":3,"count":2}"#,
+            r#"{"index":1,"count":1000000000000}"#,
+            r#"{"index":1,"count":18446744073709551615}"#,
+        ] {
+            let e = read(bad).unwrap_err().to_string();
+            assert!(e.contains("shard ") && e.contains("part"), "{bad}: {e}");
+        }
     }
 }

@@ -311,6 +311,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
         outcomes,
         error: None,
         seconds: r.seconds,
+        seeds_run: 1,
     }]);
     assert!(
         xml.contains("<failure message=\"FAIL loop words-1 precision"),

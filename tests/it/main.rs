@@ -2,14 +2,17 @@
 
 mod architecture;
 mod authoring;
+mod ci;
 mod cli;
 mod common;
 mod eval;
 mod fuzz;
 mod io;
 mod longterm;
+mod merge;
 mod outputs;
 mod plugin;
+mod provenance;
 mod recognizer;
 mod settings;
 mod sim;

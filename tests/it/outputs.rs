@@ -115,7 +115,24 @@ fn a_failed_simulation_leaves_the_folder_and_no_temporary_files() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     let xml = std::fs::read_to_string(&junit).unwrap();
-    assert_eq!(xml.matches("the robot was blocked").count(), 1, "{xml}");
+    let doc = roxmltree::Document::parse(&xml).unwrap();
+    let error = doc.descendants().find(|n| n.has_tag_name("error")).unwrap();
+    let said = format!(
+        "{} {}",
+        error.attribute("message").unwrap(),
+        error.text().unwrap_or("")
+    );
+    assert_eq!(said.matches("the robot was blocked").count(), 1, "{xml}");
+    // the bound says why it has no figure, pointing at the error case
+    let failure = doc
+        .descendants()
+        .find(|n| n.has_tag_name("failure"))
+        .unwrap();
+    let message = failure.attribute("message").unwrap();
+    assert!(
+        message.contains("every seed failed: ") && message.contains("see the error test cases"),
+        "{xml}"
+    );
 }
 
 /// Find 12: the temporary file or folder a killed writer left beside an output is removed by
