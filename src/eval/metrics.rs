@@ -41,7 +41,7 @@
 
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
-use super::site_tree::{LapSet, Query, Site, sweep};
+use super::site_tree::{Query, Site, sweep};
 use super::tally::{Scope, Tally};
 use super::{GroundTruth, Recognition};
 use crate::recognizer::{Match, ObsId, Observation};
@@ -151,6 +151,20 @@ pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
         return e.clone();
     }
     let mut tally = Tally::new(spec, Scope::Full);
+    tally.sync(&rec.observations, &rec.truth);
+    for m in &rec.matches {
+        tally.add(m, &rec.truth);
+    }
+    tally.finish(&rec.truth)
+}
+
+/// [`evaluate`] with the earlier scoring's searches (visit recall's laps from the k-d tree of
+/// every earlier site, [`super::site_tree`]): the reference the linear-time searches are tested
+/// against on every shipped scenario. Not for use: it grows with the square of the laps.
+#[doc(hidden)]
+pub fn evaluate_by_site_tree(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
+    let mut tally = Tally::new(spec, Scope::Full);
+    tally.by_site_tree();
     tally.sync(&rec.observations, &rec.truth);
     for m in &rec.matches {
         tally.add(m, &rec.truth);
@@ -543,17 +557,24 @@ impl Scorer {
     }
 
     /// Calls `visit(i, laps)` for every observation `i` with truth, in order, with the earlier
-    /// laps that revisit it at radius `r` (facing as this scorer counts).
-    pub(super) fn sweep_laps(
-        &self,
-        r: f64,
-        laps: &mut LapSet,
-        mut visit: impl FnMut(usize, &[usize]),
-    ) {
+    /// laps that revisit it at radius `r` (facing as this scorer counts), found lap by lap
+    /// ([`super::lap_grid`]).
+    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, &[usize])) {
         let j = &self.joined;
+        let (gap, facing, tol) = (self.min_gap_m, self.facing, self.heading_tol_rad);
+        super::lap_grid::sweep_laps(&j.sites, gap, r, facing, tol, |k, laps| {
+            visit(j.obs_of_site(k), laps)
+        });
+    }
+
+    /// [`Self::sweep_laps`] by the k-d tree of every earlier site: the reference the lap grid
+    /// is tested against.
+    pub(super) fn sweep_laps_by_site(&self, r: f64, mut visit: impl FnMut(usize, &[usize])) {
+        let j = &self.joined;
+        let mut laps = super::site_tree::LapSet::default();
         sweep(&j.sites, self.min_gap_m, |k, tree| {
             laps.clear();
-            tree.laps(&self.query(k, r), laps);
+            tree.laps(&self.query(k, r), &mut laps);
             visit(j.obs_of_site(k), &laps.list);
         });
     }

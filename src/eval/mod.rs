@@ -13,6 +13,7 @@
 
 pub(crate) mod distribution;
 pub mod gate;
+mod lap_grid;
 pub mod metrics;
 pub mod pair_recall;
 pub mod pair_set;
@@ -32,7 +33,7 @@ use std::sync::Arc;
 use std::time::Instant;
 use tally::{Scope, Tally};
 
-pub use metrics::{Evaluation, Metrics, evaluate};
+pub use metrics::{Evaluation, Metrics, evaluate, evaluate_by_site_tree};
 
 /// The interface a recognizer implements to be scored lives below `eval` and `baseline` in
 /// [`crate::place`]; re-exported here for the evaluation's users.

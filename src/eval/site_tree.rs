@@ -226,7 +226,8 @@ impl<'s> SiteTree<'s> {
     }
 
     /// Adds to `laps` the lap of every active site `q` takes (nodes of one lap already in
-    /// `laps` are skipped).
+    /// `laps` are skipped). Visit recall finds laps with [`super::lap_grid`]; this is the
+    /// reference it is tested against ([`super::evaluate_by_site_tree`]).
     pub fn laps(&self, q: &Query, laps: &mut LapSet) {
         let mut stack = vec![0u32];
         while let Some(id) = stack.pop() {
@@ -337,13 +338,13 @@ pub fn sweep(sites: &[Site], min_gap_m: f64, mut visit: impl FnMut(usize, &SiteT
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
     /// Sites on several noisy passes over one path, some driven the other way, on 3 laps.
-    fn passes(seed: u64) -> Vec<Site> {
+    pub(in crate::eval) fn passes(seed: u64) -> Vec<Site> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut out = Vec::new();
         let mut travel = 0.0;

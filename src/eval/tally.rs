@@ -29,7 +29,7 @@ use super::GroundTruth;
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
 use super::pair_recall::{Facing, PairRecall, count_possible};
 use super::pair_set::pack;
-use super::site_tree::{LapSet, Site};
+use super::site_tree::Site;
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 use std::collections::{HashMap, HashSet};
@@ -118,6 +118,8 @@ pub struct Tally {
     /// Pairs forgotten since the last [`Tally::take_forgotten`], when asked to keep them.
     forgotten: Option<Vec<u64>>,
     in_match: HashSet<(ObsId, ObsId)>,
+    /// Searches with the k-d tree of every earlier site ([`Self::by_site_tree`]).
+    by_site_tree: bool,
 }
 
 impl Tally {
@@ -162,7 +164,14 @@ impl Tally {
             late_pairs: 0,
             forgotten: None,
             in_match: HashSet::new(),
+            by_site_tree: false,
         }
+    }
+
+    /// Searches as the scoring did before it was linear in the laps (the k-d tree of every
+    /// earlier site): the reference of `metrics::evaluate_by_site_tree`.
+    pub(super) fn by_site_tree(&mut self) {
+        self.by_site_tree = true;
     }
 
     /// Keep the distinct resolved pairs forgotten by [`Self::evict_below`] until
@@ -431,6 +440,21 @@ impl Tally {
     /// Visit recall at radius `r` as `scorer` faces: the earlier laps each observation was
     /// correctly paired with ÷ the earlier laps that revisit it.
     fn visit_recall(&self, scorer: &Scorer, r: f64) -> f64 {
+        if self.by_site_tree {
+            self.visit_recall_with(scorer, r, |visit| scorer.sweep_laps_by_site(r, visit))
+        } else {
+            self.visit_recall_with(scorer, r, |visit| scorer.sweep_laps(r, visit))
+        }
+    }
+
+    /// Visit recall with the earlier laps of each observation from `sweep` (observations in
+    /// increasing order, as [`Scorer::sweep_laps`] gives them).
+    fn visit_recall_with(
+        &self,
+        scorer: &Scorer,
+        r: f64,
+        sweep: impl FnOnce(&mut dyn FnMut(usize, &[usize])),
+    ) -> f64 {
         if r <= 0.0 || !r.is_finite() {
             return 0.0;
         }
@@ -439,18 +463,34 @@ impl Tally {
             Facing::Same => 1,
             Facing::Opposite => 2,
         };
-        let found_with = |i: usize, lap: usize| {
-            let base = (i as u64) << 32 | (lap as u64) << 2;
-            let k = self.visits.partition_point(|&v| v < base);
-            self.visits
-                .get(k)
-                .is_some_and(|&v| v >> 2 == base >> 2 && v & need != 0)
-        };
+        // `visits` is sorted by observation then lap, one entry per pair: the entries of each
+        // observation are a run, walked once.
+        let mut at = 0usize;
+        let mut of_lap: Vec<bool> = Vec::new();
         let (mut visits, mut found) = (0usize, 0usize);
-        let mut laps = LapSet::default();
-        scorer.sweep_laps(r, &mut laps, |i, laps| {
+        sweep(&mut |i, laps| {
             visits += laps.len();
-            found += laps.iter().filter(|&&l| found_with(i, l)).count();
+            let base = (i as u64) << 32;
+            at += self.visits[at..].partition_point(|&v| v < base);
+            let end = at + self.visits[at..].partition_point(|&v| v >> 32 == i as u64);
+            if end == at {
+                return;
+            }
+            for &l in laps {
+                if of_lap.len() <= l {
+                    of_lap.resize(l + 1, false);
+                }
+                of_lap[l] = true;
+            }
+            found += self.visits[at..end]
+                .iter()
+                .filter(|&&v| v & need != 0)
+                .filter(|&&v| of_lap.get(((v & 0xffff_ffff) >> 2) as usize) == Some(&true))
+                .count();
+            for &l in laps {
+                of_lap[l] = false;
+            }
+            at = end;
         });
         super::metrics::ratio(found, visits)
     }

@@ -1,0 +1,194 @@
+//! The earlier laps that pass near each observation, found lap by lap: the index behind visit
+//! recall ([`super::tally`]).
+//!
+//! Visit recall asks, for every observation in creation order, which earlier laps hold an
+//! observation at least `min_gap_m` of true travel before it, within a radius and facing a given
+//! way. The answer is a set of laps, so once one site of a lap agrees, the rest of that lap need
+//! not be looked at. The k-d tree of [`super::site_tree`] finds the sites, not the laps, and
+//! grew with the square of the laps on a long run (a thousand laps of one loop). Here the
+//! active sites sit in square cells at least the radius wide, each cell's sites kept as *runs*
+//! of one lap in creation order; a query looks at the 3 × 3 cells around it and, per run of a
+//! lap not yet found, first at the lap's *witness* (the site of that lap that last agreed with a
+//! query: consecutive observations are close, so it usually agrees again) and only then at the
+//! run's sites one by one, stopping at the first that agrees. The work per query is the runs
+//! near it, about one per earlier lap that passes there, plus the sites of laps that pass near
+//! but do not agree.
+//!
+//! The answers are exactly those of testing every active site with the figures' own predicate
+//! ([`Site::agrees_with`]): a site within the radius lies in one of the 3 × 3 cells (the cells
+//! are 1 % wider than the radius, far more than the rounding of a cell index), and every site
+//! the query takes a lap from is tested with that predicate.
+
+use super::pair_recall::Facing;
+use super::site_tree::{LapSet, Query, Site};
+use foldhash::HashMap;
+
+/// Marks a lap without a witness.
+const NO_WITNESS: u32 = u32::MAX;
+
+/// One cell: its sites in creation order and where each run of one lap ends.
+#[derive(Default)]
+struct Cell {
+    sites: Vec<u32>,
+    /// (lap, end in `sites`) of each run; a run starts where the previous one ends.
+    runs: Vec<(u32, u32)>,
+}
+
+/// The active sites of one sweep in cells, with a witness per lap (see the module doc).
+pub struct LapGrid<'s> {
+    sites: &'s [Site],
+    inv_cell_m: f64,
+    cells: HashMap<(i64, i64), Cell>,
+    /// Per lap: the site that last agreed with a query, or [`NO_WITNESS`].
+    witness: Vec<u32>,
+}
+
+impl<'s> LapGrid<'s> {
+    /// An empty grid over `sites` for queries within `r_m` (positive and finite).
+    fn new(sites: &'s [Site], r_m: f64) -> Self {
+        let laps = sites.iter().map(|s| s.lap + 1).max().unwrap_or(0);
+        LapGrid {
+            sites,
+            inv_cell_m: 1.0 / (r_m * 1.01),
+            cells: HashMap::default(),
+            witness: vec![NO_WITNESS; laps],
+        }
+    }
+
+    fn cell_of(&self, s: &Site) -> (i64, i64) {
+        (
+            (s.x * self.inv_cell_m).floor() as i64,
+            (s.y * self.inv_cell_m).floor() as i64,
+        )
+    }
+
+    /// Makes site `k` active.
+    fn activate(&mut self, k: usize) {
+        let s = &self.sites[k];
+        let key = self.cell_of(s);
+        let lap = s.lap as u32;
+        let cell = self.cells.entry(key).or_default();
+        cell.sites.push(k as u32);
+        let end = cell.sites.len() as u32;
+        match cell.runs.last_mut() {
+            Some((l, e)) if *l == lap => *e = end,
+            _ => cell.runs.push((lap, end)),
+        }
+    }
+
+    /// Adds to `laps` the lap of every active site `q` takes.
+    fn laps(&mut self, q: &Query, laps: &mut LapSet) {
+        let (cx, cy) = self.cell_of(q.site);
+        let agrees = |p: &Site| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad);
+        // The query's own cell first: the laps found there are skipped in the others.
+        const AROUND: [(i64, i64); 9] = [
+            (0, 0),
+            (-1, -1),
+            (-1, 0),
+            (-1, 1),
+            (0, -1),
+            (0, 1),
+            (1, -1),
+            (1, 0),
+            (1, 1),
+        ];
+        for (dx, dy) in AROUND {
+            let Some(cell) = self.cells.get(&(cx + dx, cy + dy)) else {
+                continue;
+            };
+            let mut start = 0usize;
+            for &(lap, end) in &cell.runs {
+                let run = &cell.sites[start..end as usize];
+                start = end as usize;
+                if laps.contains(lap as usize) {
+                    continue;
+                }
+                let w = self.witness[lap as usize];
+                if w != NO_WITNESS && agrees(&self.sites[w as usize]) {
+                    laps.insert(lap as usize);
+                    continue;
+                }
+                if let Some(&j) = run.iter().find(|&&j| agrees(&self.sites[j as usize])) {
+                    self.witness[lap as usize] = j;
+                    laps.insert(lap as usize);
+                }
+            }
+        }
+    }
+}
+
+/// Calls `visit(k, laps)` for every site `k` in order, with the laps of the sites before it, at
+/// least `min_gap_m` of true travel earlier, within `r_m` and facing as `facing` says (nothing
+/// when `r_m` is not positive and finite).
+pub fn sweep_laps(
+    sites: &[Site],
+    min_gap_m: f64,
+    r_m: f64,
+    facing: Facing,
+    tol_rad: f64,
+    mut visit: impl FnMut(usize, &[usize]),
+) {
+    if r_m <= 0.0 || !r_m.is_finite() {
+        return;
+    }
+    let mut grid = LapGrid::new(sites, r_m);
+    let mut laps = LapSet::default();
+    let mut ready = 0;
+    for (k, s) in sites.iter().enumerate() {
+        while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
+            grid.activate(ready);
+            ready += 1;
+        }
+        laps.clear();
+        let q = Query {
+            site: s,
+            r2: r_m * r_m,
+            facing,
+            tol_rad,
+        };
+        grid.laps(&q, &mut laps);
+        visit(k, &laps.list);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::site_tree::{sweep, tests::passes};
+
+    /// The laps equal the k-d tree's (which equal testing every earlier site) for every site,
+    /// radius and facing, on passes that go both ways.
+    #[test]
+    fn laps_equal_the_site_tree() {
+        let sites = passes(5);
+        for r in [0.05, 0.5, 1.0, 3.0] {
+            for facing in [Facing::Same, Facing::Opposite, Facing::Either] {
+                let mut want = Vec::new();
+                let mut set = LapSet::default();
+                sweep(&sites, 2.0, |k, tree| {
+                    set.clear();
+                    let q = Query {
+                        site: &sites[k],
+                        r2: r * r,
+                        facing,
+                        tol_rad: 0.7,
+                    };
+                    tree.laps(&q, &mut set);
+                    let mut l = set.list.clone();
+                    l.sort_unstable();
+                    want.push(l);
+                });
+                let mut got = Vec::new();
+                sweep_laps(&sites, 2.0, r, facing, 0.7, |_, laps| {
+                    let mut l = laps.to_vec();
+                    l.sort_unstable();
+                    got.push(l);
+                });
+                assert_eq!(got, want, "{r} {facing:?}");
+                if r >= 0.5 {
+                    assert!(want.iter().any(|l| l.len() > 1), "{r} {facing:?}");
+                }
+            }
+        }
+    }
+}
