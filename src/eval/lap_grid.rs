@@ -9,29 +9,40 @@
 //! active sites sit in square cells at least the radius wide, each cell's sites kept as *runs*
 //! of one lap in creation order; a query looks at the 3 × 3 cells around it and, per run of a
 //! lap not yet found, first at the lap's *witness* (the site of that lap that last agreed with a
-//! query: consecutive observations are close, so it usually agrees again) and only then at the
-//! run's sites one by one, stopping at the first that agrees. The work per query is the runs
+//! query: consecutive observations are close, so it usually agrees again), then at the run's
+//! bounds (position and heading: a run wholly outside the query, or wholly inside it, is decided
+//! at once) and only then at the run's sites one by one, stopping at the first that agrees. The work per query is the runs
 //! near it, about one per earlier lap that passes there, plus the sites of laps that pass near
 //! but do not agree.
 //!
 //! The answers are exactly those of testing every active site with the figures' own predicate
 //! ([`Site::agrees_with`]): a site within the radius lies in one of the 3 × 3 cells (the cells
-//! are 1 % wider than the radius, far more than the rounding of a cell index), and every site
-//! the query takes a lap from is tested with that predicate.
+//! are 1 % wider than the radius, far more than the rounding of a cell index); a lap is taken
+//! from a witness or a site that passes that predicate, or from a run whose bounds are decided
+//! as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
 
 use super::pair_recall::Facing;
-use super::site_tree::{LapSet, Query, Site};
+use super::site_tree::{Cover, LapSet, Query, Site, cover};
+use crate::geom::wrap_angle;
 use foldhash::HashMap;
 
-/// Marks a lap without a witness.
-const NO_WITNESS: u32 = u32::MAX;
+/// One run of a lap in a cell: where it ends in the cell's sites, and the bounds of its sites'
+/// positions and wrapped headings (a run wholly in or out of a query is decided at once).
+#[derive(Clone, Copy)]
+struct Run {
+    lap: u32,
+    end: u32,
+    x: [f64; 2],
+    y: [f64; 2],
+    theta: [f64; 2],
+}
 
-/// One cell: its sites in creation order and where each run of one lap ends.
+/// One cell: its sites in creation order, as runs of one lap.
 #[derive(Default)]
 struct Cell {
     sites: Vec<u32>,
-    /// (lap, end in `sites`) of each run; a run starts where the previous one ends.
-    runs: Vec<(u32, u32)>,
+    /// A run starts where the previous one ends.
+    runs: Vec<Run>,
 }
 
 /// The active sites of one sweep in cells, with a witness per lap (see the module doc).
@@ -39,8 +50,9 @@ pub struct LapGrid<'s> {
     sites: &'s [Site],
     inv_cell_m: f64,
     cells: HashMap<(i64, i64), Cell>,
-    /// Per lap: the site that last agreed with a query, or [`NO_WITNESS`].
-    witness: Vec<u32>,
+    /// Per lap: a copy of the site that last agreed with a query (kept beside each other, so
+    /// testing the witnesses of many laps reads few cache lines).
+    witness: Vec<Option<Site>>,
 }
 
 impl<'s> LapGrid<'s> {
@@ -51,7 +63,7 @@ impl<'s> LapGrid<'s> {
             sites,
             inv_cell_m: 1.0 / (r_m * 1.01),
             cells: HashMap::default(),
-            witness: vec![NO_WITNESS; laps],
+            witness: vec![None; laps],
         }
     }
 
@@ -67,12 +79,24 @@ impl<'s> LapGrid<'s> {
         let s = &self.sites[k];
         let key = self.cell_of(s);
         let lap = s.lap as u32;
+        let t = wrap_angle(s.theta);
         let cell = self.cells.entry(key).or_default();
         cell.sites.push(k as u32);
         let end = cell.sites.len() as u32;
         match cell.runs.last_mut() {
-            Some((l, e)) if *l == lap => *e = end,
-            _ => cell.runs.push((lap, end)),
+            Some(r) if r.lap == lap => {
+                r.end = end;
+                r.x = [r.x[0].min(s.x), r.x[1].max(s.x)];
+                r.y = [r.y[0].min(s.y), r.y[1].max(s.y)];
+                r.theta = [r.theta[0].min(t), r.theta[1].max(t)];
+            }
+            _ => cell.runs.push(Run {
+                lap,
+                end,
+                x: [s.x; 2],
+                y: [s.y; 2],
+                theta: [t; 2],
+            }),
         }
     }
 
@@ -97,20 +121,25 @@ impl<'s> LapGrid<'s> {
                 continue;
             };
             let mut start = 0usize;
-            for &(lap, end) in &cell.runs {
-                let run = &cell.sites[start..end as usize];
-                start = end as usize;
-                if laps.contains(lap as usize) {
+            for run in &cell.runs {
+                let (lap, from) = (run.lap as usize, start);
+                start = run.end as usize;
+                if laps.contains(lap) {
                     continue;
                 }
-                let w = self.witness[lap as usize];
-                if w != NO_WITNESS && agrees(&self.sites[w as usize]) {
-                    laps.insert(lap as usize);
+                if self.witness[lap].as_ref().is_some_and(agrees) {
+                    laps.insert(lap);
                     continue;
                 }
-                if let Some(&j) = run.iter().find(|&&j| agrees(&self.sites[j as usize])) {
-                    self.witness[lap as usize] = j;
-                    laps.insert(lap as usize);
+                let sites = &cell.sites[from..start];
+                let hit = match cover(run.x, run.y, run.theta, q) {
+                    Cover::None => None,
+                    Cover::All => sites.first(),
+                    Cover::Part => sites.iter().find(|&&j| agrees(&self.sites[j as usize])),
+                };
+                if let Some(&j) = hit {
+                    self.witness[lap] = Some(self.sites[j as usize]);
+                    laps.insert(lap);
                 }
             }
         }
