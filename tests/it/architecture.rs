@@ -19,7 +19,7 @@ const LAYERS: &[&[&str]] = &[
     &["spec"],
     &["log"],
     &["scan"],
-    &["geom"],
+    &["geom", "clock"],
 ];
 
 fn layer(module: &str) -> Option<usize> {
