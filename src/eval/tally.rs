@@ -32,7 +32,9 @@ use super::pair_set::pack;
 use super::site_tree::Site;
 use crate::recognizer::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
-use std::collections::{HashMap, HashSet};
+// foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
+// profile of scoring as matches arrive (BENCHMARKS.md, issue 30).
+use foldhash::{HashMap, HashSet};
 
 /// What a tally counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,14 +158,14 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            window: HashMap::new(),
-            unresolved: HashMap::new(),
-            visits_window: HashMap::new(),
+            window: HashMap::default(),
+            unresolved: HashMap::default(),
+            visits_window: HashMap::default(),
             visits: Vec::new(),
             evicted_below: 0,
             late_pairs: 0,
             forgotten: None,
-            in_match: HashSet::new(),
+            in_match: HashSet::default(),
             by_site_tree: false,
         }
     }
