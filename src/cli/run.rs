@@ -4,9 +4,9 @@
 use super::common::{LevelsArg, SeedsArg, print_and_write, write_file};
 use clap::Args;
 use placewords::clock::Stopwatch;
-use placewords::report::profile::profile_text;
 use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::{self, ExperimentOptions};
+use placewords::report::profile::profile_text;
 use std::path::PathBuf;
 use std::process::ExitCode;
 

@@ -45,17 +45,18 @@ struct Cell {
     runs: Vec<Run>,
 }
 
-/// The active sites of one sweep in cells, with a witness per lap (see the module doc).
-pub struct LapGrid<'s> {
+/// The active sites of one sweep in cells, with a witness per lap and facing asked about (see
+/// the module doc).
+pub struct LapGrid<'s, const N: usize> {
     sites: &'s [Site],
     inv_cell_m: f64,
     cells: HashMap<(i64, i64), Cell>,
-    /// Per lap: a copy of the site that last agreed with a query (kept beside each other, so
-    /// testing the witnesses of many laps reads few cache lines).
-    witness: Vec<Option<Site>>,
+    /// Per facing asked about, per lap: a copy of the site that last agreed with a query (kept
+    /// beside each other, so testing the witnesses of many laps reads few cache lines).
+    witness: [Vec<Option<Site>>; N],
 }
 
-impl<'s> LapGrid<'s> {
+impl<'s, const N: usize> LapGrid<'s, N> {
     /// An empty grid over `sites` for queries within `r_m` (positive and finite).
     fn new(sites: &'s [Site], r_m: f64) -> Self {
         let laps = sites.iter().map(|s| s.lap + 1).max().unwrap_or(0);
@@ -63,7 +64,7 @@ impl<'s> LapGrid<'s> {
             sites,
             inv_cell_m: 1.0 / (r_m * 1.01),
             cells: HashMap::default(),
-            witness: vec![None; laps],
+            witness: std::array::from_fn(|_| vec![None; laps]),
         }
     }
 
@@ -100,10 +101,10 @@ impl<'s> LapGrid<'s> {
         }
     }
 
-    /// Adds to `laps` the lap of every active site `q` takes.
-    fn laps(&mut self, q: &Query, laps: &mut LapSet) {
-        let (cx, cy) = self.cell_of(q.site);
-        let agrees = |p: &Site| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad);
+    /// Adds to `laps[f]` the lap of every active site `qs[f]` takes (the queries ask about one
+    /// site, each facing its own way: the cells and runs are walked once for all).
+    fn laps(&mut self, qs: &[Query; N], laps: &mut [LapSet; N]) {
+        let (cx, cy) = self.cell_of(qs[0].site);
         // The query's own cell first: the laps found there are skipped in the others.
         const AROUND: [(i64, i64); 9] = [
             (0, 0),
@@ -124,59 +125,62 @@ impl<'s> LapGrid<'s> {
             for run in &cell.runs {
                 let (lap, from) = (run.lap as usize, start);
                 start = run.end as usize;
-                if laps.contains(lap) {
-                    continue;
-                }
-                if self.witness[lap].as_ref().is_some_and(agrees) {
-                    laps.insert(lap);
-                    continue;
-                }
-                let sites = &cell.sites[from..start];
-                let hit = match cover(run.x, run.y, run.theta, q) {
-                    Cover::None => None,
-                    Cover::All => sites.first(),
-                    Cover::Part => sites.iter().find(|&&j| agrees(&self.sites[j as usize])),
-                };
-                if let Some(&j) = hit {
-                    self.witness[lap] = Some(self.sites[j as usize]);
-                    laps.insert(lap);
+                for ((q, laps), witness) in qs.iter().zip(laps.iter_mut()).zip(&mut self.witness) {
+                    if laps.contains(lap) {
+                        continue;
+                    }
+                    let agrees = |p: &Site| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad);
+                    if witness[lap].as_ref().is_some_and(agrees) {
+                        laps.insert(lap);
+                        continue;
+                    }
+                    let sites = &cell.sites[from..start];
+                    let hit = match cover(run.x, run.y, run.theta, q) {
+                        Cover::None => None,
+                        Cover::All => sites.first(),
+                        Cover::Part => sites.iter().find(|&&j| agrees(&self.sites[j as usize])),
+                    };
+                    if let Some(&j) = hit {
+                        witness[lap] = Some(self.sites[j as usize]);
+                        laps.insert(lap);
+                    }
                 }
             }
         }
     }
 }
 
-/// Calls `visit(k, laps)` for every site `k` in order, with the laps of the sites before it, at
-/// least `min_gap_m` of true travel earlier, within `r_m` and facing as `facing` says (nothing
-/// when `r_m` is not positive and finite).
-pub fn sweep_laps(
+/// Calls `visit(k, laps)` for every site `k` in order, with, per facing of `facings`, the laps
+/// of the sites before it, at least `min_gap_m` of true travel earlier, within `r_m` and facing
+/// that way (nothing when `r_m` is not positive and finite).
+pub fn sweep_laps<const N: usize>(
     sites: &[Site],
     min_gap_m: f64,
     r_m: f64,
-    facing: Facing,
+    facings: [Facing; N],
     tol_rad: f64,
-    mut visit: impl FnMut(usize, &[usize]),
+    mut visit: impl FnMut(usize, [&[usize]; N]),
 ) {
     if r_m <= 0.0 || !r_m.is_finite() {
         return;
     }
-    let mut grid = LapGrid::new(sites, r_m);
-    let mut laps = LapSet::default();
+    let mut grid = LapGrid::<N>::new(sites, r_m);
+    let mut laps: [LapSet; N] = std::array::from_fn(|_| LapSet::default());
     let mut ready = 0;
     for (k, s) in sites.iter().enumerate() {
         while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
             grid.activate(ready);
             ready += 1;
         }
-        laps.clear();
-        let q = Query {
+        laps.iter_mut().for_each(LapSet::clear);
+        let qs = facings.map(|facing| Query {
             site: s,
             r2: r_m * r_m,
             facing,
             tol_rad,
-        };
-        grid.laps(&q, &mut laps);
-        visit(k, &laps.list);
+        });
+        grid.laps(&qs, &mut laps);
+        visit(k, std::array::from_fn(|f| laps[f].list.as_slice()));
     }
 }
 
@@ -208,12 +212,21 @@ mod tests {
                     want.push(l);
                 });
                 let mut got = Vec::new();
-                sweep_laps(&sites, 2.0, r, facing, 0.7, |_, laps| {
+                sweep_laps(&sites, 2.0, r, [facing], 0.7, |_, [laps]| {
                     let mut l = laps.to_vec();
                     l.sort_unstable();
                     got.push(l);
                 });
                 assert_eq!(got, want, "{r} {facing:?}");
+                // Asked with the other facings at once, each facing's laps are the same.
+                let mut all = Vec::new();
+                let facings = [Facing::Opposite, facing, Facing::Same];
+                sweep_laps(&sites, 2.0, r, facings, 0.7, |_, [_, laps, _]| {
+                    let mut l = laps.to_vec();
+                    l.sort_unstable();
+                    all.push(l);
+                });
+                assert_eq!(all, want, "{r} {facing:?} with the others");
                 if r >= 0.5 {
                     assert!(want.iter().any(|l| l.len() > 1), "{r} {facing:?}");
                 }

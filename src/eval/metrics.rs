@@ -449,10 +449,6 @@ impl Scorer {
         self.heading_tol_rad
     }
 
-    pub(super) fn facing(&self) -> Facing {
-        self.facing
-    }
-
     /// The input frame of observation `i`.
     pub(super) fn frame_of(&self, i: usize) -> usize {
         self.joined.frame_of[i] as usize
@@ -556,19 +552,21 @@ impl Scorer {
         }
     }
 
-    /// Calls `visit(i, laps)` for every observation `i` with truth, in order, with the earlier
-    /// laps that revisit it at radius `r` (facing as this scorer counts), found lap by lap
-    /// ([`super::lap_grid`]).
-    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, &[usize])) {
+    /// Calls `visit(i, [same, opposite])` for every observation `i` with truth, in order, with
+    /// the earlier laps that revisit it at radius `r` facing the same and the opposite way,
+    /// found lap by lap ([`super::lap_grid`]); the laps of either facing are their union.
+    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, [&[usize]; 2])) {
         let j = &self.joined;
-        let (gap, facing, tol) = (self.min_gap_m, self.facing, self.heading_tol_rad);
-        super::lap_grid::sweep_laps(&j.sites, gap, r, facing, tol, |k, laps| {
+        let facings = [Facing::Same, Facing::Opposite];
+        let (gap, tol) = (self.min_gap_m, self.heading_tol_rad);
+        super::lap_grid::sweep_laps(&j.sites, gap, r, facings, tol, |k, laps| {
             visit(j.obs_of_site(k), laps)
         });
     }
 
-    /// [`Self::sweep_laps`] by the k-d tree of every earlier site: the reference the lap grid
-    /// is tested against.
+    /// The earlier laps that revisit each observation at radius `r`, facing as this scorer
+    /// counts, by the k-d tree of every earlier site: the reference the lap grid
+    /// ([`Self::sweep_laps`]) is tested against.
     pub(super) fn sweep_laps_by_site(&self, r: f64, mut visit: impl FnMut(usize, &[usize])) {
         let j = &self.joined;
         let mut laps = super::site_tree::LapSet::default();

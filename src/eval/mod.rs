@@ -23,6 +23,7 @@ pub mod suite;
 pub mod sweep;
 pub mod tally;
 
+use crate::clock::Stopwatch;
 use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::recognizer::{
@@ -30,7 +31,6 @@ use crate::recognizer::{
 };
 use crate::spec::evaluation::EvaluationSpec;
 use std::sync::Arc;
-use crate::clock::Stopwatch;
 use tally::{Scope, Tally};
 
 pub use metrics::{Evaluation, Metrics, evaluate, evaluate_by_site_tree};

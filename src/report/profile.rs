@@ -15,7 +15,10 @@ struct Stage {
 }
 
 /// The summary of `reports` (with `write_wall_s` spent writing the outputs).
-pub fn profile_text<'r>(reports: impl IntoIterator<Item = &'r Report>, write_wall_s: f64) -> String {
+pub fn profile_text<'r>(
+    reports: impl IntoIterator<Item = &'r Report>,
+    write_wall_s: f64,
+) -> String {
     let mut laps = 0usize;
     let mut simulate = 0.0;
     // (subject, recognize, score), in order of first appearance.
@@ -122,7 +125,10 @@ mod tests {
         let line = |name: &str| text.lines().find(|l| l.contains(name)).unwrap().to_string();
         assert!(line("simulate").contains("4.000 s"), "{text}");
         assert!(line("recognize 3 levels").contains("10.000 s"), "{text}");
-        assert!(line("recognize 3 levels").contains("wall 20.000 s"), "{text}");
+        assert!(
+            line("recognize 3 levels").contains("wall 20.000 s"),
+            "{text}"
+        );
         assert!(line("score 3 levels").contains("8.000 s"), "{text}");
         assert!(line("total CPU").contains("22.000 s"), "{text}");
         assert!(line("total CPU").contains("scoring 36.4 %"), "{text}");
