@@ -105,10 +105,12 @@ mod tests {
         let report = |sim: f64| {
             let mut r = Report::new("B", 1, 10, EvaluationSpec::default());
             r.simulate_seconds_per_lap = sim;
-            let mut scores = Scores::default();
-            scores.recognize_seconds_per_lap = 0.5;
-            scores.recognize_wall_seconds_per_lap = 1.0;
-            scores.score_seconds = 4.0;
+            let scores = Scores {
+                recognize_seconds_per_lap: 0.5,
+                recognize_wall_seconds_per_lap: 1.0,
+                score_seconds: 4.0,
+                ..Scores::default()
+            };
             r.levels.push(LevelReport {
                 levels: 3,
                 thresholds: vec![6, 9, 12],
