@@ -211,7 +211,7 @@ impl<'s> SiteTree<'s> {
     }
 
     /// Adds to `laps` the lap of every active site `q` takes (nodes of one lap already in
-    /// `laps` are skipped). Visit recall finds laps with [`super::lap_grid`]; this is the
+    /// `laps` are skipped). Visit recall finds laps with `eval::lap_grid`; this is the
     /// reference it is tested against ([`super::evaluate_by_site_tree`]).
     pub fn laps(&self, q: &Query, laps: &mut LapSet) {
         let mut stack = vec![0u32];
