@@ -10,6 +10,7 @@
 
 pub mod authoring;
 pub mod baseline;
+pub mod clock;
 pub mod eval;
 pub mod experiment;
 pub mod external;

@@ -54,6 +54,10 @@ pub struct CheckArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Print where the time went on stderr: CPU seconds per stage over every scenario and seed
+    /// (simulate, recognize and score per subject) and the wall clock of writing the outputs.
+    #[arg(long)]
+    pub profile: bool,
 }
 
 pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
@@ -84,15 +88,23 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         command_line: super::common::command_line(),
     };
     let suite = stress::run_stress(&args.scenarios, &opts);
+    let w = placewords::clock::Stopwatch::start();
     if let Some(path) = &args.report {
         stress::write_file(path, suite.to_json().as_bytes())?;
     }
-    finish(
+    let code = finish(
         &suite,
         args.out.as_deref(),
         args.junit.as_deref(),
         args.json,
-    )
+    );
+    if args.profile {
+        eprint!(
+            "{}",
+            placewords::report::profile::profile_text(suite.reports(), w.wall_s())
+        );
+    }
+    code
 }
 
 /// Prints a stress run's verdict, writes the outputs asked for, and gives the exit code (a

@@ -3,8 +3,10 @@
 
 use super::common::{ExternalArg, LevelsArg, SeedsArg, print_and_write, write_file};
 use clap::Args;
+use placewords::clock::Stopwatch;
 use placewords::experiment::stress::{self, StressOptions};
 use placewords::experiment::{self, ExperimentOptions};
+use placewords::report::profile::profile_text;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -40,6 +42,10 @@ pub struct RunArgs {
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Print where the time went on stderr: CPU seconds per stage (simulate, recognize and
+    /// score per subject) and the wall clock of writing the outputs.
+    #[arg(long)]
+    pub profile: bool,
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
@@ -60,10 +66,14 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
             ..StressOptions::default()
         };
         let suite = stress::run_stress(std::slice::from_ref(&args.scenario), &stress_opts);
+        let w = Stopwatch::start();
         out!("{}", placewords::report::suite::text_table(&suite))?;
         if let Some(path) = &args.report {
             write_file(path, suite.to_json().as_bytes())?;
             errln!("report: {}", path.display());
+        }
+        if args.profile {
+            eprint!("{}", profile_text(suite.reports(), w.wall_s()));
         }
         if let Some(e) = suite.scenarios.iter().flat_map(|s| s.errors()).next() {
             anyhow::bail!("{e}");
@@ -80,6 +90,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     } else {
         experiment::run_scenario(&scn, &opts)?
     };
+    let w = Stopwatch::start();
     if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
         super::score::export(path, rec, &exp.runs)?;
     }
@@ -92,5 +103,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         args.report.as_deref().map(|p| (p, &provenance)),
         args.svg.as_deref(),
     )?;
+    if args.profile {
+        eprint!("{}", profile_text([&exp.report], w.wall_s()));
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -41,7 +41,7 @@
 
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
-use super::site_tree::{LapSet, Query, Site, sweep};
+use super::site_tree::{Query, Site, sweep};
 use super::tally::{Scope, Tally};
 use super::{GroundTruth, Recognition};
 use crate::place::{Match, ObsId, Observation};
@@ -151,6 +151,20 @@ pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
         return e.clone();
     }
     let mut tally = Tally::new(spec, Scope::Full);
+    tally.sync(&rec.observations, &rec.truth);
+    for m in &rec.matches {
+        tally.add(m, &rec.truth);
+    }
+    tally.finish(&rec.truth)
+}
+
+/// [`evaluate`] with the earlier scoring's searches (visit recall's laps from the k-d tree of
+/// every earlier site, [`super::site_tree`]): the reference the linear-time searches are tested
+/// against on every shipped scenario. Not for use: it grows with the square of the laps.
+#[doc(hidden)]
+pub fn evaluate_by_site_tree(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
+    let mut tally = Tally::new(spec, Scope::Full);
+    tally.by_site_tree();
     tally.sync(&rec.observations, &rec.truth);
     for m in &rec.matches {
         tally.add(m, &rec.truth);
@@ -435,10 +449,6 @@ impl Scorer {
         self.heading_tol_rad
     }
 
-    pub(super) fn facing(&self) -> Facing {
-        self.facing
-    }
-
     /// The input frame of observation `i`.
     pub(super) fn frame_of(&self, i: usize) -> usize {
         self.joined.frame_of[i] as usize
@@ -542,18 +552,27 @@ impl Scorer {
         }
     }
 
-    /// Calls `visit(i, laps)` for every observation `i` with truth, in order, with the earlier
-    /// laps that revisit it at radius `r` (facing as this scorer counts).
-    pub(super) fn sweep_laps(
-        &self,
-        r: f64,
-        laps: &mut LapSet,
-        mut visit: impl FnMut(usize, &[usize]),
-    ) {
+    /// Calls `visit(i, [same, opposite])` for every observation `i` with truth, in order, with
+    /// the earlier laps that revisit it at radius `r` facing the same and the opposite way,
+    /// found lap by lap ([`super::lap_grid`]); the laps of either facing are their union.
+    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, [&[usize]; 2])) {
         let j = &self.joined;
+        let facings = [Facing::Same, Facing::Opposite];
+        let (gap, tol) = (self.min_gap_m, self.heading_tol_rad);
+        super::lap_grid::sweep_laps(&j.sites, gap, r, facings, tol, |k, laps| {
+            visit(j.obs_of_site(k), laps)
+        });
+    }
+
+    /// The earlier laps that revisit each observation at radius `r`, facing as this scorer
+    /// counts, by the k-d tree of every earlier site: the reference the lap grid
+    /// ([`Self::sweep_laps`]) is tested against.
+    pub(super) fn sweep_laps_by_site(&self, r: f64, mut visit: impl FnMut(usize, &[usize])) {
+        let j = &self.joined;
+        let mut laps = super::site_tree::LapSet::default();
         sweep(&j.sites, self.min_gap_m, |k, tree| {
             laps.clear();
-            tree.laps(&self.query(k, r), laps);
+            tree.laps(&self.query(k, r), &mut laps);
             visit(j.obs_of_site(k), &laps.list);
         });
     }
@@ -840,6 +859,8 @@ pub(crate) mod tests {
                     ..one_match(pairs.clone())
                 }],
                 seconds: 0.0,
+                wall_seconds: 0.0,
+                score_seconds: 0.0,
                 laps: 2,
                 truth: std::sync::Arc::new(gt.clone()),
                 diagnostics: None,
@@ -900,6 +921,8 @@ pub(crate) mod tests {
             observations: obs,
             matches,
             seconds: 1.0,
+            wall_seconds: 1.0,
+            score_seconds: 0.0,
             laps: 3,
             truth: std::sync::Arc::new(gt),
             diagnostics: None,
@@ -950,6 +973,8 @@ pub(crate) mod tests {
             observations: obs,
             matches,
             seconds: 0.0,
+            wall_seconds: 0.0,
+            score_seconds: 0.0,
             laps: 2,
             truth: std::sync::Arc::new(gt),
             diagnostics: None,

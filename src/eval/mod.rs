@@ -13,6 +13,7 @@
 
 pub(crate) mod distribution;
 pub mod gate;
+mod lap_grid;
 pub mod metrics;
 pub mod pair_recall;
 pub mod pair_set;
@@ -23,15 +24,15 @@ pub mod suite;
 pub mod sweep;
 pub mod tally;
 
+use crate::clock::Stopwatch;
 use crate::geom::{OdomPose, TruePose};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::place::{Diagnostics, Direction, Match, ObsId, Observation, RejectedCandidate};
 use crate::spec::evaluation::EvaluationSpec;
 use std::sync::Arc;
-use std::time::Instant;
 use tally::{Scope, Tally};
 
-pub use metrics::{Evaluation, Metrics, evaluate};
+pub use metrics::{Evaluation, Metrics, evaluate, evaluate_by_site_tree};
 
 /// The interface a recognizer implements to be scored lives below `eval` and `baseline` in
 /// [`crate::place`]; re-exported here for the evaluation's users.
@@ -188,8 +189,15 @@ pub struct Recognition {
     pub observations: Vec<Observation>,
     /// Every match, in the order found.
     pub matches: Vec<Match>,
-    /// Wall-clock seconds spent inside `start_run` and `push` (truth bookkeeping excluded).
+    /// CPU seconds of the thread that fed the recognizer, spent inside `start_run`, `push` and
+    /// `finish` (truth bookkeeping and scoring excluded; [`crate::clock`]).
     pub seconds: f64,
+    /// Wall-clock seconds of the same calls (longer than `seconds` when other work shares the
+    /// cores: seeds or level configurations run in parallel).
+    pub wall_seconds: f64,
+    /// CPU seconds spent scoring the matches: as they arrived, the end of the scoring, or the
+    /// whole of it when scored after the recognition ([`scores::Scores::of`] adds its own).
+    pub score_seconds: f64,
     /// Number of laps fed.
     pub laps: usize,
     /// Truth of every frame fed, by input index (shared by the recognitions of one input).
@@ -197,8 +205,8 @@ pub struct Recognition {
     /// What the recognizer saw (to say why nothing matched), when it tells.
     pub diagnostics: Option<Arc<dyn Diagnostics>>,
     /// Seconds the recognizer spent on each lap's frames, in the order fed: CPU time of the
-    /// thread that fed them (so a loaded machine does not blur how the work grows with history),
-    /// wall clock where the thread's CPU time cannot be read; empty when not recorded.
+    /// thread that fed them (so a loaded machine does not blur how the work grows with history);
+    /// empty when not recorded.
     pub lap_seconds: Vec<f64>,
     /// The evaluation, with the rules it was made with, when the matches were scored as they
     /// arrived ([`Recording::streaming`]; `matches` is then empty).
@@ -272,13 +280,14 @@ fn rejected_truth(
 }
 
 impl Recognition {
-    /// Recognition seconds per lap (0 when no lap was fed).
+    /// Recognition CPU seconds per lap (0 when no lap was fed).
     pub fn seconds_per_lap(&self) -> f64 {
-        if self.laps == 0 {
-            0.0
-        } else {
-            self.seconds / self.laps as f64
-        }
+        self.seconds / self.laps.max(1) as f64
+    }
+
+    /// Recognition wall-clock seconds per lap (0 when no lap was fed).
+    pub fn wall_seconds_per_lap(&self) -> f64 {
+        self.wall_seconds / self.laps.max(1) as f64
     }
 }
 
@@ -310,13 +319,6 @@ pub fn recognize_runs_with_progress(
     recording.finish(rec, Arc::new(truth))
 }
 
-/// CPU time of the calling thread, seconds (Linux: /proc/thread-self/schedstat; `None` elsewhere).
-fn thread_cpu_s() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
-    Some(ns / 1e9)
-}
-
 /// A recognition in progress, fed lap by lap or frames at a time (so a caller need not hold
 /// every lap's scans): the matches so far and the recognizer's time, in total and per lap. The
 /// truth of the frames is the caller's ([`GroundTruth::push_frames`] before each feed), so the
@@ -326,9 +328,11 @@ fn thread_cpu_s() -> Option<f64> {
 pub struct Recording {
     matches: Vec<Match>,
     seconds: f64,
+    wall_seconds: f64,
+    score_seconds: f64,
     laps: usize,
     lap_seconds: Vec<f64>,
-    /// Seconds of the lap being fed so far (thread CPU where it can be read).
+    /// CPU seconds of the lap being fed so far.
     lap_so_far: f64,
     /// Scores the matches as they arrive, when streaming.
     tally: Option<(EvaluationSpec, Tally)>,
@@ -351,10 +355,12 @@ impl Recording {
         match &mut self.tally {
             Some((_, tally)) => {
                 if !found.is_empty() {
+                    let w = Stopwatch::start();
                     tally.sync(rec.observations(), truth);
                     for m in &found {
                         tally.add(m, truth);
                     }
+                    self.score_seconds += w.cpu_s();
                 }
             }
             None => self.matches.extend(found),
@@ -363,9 +369,9 @@ impl Recording {
 
     /// Starts a run (call before each run's first lap, the first run included).
     pub fn start_run(&mut self, rec: &mut dyn PlaceRecognizer, truth: &GroundTruth) {
-        let t = Instant::now();
+        let w = Stopwatch::start();
         let found = rec.start_run();
-        self.seconds += t.elapsed().as_secs_f64();
+        self.clocked(&w, rec.runs_out_of_process());
         self.take(rec, truth, found);
     }
 
@@ -398,20 +404,28 @@ impl Recording {
         truth: &GroundTruth,
     ) {
         let mut found = Vec::new();
-        let (t, cpu) = (Instant::now(), thread_cpu_s());
+        let w = Stopwatch::start();
         for (i, frame) in frames.iter().enumerate() {
             found.extend(rec.push(first_id + i, frame.odom, &frame.scan));
         }
-        let s = t.elapsed().as_secs_f64();
-        self.seconds += s;
         // A recognizer in another process works while this thread waits: its time is the
         // wall clock's.
-        self.lap_so_far += match (cpu, thread_cpu_s()) {
-            (Some(a), Some(b)) if !rec.runs_out_of_process() => b - a,
-            _ => s,
-        };
+        self.lap_so_far += self.clocked(&w, rec.runs_out_of_process());
         // Scored outside the timing: the recognizer's time is its own.
         self.take(rec, truth, found);
+    }
+
+    /// Adds the time since `w` started to the recognizer's; returns its seconds: CPU, or wall
+    /// for a recognizer that works in another process (`out_of_process`).
+    fn clocked(&mut self, w: &Stopwatch, out_of_process: bool) -> f64 {
+        let t = if out_of_process {
+            w.wall_s()
+        } else {
+            w.cpu_s()
+        };
+        self.seconds += t;
+        self.wall_seconds += w.wall_s();
+        t
     }
 
     /// Ends the lap started.
@@ -475,9 +489,9 @@ impl Recording {
             return;
         }
         self.closed = true;
-        let t = Instant::now();
+        let w = Stopwatch::start();
         let found = rec.finish();
-        self.seconds += t.elapsed().as_secs_f64();
+        self.clocked(&w, rec.runs_out_of_process());
         self.take(rec, truth, found);
     }
 
@@ -527,15 +541,19 @@ impl Ended {
     /// The recognition, scored when the recording was streaming.
     pub fn finish(self, truth: Arc<GroundTruth>) -> Recognition {
         let r = self.recording;
+        let w = Stopwatch::start();
         let evaluation = r.tally.map(|(spec, tally)| {
             let e = tally.finish(&truth);
             (spec, e)
         });
+        let score_seconds = r.score_seconds + w.cpu_s();
         Recognition {
             name: self.name,
             observations: self.observations,
             matches: r.matches,
             seconds: r.seconds,
+            wall_seconds: r.wall_seconds,
+            score_seconds,
             laps: r.laps,
             truth,
             diagnostics: self.diagnostics,

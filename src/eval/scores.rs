@@ -64,7 +64,15 @@ pub struct Scores {
     /// Correct pairs ÷ every pair that could have been found (see `eval::pair_recall`).
     #[serde(default)]
     pub pair_recall: f64,
+    /// The recognizer's CPU seconds per lap (the thread's clock, [`crate::clock`]).
     pub recognize_seconds_per_lap: f64,
+    /// The recognizer's wall-clock seconds per lap (more than the CPU figure when other work
+    /// shares the cores).
+    #[serde(default)]
+    pub recognize_wall_seconds_per_lap: f64,
+    /// CPU seconds spent scoring this subject's matches, in all.
+    #[serde(default)]
+    pub score_seconds: f64,
     /// Scores at each sensitivity radius.
     pub sensitivity: Vec<Metrics>,
     /// Scores per door configuration at `tp_radius_m`.
@@ -120,6 +128,8 @@ impl Scores {
             visit_recall: m.visit_recall,
             pair_recall: m.pair_recall,
             recognize_seconds_per_lap,
+            recognize_wall_seconds_per_lap: 0.0,
+            score_seconds: 0.0,
             sensitivity: Vec::new(),
             door_configs: Vec::new(),
             directions: DirectionMetrics::default(),
@@ -146,12 +156,15 @@ impl Scores {
         self.directions.opposite.revisits > 0 || self.directions.opposite.pairs > 0
     }
 
-    /// Evaluates `rec` with `spec` and takes its timing.
+    /// Evaluates `rec` with `spec` and takes its timing (the scoring's included).
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
+        let w = crate::clock::Stopwatch::start();
         let e = super::evaluate(rec, spec);
         let d = rec.diagnostics.as_deref();
         let rejected = d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec));
         Scores {
+            recognize_wall_seconds_per_lap: rec.wall_seconds_per_lap(),
+            score_seconds: rec.score_seconds + w.cpu_s(),
             no_pairs_reason: no_pairs_reason(&e, d, rejected.as_ref(), spec),
             rejected_candidates: rejected,
             diagnostics: d.map(Diagnostics::to_json),

@@ -62,7 +62,7 @@ struct Node {
 
 /// How much of a node a query takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Cover {
+pub(super) enum Cover {
     None,
     Part,
     All,
@@ -82,6 +82,8 @@ pub struct SiteTree<'s> {
     sites: &'s [Site],
     /// Site indices in tree order (each node holds a contiguous slice).
     order: Vec<u32>,
+    /// The sites in tree order, so that a leaf's sites are read from consecutive memory.
+    placed: Vec<Site>,
     nodes: Vec<Node>,
     parent: Vec<u32>,
     leaf_of: Vec<u32>,
@@ -96,6 +98,7 @@ impl<'s> SiteTree<'s> {
         let mut t = SiteTree {
             sites,
             order: (0..sites.len() as u32).collect(),
+            placed: Vec::new(),
             nodes: Vec::new(),
             parent: Vec::new(),
             leaf_of: vec![0; sites.len()],
@@ -106,6 +109,7 @@ impl<'s> SiteTree<'s> {
             t.build(0, sites.len(), NO_CHILD);
         }
         t.active = vec![0; t.nodes.len()];
+        t.placed = t.order.iter().map(|&s| sites[s as usize]).collect();
         t
     }
 
@@ -179,26 +183,7 @@ impl<'s> SiteTree<'s> {
 
     /// How much of node `n` the query `q` takes.
     fn cover(&self, n: &Node, q: &Query) -> Cover {
-        let s = q.site;
-        // Distance bounds with the site test's own operations (see the module doc).
-        let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
-        let near = |v: f64, b: [f64; 2]| {
-            let (lo, hi) = (v - b[1], v - b[0]);
-            if lo <= 0.0 && hi >= 0.0 {
-                0.0
-            } else {
-                lo.powi(2).min(hi.powi(2))
-            }
-        };
-        if near(s.x, n.x) + near(s.y, n.y) > q.r2 {
-            return Cover::None;
-        }
-        let inside = far(s.x, n.x) + far(s.y, n.y) <= q.r2;
-        match (inside, heading_cover(s.theta, n.theta, q.facing, q.tol_rad)) {
-            (_, Cover::None) => Cover::None,
-            (true, Cover::All) => Cover::All,
-            _ => Cover::Part,
-        }
+        cover(n.x, n.y, n.theta, q)
     }
 
     /// Active sites that `q` takes; with `first`, stops at the first (returns 0 or 1).
@@ -226,7 +211,8 @@ impl<'s> SiteTree<'s> {
     }
 
     /// Adds to `laps` the lap of every active site `q` takes (nodes of one lap already in
-    /// `laps` are skipped).
+    /// `laps` are skipped). Visit recall finds laps with `eval::lap_grid`; this is the
+    /// reference it is tested against ([`super::evaluate_by_site_tree`]).
     pub fn laps(&self, q: &Query, laps: &mut LapSet) {
         let mut stack = vec![0u32];
         while let Some(id) = stack.pop() {
@@ -257,10 +243,37 @@ impl<'s> SiteTree<'s> {
     /// The active sites of a leaf.
     fn leaf_sites<'a>(&'a self, node: &Node) -> impl Iterator<Item = &'a Site> + 'a {
         let frontier = self.frontier;
-        self.order[node.start as usize..node.end as usize]
+        let (start, end) = (node.start as usize, node.end as usize);
+        self.order[start..end]
             .iter()
-            .filter(move |&&s| (s as usize) < frontier)
-            .map(move |&s| &self.sites[s as usize])
+            .zip(&self.placed[start..end])
+            .filter(move |&(&s, _)| (s as usize) < frontier)
+            .map(|(_, p)| p)
+    }
+}
+
+/// How much of a box of sites (position bounds `x`, `y`, wrapped-heading bounds `theta`) the
+/// query `q` takes.
+pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cover {
+    let s = q.site;
+    // Distance bounds with the site test's own operations (see the module doc).
+    let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
+    let near = |v: f64, b: [f64; 2]| {
+        let (lo, hi) = (v - b[1], v - b[0]);
+        if lo <= 0.0 && hi >= 0.0 {
+            0.0
+        } else {
+            lo.powi(2).min(hi.powi(2))
+        }
+    };
+    if near(s.x, x) + near(s.y, y) > q.r2 {
+        return Cover::None;
+    }
+    let inside = far(s.x, x) + far(s.y, y) <= q.r2;
+    match (inside, heading_cover(s.theta, theta, q.facing, q.tol_rad)) {
+        (_, Cover::None) => Cover::None,
+        (true, Cover::All) => Cover::All,
+        _ => Cover::Part,
     }
 }
 
@@ -337,13 +350,13 @@ pub fn sweep(sites: &[Site], min_gap_m: f64, mut visit: impl FnMut(usize, &SiteT
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
     /// Sites on several noisy passes over one path, some driven the other way, on 3 laps.
-    fn passes(seed: u64) -> Vec<Site> {
+    pub(in crate::eval) fn passes(seed: u64) -> Vec<Site> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut out = Vec::new();
         let mut travel = 0.0;

@@ -210,6 +210,14 @@ impl SuiteReport {
         serde_json::to_string_pretty(self).expect("a suite report always serializes")
     }
 
+    /// Every seed's report, scenario by scenario (the seeds that ran).
+    pub fn reports(&self) -> impl Iterator<Item = &Report> + '_ {
+        self.scenarios
+            .iter()
+            .flat_map(|s| &s.results)
+            .filter_map(|r| r.report.as_ref())
+    }
+
     pub fn from_json(s: &str) -> serde_json::Result<Self> {
         serde_json::from_str(s)
     }

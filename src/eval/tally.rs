@@ -29,10 +29,12 @@ use super::GroundTruth;
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
 use super::pair_recall::{Facing, PairRecall, count_possible};
 use super::pair_set::pack;
-use super::site_tree::{LapSet, Site};
+use super::site_tree::Site;
 use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
-use std::collections::{HashMap, HashSet};
+// foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
+// profile of scoring as matches arrive (BENCHMARKS.md, issue 30).
+use foldhash::{HashMap, HashSet};
 
 /// What a tally counts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,6 +120,8 @@ pub struct Tally {
     /// Pairs forgotten since the last [`Tally::take_forgotten`], when asked to keep them.
     forgotten: Option<Vec<u64>>,
     in_match: HashSet<(ObsId, ObsId)>,
+    /// Searches with the k-d tree of every earlier site ([`Self::by_site_tree`]).
+    by_site_tree: bool,
 }
 
 impl Tally {
@@ -154,15 +158,22 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            window: HashMap::new(),
-            unresolved: HashMap::new(),
-            visits_window: HashMap::new(),
+            window: HashMap::default(),
+            unresolved: HashMap::default(),
+            visits_window: HashMap::default(),
             visits: Vec::new(),
             evicted_below: 0,
             late_pairs: 0,
             forgotten: None,
-            in_match: HashSet::new(),
+            in_match: HashSet::default(),
+            by_site_tree: false,
         }
+    }
+
+    /// Searches as the scoring did before it was linear in the laps (the k-d tree of every
+    /// earlier site): the reference of `metrics::evaluate_by_site_tree`.
+    pub(super) fn by_site_tree(&mut self) {
+        self.by_site_tree = true;
     }
 
     /// Keep the distinct resolved pairs forgotten by [`Self::evict_below`] until
@@ -389,19 +400,22 @@ impl Tally {
             same
         });
         let sites = self.frame_sites(truth);
+        let mut possible_of = Vec::new();
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
+        // Every figure with visit recall is at `tp_radius_m`.
+        let mut visit_recalls = None;
         for s in &self.slots {
             let scorer = self.scorer.with_facing(s.facing);
             let revisits = scorer.revisits(s.radius_m);
             let (mut m, cfgs) = s.metrics(&revisits, &scorer);
             if s.recalls {
-                m.visit_recall = self.visit_recall(&scorer, s.radius_m);
-                let possible = if s.radius_m <= 0.0 || !s.radius_m.is_finite() {
-                    0
-                } else {
-                    let tol = self.scorer.heading_tol_rad();
-                    count_possible(&sites, self.spec.min_gap_m, s.radius_m, s.facing, tol)
+                let recalls = match visit_recalls {
+                    Some((r, v)) if r == s.radius_m => v,
+                    _ => self.visit_recalls(s.radius_m),
                 };
+                visit_recalls = Some((s.radius_m, recalls));
+                m.visit_recall = recalls[usize::from(facing_bit(s.facing))];
+                let possible = self.possible(&sites, s.radius_m, s.facing, &mut possible_of);
                 m.pair_recall = PairRecall {
                     possible,
                     found: s.found,
@@ -428,31 +442,122 @@ impl Tally {
         }
     }
 
-    /// Visit recall at radius `r` as `scorer` faces: the earlier laps each observation was
-    /// correctly paired with ÷ the earlier laps that revisit it.
-    fn visit_recall(&self, scorer: &Scorer, r: f64) -> f64 {
+    /// Pair recall's possible pairs at radius `r` facing as `facing` says (`known`: the counts
+    /// made so far). With a heading tolerance below 90° no pair faces both the same and the
+    /// opposite way, so the pairs of either facing are those of the two counted apart (one
+    /// sweep of the k-d tree fewer; the reference, [`Self::by_site_tree`], counts them too).
+    fn possible(
+        &self,
+        sites: &[Site],
+        r: f64,
+        facing: Facing,
+        known: &mut Vec<(Facing, u64, u64)>,
+    ) -> u64 {
         if r <= 0.0 || !r.is_finite() {
-            return 0.0;
+            return 0;
         }
-        let need: u64 = match scorer.facing() {
+        if let Some(&(.., n)) = known
+            .iter()
+            .find(|(f, r_bits, _)| *f == facing && *r_bits == r.to_bits())
+        {
+            return n;
+        }
+        let tol = self.scorer.heading_tol_rad();
+        let disjoint = tol < std::f64::consts::FRAC_PI_2 - 1e-6;
+        let n = if facing == Facing::Either && disjoint && !self.by_site_tree {
+            self.possible(sites, r, Facing::Same, known)
+                + self.possible(sites, r, Facing::Opposite, known)
+        } else {
+            count_possible(sites, self.spec.min_gap_m, r, facing, tol)
+        };
+        known.push((facing, r.to_bits(), n));
+        n
+    }
+
+    /// Visit recall at radius `r` of each facing, indexed as [`facing_bit`]: the earlier laps
+    /// each observation was correctly paired with ÷ the earlier laps that revisit it. The laps
+    /// of either facing are the union of those of the same and the opposite facing, found in
+    /// one sweep of the lap grid ([`Scorer::sweep_laps`]).
+    fn visit_recalls(&self, r: f64) -> [f64; 3] {
+        if r <= 0.0 || !r.is_finite() {
+            return [0.0; 3];
+        }
+        if self.by_site_tree {
+            return [Facing::Either, Facing::Same, Facing::Opposite]
+                .map(|f| self.visit_recall_by_site_tree(r, f));
+        }
+        // Per lap: bit 0 revisits the query the same way, bit 1 the opposite way.
+        let mut mark: Vec<u8> = Vec::new();
+        let mut at = 0usize;
+        let (mut visits, mut found) = ([0usize; 3], [0usize; 3]);
+        self.scorer.sweep_laps(r, |i, [same, opposite]| {
+            for (laps, bit) in [(same, 1), (opposite, 2)] {
+                for &l in laps {
+                    if mark.len() <= l {
+                        mark.resize(l + 1, 0);
+                    }
+                    mark[l] |= bit;
+                }
+            }
+            let both = same.iter().filter(|&&l| mark[l] == 3).count();
+            visits[0] += same.len() + opposite.len() - both;
+            visits[1] += same.len();
+            visits[2] += opposite.len();
+            for &v in self.visits_of(i, &mut at) {
+                let (m, claims) = (lap_mark(&mark, v), v & 3);
+                found[0] += usize::from(m != 0 && claims != 0);
+                found[1] += usize::from(m & 1 != 0 && claims & 1 != 0);
+                found[2] += usize::from(m & 2 != 0 && claims & 2 != 0);
+            }
+            for &l in same.iter().chain(opposite) {
+                mark[l] = 0;
+            }
+        });
+        [0, 1, 2].map(|f| super::metrics::ratio(found[f], visits[f]))
+    }
+
+    /// Visit recall at radius `r` of one facing, the laps from the k-d tree of every earlier
+    /// site: the reference of [`Self::visit_recalls`].
+    fn visit_recall_by_site_tree(&self, r: f64, facing: Facing) -> f64 {
+        let need: u64 = match facing {
             Facing::Either => 3,
             Facing::Same => 1,
             Facing::Opposite => 2,
         };
-        let found_with = |i: usize, lap: usize| {
-            let base = (i as u64) << 32 | (lap as u64) << 2;
-            let k = self.visits.partition_point(|&v| v < base);
-            self.visits
-                .get(k)
-                .is_some_and(|&v| v >> 2 == base >> 2 && v & need != 0)
-        };
+        let mut mark: Vec<u8> = Vec::new();
+        let mut at = 0usize;
         let (mut visits, mut found) = (0usize, 0usize);
-        let mut laps = LapSet::default();
-        scorer.sweep_laps(r, &mut laps, |i, laps| {
-            visits += laps.len();
-            found += laps.iter().filter(|&&l| found_with(i, l)).count();
-        });
+        self.scorer
+            .with_facing(facing)
+            .sweep_laps_by_site(r, |i, laps| {
+                visits += laps.len();
+                for &l in laps {
+                    if mark.len() <= l {
+                        mark.resize(l + 1, 0);
+                    }
+                    mark[l] = 1;
+                }
+                found += self
+                    .visits_of(i, &mut at)
+                    .iter()
+                    .filter(|&&v| v & need != 0 && lap_mark(&mark, v) != 0)
+                    .count();
+                for &l in laps {
+                    mark[l] = 0;
+                }
+            });
         super::metrics::ratio(found, visits)
+    }
+
+    /// The entries of `visits` of observation `i`, one per lap it was correctly paired with;
+    /// `at` walks `visits` once for observations asked about in increasing order.
+    fn visits_of(&self, i: usize, at: &mut usize) -> &[u64] {
+        let base = (i as u64) << 32;
+        *at += self.visits[*at..].partition_point(|&v| v < base);
+        let end = *at + self.visits[*at..].partition_point(|&v| v >> 32 == i as u64);
+        let entries = &self.visits[*at..end];
+        *at = end;
+        entries
     }
 
     /// Pair recall's sites: each observation's frame truth (not moved to the observation).
@@ -504,6 +609,13 @@ impl Slot {
         };
         (metrics, configs)
     }
+}
+
+/// The mark of the lap of `visits` entry `v` (`query << 32 | lap << 2 | claims`), 0 when unmarked.
+fn lap_mark(mark: &[u8], v: u64) -> u8 {
+    mark.get(((v & 0xffff_ffff) >> 2) as usize)
+        .copied()
+        .unwrap_or(0)
 }
 
 /// One flag per observation, 64 to a word (125 KB per figure for a million observations).

@@ -168,7 +168,8 @@ pub fn config_for_levels(base: &RecognizerConfig, levels: usize) -> RecognizerCo
 
 pub use crate::recognizer::thresholds;
 
-/// Simulates a scenario, telling its progress per lap; returns the runs and the wall-clock seconds.
+/// Simulates a scenario, telling its progress per lap; returns the runs and the CPU seconds
+/// the laps cost.
 pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
     let laps: usize = scn
         .sim
@@ -177,11 +178,9 @@ pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>
         .map(|r| opts.laps.unwrap_or(r.laps))
         .sum();
     opts.progress.start("simulating", laps as u64);
-    let t = Instant::now();
-    let runs = crate::sim::runner::simulate(&scn.sim, opts.laps, &|| opts.progress.step());
+    let runs = crate::sim::runner::simulate_timed(&scn.sim, opts.laps, &|| opts.progress.step());
     opts.progress.done();
-    let runs = runs?;
-    Ok((runs, t.elapsed().as_secs_f64()))
+    runs
 }
 
 /// Simulates a scenario and evaluates it.

@@ -283,6 +283,8 @@ impl LoggedRuns {
             observations: self.observations.clone(),
             matches,
             seconds: 0.0,
+            wall_seconds: 0.0,
+            score_seconds: 0.0,
             laps: self.laps,
             truth: std::sync::Arc::new(self.truth.clone()),
             diagnostics: None,

@@ -85,7 +85,7 @@ pub(super) fn with_laps<T>(
 }
 
 /// Simulates every lap of every run in order, sending each as it is made (blocks while
-/// [`LAPS_AHEAD`] laps wait); returns the seconds spent simulating. Stops early when the
+/// [`LAPS_AHEAD`] laps wait); returns the CPU seconds spent simulating. Stops early when the
 /// receiver is gone.
 fn simulate_laps(
     plan: &SimPlan,
@@ -96,9 +96,9 @@ fn simulate_laps(
     for run in 0..plan.runs.len() {
         let mut sim = RunSim::new(plan, run);
         for lap in 0..laps_of(run) {
-            let t = Instant::now();
+            let w = crate::clock::Stopwatch::start();
             let log = sim.run_lap(lap)?;
-            seconds += t.elapsed().as_secs_f64();
+            seconds += w.cpu_s();
             if tx.send((run, log)).is_err() {
                 return Ok(seconds);
             }

@@ -4,6 +4,7 @@ pub mod json;
 pub mod junit;
 pub(crate) mod lap_strip;
 pub mod plot;
+pub mod profile;
 pub mod suite;
 pub(crate) mod svg;
 pub mod table;

@@ -71,7 +71,17 @@ pub fn simulate(
     laps_override: Option<usize>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<RunLog>, SimError> {
-    (0..scn.runs.len())
+    Ok(simulate_timed(scn, laps_override, progress)?.0)
+}
+
+/// [`simulate`], with the CPU seconds the laps cost (summed over the threads that made them).
+pub fn simulate_timed(
+    scn: &SimPlan,
+    laps_override: Option<usize>,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(Vec<RunLog>, f64), SimError> {
+    let cpu_s = std::sync::Mutex::new(0.0f64);
+    let runs = (0..scn.runs.len())
         .into_par_iter()
         .map(|run| {
             let laps = laps_override.unwrap_or(scn.runs[run].laps);
@@ -81,12 +91,16 @@ pub fn simulate(
                 laps: Vec::with_capacity(laps),
             };
             for lap in 0..laps {
+                let w = crate::clock::Stopwatch::start();
                 out.laps.push(sim.run_lap(lap)?);
+                *cpu_s.lock().unwrap_or_else(|e| e.into_inner()) += w.cpu_s();
                 progress();
             }
             Ok(out)
         })
-        .collect()
+        .collect::<Result<Vec<RunLog>, SimError>>()?;
+    let cpu_s = cpu_s.into_inner().unwrap_or_else(|e| e.into_inner());
+    Ok((runs, cpu_s))
 }
 
 /// The state of one run: robot, odometry, laser, physics, pedestrians, time.

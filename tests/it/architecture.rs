@@ -19,7 +19,7 @@ const LAYERS: &[&[&str]] = &[
     &["log"],
     &["place"],
     &["scan"],
-    &["geom"],
+    &["geom", "clock"],
 ];
 
 fn layer(module: &str) -> Option<usize> {

@@ -102,3 +102,34 @@ fn scoring_as_matches_arrive_gives_the_report_of_scoring_them_at_the_end() {
     assert!(levels[2]["pairs"].as_u64().unwrap() > 100, "smoke matches");
     assert!(streamed == kept, "streamed and kept reports differ");
 }
+
+/// The linear-time scoring (visit recall lap by lap, `eval::lap_grid`) gives every figure of the
+/// earlier k-d tree searches (`evaluate_by_site_tree`) on every shipped scenario, cut short: A,
+/// B, C, `reverse` and smoke at 2 laps a run, long-term at 1 (40 laps of 1 run each), 3 levels.
+#[test]
+fn linear_scoring_gives_the_figures_of_the_site_tree_searches() {
+    use placewords::eval::{evaluate, evaluate_by_site_tree, recognize_runs};
+    use placewords::experiment::load_scenario;
+    use placewords::experiment::{config_for_levels, recognizer_config};
+    use placewords::recognizer::Recognizer;
+    for (file, laps) in [
+        ("A.toml", 2),
+        ("B.toml", 2),
+        ("C.toml", 2),
+        ("reverse.toml", 2),
+        ("smoke.toml", 2),
+        ("long-term.toml", 1),
+    ] {
+        let scn = load_scenario(&root().join("scenarios").join(file)).unwrap();
+        let runs = placewords::sim::runner::simulate(&scn.sim, Some(laps), &|| {}).unwrap();
+        let cfg = config_for_levels(&recognizer_config(&scn).unwrap(), 3);
+        let mut rec = Recognizer::new(cfg).unwrap();
+        let r = recognize_runs(&mut rec, &runs);
+        let (got, want) = (
+            evaluate(&r, &scn.evaluation),
+            evaluate_by_site_tree(&r, &scn.evaluation),
+        );
+        assert!(want.main.visit_recall > 0.0, "{file}: {:?}", want.main);
+        assert_eq!(got, want, "{file}");
+    }
+}
