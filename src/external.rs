@@ -16,6 +16,7 @@
 use crate::geom::OdomPose;
 use crate::place::{Direction, FrameId, Match, ObsId, Observation, PlaceRecognizer, push_pair};
 use crate::scan::Scan;
+use crate::spec::evaluation::{is_builtin_subject_name, is_subject_name};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Write};
@@ -53,13 +54,12 @@ impl ExternalSpec {
             ));
         };
         let name = name.trim();
-        let valid = |c: char| c.is_ascii_alphanumeric() || c == '-' || c == '_';
-        if name.is_empty() || !name.chars().all(valid) {
+        if !is_subject_name(name) {
             return Err(format!(
                 "`{name}` cannot name a subject: use letters, digits, `-` and `_`"
             ));
         }
-        if name.starts_with("words-") || name == "icp" {
+        if is_builtin_subject_name(name) {
             return Err(format!(
                 "`{name}` is the name of a built-in subject; choose another name"
             ));

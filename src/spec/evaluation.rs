@@ -87,6 +87,21 @@ pub fn words_subject_levels(name: &str) -> Option<usize> {
 /// levels, and the ICP baseline.
 pub const KNOWN_SUBJECTS: &[&str] = &["words-1", "words-2", "words-3", "icp"];
 
+/// Whether `name` is spelt as a subject's name may be: non-empty, of ASCII letters, digits,
+/// `-` and `_` (so it is safe in file names, JUnit names and reproducing commands).
+pub fn is_subject_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+}
+
+/// Whether `name` belongs to the built-in subjects: one of [`KNOWN_SUBJECTS`] or the paper
+/// recognizer's `words-…` family. An external recognizer may not take such a name.
+pub fn is_builtin_subject_name(name: &str) -> bool {
+    KNOWN_SUBJECTS.contains(&name) || name.starts_with("words-")
+}
+
 /// What one subject must achieve.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -287,12 +302,7 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
                     // Any other name is an external subject's (`--recognizer NAME=…`), unless
                     // it looks like a built-in one mistyped.
                     let near = crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().copied());
-                    let valid = |c: char| c.is_ascii_alphanumeric() || c == '-' || c == '_';
-                    if near.is_some()
-                        || name.starts_with("words-")
-                        || name.is_empty()
-                        || !name.chars().all(valid)
-                    {
+                    if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
                         let hint = match near {
                             Some(k) => format!("did you mean `{k}`? "),
                             None => String::new(),
