@@ -414,6 +414,28 @@ pub struct Report {
     pub simulate_seconds_per_lap: f64,
     /// How the scores were computed.
     pub evaluation: EvaluationSpec,
+    /// Set when the runs are a real log's (not simulated): what it held.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log: Option<LogSummary>,
+}
+
+/// What a real log held, for a report's header (a log has no laps or door states).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LogSummary {
+    /// Scans the recognizers were given (after `--scan-step`).
+    pub scans: usize,
+    /// True travel along the log, metres.
+    pub travel_m: f64,
+}
+
+impl LogSummary {
+    /// The scans and travel of a real log's ground truth.
+    pub fn of(truth: &super::GroundTruth) -> Self {
+        LogSummary {
+            scans: truth.frames.len(),
+            travel_m: truth.frames.last().map_or(0.0, |f| f.travel_m),
+        }
+    }
 }
 
 impl Report {
@@ -427,6 +449,7 @@ impl Report {
             subjects: Vec::new(),
             simulate_seconds_per_lap: 0.0,
             evaluation,
+            log: None,
         }
     }
 

@@ -138,7 +138,7 @@ pub struct PrPoint {
 /// A precision-recall curve: one threshold varied, the others fixed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PrCurve {
-    /// "1 level" or "2 levels, τ0=6".
+    /// "1 level: τ = [t]" or "2 levels: τ = [6, t]" (`t` varies along the curve).
     pub label: String,
     pub levels: usize,
     /// Thresholds of the levels below the varied one (empty for one level).
@@ -199,16 +199,17 @@ pub fn pr_curves(results: &[SweepResult]) -> Vec<PrCurve> {
     curves
 }
 
+/// "1 level: τ = [t]" or "2 levels: τ = [6, t]": the thresholds in the tables' notation
+/// (one per level), `t` the one the curve varies.
 fn curve_label(levels: usize, fixed: &[usize]) -> String {
-    let mut s = if levels == 1 {
+    let mut th: Vec<String> = fixed.iter().map(|t| t.to_string()).collect();
+    th.push("t".into());
+    let levels = if levels == 1 {
         "1 level".to_string()
     } else {
         format!("{levels} levels")
     };
-    for (l, t) in fixed.iter().enumerate() {
-        s.push_str(&format!(", τ{l}={t}"));
-    }
-    s
+    format!("{levels}: τ = [{}]", th.join(", "))
 }
 
 /// The first point (in order) with the largest `key` among those passing `keep`.
@@ -265,7 +266,7 @@ mod tests {
         ];
         let c = pr_curves(&results);
         assert_eq!(c.len(), 3);
-        assert_eq!(c[0].label, "1 level");
+        assert_eq!(c[0].label, "1 level: τ = [t]");
         assert_eq!(
             c[0].points.iter().map(|p| p.threshold).collect::<Vec<_>>(),
             [0, 1, 2, 3]
@@ -274,7 +275,7 @@ mod tests {
         assert_eq!(c[0].max_f1.as_ref().unwrap().threshold, 1);
         assert!((c[0].max_f1.as_ref().unwrap().f1 - 0.5).abs() < 1e-12);
         assert_eq!(c[0].best_recall_at_precision.as_ref().unwrap().threshold, 2);
-        assert_eq!(c[1].label, "2 levels, τ0=3");
+        assert_eq!(c[1].label, "2 levels: τ = [3, t]");
         // Equal recall: the lowest threshold wins.
         assert_eq!(c[1].best_recall_at_precision.as_ref().unwrap().threshold, 0);
         assert!(c[2].best_recall_at_precision.is_none());

@@ -9,6 +9,7 @@
 
 use super::stream::{Job, finish_jobs, jobs, settle};
 use super::{Experiment, ExperimentError, ExperimentOptions, assemble, level_configs};
+use crate::eval::scores::LogSummary;
 use crate::eval::{GroundTruth, LapInfo};
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
@@ -173,7 +174,9 @@ pub fn recognize_log(
     let (mut run, skipped) =
         load_real_run(path, log.lenient, log.truth, log.noise.as_ref(), log.seed)?;
     keep_every_nth_scan(&mut run, log.scan_step);
-    let exp = super::evaluate_runs(name, log.seed, vec![run], base, evaluation, opts)?;
+    let summary = LogSummary::of(&GroundTruth::from_runs(std::slice::from_ref(&run)));
+    let mut exp = super::evaluate_runs(name, log.seed, vec![run], base, evaluation, opts)?;
+    exp.report.log = Some(summary);
     Ok((exp, skipped))
 }
 
@@ -215,8 +218,10 @@ pub fn recognize_log_streamed(
     });
     opts.progress.done();
     read?;
+    let summary = LogSummary::of(&truth);
     let results = finish_jobs(jobs, truth)?;
-    let exp = assemble(name, log.seed, 1, evaluation, &configs, results, Vec::new());
+    let mut exp = assemble(name, log.seed, 1, evaluation, &configs, results, Vec::new());
+    exp.report.log = Some(summary);
     Ok((exp, survey.counts.skipped_lines))
 }
 

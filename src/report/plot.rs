@@ -19,25 +19,50 @@ const COLOURS: [&str; 10] = [
     "#bcbd22", "#000000",
 ];
 
-/// Upper end of an axis holding `max`: the next multiple of 0.1, at least 0.1, at most 1.
-pub fn axis_max(max: f64) -> f64 {
-    if !max.is_finite() || max <= 0.0 {
-        return 0.1;
+/// An axis over `[lo, hi]` (ratios in [0, 1]) fitted to the data: a round tick step of 1, 2 or
+/// 5 × 10^k giving about 5 to 10 ticks, the ends on ticks, at least one step wide.
+pub fn fitted_axis(lo: f64, hi: f64) -> (f64, f64, f64) {
+    let (lo, hi) = if lo.is_finite() && hi.is_finite() && lo <= hi {
+        (lo.clamp(0.0, 1.0), hi.clamp(0.0, 1.0))
+    } else {
+        (0.0, 1.0)
+    };
+    let span = (hi - lo).max(0.01);
+    let raw = span / 6.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * mag)
+        .find(|st| span / st <= 8.0)
+        .unwrap_or(10.0 * mag);
+    let mut a = ((lo / step) + 1e-9).floor() * step;
+    let mut b = ((hi / step) - 1e-9).ceil() * step;
+    if b - a < step * 0.5 {
+        b = a + step;
     }
-    ((max * 10.0 - 1e-9).ceil() / 10.0).clamp(0.1, 1.0)
+    if b > 1.0 + 1e-9 {
+        (a, b) = ((1.0 - (b - a)).max(0.0), 1.0);
+    }
+    (a.max(0.0), b.min(1.0), step)
 }
 
 /// The SVG document of `curves` titled `title`.
 pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
-    let max_recall = curves
-        .iter()
-        .flat_map(|c| c.points.iter().map(|p| p.recall))
-        .fold(0.0, f64::max);
-    let x_max = axis_max(max_recall);
-    let (y_min, y_max) = (0.0, 1.0);
+    // Axes fitted to the points drawn (and the precision floor), so curves near P = 1 spread.
+    let drawn = || {
+        curves
+            .iter()
+            .flat_map(|c| c.points.iter().filter(|p| p.pairs > 0))
+    };
+    let (r_lo, r_hi) = drawn().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+        (a.min(p.recall), b.max(p.recall))
+    });
+    let p_lo = drawn().map(|p| p.precision).fold(PRECISION_FLOOR, f64::min);
+    let (x_min, x_max, x_step) = fitted_axis(r_lo, r_hi);
+    let (y_min, y_max, y_step) = fitted_axis(p_lo, 1.0);
     let pw = W - LEFT - RIGHT;
     let ph = H - TOP - BOTTOM;
-    let sx = |x: f64| LEFT + x / x_max * pw;
+    let sx = |x: f64| LEFT + (x - x_min) / (x_max - x_min) * pw;
     let sy = |y: f64| TOP + (y_max - y) / (y_max - y_min) * ph;
     let mut s = String::new();
     let _ = writeln!(
@@ -52,8 +77,11 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         escape(title)
     );
     // Grid, ticks and labels.
-    for i in 0..=10 {
-        let fx = x_max * i as f64 / 10.0;
+    let ticks = |a: f64, b: f64, st: f64| {
+        let n = ((b - a) / st).round() as usize;
+        (0..=n).map(move |i| a + st * i as f64)
+    };
+    for fx in ticks(x_min, x_max, x_step) {
         let x = sx(fx);
         let _ = writeln!(
             s,
@@ -62,7 +90,8 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
             TOP + ph + 16.0,
             trim(fx)
         );
-        let fy = y_min + (y_max - y_min) * i as f64 / 10.0;
+    }
+    for fy in ticks(y_min, y_max, y_step) {
         let y = sy(fy);
         let _ = writeln!(
             s,
@@ -97,6 +126,7 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         TOP + ph / 2.0
     );
     // Curves.
+    let mut labels: Vec<(f64, f64)> = Vec::new();
     for (i, c) in curves.iter().enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
         let dash = if c.levels == 1 {
@@ -119,14 +149,38 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         for p in c.points.iter().filter(|p| p.pairs > 0) {
             let _ = writeln!(
                 s,
-                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{} τ{}={}: P {:.3} R {:.3}</title></circle>"#,
+                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{}, t = {}: P {:.3} R {:.3}</title></circle>"#,
                 sx(p.recall),
                 sy(p.precision),
                 escape(&c.label),
-                c.fixed_thresholds.len(),
                 p.threshold,
                 p.precision,
                 p.recall
+            );
+        }
+        // Each end of the curve says its t, so a reader sees which way t grows.
+        let drawn: Vec<_> = c.points.iter().filter(|p| p.pairs > 0).collect();
+        let ends = match (drawn.first(), drawn.last()) {
+            (Some(a), Some(b)) if drawn.len() > 1 => vec![*a, *b],
+            (Some(a), _) => vec![*a],
+            _ => Vec::new(),
+        };
+        for p in ends {
+            // A label where another already stands would hide both: the point's tooltip says it.
+            let (x, y) = (sx(p.recall), sy(p.precision));
+            if labels
+                .iter()
+                .any(|&(lx, ly): &(f64, f64)| (lx - x).abs() < 34.0 && (ly - y).abs() < 12.0)
+            {
+                continue;
+            }
+            labels.push((x, y));
+            let _ = writeln!(
+                s,
+                r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{colour}">t={}</text>"#,
+                x + 4.0,
+                y - 4.0,
+                p.threshold
             );
         }
         // Legend entry.
@@ -140,22 +194,21 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
             ly + 4.0,
             escape(&c.label)
         );
-        let v = c.fixed_thresholds.len();
         let f1 = c
             .max_f1
             .as_ref()
-            .map(|p| format!("max F1 {:.3} (τ{v}={})", p.f1, p.threshold))
+            .map(|p| format!("max F1 {:.3} at t = {}", p.f1, p.threshold))
             .unwrap_or_else(|| "max F1 –".into());
         let br = c
             .best_recall_at_precision
             .as_ref()
             .map(|p| {
                 format!(
-                    "R {:.3} at P≥{PRECISION_FLOOR} (τ={})",
+                    "recall {:.3} at P ≥ {PRECISION_FLOOR}, t = {}",
                     p.recall, p.threshold
                 )
             })
-            .unwrap_or_else(|| format!("no point at P≥{PRECISION_FLOOR}"));
+            .unwrap_or_else(|| format!("no point at P ≥ {PRECISION_FLOOR}"));
         let _ = writeln!(
             s,
             r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text><text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text>"##,
@@ -185,11 +238,15 @@ mod tests {
     use crate::eval::sweep::{GridPoint, SweepResult, pr_curves};
 
     #[test]
-    fn axis_rounds_up_to_tenths() {
-        assert_eq!(axis_max(0.0), 0.1);
-        assert_eq!(axis_max(0.31), 0.4);
-        assert_eq!(axis_max(0.3), 0.3);
-        assert_eq!(axis_max(1.7), 1.0);
+    fn fitted_axes_end_on_round_ticks() {
+        let (a, b, st) = fitted_axis(0.93, 1.0);
+        assert!((st - 0.01).abs() < 1e-12 && (a - 0.93).abs() < 1e-9 && b == 1.0);
+        let (a, b, st) = fitted_axis(0.08, 0.87);
+        assert_eq!((a, st), (0.0, 0.1));
+        assert!((b - 0.9).abs() < 1e-9);
+        let (a, b, _) = fitted_axis(0.5, 0.5);
+        assert!(a <= 0.5 && b > a);
+        assert_eq!(fitted_axis(f64::INFINITY, f64::NEG_INFINITY).0, 0.0);
     }
 
     #[test]

@@ -63,22 +63,105 @@ pub(crate) fn render(header: &[&str], body: &[Vec<String>]) -> String {
     out
 }
 
-/// The terminal summary of one report: the main table, then sensitivity and door
-/// configurations per recognizer.
+/// The terminal summary of one report: what was run and how it was judged, one headline per
+/// subject (the paper's precision and recall, with what they count), the main table with a
+/// legend line per column, the other recalls in a block of their own, the notes, then the
+/// figures by radius and by door configuration per subject.
 pub fn text_table(report: &Report) -> String {
+    let mut out = header(report);
+    headlines(report, &mut out);
+    main_table(report, &mut out);
+    other_recalls(report, &mut out);
+    notes(report, &mut out);
+    breakdowns(report, &mut out);
+    out
+}
+
+/// What was run (a scenario's laps, or a real log's scans and metres) and the ground-truth rule.
+fn header(report: &Report) -> String {
     let mut out = String::new();
+    let e = &report.evaluation;
+    match &report.log {
+        Some(log) => {
+            let _ = writeln!(
+                out,
+                "log {}  noise seed {}  {} scans over {:.0} m of travel",
+                report.scenario, report.seed, log.scans, log.travel_m
+            );
+        }
+        None => {
+            let _ = writeln!(
+                out,
+                "scenario {}  seed {}  {} laps  (simulated in {:.2} CPU s per lap)",
+                report.scenario, report.seed, report.laps, report.simulate_seconds_per_lap
+            );
+        }
+    }
+    let truth = format!(
+        "ground truth: an observation has a revisit when an earlier one, at least {} m of true \
+         travel before, lies within {} m facing within {}° (the same way, or the opposite way); \
+         {} observations have one. A pair the recognizer claims is correct within {} m.",
+        e.min_gap_m, e.tp_radius_m, e.heading_tolerance_deg, report.revisits, e.tp_radius_m
+    );
+    for l in textwrap::wrap(&truth, TEXT_WIDTH) {
+        let _ = writeln!(out, "{l}");
+    }
+    out.push('\n');
+    out
+}
+
+/// The width prose in the terminal summary is wrapped to, characters.
+const TEXT_WIDTH: usize = 100;
+
+/// One line per subject: the two figures of the paper's Table I, each with what it counts.
+/// The paper counts recall over the revisits driven the same way (its search runs one way).
+fn headlines(report: &Report, out: &mut String) {
     let _ = writeln!(
         out,
-        "scenario {}  seed {}  laps {}  revisits {}  simulation {:.2} s/lap",
-        report.scenario, report.seed, report.laps, report.revisits, report.simulate_seconds_per_lap
+        "as the paper's Table I reports them (its recall counts the revisits driven the same way):"
     );
-    let _ = writeln!(
-        out,
-        "a pair is correct within {} m; revisits need {} m of travel and {}° of heading\n",
-        report.evaluation.tp_radius_m,
-        report.evaluation.min_gap_m,
-        report.evaluation.heading_tolerance_deg
-    );
+    let cells: Vec<[String; 3]> = report
+        .subjects
+        .iter()
+        .map(|sub| {
+            let (s, same) = (&sub.scores, &sub.scores.directions.same);
+            let precision = if s.no_pairs {
+                "no matches".to_string()
+            } else {
+                format!(
+                    "precision {:.3} ({} of {} pairs)",
+                    s.precision, s.correct_pairs, s.pairs
+                )
+            };
+            let recall = format!(
+                "recall {:.3} ({} of {} revisits)",
+                same.recall, same.recalled, same.revisits
+            );
+            [sub.label(), precision, recall]
+        })
+        .collect();
+    let width = |i: usize| {
+        cells
+            .iter()
+            .map(|c| c[i].chars().count())
+            .max()
+            .unwrap_or(0)
+    };
+    let (w0, w1) = (width(0), width(1));
+    for [label, precision, recall] in &cells {
+        let _ = writeln!(
+            out,
+            "  {label}{}  {precision}{}  {recall}",
+            " ".repeat(w0 - label.chars().count()),
+            " ".repeat(w1 - precision.chars().count())
+        );
+    }
+    out.push('\n');
+}
+
+/// The main table, a row per subject (and per direction where the other way has revisits or
+/// matches), then a legend line per column.
+fn main_table(report: &Report, out: &mut String) {
     let body: Vec<Vec<String>> = rows_with_directions(report)
         .into_iter()
         .map(|(label, s)| {
@@ -86,9 +169,6 @@ pub fn text_table(report: &Report) -> String {
                 label,
                 fmt_p(&s),
                 format!("{:.3}", s.recall),
-                format!("{:.3}", s.visit_recall),
-                format!("{:.3}", s.pair_recall),
-                format!("{:.3}", s.match_precision),
                 s.pairs.to_string(),
                 s.matches.to_string(),
                 s.revisits.to_string(),
@@ -96,56 +176,150 @@ pub fn text_table(report: &Report) -> String {
             ]
         })
         .collect();
-    out.push_str(&render(
-        &[
+    // A real log is one run, not laps: its time is the whole log's.
+    let (time, time_meaning) = match report.log {
+        Some(_) => ("CPU s", "the recognizer's CPU seconds over the whole log"),
+        None => ("s/lap", "the recognizer's CPU seconds per lap"),
+    };
+    let split = if report.subjects.iter().any(|s| s.scores.has_opposite()) {
+        " (both directions; the same/opposite rows split them)"
+    } else {
+        ""
+    };
+    let recall = format!(
+        "observations with a revisit that are the newer side of a correct pair ÷ observations \
+         with a revisit{split}"
+    );
+    let header = [
+        "subject [τ]",
+        "precision",
+        "recall",
+        "pairs",
+        "matches",
+        "revisits",
+        time,
+    ];
+    out.push_str(&render(&header, &body));
+    let legend = [
+        (
             "subject [τ]",
-            "precision",
-            "recall",
-            "visit R",
-            "pair R",
-            "match P",
+            "the recognizer; words-N is the paper's at N levels, τ the fewest matching words a \
+             chain needs at each level",
+        ),
+        ("precision", "correct pairs ÷ pairs"),
+        ("recall", recall.as_str()),
+        (
             "pairs",
+            "(newer, earlier) observation pairs the matches claim, each once: one observation \
+             can be in many",
+        ),
+        (
             "matches",
+            "the matches the recognizer reported (a chain of words for words-N)",
+        ),
+        (
             "revisits",
-            "s/lap",
-        ],
+            "observations that have a revisit: a count of observations, not pairs",
+        ),
+        (time, time_meaning),
+    ];
+    legend_lines(&legend, out);
+}
+
+/// `  key   meaning` lines, the keys aligned and each meaning wrapped under itself.
+fn legend_lines(legend: &[(&str, &str)], out: &mut String) {
+    let width = legend
+        .iter()
+        .map(|(k, _)| k.chars().count())
+        .max()
+        .unwrap_or(0);
+    let indent = " ".repeat(width + 4);
+    for (k, v) in legend {
+        let first = format!("  {k}{}  ", " ".repeat(width - k.chars().count()));
+        let opts = textwrap::Options::new(TEXT_WIDTH)
+            .initial_indent(&first)
+            .subsequent_indent(&indent);
+        for l in textwrap::wrap(v, opts) {
+            let _ = writeln!(out, "{l}");
+        }
+    }
+}
+
+/// The recalls beside the paper's, and match precision, in a block of their own.
+fn other_recalls(report: &Report, out: &mut String) {
+    let _ = writeln!(out, "\nother recalls");
+    let body: Vec<Vec<String>> = rows_with_directions(report)
+        .into_iter()
+        .map(|(label, s)| {
+            vec![
+                label,
+                format!("{:.3}", s.visit_recall),
+                format!("{:.3}", s.pair_recall),
+                format!("{:.3}", s.match_precision),
+            ]
+        })
+        .collect();
+    out.push_str(&render(
+        &["subject [τ]", "visit R", "pair R", "match P"],
         &body,
     ));
+    legend_lines(
+        &[
+            (
+                "visit R",
+                "(observation, earlier lap through the same spot) combinations recognized ÷ all \
+                 such: rewards matching across door changes",
+            ),
+            (
+                "pair R",
+                "correct pairs ÷ every (observation, earlier observation) pair the truth allows",
+            ),
+            (
+                "match P",
+                "matches most of whose pairs are correct ÷ matches",
+            ),
+        ],
+        out,
+    );
+}
+
+/// What each level adds, why a subject has no pair, the recognizers' notes, and what
+/// verification turned down.
+fn notes(report: &Report, out: &mut String) {
+    let mut lines: Vec<String> = Vec::new();
     for l in &report.subjects {
-        if let (Some(g), Some(levels)) = (&l.only_here, l.levels) {
-            let _ = writeln!(
-                out,
-                "{} levels found {} pair(s) that {} level(s) did not ({} correct)",
-                levels, g.pairs, g.than_levels, g.correct_pairs
-            );
+        if let Some(g) = &l.only_here {
+            lines.push(format!(
+                "{} claims {} pair(s) that {} does not ({} correct)",
+                l.name,
+                g.pairs,
+                crate::spec::evaluation::words_subject_name(g.than_levels),
+                g.correct_pairs
+            ));
         }
     }
     for (label, s) in rows(report) {
         if let Some(why) = &s.no_pairs_reason {
-            let _ = writeln!(out, "{label}: no matches: {why}");
+            lines.push(format!("{label}: no matches: {why}"));
         }
     }
     // Every configuration sees the same scans; say it once, where the reason did not.
-    let mut notes: Vec<&String> = Vec::new();
     for (_, s) in rows(report) {
         if s.no_pairs_reason.is_none() {
             for n in &s.notes {
-                if !notes.contains(&n) {
-                    notes.push(n);
+                let n = format!("note: {n}");
+                if !lines.contains(&n) {
+                    lines.push(n);
                 }
             }
         }
-    }
-    for n in notes {
-        let _ = writeln!(out, "note: {n}");
     }
     // Where there are pairs (the reason says it otherwise): what verification turned down.
     for (label, s) in rows(report) {
         if let (None, Some(r)) = (&s.no_pairs_reason, &s.rejected_candidates) {
             let s = |n: usize| if n == 1 { "" } else { "s" };
             let alike = r.sampled - r.correct;
-            let _ = writeln!(
-                out,
+            lines.push(format!(
                 "{label}: verification turned down {} true revisit{} and {alike} look-alike{} \
                  (of {} candidate{} sampled)",
                 r.correct,
@@ -153,38 +327,70 @@ pub fn text_table(report: &Report) -> String {
                 s(alike),
                 r.sampled,
                 s(r.sampled)
-            );
+            ));
         }
     }
+    if !lines.is_empty() {
+        out.push('\n');
+        let opts = textwrap::Options::new(TEXT_WIDTH).subsequent_indent("    ");
+        for l in lines {
+            for w in textwrap::wrap(&l, &opts) {
+                let _ = writeln!(out, "{w}");
+            }
+        }
+    }
+}
+
+/// Per subject: the figures at each sensitivity radius, and (for simulated runs) per door
+/// configuration of the newer observation's lap.
+fn breakdowns(report: &Report, out: &mut String) {
+    let simulated = report.log.is_none();
+    let ratio = |x: f64, of: usize| {
+        if of == 0 {
+            "–".to_string()
+        } else {
+            format!("{x:.3}")
+        }
+    };
+    let mut any = false;
     for (label, s) in rows(report) {
-        if s.sensitivity.is_empty() && s.door_configs.is_empty() {
+        let doors = if simulated { &s.door_configs[..] } else { &[] };
+        if s.sensitivity.is_empty() && doors.is_empty() {
             continue;
         }
+        any = true;
         let _ = writeln!(out, "\n{label}");
         let mut body: Vec<Vec<String>> = s
             .sensitivity
             .iter()
             .map(|m| {
                 vec![
-                    format!("radius {} m", m.radius_m),
-                    format!("{:.3}", m.precision),
-                    format!("{:.3}", m.recall),
+                    format!("correct within {} m", m.radius_m),
+                    ratio(m.precision, m.pairs),
+                    ratio(m.recall, m.revisits),
                     m.pairs.to_string(),
                     m.revisits.to_string(),
                 ]
             })
             .collect();
-        body.extend(s.door_configs.iter().map(|d| {
+        body.extend(doors.iter().map(|d| {
+            let laps = if d.laps == 1 { "lap" } else { "laps" };
             vec![
-                format!("doors {} ({} laps)", d.door_config, d.laps),
-                format!("{:.3}", d.metrics.precision),
-                format!("{:.3}", d.metrics.recall),
+                format!("doors {} ({} {laps})", d.door_config, d.laps),
+                ratio(d.metrics.precision, d.metrics.pairs),
+                ratio(d.metrics.recall, d.metrics.revisits),
                 d.metrics.pairs.to_string(),
                 d.metrics.revisits.to_string(),
             ]
         }));
         out.push_str(&render(
-            &["  breakdown", "precision", "recall", "pairs", "revisits"],
+            &[
+                "  by radius and doors",
+                "precision",
+                "recall",
+                "pairs",
+                "revisits",
+            ],
             &body
                 .into_iter()
                 .map(|mut r| {
@@ -194,7 +400,26 @@ pub fn text_table(report: &Report) -> String {
                 .collect::<Vec<_>>(),
         ));
     }
-    out
+    if any {
+        let doors = if simulated {
+            "; doors X: the pairs and revisits whose newer observation was made in a lap with \
+             door configuration X"
+        } else {
+            ""
+        };
+        let text = format!(
+            "correct within R m: the figures with a pair (and a revisit) counted within R m \
+             instead of {} m{doors}; – where nothing was there to count",
+            report.evaluation.tp_radius_m
+        );
+        out.push('\n');
+        let opts = textwrap::Options::new(TEXT_WIDTH)
+            .initial_indent("  ")
+            .subsequent_indent("  ");
+        for l in textwrap::wrap(&text, opts) {
+            let _ = writeln!(out, "{l}");
+        }
+    }
 }
 
 fn fmt_p(s: &Scores) -> String {
@@ -320,12 +545,12 @@ pub fn curves_table(curves: &[crate::eval::sweep::PrCurve]) -> String {
             let (f1, f1_at) = match &c.max_f1 {
                 Some(p) => (
                     format!("{:.3}", p.f1),
-                    format!("τ={} P {:.3} R {:.3}", p.threshold, p.precision, p.recall),
+                    format!("t={} P {:.3} R {:.3}", p.threshold, p.precision, p.recall),
                 ),
                 None => ("-".into(), "-".into()),
             };
             let best = match &c.best_recall_at_precision {
-                Some(p) => format!("{:.3} (τ={}, P {:.3})", p.recall, p.threshold, p.precision),
+                Some(p) => format!("{:.3} (t={}, P {:.3})", p.recall, p.threshold, p.precision),
                 None => "-".into(),
             };
             vec![c.label.clone(), f1, f1_at, best]
@@ -375,7 +600,7 @@ mod tests {
         let c = pr_curves(&[r(1, &[5], 0.95, 0.1), r(2, &[6, 3], 0.5, 0.5)]);
         let t = curves_table(&c);
         assert_eq!(t.lines().count(), 4, "{t}");
-        assert!(t.contains("0.100 (τ=5, P 0.950)"), "{t}");
+        assert!(t.contains("0.100 (t=5, P 0.950)"), "{t}");
     }
 
     /// Where opposite revisits exist, the terminal table and Table I add a row per direction
@@ -423,7 +648,13 @@ mod tests {
     #[test]
     fn rows_per_direction_where_opposite_revisits_exist() {
         let plain = sample("A", [0.9; 3], [0.2; 3]);
-        assert!(!text_table(&plain).contains("opposite"));
+        let direction_rows = |t: &str| t.lines().any(|l| l.starts_with("  opposite"));
+        assert!(
+            !direction_rows(&text_table(&plain)),
+            "{}",
+            text_table(&plain)
+        );
+        assert!(!text_table(&plain).contains("same/opposite rows"));
         assert!(!markdown_table_i(std::slice::from_ref(&plain)).contains("opposite"));
         let mut both = plain.clone();
         let s = &mut both.subjects[2].scores;
@@ -444,6 +675,53 @@ mod tests {
         assert!(md.contains("| words-3 opposite | 0.800 – "), "{md}");
     }
 
+    /// Each subject leads with the paper's two figures and what they count; a real log's
+    /// summary speaks of scans and metres, with no laps, door configurations or time per lap.
+    #[test]
+    fn headlines_and_a_real_logs_header() {
+        let mut rep = sample("B", [0.9; 3], [0.2; 3]);
+        for s in &mut rep.subjects {
+            s.scores.correct_pairs = 90;
+            s.scores.pairs = 100;
+            s.scores.directions.same.recall = 0.25;
+            s.scores.directions.same.recalled = 50;
+            s.scores.directions.same.revisits = 200;
+            s.scores.door_configs = vec![crate::eval::metrics::DoorConfigMetrics {
+                door_config: "all-closed".into(),
+                laps: 3,
+                ..Default::default()
+            }];
+        }
+        let t = text_table(&rep);
+        let headline = t.lines().find(|l| l.starts_with("  words-3")).unwrap();
+        assert!(
+            headline.contains("precision 0.900 (90 of 100 pairs)"),
+            "{t}"
+        );
+        assert!(
+            headline.contains("recall 0.250 (50 of 200 revisits)"),
+            "{t}"
+        );
+        assert!(t.contains("40 laps") && t.contains("s/lap"), "{t}");
+        assert!(t.contains("doors all-closed (3 laps)"), "{t}");
+        rep.log = Some(crate::eval::scores::LogSummary {
+            scans: 910,
+            travel_m: 500.4,
+        });
+        let t = text_table(&rep);
+        assert!(
+            t.starts_with("log B  noise seed 7  910 scans over 500 m"),
+            "{t}"
+        );
+        for absent in ["laps", "doors", "s/lap", "simulated"] {
+            assert!(
+                !t.contains(absent),
+                "`{absent}` in a real log's summary:\n{t}"
+            );
+        }
+        assert!(t.contains("CPU s"), "{t}");
+    }
+
     #[test]
     fn text_table_lists_every_recognizer() {
         let t = text_table(&sample("B", [0.9; 3], [0.2; 3]));
@@ -455,7 +733,7 @@ mod tests {
             "words-2 [6, 9]",
             "words-3 [6, 9, 12]",
             "icp",
-            "revisits 5000",
+            "5000 observations have one",
         ] {
             assert!(t.contains(needle), "{needle} missing in\n{t}");
         }

@@ -878,5 +878,7 @@ fn a_run_without_pairs_says_why() {
     assert!(json.contains("\"no_pairs_reason\""), "{json}");
     let table = placewords::report::table::text_table(&exp.report);
     assert!(table.contains("no matches"), "{table}");
-    assert!(table.contains(why), "{table}");
+    // The table wraps long lines: compare the words.
+    let words = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(words(&table).contains(&words(why)), "{table}");
 }
