@@ -167,7 +167,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     for f in &args.files {
         let format = placewords::spec::diag::MessageFormat::from_name(&args.format.message_format)
             .unwrap_or_default();
-        match placewords::world::check_world(f) {
+        match placewords::sim::test_drive::check_world(f) {
             Ok((w, warnings)) => {
                 for line in
                     placewords::spec::diag::SpecError::Invalid(warnings.clone()).render(format)
