@@ -1,6 +1,6 @@
 //! A test drive of a route before any long run: the simulator's own robot, controller and
 //! route tracker ([`RunSim`], so the turning path is the one laps are driven on: smooth arcs
-//! inside ordinary corners, turns on the spot where [`spin_waypoints`] says) drive the route
+//! inside ordinary corners, turns on the spot where `sim::robot::spin_waypoints` says) drive the route
 //! once round, noise-free, with nobody about, no wander and no lap variation, once with every
 //! door closed and once with every door open. A route is refused where the robot's disc would
 //! touch a wall or door (by more than [`TOUCH_TOLERANCE_M`]) or where the robot would be

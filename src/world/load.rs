@@ -37,7 +37,7 @@ pub fn parse_world_spec_warned(
     parse_world_spec_checked(src, path, check, None)
 }
 
-/// Like [`parse_world_spec_warned`]; when the world has no error, `more` checks its routes too
+/// Like `parse_world_spec_warned`; when the world has no error, `more` checks its routes too
 /// and each problem it finds is reported at its waypoint (`file:line:col`).
 pub fn parse_world_spec_checked(
     src: &str,
