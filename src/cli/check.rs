@@ -122,11 +122,8 @@ pub fn finish(
         let xml = junit::document(suite);
         stress::write_file(path, xml.as_bytes())?;
     }
-    if json {
-        // The text summary lists each error under its scenario; print each once.
-        for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
-            errln!("error: {e}");
-        }
+    for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
+        errln!("error: {e}");
     }
     if json {
         outln!("{}", format::summary_json(suite))?;

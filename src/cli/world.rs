@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 #[derive(Debug, Subcommand)]
 pub enum WorldCommand {
-    /// Validate world files; every problem is printed as file:line:col on stderr (exit 2).
+    /// Validate world files and test-drive their routes (with all doors closed and all open); every problem is printed as file:line:col on stderr (exit 2).
     #[command(after_help = "Example:\n  placewords world check worlds/*.toml")]
     Check(CheckArgs),
     /// Draw a world as SVG: walls, doors, routes, home pose, scale bar, legend.
