@@ -75,8 +75,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         if args.profile {
             eprint!("{}", profile_text(suite.reports(), w.wall_s()));
         }
-        if let Some(e) = suite.scenarios.iter().flat_map(|s| s.errors()).next() {
-            anyhow::bail!("{e}");
+        let errors: Vec<String> = suite.scenarios.iter().flat_map(|s| s.errors()).collect();
+        if !errors.is_empty() {
+            errors.iter().for_each(|e| errln!("error: {e}"));
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
         }
         return Ok(ExitCode::SUCCESS);
     }

@@ -27,7 +27,7 @@ pub fn run(cmd: ScenarioCommand) -> anyhow::Result<ExitCode> {
     let format = MessageFormat::from_name(&args.format.message_format).unwrap_or_default();
     let mut failed = false;
     for f in &args.files {
-        match placewords::experiment::load_scenario(f) {
+        match placewords::experiment::check_scenario(f) {
             Ok(s) if format == MessageFormat::Human => outln!(
                 "{}: ok ({} runs, world {})",
                 f.display(),

@@ -10,7 +10,7 @@ use std::process::ExitCode;
 
 #[derive(Debug, Subcommand)]
 pub enum WorldCommand {
-    /// Validate world files; every problem is printed as file:line:col on stderr (exit 2).
+    /// Validate world files and test-drive their routes (with all doors closed and all open); every problem is printed as file:line:col on stderr (exit 2).
     #[command(after_help = "Example:\n  placewords world check worlds/*.toml")]
     Check(CheckArgs),
     /// Draw a world as SVG: walls, doors, routes, home pose, scale bar, legend.
@@ -167,7 +167,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     for f in &args.files {
         let format = placewords::spec::diag::MessageFormat::from_name(&args.format.message_format)
             .unwrap_or_default();
-        match placewords::world::check_world(f) {
+        match placewords::sim::test_drive::check_world(f) {
             Ok((w, warnings)) => {
                 for line in
                     placewords::spec::diag::SpecError::Invalid(warnings.clone()).render(format)

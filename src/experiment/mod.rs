@@ -27,7 +27,8 @@ use crate::spec::evaluation::EvaluationSpec;
 pub use progress::{Progress, ProgressSink};
 use rayon::prelude::*;
 pub use scenario::{
-    Scenario, load_recognizer_config, load_scenario, parse_recognizer_config, parse_scenario,
+    Scenario, check_scenario, load_recognizer_config, load_scenario, parse_recognizer_config,
+    parse_scenario,
 };
 use std::time::Instant;
 pub use stream::run_scenario_streamed;

@@ -93,6 +93,26 @@ pub fn load_scenario(path: &Path) -> Result<Scenario, SpecError> {
     parse_scenario(&src, path, &crate::world::load_world_for)
 }
 
+/// `scenario check` of a file: [`load_scenario`], then a test drive of its route as its runs
+/// drive it, for its robot and laser (`sim::test_drive`); a route the robot cannot drive is
+/// refused at the waypoint's place in the world file.
+pub fn check_scenario(path: &Path) -> Result<Scenario, SpecError> {
+    let s = load_scenario(path)?;
+    let sim = &s.sim;
+    let route = sim.world.routes.iter().position(|r| r.id == sim.route.id);
+    let problems = crate::sim::test_drive::plan_problems(sim, route.unwrap_or(0));
+    if problems.is_empty() {
+        return Ok(s);
+    }
+    let src = read_text(&sim.world_path)?;
+    let check = WorldCheck {
+        robot_radius_m: sim.robot.radius_m,
+    };
+    let shown = sim.world_path.display().to_string();
+    crate::world::parse_world_spec_checked(&src, &shown, &check, Some(&|_| problems.clone()))?;
+    Ok(s)
+}
+
 /// Parses and checks a scenario's text. `path` names the file in messages and anchors the world
 /// path. Every problem of the file is reported, then those of its world.
 pub fn parse_scenario(

@@ -52,8 +52,12 @@ pub fn text_table(suite: &SuiteReport) -> String {
     let mut out = String::new();
     for sc in &suite.scenarios {
         let _ = writeln!(out, "{}", header(sc));
-        for e in sc.errors() {
-            let _ = writeln!(out, "  error: {e}");
+        // Each error is printed once, on stderr, by the command; the table only counts them.
+        match sc.errors().len() {
+            0 => {}
+            n => {
+                let _ = writeln!(out, "  {n} error(s): see the `error:` lines on stderr");
+            }
         }
         if sc.summary.is_empty() {
             out.push('\n');

@@ -746,13 +746,15 @@ fn grid(svg: &mut Svg, f: &Frame, map_w: f64, map_h: f64) {
     let step = nice_length(60.0 / f.s).max(0.5);
     svg.open_group(r##"id="grid" stroke="#d8d8d8" stroke-width="0.6" font-size="10" fill="#888""##);
     let first = |lo: f64| (lo / step).ceil() * step;
+    // "0", never "-0", and no float residue ("0.30000000000000004") in the labels.
+    let label = |v: f64| format!("{}", (v / step).round() * step + 0.0);
     let mut x = first(f.min.x);
     while x <= f.max.x {
         let (px, _) = f.p(Vec2::new(x, f.min.y));
         svg.line((px, f.top), (px, f.top + map_h), "");
         svg.text(
             (px + 2.0, f.top + map_h - 3.0),
-            &format!("{x}"),
+            &label(x),
             r#"stroke="none""#,
         );
         x += step;
@@ -761,11 +763,7 @@ fn grid(svg: &mut Svg, f: &Frame, map_w: f64, map_h: f64) {
     while y <= f.max.y {
         let (_, py) = f.p(Vec2::new(f.min.x, y));
         svg.line((f.left, py), (f.left + map_w, py), "");
-        svg.text(
-            (f.left + 2.0, py - 2.0),
-            &format!("{y}"),
-            r#"stroke="none""#,
-        );
+        svg.text((f.left + 2.0, py - 2.0), &label(y), r#"stroke="none""#);
         y += step;
     }
     svg.close_group();

@@ -12,6 +12,7 @@ pub(crate) mod plan;
 pub mod rng;
 pub(crate) mod robot;
 pub mod runner;
+pub mod test_drive;
 pub(crate) mod variation;
 
 pub use plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};

@@ -1,10 +1,23 @@
 //! The Pioneer 3-DX: differential-drive kinematics, route tracking on the true trajectory, and a
 //! pure-pursuit controller that keeps to cruise speed within the acceleration limits, slows for
 //! obstacles ahead and waits for them to clear.
+//!
+//! **Turning on the spot.** Ordinary corners are driven smoothly: the pure-pursuit target runs
+//! `lookahead_m` ahead along the route, so the robot rounds a corner on an arc just inside it.
+//! Where the route reverses or turns sharply ([`spin_waypoints`]: a heading change of at least
+//! `spin_turn_rad`, 120° by default, or of at least `short_leg_spin_turn_rad`, 60°, when a leg
+//! next to the waypoint is shorter than twice the look-ahead or a wall or door is closer to the
+//! waypoint than `radius_m + stop_distance_m`, 0.85 m), the robot does what a P3-DX does
+//! in a dead end or a narrow corridor: it drives to the waypoint itself, braking to arrive,
+//! stops, turns on the spot to the next leg's heading, and drives on. The route tracker treats
+//! such a waypoint as a gate: progress never runs past it before the turn nor falls back behind
+//! it after, so a route into a dead end and back out along the same line is tracked leg by leg.
+//! A wall or person further ahead than the turning point does not stop the robot short of it.
 
 use crate::geom::{Pose2, Segment, Vec2, wrap_angle};
 use crate::sim::variation::{LapVariationConfig, PathShape};
 use crate::world::Route;
+use crate::world::geometry::SegmentIndex;
 
 /// Robot and controller parameters (P3-DX defaults from ARIA/MobileSim).
 #[derive(Clone, Debug, PartialEq)]
@@ -40,6 +53,14 @@ pub struct RobotConfig {
     /// Lanes across the corridor, speed changes, short stops and turns on the spot per lap
     /// (see [`crate::sim::variation`]). Default: all off.
     pub variation: LapVariationConfig,
+    /// The robot turns on the spot at a waypoint where the route's heading changes by at least
+    /// this much, radians. Default 120° (a reversal is 180°; office corners are 90°).
+    pub spin_turn_rad: f64,
+    /// ... or by at least this much where a leg next to the waypoint is shorter than twice
+    /// `lookahead_m` (a smooth turn would cut across the whole short leg), or where a wall or
+    /// door is closer to the waypoint than `radius_m + stop_distance_m` (so narrow that the wall
+    /// ahead would stop the robot before it had turned), radians. Default 60°.
+    pub short_leg_spin_turn_rad: f64,
 }
 
 impl Default for RobotConfig {
@@ -59,8 +80,49 @@ impl Default for RobotConfig {
             step_s: 0.05,
             path_wander_m: 0.0,
             variation: LapVariationConfig::default(),
+            spin_turn_rad: 120f64.to_radians(),
+            short_leg_spin_turn_rad: 60f64.to_radians(),
         }
     }
+}
+
+/// Which waypoints of `route` (driven in its own order) the robot turns on the spot at; see
+/// the module docs for the rule. `room_m[k]` is the clearance from waypoint `k` to the nearest
+/// wall or door (in either state; [`waypoint_room`]). The one rule both the controller and the
+/// route checks use.
+pub fn spin_waypoints(route: &Route, cfg: &RobotConfig, room_m: &[f64]) -> Vec<bool> {
+    let n = route.waypoints.len();
+    let legs = route.legs();
+    (0..n)
+        .map(|k| {
+            let (into, out) = (legs[(k + n - 1) % n], legs[k]);
+            let (din, dout) = (into.b - into.a, out.b - out.a);
+            if n < 3 || din.norm() < 1e-9 || dout.norm() < 1e-9 {
+                return false;
+            }
+            let turn = wrap_angle(dout.y.atan2(dout.x) - din.y.atan2(din.x)).abs();
+            let short = into.length().min(out.length()) < 2.0 * cfg.lookahead_m;
+            let narrow = room_m
+                .get(k)
+                .is_some_and(|&r| r < cfg.radius_m + cfg.stop_distance_m);
+            turn >= cfg.spin_turn_rad - 1e-9
+                || ((short || narrow) && turn >= cfg.short_leg_spin_turn_rad - 1e-9)
+        })
+        .collect()
+}
+
+/// Clearance from each waypoint of `route` to the nearest of `obstacles` (walls and door
+/// panels), metres; infinite where nothing is within 10 m.
+pub fn waypoint_room(route: &Route, obstacles: &SegmentIndex) -> Vec<f64> {
+    route
+        .waypoints
+        .iter()
+        .map(|&p| {
+            obstacles
+                .nearest_within(Segment::new(p, p), 10.0)
+                .map_or(f64::INFINITY, |(_, c)| c)
+        })
+        .collect()
 }
 
 /// Exact motion of a differential drive at constant (v, ω) for `dt` seconds.
@@ -94,9 +156,46 @@ pub struct RouteTracker {
     origin_m: f64,
     /// Unwrapped progress since the start, metres.
     progress_m: f64,
+    /// Arc lengths (from waypoint 0, within one lap, ascending) of the waypoints the robot turns
+    /// on the spot at: gates progress does not pass until the turn is done.
+    gates_m: Vec<f64>,
+    /// Absolute arc length of the last gate passed (the start at first).
+    passed_gate_m: f64,
 }
 
 impl RouteTracker {
+    /// A tracker with a gate at each waypoint `spins` marks (see [`spin_waypoints`]).
+    pub fn with_gates(route: &Route, start_waypoint: usize, spins: &[bool]) -> Self {
+        let mut t = RouteTracker::new(route, start_waypoint);
+        t.gates_m = (0..t.starts.len())
+            .filter(|&k| spins.get(k).copied().unwrap_or(false))
+            .map(|k| t.starts[k])
+            .collect();
+        t
+    }
+
+    /// Absolute arc length of the next gate ahead, if the route has any.
+    pub fn next_gate_m(&self) -> Option<f64> {
+        let first = *self.gates_m.first()?;
+        let passed = self.passed_gate_m;
+        let base = passed - self.wrap(passed);
+        Some(
+            self.gates_m
+                .iter()
+                .map(|g| base + g)
+                .find(|&g| g > passed + 1e-9)
+                .unwrap_or(base + self.length_m + first),
+        )
+    }
+
+    /// The turn at the next gate is done: progress moves up to it and the gate is passed.
+    pub fn pass_gate(&mut self) {
+        if let Some(g) = self.next_gate_m() {
+            self.progress_m = self.progress_m.max(g - self.origin_m);
+            self.passed_gate_m = g;
+        }
+    }
+
     pub fn new(route: &Route, start_waypoint: usize) -> Self {
         let legs = route.legs();
         let mut starts = Vec::with_capacity(legs.len());
@@ -112,6 +211,8 @@ impl RouteTracker {
             length_m: acc,
             origin_m,
             progress_m: 0.0,
+            gates_m: Vec::new(),
+            passed_gate_m: origin_m,
         }
     }
 
@@ -165,6 +266,10 @@ impl RouteTracker {
     pub fn update(&mut self, p: Vec2) -> f64 {
         let window = 3.0;
         let prev = self.wrap(self.arc_m());
+        // Between gates: not past the next one, not behind the last one passed.
+        let bounds = self
+            .next_gate_m()
+            .map(|g| (self.passed_gate_m - self.arc_m(), g - self.arc_m()));
         let mut best: Option<(f64, f64)> = None; // (distance, delta)
         for (i, leg) in self.legs.iter().enumerate() {
             let d = leg.b - leg.a;
@@ -182,7 +287,9 @@ impl RouteTracker {
             } else if delta < -half {
                 delta += self.length_m;
             }
-            if delta.abs() > window {
+            if delta.abs() > window
+                || bounds.is_some_and(|(lo, hi)| delta < lo - 1e-9 || delta > hi + 1e-9)
+            {
                 continue;
             }
             let dist = (p - (leg.a + d * t)).norm();
@@ -259,7 +366,9 @@ pub struct Controller {
 
 impl Controller {
     /// New speeds for the next step. `free_ahead_m` is the clear distance in front of the
-    /// robot's body along its heading (from its last scan).
+    /// robot's body along its heading (from its last scan). Before a gate (a waypoint the robot
+    /// turns on the spot at, [`RouteTracker::next_gate_m`]) the target stops at the gate, the
+    /// robot brakes to arrive there, and what lies beyond the gate does not stop it.
     pub fn command(
         &mut self,
         cfg: &RobotConfig,
@@ -269,7 +378,14 @@ impl Controller {
         free_ahead_m: f64,
     ) -> (f64, f64) {
         let dt = cfg.step_s;
-        let s = tracker.arc_m() + cfg.lookahead_m;
+        let gate_left_m = tracker
+            .next_gate_m()
+            .map(|g| g - tracker.arc_m())
+            .filter(|&left| left < cfg.lookahead_m + cfg.slow_distance_m + 2.0);
+        let mut s = tracker.arc_m() + cfg.lookahead_m;
+        if let Some(left) = gate_left_m {
+            s = s.min(tracker.arc_m() + left.max(0.0));
+        }
         let target = path.target(tracker, s);
         let to = target - pose.position();
         let alpha = wrap_angle(to.y.atan2(to.x) - pose.theta);
@@ -283,8 +399,15 @@ impl Controller {
             alpha.cos().max(0.0)
         };
         let span = (cfg.slow_distance_m - cfg.stop_distance_m).max(1e-6);
-        let obstacle_factor = ((free_ahead_m - cfg.stop_distance_m) / span).clamp(0.0, 1.0);
-        let v_goal = cruise * heading_factor * obstacle_factor;
+        let mut obstacle_factor = ((free_ahead_m - cfg.stop_distance_m) / span).clamp(0.0, 1.0);
+        let mut v_goal_cap = f64::INFINITY;
+        if let Some(left) = gate_left_m {
+            if free_ahead_m > left {
+                obstacle_factor = 1.0;
+            }
+            v_goal_cap = (2.0 * cfg.accel_m_s2 * left.max(0.0)).sqrt();
+        }
+        let v_goal = (cruise * heading_factor * obstacle_factor).min(v_goal_cap);
         let dv = cfg.accel_m_s2 * dt;
         let v = v_goal.clamp(self.v_m_s - dv, self.v_m_s + dv);
         // Turn: pure pursuit curvature at (at least) a nominal speed so the robot can line up

@@ -11,14 +11,17 @@
 //! Each run starts at its start waypoint facing along the route, at rest, with the odometry at
 //! (0, 0, 0) as on a robot just switched on; odometry is continuous across the run's laps.
 
-use crate::geom::{OdomPose, Pose2, TruePose};
+use crate::geom::{OdomPose, Pose2, TruePose, wrap_angle};
 use crate::log::{Frame, LapLog, RunLog};
 use crate::sim::laser::Laser;
 use crate::sim::odometry::Odometry;
 use crate::sim::pedestrians::{self, Pedestrian};
 use crate::sim::plan::{DoorPlan, SimPlan};
 use crate::sim::rng::{Purpose, RUN_WIDE, SimRng, stream};
-use crate::sim::robot::{Controller, RouteTracker, Wander, free_ahead, integrate, wheel_speeds};
+use crate::sim::robot::{
+    Controller, RouteTracker, Wander, free_ahead, integrate, spin_waypoints, waypoint_room,
+    wheel_speeds,
+};
 use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
 use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
@@ -146,19 +149,28 @@ enum Hold {
     StopUntil(f64),
     /// Signed angle left to turn, radians.
     Spin(f64),
+    /// Turning on the spot at a route waypoint ([`spin_waypoints`]): signed angle left to turn,
+    /// radians; the tracker passes the gate when it is done.
+    TurnAtWaypoint(f64),
 }
 
 /// Turn rate of a turn on the spot, rad/s (45°/s).
 const SPIN_RATE_RAD_S: f64 = std::f64::consts::FRAC_PI_4;
+
+/// The robot starts its turn on the spot at a waypoint when its progress is this close to it,
+/// metres.
+pub const TURN_CAPTURE_M: f64 = 0.05;
 
 impl<'a> RunSim<'a> {
     /// A run at its start waypoint, with all doors closed until the first lap sets them.
     pub fn new(scn: &'a SimPlan, run: usize) -> Self {
         let plan = &scn.runs[run];
         let (route, start) = plan.driven_route(&scn.route);
-        let tracker = RouteTracker::new(&route, start);
-        let truth = tracker.start_pose();
         let obstacles = obstacles(&scn.world);
+        let room_m = waypoint_room(&route, &obstacles);
+        let spins = spin_waypoints(&route, &scn.robot, &room_m);
+        let tracker = RouteTracker::with_gates(&route, start, &spins);
+        let truth = tracker.start_pose();
         let clearance_m = scn.robot.radius_m + scn.robot.variation.lane_margin_m;
         let room = LaneRoom::measure(&route, &obstacles, clearance_m);
         let mut angle_rng = stream(scn.seed, run as u64, RUN_WIDE, Purpose::LaserAngles);
@@ -292,13 +304,25 @@ impl<'a> RunSim<'a> {
             self.contact_steps += 1;
         }
         self.truth = next;
-        if let Hold::Spin(left) = self.hold {
-            let turned = w * dt;
-            self.hold = if left.abs() <= turned.abs() {
-                Hold::Drive
-            } else {
-                Hold::Spin(left - turned)
-            };
+        match self.hold {
+            Hold::Spin(left) => {
+                let turned = w * dt;
+                self.hold = if left.abs() <= turned.abs() {
+                    Hold::Drive
+                } else {
+                    Hold::Spin(left - turned)
+                };
+            }
+            Hold::TurnAtWaypoint(left) => {
+                let turned = w * dt;
+                self.hold = if left.abs() <= turned.abs() {
+                    self.tracker.pass_gate();
+                    Hold::Drive
+                } else {
+                    Hold::TurnAtWaypoint(left - turned)
+                };
+            }
+            _ => {}
         }
         let progress = self.tracker.update(next.position());
         if self.hold != Hold::Drive {
@@ -329,7 +353,15 @@ impl<'a> RunSim<'a> {
         let cfg = &self.scn.robot;
         let arc = self.tracker.arc_m();
         if self.hold == Hold::Drive {
-            if let Some(d) = self.plan.take_stop(arc) {
+            if let Some(gate) = self
+                .tracker
+                .next_gate_m()
+                .filter(|g| g - arc <= TURN_CAPTURE_M)
+            {
+                let (_, out) = self.tracker.point_at(gate + 1e-6);
+                let turn = wrap_angle(out.y.atan2(out.x) - self.truth.theta);
+                self.hold = Hold::TurnAtWaypoint(turn);
+            } else if let Some(d) = self.plan.take_stop(arc) {
                 self.hold = Hold::StopUntil(self.time_s + d);
             } else if let Some(a) = self.plan.take_spin(arc) {
                 self.hold = Hold::Spin(a);
@@ -337,7 +369,9 @@ impl<'a> RunSim<'a> {
         }
         match self.hold {
             Hold::StopUntil(t) if self.time_s < t => self.controller.hold(cfg, 0.0),
-            Hold::Spin(left) => self.controller.hold(cfg, left.signum() * SPIN_RATE_RAD_S),
+            Hold::Spin(left) | Hold::TurnAtWaypoint(left) => {
+                self.controller.hold(cfg, left.signum() * SPIN_RATE_RAD_S)
+            }
             _ => {
                 self.hold = Hold::Drive;
                 self.controller.command(

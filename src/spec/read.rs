@@ -349,7 +349,7 @@ pub(crate) fn table_array<'t, 'i>(
 pub(crate) fn ctx_of(kind: &str, id: &Option<String>, i: usize) -> String {
     match id {
         Some(id) => format!("{kind} '{id}'"),
-        None => format!("{kind} #{}", i + 1),
+        None => format!("{kind} #{i}"),
     }
 }
 

@@ -515,7 +515,7 @@ fn read_runs(top: &DeTable<'_>, d: &mut Diags) -> Option<Vec<RunSpec>> {
 }
 
 fn read_run(t: &DeTable<'_>, at: usize, i: usize, d: &mut Diags) -> Option<RunSpec> {
-    let ctx = format!("run #{}", i + 1);
+    let ctx = format!("run #{i}");
     unknown_keys(t, RUN_KEYS, &ctx, d);
     let laps = match get(t, "laps") {
         None => {

@@ -485,7 +485,7 @@ fn read_wall(
     d: &mut Diags,
     l: &mut WallLoc,
 ) -> Option<WallSpec> {
-    let (id, id_at) = id(t, WALL_KEYS, at, &format!("wall #{}", i + 1), d);
+    let (id, id_at) = id(t, WALL_KEYS, at, &format!("wall #{i}"), d);
     l.id = id_at;
     let ctx = ctx_of("wall", &id, i);
     unknown_keys(t, WALL_KEYS, &ctx, d);
@@ -527,7 +527,7 @@ fn read_door(
     d: &mut Diags,
     l: &mut DoorLoc,
 ) -> Option<DoorSpec> {
-    let (id, id_at) = id(t, DOOR_KEYS, at, &format!("door #{}", i + 1), d);
+    let (id, id_at) = id(t, DOOR_KEYS, at, &format!("door #{i}"), d);
     l.id = id_at;
     let ctx = ctx_of("door", &id, i);
     unknown_keys(t, DOOR_KEYS, &ctx, d);
@@ -588,7 +588,7 @@ fn read_route(
     d: &mut Diags,
     l: &mut RouteLoc,
 ) -> Option<RouteSpec> {
-    let (id, id_at) = id(t, ROUTE_KEYS, at, &format!("route #{}", i + 1), d);
+    let (id, id_at) = id(t, ROUTE_KEYS, at, &format!("route #{i}"), d);
     l.id = id_at;
     let ctx = ctx_of("route", &id, i);
     unknown_keys(t, ROUTE_KEYS, &ctx, d);
@@ -615,7 +615,7 @@ fn read_area(
     d: &mut Diags,
     l: &mut AreaLoc,
 ) -> Option<AreaSpec> {
-    let (id, id_at) = id(t, AREA_KEYS, at, &format!("area #{}", i + 1), d);
+    let (id, id_at) = id(t, AREA_KEYS, at, &format!("area #{i}"), d);
     l.id = id_at;
     let ctx = ctx_of("area", &id, i);
     unknown_keys(t, AREA_KEYS, &ctx, d);

@@ -12,15 +12,53 @@ pub fn parse_world_spec(src: &str, path: &str, check: &WorldCheck) -> Result<Wor
     parse_world_spec_warned(src, path, check).map(|(spec, _)| spec)
 }
 
+/// A problem a check above this layer (the simulator's test drive of a route) found at a route
+/// waypoint; reported at the waypoint's place in the file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RouteProblem {
+    /// Index of the route in the file (from 0).
+    pub route: usize,
+    /// Index of the waypoint in the route as the file lists it (from 0).
+    pub waypoint: usize,
+    /// `what is wrong; what to try`.
+    pub message: String,
+}
+
+/// Checks of a valid world that need more than the world itself (a simulated drive): run only
+/// when every check here passed.
+pub type RouteCheck<'a> = &'a dyn Fn(&World) -> Vec<RouteProblem>;
+
 /// Like [`parse_world_spec`], with the warnings of a world that has no error.
 pub fn parse_world_spec_warned(
     src: &str,
     path: &str,
     check: &WorldCheck,
 ) -> Result<(WorldSpec, Vec<Diagnostic>), SpecError> {
+    parse_world_spec_checked(src, path, check, None)
+}
+
+/// Like `parse_world_spec_warned`; when the world has no error, `more` checks its routes too
+/// and each problem it finds is reported at its waypoint (`file:line:col`).
+pub fn parse_world_spec_checked(
+    src: &str,
+    path: &str,
+    check: &WorldCheck,
+    more: Option<RouteCheck>,
+) -> Result<(WorldSpec, Vec<Diagnostic>), SpecError> {
     let mut d = Diags::new(src, path);
     let spec = read_world(src, &mut d).map(|(spec, loc)| {
         validate::validate(&spec, &loc, check, &mut d);
+        if let Some(more) = more.filter(|_| !d.has_errors()) {
+            for p in more(&World::from_spec(&spec)) {
+                let at = loc.routes.get(p.route).map_or(0, |l| {
+                    l.waypoints
+                        .get(p.waypoint)
+                        .copied()
+                        .unwrap_or(l.waypoints_key)
+                });
+                d.at(at, p.message);
+            }
+        }
         spec
     });
     let has_errors = d.has_errors();
@@ -61,6 +99,22 @@ pub fn check_world(path: &Path) -> Result<(World, Vec<Diagnostic>), SpecError> {
     let src = crate::spec::diag::read_text(path)?;
     parse_world_spec_warned(&src, &path.display().to_string(), &WorldCheck::default())
         .map(|(spec, warnings)| (World::from_spec(&spec), warnings))
+}
+
+/// [`check_world`], and when the world has no error, `more` on its routes (see
+/// [`parse_world_spec_checked`]).
+pub fn check_world_with(
+    path: &Path,
+    more: RouteCheck,
+) -> Result<(World, Vec<Diagnostic>), SpecError> {
+    let src = crate::spec::diag::read_text(path)?;
+    parse_world_spec_checked(
+        &src,
+        &path.display().to_string(),
+        &WorldCheck::default(),
+        Some(more),
+    )
+    .map(|(spec, warnings)| (World::from_spec(&spec), warnings))
 }
 
 /// Reads and checks a world file for the robot in `check`.

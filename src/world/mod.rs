@@ -11,7 +11,8 @@ pub mod raycast;
 pub(crate) mod validate;
 
 pub use load::{
-    check_world, load_world, load_world_for, parse_world, parse_world_for, parse_world_spec,
+    RouteCheck, RouteProblem, check_world, check_world_with, load_world, load_world_for,
+    parse_world, parse_world_for, parse_world_spec, parse_world_spec_checked,
 };
 pub use validate::WorldCheck;
 

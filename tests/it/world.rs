@@ -653,3 +653,19 @@ fn world_check_warns_about_a_tight_leg_and_still_passes() {
         assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
     }
 }
+
+/// Grid labels read "0" where the axis crosses zero, never "-0" (a world whose frame starts
+/// just below zero rounds its first grid line up to minus zero).
+#[test]
+fn grid_labels_never_read_minus_zero() {
+    for name in ["drivable/narrow-corners.toml", "valid-base.toml"] {
+        let w = load_world(&root().join("tests/fixtures").join(name)).unwrap();
+        let opts = RenderOptions {
+            show_grid: true,
+            ..RenderOptions::default()
+        };
+        let svg = render_world_svg(&w, &opts);
+        assert!(!svg.contains(">-0<"), "{name}: a grid label reads -0");
+        assert!(svg.contains(">0<"), "{name}: no grid label at 0");
+    }
+}
