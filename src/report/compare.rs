@@ -67,6 +67,10 @@ pub fn metric_line(m: &MetricComparison) -> String {
     if m.decision == Decision::Identical {
         return s;
     }
+    if m.decision == Decision::NoChange && m.beyond_seeds.is_empty() && m.paired {
+        let _ = write!(s, "; within {}", tolerance(m));
+        return s;
+    }
     if m.paired {
         let _ = write!(
             s,
