@@ -701,7 +701,7 @@ mod tests {
 
     #[test]
     fn few_seeds_decide_on_every_seed() {
-        let v = values(&[0.9, 0.9], &[0.85, 0.89]);
+        let v = values(&[0.9, 0.9], &[0.85, 0.895]);
         let m = compare_metric(
             "B",
             "words-3",
