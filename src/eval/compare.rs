@@ -280,13 +280,7 @@ pub fn compare(
                 .join(", "),
         })?;
         let tolerance = overrides.apply(sc.expect.regression);
-        scenarios.push(compare_scenario(
-            (base_file, b),
-            (new_file, sc),
-            base,
-            new,
-            tolerance,
-        )?);
+        scenarios.push(compare_scenario((base_file, b), sc, base, new, tolerance)?);
     }
     let p = &base.provenance;
     Ok(Comparison {
@@ -317,20 +311,17 @@ fn find_scenario<'a>(base: &'a SuiteReport, sc: &ScenarioResult) -> Option<&'a S
         })
 }
 
-/// Each seed of `sc` with the baseline's report of the same seed.
+/// Each seed of `sc` that ran with the baseline's report of the same seed.
 fn seed_pairs<'a>(
     (base_file, b): (&str, &'a ScenarioResult),
-    (new_file, sc): (&str, &'a ScenarioResult),
+    sc: &'a ScenarioResult,
 ) -> Result<Vec<(u64, &'a Report, &'a Report, bool)>, CompareError> {
     let mut out = Vec::new();
+    // A seed that failed in the new run is an error of the run itself (the gate reports it,
+    // exit 2); the comparison goes on without it.
     for r in &sc.results {
         let Some(nr) = &r.report else {
-            return Err(CompareError::FailedSeed {
-                label: sc.label.clone(),
-                seed: r.seed,
-                file: new_file.to_string(),
-                why: r.error.clone().unwrap_or_default(),
-            });
+            continue;
         };
         let Some(br) = b.results.iter().find(|x| x.seed == r.seed) else {
             return Err(CompareError::MissingSeed {
@@ -356,12 +347,18 @@ fn seed_pairs<'a>(
 
 fn compare_scenario(
     (base_file, b): (&str, &ScenarioResult),
-    (new_file, sc): (&str, &ScenarioResult),
+    sc: &ScenarioResult,
     base: &SuiteReport,
     new: &SuiteReport,
     tolerance: RegressionSpec,
 ) -> Result<ScenarioComparison, CompareError> {
-    let pairs = seed_pairs((base_file, b), (new_file, sc))?;
+    let pairs = seed_pairs((base_file, b), sc)?;
+    let failed: Vec<u64> = sc
+        .results
+        .iter()
+        .filter(|r| r.report.is_none())
+        .map(|r| r.seed)
+        .collect();
     let differ: Vec<u64> = pairs.iter().filter(|p| !p.3).map(|p| p.0).collect();
     let paired = differ.is_empty();
     let pairing = if paired {
@@ -389,6 +386,13 @@ fn compare_scenario(
     }
     let mut metrics = Vec::new();
     let mut notes = Vec::new();
+    if !failed.is_empty() {
+        notes.push(format!(
+            "{}: seeds {} failed in the new run, not compared",
+            sc.label,
+            seed_list(&failed)
+        ));
+    }
     for subject in &subjects {
         if pairs
             .iter()
