@@ -3,13 +3,13 @@
 //! bound, then `N passed, M failed`; exit 0 all pass, 1 any missed, 2 error. With `--shard K/N`
 //! it runs one part of the work and writes it for `merge`.
 
-use super::common::SeedsArg;
+use super::common::{BaselineArg, SeedsArg};
 use anyhow::Context;
 use clap::Args;
 use placewords::eval::suite::SuiteReport;
 use placewords::experiment::ExperimentOptions;
 use placewords::experiment::stress::{self, StressOptions};
-use placewords::report::{junit, suite as format};
+use placewords::report::{compare as compare_format, junit, suite as format};
 use placewords::spec::seeds::Shard;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -54,6 +54,8 @@ pub struct CheckArgs {
     /// No progress bar.
     #[arg(long, short)]
     pub quiet: bool,
+    #[command(flatten)]
+    pub baseline: BaselineArg,
     /// Print where the time went on stderr: CPU seconds per stage over every scenario and seed
     /// (simulate, recognize and score per subject) and the wall clock of writing the outputs.
     #[arg(long)]
@@ -69,6 +71,13 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     if shard.is_some() && args.report.is_none() {
         anyhow::bail!("--shard writes a part for `merge`; add --report PART.json");
     }
+    if shard.is_some() && args.baseline.baseline.is_some() {
+        anyhow::bail!(
+            "a part (--shard) has no verdict to compare; give --baseline to `merge` instead"
+        );
+    }
+    // Read now, so a bad baseline is refused before the work rather than after it.
+    let baseline = read_baseline(&args.baseline)?;
     super::common::check_outputs([args.report.as_deref(), args.junit.as_deref()])?;
     if let Some(dir) = &args.out {
         // Refused now (another output there, or a live writer) rather than after the work.
@@ -97,6 +106,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
         args.out.as_deref(),
         args.junit.as_deref(),
         args.json,
+        baseline
+            .as_ref()
+            .map(|(p, b)| (p.as_path(), b, &args.baseline.tolerance)),
     );
     if args.profile {
         eprint!(
@@ -107,43 +119,104 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     code
 }
 
-/// Prints a stress run's verdict, writes the outputs asked for, and gives the exit code (a
-/// part exits 0 unless something failed to run: its seeds are not the distribution).
+/// The baseline of `--baseline`, read, with its path.
+pub fn read_baseline(arg: &BaselineArg) -> anyhow::Result<Option<(PathBuf, SuiteReport)>> {
+    match &arg.baseline {
+        None => Ok(None),
+        Some(p) => Ok(Some((p.clone(), stress::read_baseline(p)?))),
+    }
+}
+
+/// Whether the process runs under GitHub Actions.
+fn github_actions() -> bool {
+    std::env::var("GITHUB_ACTIONS").is_ok_and(|v| v == "true")
+}
+
+/// Appends `md` to `$GITHUB_STEP_SUMMARY` when running under GitHub Actions.
+pub fn step_summary(md: &str) -> anyhow::Result<()> {
+    let summary = std::env::var_os("GITHUB_STEP_SUMMARY").filter(|p| !p.is_empty());
+    if let Some(path) = summary.filter(|_| github_actions()) {
+        stress::append_markdown(md, Path::new(&path))?;
+    }
+    Ok(())
+}
+
+/// Prints a stress run's verdict (and its comparison with a baseline, if given), writes the
+/// outputs asked for, and gives the exit code (a part exits 0 unless something failed to run:
+/// its seeds are not the distribution).
 pub fn finish(
     suite: &SuiteReport,
     out: Option<&Path>,
     junit_path: Option<&Path>,
     json: bool,
+    baseline: Option<(&Path, &SuiteReport, &super::common::ToleranceArg)>,
 ) -> anyhow::Result<ExitCode> {
+    let cmp = match baseline {
+        Some((path, base, tol)) => Some(stress::compare_with(
+            path,
+            base,
+            "this run",
+            suite,
+            tol.overrides(),
+        )?),
+        None => None,
+    };
+    let cmp = cmp.as_ref();
     if let Some(dir) = out {
-        stress::write_dir(suite, dir).with_context(|| "writing the outputs")?;
+        stress::write_dir_with(suite, cmp, dir).with_context(|| "writing the outputs")?;
     }
     if let Some(path) = junit_path {
-        let xml = junit::document(suite);
+        let xml = junit::document_with(suite, cmp);
         stress::write_file(path, xml.as_bytes())?;
     }
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
         errln!("error: {e}");
     }
+    let code = suite.exit_code();
+    let code = match cmp {
+        Some(c) if code != placewords::eval::gate::EXIT_ERROR => code.max(c.exit_code()),
+        _ => code,
+    };
     if json {
-        outln!("{}", format::summary_json(suite))?;
+        let summary = format::summary_json(suite);
+        match cmp {
+            None => outln!("{summary}")?,
+            Some(c) => {
+                let mut v: serde_json::Value = serde_json::from_str(&summary)?;
+                v["baseline"] = serde_json::from_str(&compare_format::json(c))?;
+                v["exit_code"] = code.into();
+                outln!("{}", serde_json::to_string_pretty(&v)?)?;
+            }
+        }
     } else {
         out!("{}", format::check_text(suite))?;
+        if let Some(c) = cmp {
+            out!("{}", compare_format::text(c))?;
+        }
     }
-    if std::env::var("GITHUB_ACTIONS").is_ok_and(|v| v == "true") {
+    if github_actions() {
         // The runner reads workflow commands from stdout and stderr; keep --json's stdout JSON.
-        for a in stress::github_annotations(suite) {
+        let mut annotations = stress::github_annotations(suite);
+        annotations.extend(
+            cmp.map(compare_format::github_annotations)
+                .unwrap_or_default(),
+        );
+        for a in annotations {
             if json {
                 eprintln!("{a}");
             } else {
                 outln!("{a}")?;
             }
         }
-        let summary = std::env::var_os("GITHUB_STEP_SUMMARY").filter(|p| !p.is_empty());
         // A part has no verdict to show: the merge writes the summary.
-        if let Some(path) = summary.filter(|_| suite.shard.is_none()) {
-            stress::append_step_summary(suite, Path::new(&path))?;
+        if suite.shard.is_none() {
+            let mut md = format::markdown(suite);
+            if let Some(c) = cmp {
+                md.push('\n');
+                md.push_str(&compare_format::markdown(c));
+            }
+            step_summary(&md)?;
         }
     }
-    Ok(ExitCode::from(suite.exit_code()))
+    Ok(ExitCode::from(code))
 }

@@ -145,3 +145,59 @@ impl SeedsArg {
             .or(self.seed.map(placewords::spec::seeds::SeedRange::one))
     }
 }
+
+/// `--baseline BASE.json` with the tolerance flags, shared by `check` and `merge`.
+#[derive(Debug, Args)]
+pub struct BaselineArg {
+    /// Also compare with a baseline report (`check --report` or `-o DIR`'s report.json of an
+    /// earlier run, e.g. main's): per scenario × subject × metric, paired by seed when the
+    /// simulation keys agree; exit 1 on a regression. Example: --baseline main/report.json
+    #[arg(long, value_name = "BASE.json")]
+    pub baseline: Option<std::path::PathBuf>,
+    #[command(flatten)]
+    pub tolerance: ToleranceArg,
+}
+
+/// `--max-drop` and `--max-slowdown`: override `[expect.regression]`.
+#[derive(Debug, Args)]
+pub struct ToleranceArg {
+    /// How much precision or a recall may drop before it is a regression (overrides
+    /// `[expect.regression] max_drop`, default 0.01).
+    #[arg(long, value_name = "X", value_parser = parse_max_drop)]
+    pub max_drop: Option<f64>,
+    /// How many times slower the CPU time per lap may get (overrides `[expect.regression]
+    /// max_slowdown`, default 1.5).
+    #[arg(long, value_name = "FACTOR", value_parser = parse_max_slowdown)]
+    pub max_slowdown: Option<f64>,
+}
+
+impl ToleranceArg {
+    pub fn overrides(&self) -> placewords::eval::compare::ToleranceOverride {
+        placewords::eval::compare::ToleranceOverride {
+            max_drop: self.max_drop,
+            max_slowdown: self.max_slowdown,
+        }
+    }
+}
+
+fn parse_max_drop(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if placewords::spec::evaluation::valid_max_drop(x) {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{x} is outside 0..1; a drop of precision or recall, e.g. 0.01"
+        ))
+    }
+}
+
+fn parse_max_slowdown(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if placewords::spec::evaluation::valid_max_slowdown(x) {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{x} is less than 1; a factor on the time per lap, e.g. 1.5"
+        ))
+    }
+}

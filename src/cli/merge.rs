@@ -17,11 +17,22 @@ pub struct MergeArgs {
     /// Print a JSON summary on stdout instead of the tables and lines.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub baseline: super::common::BaselineArg,
 }
 
 pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
     super::common::check_output_dirs([Some(args.out.as_path())])?;
+    let baseline = super::check::read_baseline(&args.baseline)?;
     let suite =
         placewords::experiment::stress::merge_files(&args.parts, super::common::command_line())?;
-    super::check::finish(&suite, Some(&args.out), None, args.json)
+    super::check::finish(
+        &suite,
+        Some(&args.out),
+        None,
+        args.json,
+        baseline
+            .as_ref()
+            .map(|(p, b)| (p.as_path(), b, &args.baseline.tolerance)),
+    )
 }

@@ -21,6 +21,7 @@ use std::process::ExitCode;
 
 pub mod check;
 pub mod common;
+pub mod compare;
 pub mod import;
 pub mod merge;
 pub mod out;
@@ -69,6 +70,12 @@ pub enum Command {
         after_help = "Example:\n  placewords check scenarios/B.toml --shard 1/2 --report part-1.json\n  placewords check scenarios/B.toml --shard 2/2 --report part-2.json\n  placewords merge part-1.json part-2.json -o gate/"
     )]
     Merge(merge::MergeArgs),
+    /// Compare two reports of `check` (a baseline and a new run), paired by seed: exit 1 on a
+    /// regression beyond [expect.regression].
+    #[command(
+        after_help = "Example:\n  placewords check scenarios/B.toml --report main.json   # on main\n  placewords check scenarios/B.toml --report pr.json     # on the branch\n  placewords compare main.json pr.json --markdown moved.md\n  placewords check scenarios/B.toml --baseline main.json   # the same in one step"
+    )]
+    Compare(compare::CompareArgs),
     /// The paper's Table I for one or more scenarios, as Markdown and JSON.
     #[command(
         after_help = "Example:\n  placewords table scenarios/A.toml scenarios/B.toml scenarios/C.toml -o table/\n  placewords table scenarios/A.toml -o table/ --laps 1 --no-icp   # a quick look"
@@ -97,6 +104,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Run(a) => run::run(a),
         Command::Check(a) => check::run(a),
         Command::Merge(a) => merge::run(a),
+        Command::Compare(a) => compare::run(a),
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),

@@ -337,6 +337,7 @@ mod tests {
         let spec = ExpectSpec {
             subjects: vec![expect(3, 0.9, 0.3, Some(2.0)), expect(1, 0.9, 0.1, None)],
             quantile: None,
+            regression: None,
         };
         let o = check(&rep, &spec);
         assert_eq!(o.len(), 5);
@@ -358,6 +359,7 @@ mod tests {
         let spec = ExpectSpec {
             subjects: vec![expect(2, 0.95, 0.2, None), icp(Some(0.01), None)],
             quantile: None,
+            regression: None,
         };
         let o = check(&rep, &spec);
         assert_eq!(exit_code(&o), 1);
@@ -376,6 +378,7 @@ mod tests {
         let spec = ExpectSpec {
             subjects: vec![expect(3, 0.5, 0.1, None), icp(None, Some(0.0))],
             quantile: None,
+            regression: None,
         };
         let o = check(&rep, &spec);
         assert!(o.iter().all(|o| !o.passed));
@@ -407,6 +410,7 @@ mod tests {
         let mut spec = ExpectSpec {
             subjects: vec![expect(3, 0.8, 0.0, None)],
             quantile: None,
+            regression: None,
         };
         let worst = check_seeds("A", &reports, &spec);
         assert!(!worst[0].passed);
@@ -428,6 +432,7 @@ mod tests {
         let spec = ExpectSpec {
             subjects: vec![expect(1, 0.5, 0.0, None)],
             quantile: None,
+            regression: None,
         };
         let o = check(&rep, &spec);
         assert!(!o[0].passed);
@@ -475,6 +480,7 @@ mod tests {
         ExpectSpec {
             subjects: vec![entry],
             quantile: None,
+            regression: None,
         }
     }
 

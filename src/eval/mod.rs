@@ -9,8 +9,10 @@
 //! in memory that grows with its observations, not its pairs; [`sweep`] repeats this over a
 //! grid of thresholds;
 //! [`scores`] holds the computed results ([`scores::Report`]) that `report` formats;
-//! [`gate`] compares a report with a scenario's `[expect]` block.
+//! [`gate`] compares a report with a scenario's `[expect]` block; [`compare`] compares a
+//! stress run with a baseline run, paired by seed.
 
+pub mod compare;
 pub(crate) mod distribution;
 pub mod gate;
 mod lap_grid;
@@ -18,6 +20,7 @@ pub mod metrics;
 pub mod pair_recall;
 pub mod pair_set;
 pub mod provenance;
+pub mod rank_test;
 pub mod scores;
 pub mod site_tree;
 pub mod suite;

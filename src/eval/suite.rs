@@ -510,6 +510,7 @@ mod tests {
                     opposite: None,
                 }],
                 quantile: None,
+                regression: None,
             },
             error: None,
             results: seeds

@@ -257,6 +257,68 @@ pub enum StressError {
     },
     #[error(transparent)]
     Output(#[from] crate::io::atomic::StageError),
+    #[error(transparent)]
+    Compare(#[from] crate::eval::compare::CompareError),
+}
+
+/// Reads a suite report (`check --report`, `check -o DIR`'s `report.json`, a part, a merge),
+/// `what` saying in the error what the file should have been.
+pub fn read_suite(path: &Path, what: &str) -> Result<SuiteReport, StressError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| StressError::Read {
+        path: file.clone(),
+        source,
+    })?;
+    let located = |at: (usize, usize), msg: String| {
+        StressError::Parse(crate::spec::diag::Diagnostic::error(&file, at, msg))
+    };
+    let suite = SuiteReport::from_json(&text)
+        .map_err(|e| located((e.line(), e.column()), format!("not {what}: {e}")))?;
+    if suite.format != crate::eval::suite::FORMAT {
+        return Err(located(
+            (1, 1),
+            format!(
+                "not {what}: its format is `{}`, not `{}`",
+                suite.format,
+                crate::eval::suite::FORMAT
+            ),
+        ));
+    }
+    Ok(suite)
+}
+
+/// What a baseline file must be, for messages.
+const BASELINE: &str = "a report of `placewords check` (`--report FILE` or `-o DIR`'s report.json)";
+
+/// Reads a baseline report (`check --baseline`, `compare`).
+pub fn read_baseline(path: &Path) -> Result<SuiteReport, StressError> {
+    read_suite(path, BASELINE)
+}
+
+/// Compares the run `new` (`new_name` in messages) with the baseline `base` read from
+/// `base_path`.
+pub fn compare_with(
+    base_path: &Path,
+    base: &SuiteReport,
+    new_name: &str,
+    new: &SuiteReport,
+    overrides: crate::eval::compare::ToleranceOverride,
+) -> Result<crate::eval::compare::Comparison, StressError> {
+    let base_name = base_path.display().to_string();
+    Ok(crate::eval::compare::compare(
+        &base_name, base, new_name, new, overrides,
+    )?)
+}
+
+/// Compares two report files (`placewords compare BASE NEW`).
+pub fn compare_files(
+    base: &Path,
+    new: &Path,
+    overrides: crate::eval::compare::ToleranceOverride,
+) -> Result<crate::eval::compare::Comparison, StressError> {
+    let b = read_baseline(base)?;
+    let n = read_suite(new, BASELINE)?;
+    compare_with(base, &b, &new.display().to_string(), &n, overrides)
 }
 
 /// Reads the parts at `paths` and merges them into the whole run's report; its provenance is
@@ -267,19 +329,8 @@ pub fn merge_files(
 ) -> Result<SuiteReport, StressError> {
     let mut parts = Vec::new();
     for path in paths {
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|source| StressError::Read {
-            path: file.clone(),
-            source,
-        })?;
-        let part = SuiteReport::from_json(&text).map_err(|e| {
-            StressError::Parse(crate::spec::diag::Diagnostic::error(
-                &file,
-                (e.line(), e.column()),
-                format!("not a part written by `check --shard K/N --report`: {e}"),
-            ))
-        })?;
-        parts.push((file, part));
+        let part = read_suite(path, "a part written by `check --shard K/N --report`")?;
+        parts.push((path.display().to_string(), part));
     }
     let mut whole = crate::eval::suite::merge(parts)?;
     whole.provenance.command_line = command_line;
@@ -306,11 +357,9 @@ pub fn github_annotations(suite: &SuiteReport) -> Vec<String> {
     })
 }
 
-/// Appends the Markdown table (`table.md`) to GitHub's step summary file: appended, not
-/// replaced, since every step of a job shares the file.
-pub fn append_step_summary(suite: &SuiteReport, path: &Path) -> Result<(), StressError> {
+/// Appends Markdown `md` to GitHub's step summary file at `path`.
+pub fn append_markdown(md: &str, path: &Path) -> Result<(), StressError> {
     use std::io::Write;
-    let md = crate::report::suite::markdown(suite);
     std::fs::OpenOptions::new()
         .create(true)
         .append(true)
@@ -337,12 +386,27 @@ pub fn stage_dir(dir: &Path) -> Result<StagedDir, StressError> {
 /// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`, staged and
 /// put in place in one step: `DIR` holds the old three or the new three, never a mix.
 pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
+    write_dir_with(suite, None, dir)
+}
+
+/// [`write_dir`] with a comparison with a baseline: its Markdown section follows the table in
+/// `table.md`, its test cases follow the gate's in `junit.xml`.
+pub fn write_dir_with(
+    suite: &SuiteReport,
+    baseline: Option<&crate::eval::compare::Comparison>,
+    dir: &Path,
+) -> Result<(), StressError> {
     use crate::report::{junit, suite as format};
     let stage = stage_dir(dir)?;
     let at = stage.path().to_path_buf();
     write_file(&at.join(DIR_FILES[0]), suite.to_json().as_bytes())?;
-    write_file(&at.join(DIR_FILES[1]), format::markdown(suite).as_bytes())?;
-    let xml = junit::document(suite);
+    let mut md = format::markdown(suite);
+    if let Some(c) = baseline {
+        md.push('\n');
+        md.push_str(&crate::report::compare::markdown(c));
+    }
+    write_file(&at.join(DIR_FILES[1]), md.as_bytes())?;
+    let xml = junit::document_with(suite, baseline);
     write_file(&at.join(DIR_FILES[2]), xml.as_bytes())?;
     stage.commit().map_err(|source| StressError::Write {
         path: dir.display().to_string(),

@@ -13,6 +13,7 @@
 //! wall time (for a merge, the longest part's), never negative.
 
 pub use super::xml::escape;
+use crate::eval::compare::Comparison;
 use crate::eval::gate::{Outcome, fmt_value};
 use crate::eval::provenance::{GIT_COMMIT, TOOL_VERSION};
 use crate::eval::suite::{SuiteReport, reproduce_command};
@@ -58,6 +59,12 @@ impl Default for RunInfo {
 
 /// The JUnit document of a stress run (or a merge): its suites, version, commit, wall time.
 pub fn document(report: &SuiteReport) -> String {
+    document_with(report, None)
+}
+
+/// [`document`] with, after the gate's suites, one suite per scenario of a comparison with a
+/// baseline (`report::compare::junit_suites`).
+pub fn document_with(report: &SuiteReport, baseline: Option<&Comparison>) -> String {
     let p = &report.provenance;
     let known = |s: &str| {
         if s.is_empty() {
@@ -71,7 +78,8 @@ pub fn document(report: &SuiteReport) -> String {
         commit: known(&p.commit),
         wall_seconds: Some(report.wall_seconds),
     };
-    junit_xml_of(&suites(report), &run)
+    let extra = baseline.map(super::compare::junit_suites);
+    junit_xml_with(&suites(report), &run, extra.as_ref())
 }
 
 /// Seconds as JUnit writes them: three decimals, never `-0.000` or a negative time.
@@ -106,10 +114,20 @@ pub fn junit_xml(suites: &[Suite]) -> String {
 
 /// The JUnit XML document of `suites` with `run`'s version, commit and wall time.
 pub fn junit_xml_of(suites: &[Suite], run: &RunInfo) -> String {
+    junit_xml_with(suites, run, None)
+}
+
+/// [`junit_xml_of`] with `extra` (tests, failures, `<testsuite>` elements) after the suites.
+fn junit_xml_with(
+    suites: &[Suite],
+    run: &RunInfo,
+    extra: Option<&(usize, usize, String)>,
+) -> String {
     let count = |s: &Suite| s.outcomes.len() + s.error.is_some() as usize;
     let fails = |s: &Suite| s.outcomes.iter().filter(|o| !o.passed).count();
-    let tests: usize = suites.iter().map(count).sum();
-    let failures: usize = suites.iter().map(fails).sum();
+    let (extra_tests, extra_failures, extra_xml) = extra.map_or((0, 0, ""), |e| (e.0, e.1, &e.2));
+    let tests: usize = suites.iter().map(count).sum::<usize>() + extra_tests;
+    let failures: usize = suites.iter().map(fails).sum::<usize>() + extra_failures;
     let errors = suites.iter().filter(|s| s.error.is_some()).count();
     let time = run
         .wall_seconds
@@ -147,6 +165,7 @@ pub fn junit_xml_of(suites: &[Suite], run: &RunInfo) -> String {
         }
         x.push_str("  </testsuite>\n");
     }
+    x.push_str(extra_xml);
     x.push_str("</testsuites>\n");
     x
 }
@@ -257,6 +276,7 @@ mod tests {
                 opposite: None,
             }],
             quantile: None,
+            regression: None,
         };
         let outcomes = check(&rep, &spec);
         assert_eq!(outcomes[0].bound, Bound::MinPrecision);

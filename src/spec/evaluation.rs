@@ -47,6 +47,46 @@ pub struct ExpectSpec {
     /// Default: none (the worst seed).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quantile: Option<f64>,
+    /// `[expect.regression]`: how much worse than a baseline (`check --baseline`, `compare`)
+    /// a figure may get. Default: none (the defaults of [`RegressionSpec`] apply).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regression: Option<RegressionSpec>,
+}
+
+/// `[expect.regression]`: the tolerance of a comparison with a baseline report. A metric is a
+/// regression when, over the compared seeds, it got worse by more than this with confidence
+/// (`eval::compare`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RegressionSpec {
+    /// How much precision and each recall may drop (new − baseline, a ratio in [0, 1)).
+    /// Default 0.01.
+    pub max_drop: f64,
+    /// How many times slower the recognition time per lap (CPU seconds) may get, at least 1.
+    /// Default 1.5.
+    pub max_slowdown: f64,
+}
+
+impl Default for RegressionSpec {
+    fn default() -> Self {
+        RegressionSpec {
+            max_drop: 0.01,
+            max_slowdown: 1.5,
+        }
+    }
+}
+
+/// Keys of `[expect.regression]`.
+pub const EXPECT_REGRESSION_KEYS: &[&str] = &["max_drop", "max_slowdown"];
+
+/// Whether `max_drop` may be `x`: a ratio in [0, 1).
+pub fn valid_max_drop(x: f64) -> bool {
+    (0.0..1.0).contains(&x)
+}
+
+/// Whether `max_slowdown` may be `x`: a finite factor of at least 1.
+pub fn valid_max_slowdown(x: f64) -> bool {
+    x.is_finite() && x >= 1.0
 }
 
 impl ExpectSpec {
@@ -200,7 +240,7 @@ pub const EVALUATION_KEYS: &[&str] = &[
     "sensitivity_radii_m",
 ];
 /// Keys of `[expect]`.
-pub const EXPECT_KEYS: &[&str] = &["subjects", "quantile"];
+pub const EXPECT_KEYS: &[&str] = &["subjects", "quantile", "regression"];
 /// Keys of an `[[expect.subjects]]` entry.
 pub const EXPECT_SUBJECT_KEYS: &[&str] = &[
     "subject",
@@ -357,7 +397,42 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
             );
         }
     }
+    ex.regression = read_regression(t, d);
     ex
+}
+
+/// `[expect.regression]` over [`RegressionSpec::default`]; each bad value reported at its key.
+fn read_regression(expect: &DeTable<'_>, d: &mut Diags) -> Option<RegressionSpec> {
+    let (_, t) = table(expect, "regression", d)?;
+    let ctx = "[expect.regression]";
+    unknown_keys(t, EXPECT_REGRESSION_KEYS, ctx, d);
+    let mut r = RegressionSpec::default();
+    let checks: [Check; 2] = [
+        (
+            "max_drop",
+            &mut r.max_drop,
+            valid_max_drop,
+            "in 0..1 (a drop of precision or recall, e.g. 0.01)",
+        ),
+        (
+            "max_slowdown",
+            &mut r.max_slowdown,
+            valid_max_slowdown,
+            "at least 1 (a factor on the time per lap, e.g. 1.5)",
+        ),
+    ];
+    for (key, slot, ok, what) in checks {
+        let Some((_, v)) = get(t, key) else { continue };
+        match number(v, key, ctx, d) {
+            Some(x) if ok(x) => *slot = x,
+            Some(x) => d.at(
+                v.span().start,
+                format!("{key} = {x} in {ctx} must be {what}"),
+            ),
+            None => {}
+        }
+    }
+    Some(r)
 }
 
 /// Refuses the `[expect]` form before subjects, at each old key, saying what to write instead.

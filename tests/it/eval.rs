@@ -287,6 +287,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             },
         ],
         quantile: None,
+        regression: None,
     };
     let outcomes = check(&report, &pass);
     assert_eq!(exit_code(&outcomes), 0, "{outcomes:?}");
@@ -302,6 +303,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
             opposite: None,
         }],
         quantile: None,
+        regression: None,
     };
     let outcomes = check(&report, &too_high);
     assert_eq!(exit_code(&outcomes), 1);

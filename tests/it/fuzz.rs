@@ -184,6 +184,19 @@ proptest! {
         std::fs::write(&part, mutate(&c[0], &muts)).unwrap();
         let _ = placewords::experiment::stress::merge_files(&[part.clone(), part], Vec::new());
     }
+
+    /// Baselines are read and compared by `check --baseline` and `compare` (issue 25): a
+    /// mutated report on either side gives a comparison or an error, never a panic.
+    #[test]
+    fn baselines_never_panic(muts in mutations(), mutated_is_base in any::<bool>()) {
+        let c = corpus(&["tests/fixtures/fuzz-corpus/baseline-smoke.json"]);
+        let dir = tempfile::tempdir().unwrap();
+        let mutated = dir.path().join("mutated.json");
+        std::fs::write(&mutated, mutate(&c[0], &muts)).unwrap();
+        let good = root().join("tests/fixtures/fuzz-corpus/baseline-smoke.json");
+        let (base, new) = if mutated_is_base { (&mutated, &good) } else { (&good, &mutated) };
+        let _ = placewords::experiment::stress::compare_files(base, new, Default::default());
+    }
 }
 
 /// The mutator reaches numbers: a corpus file comes back changed where a number stood.

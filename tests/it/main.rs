@@ -5,6 +5,7 @@ mod authoring;
 mod ci;
 mod cli;
 mod common;
+mod compare;
 mod eval;
 mod fuzz;
 mod io;

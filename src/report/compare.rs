@@ -1,0 +1,323 @@
+//! A comparison with a baseline (`eval::compare`) for people and machines: the terminal lines
+//! (one per metric that moved, every regression with the commands reproducing its worst seed
+//! on both sides), the Markdown table of what moved both ways (for a pull-request comment and
+//! GitHub's step summary), and the JUnit test cases `B/words-3/precision/vs-baseline`.
+
+use crate::eval::compare::{Comparison, Decision, MetricComparison, ScenarioComparison};
+use crate::report::xml::escape;
+use std::fmt::Write;
+
+/// A figure as printed: ratios with 3 decimals, seconds with 4.
+fn value(m: &MetricComparison, v: f64) -> String {
+    if m.is_time() {
+        format!("{v:.4}s")
+    } else {
+        format!("{v:.3}")
+    }
+}
+
+/// A change: `-0.012` / `+0.004`, or for time `×1.27`.
+fn change(m: &MetricComparison, c: f64) -> String {
+    if m.is_time() {
+        format!("×{c:.2}")
+    } else {
+        format!("{c:+.3}")
+    }
+}
+
+fn seeds(s: &[u64]) -> String {
+    crate::eval::compare::seed_list(s)
+}
+
+/// The test's p-values, `p(worse) 0.002, p(better) 0.99`, or why there is none.
+fn test_words(m: &MetricComparison) -> String {
+    let p = |x: Option<f64>| x.map_or("–".to_string(), |p| format!("{p:.3}"));
+    format!(
+        "{}: p(worse beyond tolerance) {}, p(better beyond it) {}",
+        m.why,
+        p(m.p_worse),
+        p(m.p_better)
+    )
+}
+
+/// What the tolerance is, in words: `max_drop 0.01` or `max_slowdown ×1.50`.
+fn tolerance(m: &MetricComparison) -> String {
+    if m.is_time() {
+        format!("max_slowdown ×{:.2}", m.tolerance)
+    } else {
+        format!("max_drop {}", m.tolerance)
+    }
+}
+
+/// One metric's line: decision, name, mean and worst change, seeds that got worse, the test.
+pub fn metric_line(m: &MetricComparison) -> String {
+    let mut s = format!(
+        "{} {}: mean {} → {} ({}), worst {} (seed {}) → {} (seed {}) ({})",
+        m.decision.name(),
+        m.name(),
+        value(m, m.base_mean),
+        value(m, m.new_mean),
+        change(m, m.mean_change),
+        value(m, m.base_worst),
+        m.base_worst_seed,
+        value(m, m.new_worst),
+        m.new_worst_seed,
+        change(m, m.worst_change),
+    );
+    if m.decision == Decision::Identical {
+        return s;
+    }
+    if m.decision == Decision::NoChange && m.beyond_seeds.is_empty() && m.paired {
+        let _ = write!(s, "; within {}", tolerance(m));
+        return s;
+    }
+    if m.paired {
+        let _ = write!(
+            s,
+            "; worse at {} of {} seeds {}, beyond {} at {}",
+            m.worse_seeds.len(),
+            m.seeds.len(),
+            seeds(&m.worse_seeds),
+            tolerance(m),
+            seeds(&m.beyond_seeds)
+        );
+    } else {
+        let _ = write!(s, "; {} against {}", m.seeds.len(), tolerance(m));
+    }
+    let _ = write!(s, "; {}", test_words(m));
+    s
+}
+
+/// The commands reproducing the worst seed of both sides: paired, the seed that got most
+/// worse; unpaired, each side's worst seed.
+pub fn reproduce_lines(sc: &ScenarioComparison, m: &MetricComparison, commit: &str) -> Vec<String> {
+    let (new_seed, base_seed) = match m.most_worse_seed {
+        Some(s) if m.paired => (s, s),
+        _ => (m.new_worst_seed, m.base_worst_seed),
+    };
+    let (new, _) = sc.reproduce(new_seed, commit);
+    let (_, base) = sc.reproduce(base_seed, commit);
+    vec![
+        format!("  reproduce new seed {new_seed}: {new}"),
+        format!("  reproduce baseline seed {base_seed}: {base}"),
+    ]
+}
+
+/// The terminal text: the baseline, per scenario how seeds pair, every metric that moved (and
+/// how many did not), the reproducing commands of each regression, and the closing line.
+pub fn text(c: &Comparison) -> String {
+    let mut out = format!("compared with the baseline {} ({})\n", c.base, c.base_build);
+    for sc in &c.scenarios {
+        let _ = writeln!(out, "{}: {}", sc.label, sc.pairing);
+        let mut quiet = 0;
+        for m in &sc.metrics {
+            if m.decision == Decision::Identical {
+                quiet += 1;
+                continue;
+            }
+            let _ = writeln!(out, "{}", metric_line(m));
+            if m.decision == Decision::Regression {
+                for l in reproduce_lines(sc, m, &c.base_commit) {
+                    let _ = writeln!(out, "{l}");
+                }
+            }
+        }
+        if quiet > 0 {
+            let _ = writeln!(
+                out,
+                "{}: {quiet} metric{} identical at every seed",
+                sc.label,
+                if quiet == 1 { "" } else { "s" }
+            );
+        }
+        for n in &sc.notes {
+            let _ = writeln!(out, "note: {n}");
+        }
+    }
+    let _ = writeln!(out, "vs baseline: {}", c.line());
+    out
+}
+
+/// The Markdown section: per scenario its pairing and a table of every metric that moved
+/// (both ways), regressions first; identical metrics counted below the table.
+pub fn markdown(c: &Comparison) -> String {
+    let mut out = format!(
+        "# placewords vs baseline\n\nBaseline `{}` ({}): {}\n",
+        c.base,
+        c.base_build,
+        c.line()
+    );
+    for sc in &c.scenarios {
+        let _ = writeln!(out, "\n## {} (`{}`)\n\n{}\n", sc.label, sc.file, sc.pairing);
+        let mut moved: Vec<&MetricComparison> = sc
+            .metrics
+            .iter()
+            .filter(|m| m.decision != Decision::Identical)
+            .collect();
+        let rank = |d: Decision| match d {
+            Decision::Regression => 0,
+            Decision::Improvement => 1,
+            _ => 2,
+        };
+        moved.sort_by_key(|m| rank(m.decision));
+        if !moved.is_empty() {
+            out.push_str(
+                "| test case | baseline mean | new mean | mean change | worst change | \
+                 seeds worse | p (worse) | decision |\n|---|---|---|---|---|---|---|---|\n",
+            );
+        }
+        for m in &moved {
+            let worse = if m.paired {
+                format!("{} of {}", m.worse_seeds.len(), m.seeds.len())
+            } else {
+                "unpaired".into()
+            };
+            let p = m.p_worse.map_or("–".into(), |p| format!("{p:.3}"));
+            let decision = match m.decision {
+                Decision::Regression => "**REGRESSION**".to_string(),
+                d => d.name().to_string(),
+            };
+            let _ = writeln!(
+                out,
+                "| `{}` | {} | {} | {} | {} | {worse} | {p} | {decision} |",
+                m.name(),
+                value(m, m.base_mean),
+                value(m, m.new_mean),
+                change(m, m.mean_change),
+                change(m, m.worst_change),
+            );
+        }
+        let same = sc.metrics.len() - moved.len();
+        if same > 0 {
+            let _ = writeln!(out, "\n{same} metric(s) identical at every seed.");
+        }
+        for n in &sc.notes {
+            let _ = writeln!(out, "\n- {n}");
+        }
+    }
+    out
+}
+
+/// The `<testsuite>` elements of the comparison: one per scenario (`B vs baseline`), one test
+/// case per compared metric, a `<failure>` for a regression. Returns (tests, failures, XML).
+pub fn junit_suites(c: &Comparison) -> (usize, usize, String) {
+    let mut x = String::new();
+    let (mut tests, mut failures) = (0, 0);
+    for sc in &c.scenarios {
+        let fails = sc
+            .metrics
+            .iter()
+            .filter(|m| m.decision == Decision::Regression)
+            .count();
+        tests += sc.metrics.len();
+        failures += fails;
+        let _ = writeln!(
+            x,
+            "  <testsuite name=\"{} vs baseline\" tests=\"{}\" failures=\"{fails}\" errors=\"0\" \
+             skipped=\"0\" time=\"0.000\">",
+            escape(&sc.label),
+            sc.metrics.len()
+        );
+        for m in &sc.metrics {
+            let _ = writeln!(
+                x,
+                "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"0.000\">\n      \
+                 <properties>",
+                escape(&m.name()),
+                escape(&sc.file),
+                escape(&sc.file)
+            );
+            let props = [
+                ("baseline", c.base.clone()),
+                ("paired", m.paired.to_string()),
+                ("baseline_mean", value(m, m.base_mean)),
+                ("new_mean", value(m, m.new_mean)),
+                ("mean_change", change(m, m.mean_change)),
+                ("worst_change", change(m, m.worst_change)),
+                ("seeds_worse", seeds(&m.worse_seeds)),
+                ("tolerance", tolerance(m)),
+                (
+                    "p_worse",
+                    m.p_worse.map_or("none".into(), |p| format!("{p:.4}")),
+                ),
+                ("decision", m.decision.name().to_string()),
+            ];
+            for (k, v) in props {
+                let _ = writeln!(
+                    x,
+                    "        <property name=\"{k}\" value=\"{}\"/>",
+                    escape(&v)
+                );
+            }
+            x.push_str("      </properties>\n");
+            if m.decision == Decision::Regression {
+                let mut text = metric_line(m);
+                for l in reproduce_lines(sc, m, &c.base_commit) {
+                    text.push('\n');
+                    text.push_str(l.trim());
+                }
+                let _ = writeln!(
+                    x,
+                    "      <failure message=\"{}\" type=\"regression\">{}</failure>",
+                    escape(&metric_line(m)),
+                    escape(&text)
+                );
+            }
+            x.push_str("    </testcase>\n");
+        }
+        x.push_str("  </testsuite>\n");
+    }
+    (tests, failures, x)
+}
+
+/// A JUnit document of the comparison alone (`placewords compare --junit`).
+pub fn junit_document(c: &Comparison) -> String {
+    let (tests, failures, suites) = junit_suites(c);
+    format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites name=\"placewords compare\" \
+         tests=\"{tests}\" failures=\"{failures}\" errors=\"0\" time=\"0.000\">\n{suites}\
+         </testsuites>\n"
+    )
+}
+
+/// GitHub Actions `::error` workflow commands, one per regression, on its scenario file.
+pub fn github_annotations(c: &Comparison) -> Vec<String> {
+    use crate::report::suite::{gh_data, gh_property};
+    let mut out = Vec::new();
+    for sc in &c.scenarios {
+        for m in sc
+            .metrics
+            .iter()
+            .filter(|m| m.decision == Decision::Regression)
+        {
+            let mut text = metric_line(m);
+            for l in reproduce_lines(sc, m, &c.base_commit) {
+                text.push('\n');
+                text.push_str(l.trim());
+            }
+            out.push(format!(
+                "::error file={},title={}::{}",
+                gh_property(&sc.file),
+                gh_property(&m.name()),
+                gh_data(&text)
+            ));
+        }
+    }
+    out
+}
+
+/// The `--json` form of a comparison: the decisions, the closing line and the exit code.
+pub fn json(c: &Comparison) -> String {
+    #[derive(serde::Serialize)]
+    struct J<'a> {
+        line: String,
+        exit_code: u8,
+        comparison: &'a Comparison,
+    }
+    serde_json::to_string_pretty(&J {
+        line: c.line(),
+        exit_code: c.exit_code(),
+        comparison: c,
+    })
+    .expect("a comparison always serializes")
+}
