@@ -59,7 +59,7 @@ impl ExternalSpec {
                 "`{name}` cannot name a subject: use letters, digits, `-` and `_`"
             ));
         }
-        if name.starts_with("words-") || name == "icp" {
+        if name.starts_with("words-") || name == "icp" || name == "scan-context" {
             return Err(format!(
                 "`{name}` is the name of a built-in subject; choose another name"
             ));

@@ -14,6 +14,7 @@ mod outputs;
 mod plugin;
 mod provenance;
 mod recognizer;
+mod scan_context;
 mod settings;
 mod sim;
 mod spec;
