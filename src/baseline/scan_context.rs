@@ -54,8 +54,8 @@ const REJECTED_KEPT: usize = 10_000;
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct ScanContextConfig {
-    /// Odometric travel between observations, metres. Default 0.10 (as the paper's recognizer
-    /// and ICP).
+    /// Odometric travel between observations, metres, 0.001 to 10. Default 0.10 (as the paper's
+    /// recognizer and ICP).
     pub observation_spacing_m: f64,
     /// Rings of the descriptor (radial bins), 1 to [`MAX_RINGS`]. Default 20 (the paper's).
     pub rings: usize,
@@ -133,9 +133,9 @@ impl ScanContextConfig {
         let d = ScanContextConfig::default();
         bad(
             "observation_spacing_m",
-            positive(self.observation_spacing_m),
+            (0.001..=10.0).contains(&self.observation_spacing_m),
             format!(
-                "use a positive distance, metres (default {})",
+                "use a distance from 0.001 to 10 metres (default {})",
                 d.observation_spacing_m
             ),
         );
