@@ -226,7 +226,7 @@ impl Descriptor {
         let mut counts = vec![0u32; rings * sectors];
         for p in points {
             let r = p.norm();
-            if !(r < cfg.max_radius_m) || !r.is_finite() {
+            if !r.is_finite() || r >= cfg.max_radius_m {
                 continue;
             }
             let ring = ((r / cfg.max_radius_m * rings as f64) as usize).min(rings - 1);
