@@ -784,9 +784,11 @@ mod tests {
     /// revisit 20 m of travel behind from x = 20 m on (the runs follow each other at x = 30 m).
     fn second_pass(backward: bool) -> Vec<(f64, f64, Direction)> {
         let walls = corridor();
-        // Exact 360° scans: a true revisit is within 0.05, the corridor's look-alikes beyond 0.07.
+        // Exact 360° scans, one scan and fine cells: a true revisit is within 0.05, the corridor's
+        // look-alikes beyond 0.07.
         let mut rec = ScanContextRecognizer::new(ScanContextConfig {
             history_m: 0.0,
+            cell_m: 0.001,
             max_distance: 0.06,
             ..ScanContextConfig::default()
         })
