@@ -78,7 +78,7 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// The paper's Table I for one or more scenarios, as Markdown and JSON.
     #[command(
-        after_help = "Example:\n  placewords table scenarios/A.toml scenarios/B.toml scenarios/C.toml -o table/\n  placewords table scenarios/A.toml -o table/ --laps 1 --no-icp   # a quick look"
+        after_help = "Example:\n  placewords table scenarios/A.toml scenarios/B.toml scenarios/C.toml -o table/\n  placewords table scenarios/A.toml -o table/ --laps 1 --no-icp   # a quick look (Scan Context stays; --no-scan-context drops it)"
     )]
     Table(table::TableArgs),
     /// The paper's Fig. 8: precision/recall over the n-gram thresholds.

@@ -48,6 +48,10 @@ pub struct RecognizeArgs {
     /// Also run the ICP baseline.
     #[arg(long)]
     pub icp: bool,
+    /// Also run the Scan Context baseline (default settings; docs in `baseline::scan_context`),
+    /// e.g. `placewords recognize intel.log --levels 3 --scan-context`.
+    #[arg(long)]
+    pub scan_context: bool,
     /// Skip malformed lines (and report how many) instead of stopping at the first.
     #[arg(long)]
     pub lenient: bool,
@@ -108,6 +112,8 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
+        scan_context: args.scan_context,
+        scan_context_config: Default::default(),
         external: args.external.specs(),
         laps: None,
         progress: super::progress::bar(args.quiet),

@@ -23,6 +23,10 @@ pub struct RunArgs {
     /// Also run the ICP baseline (slow: every region is aligned with every past region).
     #[arg(long)]
     pub icp: bool,
+    /// Also run the Scan Context baseline (settings: the scenario's `[scan_context]` table),
+    /// e.g. `placewords run scenarios/A.toml --scan-context --seeds 1..5`.
+    #[arg(long)]
+    pub scan_context: bool,
     /// Replace every run's lap count (for a quick look).
     #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
@@ -54,6 +58,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
+        scan_context: args.scan_context,
+        scan_context_config: Default::default(),
         external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),

@@ -1,5 +1,5 @@
 //! `placewords table SCENARIO... -o DIR`: the paper's Table I (precision–recall at 1, 2 and 3
-//! levels and for ICP, with each one's time per lap, measured in the same run), as Markdown and
+//! levels, for ICP and for Scan Context, with each one's time per lap, measured in the same run), as Markdown and
 //! JSON.
 
 use super::common::write_file;
@@ -22,6 +22,9 @@ pub struct TableArgs {
     /// Leave out the ICP baseline (it dominates the run time).
     #[arg(long)]
     pub no_icp: bool,
+    /// Leave out the Scan Context baseline (settings: each scenario's `[scan_context]` table).
+    #[arg(long)]
+    pub no_scan_context: bool,
     /// Replace every run's lap count (for a quick look).
     #[arg(long, value_name = "N")]
     pub laps: Option<usize>,
@@ -43,6 +46,8 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         levels: vec![1, 2, 3],
         icp: !args.no_icp,
+        scan_context: !args.no_scan_context,
+        scan_context_config: Default::default(),
         external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),

@@ -13,6 +13,7 @@ pub(crate) mod stream;
 pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
+use crate::baseline::scan_context::{ScanContextConfig, ScanContextRecognizer};
 use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
@@ -59,6 +60,11 @@ pub struct ExperimentOptions {
     pub levels: Vec<usize>,
     /// Also run the ICP baseline. Default false (it is slow: every region against every past one).
     pub icp: bool,
+    /// Also run the Scan Context baseline. Default false.
+    pub scan_context: bool,
+    /// The Scan Context baseline's settings (a scenario's `[scan_context]` table; its `min_gap_m`
+    /// is replaced by the evaluation's). Default [`ScanContextConfig::default`].
+    pub scan_context_config: ScanContextConfig,
     /// Recognizers in other processes to score beside the built-in ones (`--recognizer
     /// NAME=exec:COMMAND`). Default none.
     pub external: Vec<ExternalSpec>,
@@ -73,6 +79,8 @@ impl Default for ExperimentOptions {
         ExperimentOptions {
             levels: vec![1, 2, 3],
             icp: false,
+            scan_context: false,
+            scan_context_config: ScanContextConfig::default(),
             external: Vec::new(),
             laps: None,
             progress: ProgressSink::none(),
@@ -110,6 +118,7 @@ pub struct Experiment {
     /// One recognition per level configuration, in the order of `ExperimentOptions::levels`.
     pub recognitions: Vec<(usize, Recognition)>,
     pub icp: Option<Recognition>,
+    pub scan_context: Option<Recognition>,
     /// The external subjects' recognitions, by name, in the order of
     /// `ExperimentOptions::external`.
     pub external: Vec<(String, Recognition)>,
@@ -122,6 +131,8 @@ pub enum SubjectId {
     Words(usize),
     /// The ICP baseline.
     Icp,
+    /// The Scan Context baseline.
+    ScanContext,
     /// An external recognizer, by name.
     External(String),
 }
@@ -184,11 +195,33 @@ pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>
     runs
 }
 
+/// `opts` with the scenario's own baseline settings (`[scan_context]`).
+pub fn options_for_scenario(scn: &Scenario, opts: &ExperimentOptions) -> ExperimentOptions {
+    ExperimentOptions {
+        scan_context_config: scn.scan_context.clone(),
+        ..opts.clone()
+    }
+}
+
+/// The Scan Context baseline with `opts`' settings and the evaluation's gap.
+pub(crate) fn scan_context_recognizer(
+    opts: &ExperimentOptions,
+    evaluation: &EvaluationSpec,
+) -> Result<ScanContextRecognizer, ExperimentError> {
+    let mut cfg = opts.scan_context_config.clone();
+    cfg.min_gap_m = evaluation.min_gap_m;
+    ScanContextRecognizer::new(cfg).map_err(|problems| {
+        let text: Vec<String> = problems.iter().map(ToString::to_string).collect();
+        ExperimentError::Recognizer(format!("[scan_context]: {}", text.join("; ")))
+    })
+}
+
 /// Simulates a scenario and evaluates it.
 pub fn run_scenario(
     scn: &Scenario,
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
+    let opts = &options_for_scenario(scn, opts);
     let base = recognizer_config(scn)?;
     let (runs, sim_s) = simulate(scn, opts)?;
     let mut exp = evaluate_runs(
@@ -217,7 +250,11 @@ pub fn evaluate_runs(
     let laps: usize = runs.iter().map(|r| r.laps.len()).sum();
     let configs = level_configs(base, &opts.levels)?;
     let external = start_external(&opts.external)?;
-    let jobs = configs.len() + usize::from(opts.icp);
+    let jobs = configs.len() + usize::from(opts.icp) + usize::from(opts.scan_context);
+    // The Scan Context job, when asked, is the last; its settings are checked before any work.
+    if opts.scan_context {
+        scan_context_recognizer(opts, evaluation)?;
+    }
     opts.progress
         .start("recognizing", ((jobs + external.len()) * laps) as u64);
     // Each task is single-threaded and timed on its own; the tasks share the cores.
@@ -232,6 +269,12 @@ pub fn evaluate_runs(
                 Ok((
                     SubjectId::Words(cfg.levels),
                     recognize_runs_with_progress(&mut rec, &runs, &mut on_lap),
+                ))
+            } else if j == configs.len() + usize::from(opts.icp) {
+                let mut sc = scan_context_recognizer(opts, evaluation)?;
+                Ok((
+                    SubjectId::ScanContext,
+                    recognize_runs_with_progress(&mut sc, &runs, &mut on_lap),
                 ))
             } else {
                 let mut icp = IcpRecognizer::new(IcpConfig {
@@ -292,6 +335,7 @@ fn assemble(
 ) -> Experiment {
     let mut report = Report::new(name, seed, laps, evaluation.clone());
     let (mut icp, mut recognitions, mut external) = (None, Vec::new(), Vec::new());
+    let mut scan_context = None;
     for (id, r) in results {
         match id {
             SubjectId::Words(levels) => {
@@ -301,6 +345,10 @@ fn assemble(
             SubjectId::Icp => {
                 report.add_subject("icp", SubjectKind::Icp, &r);
                 icp = Some(r);
+            }
+            SubjectId::ScanContext => {
+                report.add_subject("scan-context", SubjectKind::ScanContext, &r);
+                scan_context = Some(r);
             }
             SubjectId::External(name) => {
                 report.add_subject(&name, SubjectKind::External, &r);
@@ -315,6 +363,7 @@ fn assemble(
         runs,
         recognitions,
         icp,
+        scan_context,
         external,
     }
 }

@@ -488,7 +488,12 @@ pub fn write_pictures(
         .recognitions
         .iter()
         .map(|(levels, rec)| (format!("{levels} level(s)"), format!("levels{levels}"), rec))
-        .chain(exp.icp.iter().map(|rec| ("ICP".into(), "icp".into(), rec)));
+        .chain(exp.icp.iter().map(|rec| ("ICP".into(), "icp".into(), rec)))
+        .chain(
+            exp.scan_context
+                .iter()
+                .map(|rec| ("Scan Context".into(), "scan-context".into(), rec)),
+        );
     for (what, file, rec) in recognitions {
         let title = format!("{name}: matched pairs, {what}");
         let svg = matches_svg(world, &exp.runs, rec, radius_m, &title);

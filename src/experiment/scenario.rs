@@ -43,12 +43,16 @@
 //!                                       # lookahead_m, path_wander_m, stop_distance_m, slow_distance_m,
 //!                                       # blocked_timeout_s, step_s
 //! [recognizer]                          # any table, for the recognizer
+//! [scan_context]                        # the Scan Context baseline: observation_spacing_m, rings,
+//!                                       # sectors, max_radius_m, history_m, cell_m, candidates,
+//!                                       # max_distance, min_overlap_ratio (ScanContextConfig)
 //! [evaluation]                          # crate::spec::evaluation::EvaluationSpec
 //! [expect]                              # crate::spec::evaluation::ExpectSpec
 //! ```
 //!
 //! At most one of `doors`, `doors_cycle`, `doors_random` per run; none means all closed.
 
+use crate::baseline::scan_context::ScanContextConfig;
 use crate::geom::Vec2;
 use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
@@ -80,6 +84,8 @@ pub struct Scenario {
     pub seeds: Option<SeedRange>,
     /// Recognizer settings: the `[recognizer]` table over the defaults.
     pub recognizer: RecognizerConfig,
+    /// The Scan Context baseline's settings: the `[scan_context]` table over the defaults.
+    pub scan_context: ScanContextConfig,
     pub evaluation: EvaluationSpec,
     pub expect: ExpectSpec,
 }
@@ -125,6 +131,7 @@ pub fn parse_scenario(
     let mut world_problems = Vec::new();
     let built = read_scenario(src, &mut d).and_then(|spec| {
         let models = Models::build(&spec, &mut d);
+        let scan_context = scan_context(&spec.scan_context, &mut d);
         let world_path = resolve(path, spec.world.get_ref());
         let check = WorldCheck {
             robot_radius_m: models.robot.radius_m,
@@ -138,13 +145,14 @@ pub fn parse_scenario(
             &mut world_problems,
         )?;
         let sim = plan(&spec, world, models, path, world_path, &mut d)?;
-        Some((spec, sim))
+        Some((spec, sim, scan_context))
     });
     let mut diags = d.into_sorted();
     diags.append(&mut world_problems);
     match built {
-        Some((spec, sim)) if diags.is_empty() => Ok(Scenario {
+        Some((spec, sim, scan_context)) if diags.is_empty() => Ok(Scenario {
             recognizer: sim.1,
+            scan_context,
             sim: sim.0,
             description: spec.description,
             seeds: spec.seeds.map(|s| s.into_inner()),
@@ -420,6 +428,51 @@ fn robot_cross_checks(s: &Settings, r: &RobotConfig, d: &mut Diags) {
             ),
         );
     }
+}
+
+/// The `[scan_context]` numbers over [`ScanContextConfig::default`]; each problem at its value.
+fn scan_context(s: &Settings, d: &mut Diags) -> ScanContextConfig {
+    let mut c = ScanContextConfig::default();
+    let number = |key: &str, default: f64| s.get(key).map_or(default, |x| *x.get_ref());
+    let mut whole = |key: &str, default: usize| -> usize {
+        let Some(x) = s.get(key) else { return default };
+        let v = *x.get_ref();
+        if v.fract() != 0.0 || v < 0.0 || !v.is_finite() {
+            d.at(
+                x.span().start,
+                format!(
+                    "{key} = {} in [scan_context] is not a whole number; use one (default \
+                     {default})",
+                    fmt_number(v)
+                ),
+            );
+            return default;
+        }
+        v as usize
+    };
+    c.rings = whole("rings", c.rings);
+    c.sectors = whole("sectors", c.sectors);
+    c.candidates = whole("candidates", c.candidates);
+    c.observation_spacing_m = number("observation_spacing_m", c.observation_spacing_m);
+    c.max_radius_m = number("max_radius_m", c.max_radius_m);
+    c.history_m = number("history_m", c.history_m);
+    c.cell_m = number("cell_m", c.cell_m);
+    c.max_distance = number("max_distance", c.max_distance);
+    c.min_overlap_ratio = number("min_overlap_ratio", c.min_overlap_ratio);
+    for p in c.problems() {
+        if let Some(x) = s.get(p.key) {
+            d.at(
+                x.span().start,
+                format!(
+                    "{} = {} in [scan_context] is out of range; {}",
+                    p.key,
+                    fmt_number(*x.get_ref()),
+                    p.message
+                ),
+            );
+        }
+    }
+    c
 }
 
 /// `RecognizerConfig` fields the harness sets itself, never a file: `levels` (each level

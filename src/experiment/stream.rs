@@ -39,6 +39,7 @@ pub fn run_scenario_streamed(
     scn: &Scenario,
     opts: &ExperimentOptions,
 ) -> Result<Experiment, ExperimentError> {
+    let opts = &super::options_for_scenario(scn, opts);
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
     let mut jobs = jobs(&configs, &scn.evaluation, opts)?;
     let plan = &scn.sim;
@@ -107,8 +108,8 @@ fn simulate_laps(
     Ok(seconds)
 }
 
-/// One job per level configuration, in order, then ICP's if asked (with the evaluation's
-/// `min_gap_m`), then one per external recognizer (started here). Each scores its matches as they arrive ([`Recording::streaming`]); a
+/// One job per level configuration, in order, then ICP's and Scan Context's if asked (with the
+/// evaluation's `min_gap_m`), then one per external recognizer (started here). Each scores its matches as they arrive ([`Recording::streaming`]); a
 /// configuration with one level fewer than another keeps what it forgets, to count the other's
 /// gain ([`settle`]).
 pub(super) fn jobs(
@@ -138,6 +139,13 @@ pub(super) fn jobs(
         jobs.push((
             SubjectId::Icp,
             Box::new(icp),
+            Recording::streaming(evaluation),
+        ));
+    }
+    if opts.scan_context {
+        jobs.push((
+            SubjectId::ScanContext,
+            Box::new(super::scan_context_recognizer(opts, evaluation)?),
             Recording::streaming(evaluation),
         ));
     }

@@ -31,7 +31,8 @@ pub struct StressOptions {
     pub gate: bool,
     /// With `gate`, skip a scenario without `[expect]` instead of failing. Default false.
     pub allow_no_expect: bool,
-    /// Without `gate`: the level configurations and whether ICP runs (`levels`, `icp`), laps
+    /// Without `gate`: the level configurations and whether ICP and Scan Context run (`levels`, `icp`,
+    /// `scan_context`), laps
     /// override (`laps`); progress goes to `progress` (one step per seed).
     pub experiment: ExperimentOptions,
     /// The command line, for the report's provenance. Default empty.
@@ -112,6 +113,7 @@ fn options_for(scn: &Scenario, opts: &StressOptions) -> Option<ExperimentOptions
     Some(ExperimentOptions {
         levels: scn.expect.word_levels(),
         icp: scn.expect.names("icp"),
+        scan_context: scn.expect.names("scan-context"),
         external: opts.experiment.external.clone(),
         ..opts.experiment.clone()
     })

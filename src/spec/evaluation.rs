@@ -124,8 +124,8 @@ pub fn words_subject_levels(name: &str) -> Option<usize> {
 }
 
 /// The subjects a scenario's `[expect]` may name today: the paper's recognizer at 1, 2 or 3
-/// levels, and the ICP baseline.
-pub const KNOWN_SUBJECTS: &[&str] = &["words-1", "words-2", "words-3", "icp"];
+/// levels, the ICP baseline and the Scan Context baseline.
+pub const KNOWN_SUBJECTS: &[&str] = &["words-1", "words-2", "words-3", "icp", "scan-context"];
 
 /// Whether `name` is spelt as a subject's name may be: non-empty, of ASCII letters, digits,
 /// `-` and `_` (so it is safe in file names, JUnit names and reproducing commands).
@@ -147,7 +147,7 @@ pub fn is_builtin_subject_name(name: &str) -> bool {
 #[serde(deny_unknown_fields)]
 pub struct SubjectExpectation {
     /// The subject bounded: `words-1`, `words-2`, `words-3` (the paper's recognizer at that
-    /// many levels), `icp`, or the name of an external recognizer given to `check` with
+    /// many levels), `icp`, `scan-context`, or the name of an external recognizer given to `check` with
     /// `--recognizer NAME=exec:COMMAND`.
     pub subject: String,
     /// Minimum pair precision in [0, 1].

@@ -212,8 +212,22 @@ pub const TOP_KEYS: &[&str] = &[
     "odometry",
     "robot",
     "recognizer",
+    "scan_context",
     "evaluation",
     "expect",
+];
+
+/// Keys of `[scan_context]` (the Scan Context baseline, `baseline::scan_context`).
+pub const SCAN_CONTEXT_KEYS: &[&str] = &[
+    "observation_spacing_m",
+    "rings",
+    "sectors",
+    "max_radius_m",
+    "history_m",
+    "cell_m",
+    "candidates",
+    "max_distance",
+    "min_overlap_ratio",
 ];
 /// Keys of a `[[runs]]` entry.
 pub const RUN_KEYS: &[&str] = &[
@@ -305,6 +319,8 @@ pub struct ScenarioSpec {
     pub robot: Settings,
     /// `[recognizer]`: each key with its value; the recognizer's model knows the keys.
     pub recognizer: Vec<(S<String>, toml::Value)>,
+    /// `[scan_context]`: the Scan Context baseline's numbers ([`SCAN_CONTEXT_KEYS`]).
+    pub scan_context: Settings,
     pub evaluation: EvaluationSpec,
     pub expect: ExpectSpec,
 }
@@ -391,6 +407,7 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
         check_number_limits("pedestrians", &p.settings, d);
     }
     let recognizer = read_recognizer(top, d);
+    let scan_context = read_settings(top, "scan_context", SCAN_CONTEXT_KEYS, "", d);
     let evaluation = crate::spec::evaluation::read_evaluation(top, d);
     let expect = crate::spec::evaluation::read_expect(top, d);
     let (name, description, world, route, seed) = head?;
@@ -408,6 +425,7 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
         odometry,
         robot,
         recognizer,
+        scan_context,
         evaluation,
         expect,
     })

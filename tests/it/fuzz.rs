@@ -142,8 +142,13 @@ proptest! {
     }
 
     #[test]
-    fn scenario_files_never_panic(which in 0usize..3, muts in mutations()) {
-        let c = corpus(&["scenarios/smoke.toml", "scenarios/A.toml", "scenarios/reverse.toml"]);
+    fn scenario_files_never_panic(which in 0usize..4, muts in mutations()) {
+        let c = corpus(&[
+            "scenarios/smoke.toml",
+            "scenarios/A.toml",
+            "scenarios/reverse.toml",
+            "tests/fixtures/fuzz-corpus/scan-context.toml",
+        ]);
         let path = root().join("scenarios/fuzz.toml");
         let _ = placewords::experiment::parse_scenario(
             &mutate(&c[which], &muts),

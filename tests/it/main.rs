@@ -16,6 +16,7 @@ mod plugin;
 mod provenance;
 mod recognizer;
 mod routes;
+mod scan_context;
 mod settings;
 mod sim;
 mod spec;

@@ -231,6 +231,7 @@ fn the_format_reference_names_every_key() {
                 sc::LASER_KEYS,
                 sc::ODOMETRY_KEYS,
                 sc::ROBOT_KEYS,
+                sc::SCAN_CONTEXT_KEYS,
                 ev::EVALUATION_KEYS,
                 ev::EXPECT_KEYS,
                 ev::EXPECT_SUBJECT_KEYS,
