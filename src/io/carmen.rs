@@ -159,15 +159,7 @@ impl LapWriter {
         );
         for f in &lap.frames {
             let odom = f.odom.0;
-            let (tv, rv) = match self.prev {
-                Some((t0, p0)) if f.time_s > t0 => {
-                    let dt = f.time_s - t0;
-                    let d = p0.between(&odom);
-                    let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
-                    (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
-                }
-                _ => (0.0, 0.0),
-            };
+            let (tv, rv) = odometry_speeds(self.prev, f.time_s, odom);
             self.prev = Some((f.time_s, odom));
             self.write_frame(out, f, (tv, rv));
         }
@@ -212,6 +204,20 @@ impl LapWriter {
                 logger_timestamp: f.time_s,
             }),
         );
+    }
+}
+
+/// The forward speed (m/s, negative backwards) and turn rate (rad/s) from the odometry pose
+/// `prev` (at its time, seconds) to `odom` at `time_s`; zero for the first frame or no time step.
+pub fn odometry_speeds(prev: Option<(f64, Pose2)>, time_s: f64, odom: Pose2) -> (f64, f64) {
+    match prev {
+        Some((t0, p0)) if time_s > t0 => {
+            let dt = time_s - t0;
+            let d = p0.between(&odom);
+            let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
+            (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
+        }
+        _ => (0.0, 0.0),
     }
 }
 
