@@ -221,6 +221,20 @@ pub fn odometry_speeds(prev: Option<(f64, Pose2)>, time_s: f64, odom: Pose2) -> 
     }
 }
 
+/// `v` as a CARMEN log holds it: printed with six decimals and read back (1 µm, 1 µrad).
+pub fn at_log_resolution(v: f64) -> f64 {
+    format!("{v:.6}").parse().unwrap_or(v)
+}
+
+/// [`at_log_resolution`] of each coordinate.
+pub fn pose_at_log_resolution(p: Pose2) -> Pose2 {
+    Pose2::new(
+        at_log_resolution(p.x),
+        at_log_resolution(p.y),
+        at_log_resolution(p.theta),
+    )
+}
+
 fn fmt_pose(p: &Pose2) -> String {
     format!("{:.6} {:.6} {:.6}", p.x, p.y, p.theta)
 }

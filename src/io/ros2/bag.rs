@@ -19,13 +19,18 @@
 //! `geometry_msgs/msg/PoseStamped` channel, or `/ground_truth` among several. Each scan's pose is
 //! the odometry at its header stamp (interpolated between the two messages around it, at most
 //! [`ODOM_MAX_GAP_S`] from one); as in a CARMEN log, that pose is the sensor's (the mount is not
-//! applied). Readings that are not finite or reach `range_max` are no-returns. The file is read
+//! applied). Readings that are not finite or reach `range_max` are no-returns.
+//!
+//! **Resolution.** A `float32` range is read as the shortest decimal that gives it back (the
+//! millimetres a scanner reported: `1.234`, not `1.2339999675750732`), and poses at a CARMEN
+//! log's resolution (1 µm, 1 µrad, far below any odometry's error): a bag and a CARMEN log of
+//! the same run make the same frames, bit for bit, and so the same matches. The file is read
 //! whole, record by record; a record that runs past the end of the file, a chunk that does not
 //! decompress or a record that does not parse is an error naming its byte offset.
 
 use super::msg::{self, Header, LaserScan, Odometry, PoseStamped, Transform};
 use crate::geom::{Pose2, wrap_angle};
-use crate::io::carmen::{LaserRecord, TruePosRecord, odometry_speeds};
+use crate::io::carmen::{LaserRecord, TruePosRecord, odometry_speeds, pose_at_log_resolution};
 use crate::log::LapLog;
 use std::collections::BTreeMap;
 use std::io::{Seek, Write};
@@ -376,7 +381,9 @@ pub fn read_bag_bytes(
     let odoms = std::cell::RefCell::new(Vec::new());
     decode_all(odom, &|d| {
         let o = Odometry::decode(d)?;
-        odoms.borrow_mut().push((o.header.stamp_s, o.pose));
+        odoms
+            .borrow_mut()
+            .push((o.header.stamp_s, pose_at_log_resolution(o.pose)));
         Ok(())
     })?;
     let mut odoms = odoms.into_inner();
@@ -392,7 +399,7 @@ pub fn read_bag_bytes(
         decode_all(t, &|d| {
             let p = PoseStamped::decode(d)?;
             truepos.borrow_mut().push(TruePosRecord {
-                truth: p.pose,
+                truth: pose_at_log_resolution(p.pose),
                 odom: Pose2::IDENTITY,
                 ipc_timestamp: p.header.stamp_s,
                 host: String::new(),
@@ -403,7 +410,7 @@ pub fn read_bag_bytes(
     }
     let max_range_m = scans
         .first()
-        .map(|s| s.range_max as f64)
+        .map(|s| f32_decimal(s.range_max))
         .filter(|r| r.is_finite() && *r > 0.0);
     let no_return = max_range_m.unwrap_or(f64::INFINITY);
     let lasers = scans
@@ -426,8 +433,11 @@ pub fn read_bag_bytes(
                     .ranges
                     .iter()
                     .map(|r| {
-                        let r = *r as f64;
-                        if r.is_finite() { r } else { no_return }
+                        if r.is_finite() {
+                            f32_decimal(*r)
+                        } else {
+                            no_return
+                        }
                     })
                     .collect(),
                 pose,
@@ -444,6 +454,11 @@ pub fn read_bag_bytes(
         max_range_m,
         topics: list,
     })
+}
+
+/// `r` as the shortest decimal that reads back as `r` (what was meant before it became binary).
+fn f32_decimal(r: f32) -> f64 {
+    r.to_string().parse().unwrap_or(r as f64)
 }
 
 /// The odometry pose at `t` from `sorted` (by time): interpolated between the messages around
