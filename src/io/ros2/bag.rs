@@ -25,8 +25,10 @@
 //! millimetres a scanner reported: `1.234`, not `1.2339999675750732`), and poses at a CARMEN
 //! log's resolution (1 µm, 1 µrad, far below any odometry's error): a bag and a CARMEN log of
 //! the same run make the same frames, bit for bit, and so the same matches. The file is read
-//! whole, record by record; a record that runs past the end of the file, a chunk that does not
-//! decompress or a record that does not parse is an error naming its byte offset.
+//! whole, record by record, by a small walker of its own (the `mcap` crate writes; its record
+//! parser trusts a corrupt length field and allocates what it claims); a record that runs past
+//! the end of the file, a chunk that does not decompress or fails its CRC, or a record whose
+//! fields do not fit it is an error naming its byte offset.
 
 use super::msg::{self, Header, LaserScan, Odometry, PoseStamped, Transform};
 use crate::geom::{Pose2, wrap_angle};
@@ -628,7 +630,7 @@ fn read_channels(bytes: &[u8], path: &str) -> Result<Channels, BagError> {
             ));
         }
         let body = &bytes[start..start + body_len as usize];
-        if op == 0x02 {
+        if op == OP_FOOTER {
             // The footer: the end (the closing magic is not needed).
             break;
         }
@@ -646,6 +648,64 @@ struct Walk<'p> {
     channels: Channels,
 }
 
+/// Reads the fields of one record body, every length checked against the bytes there (the
+/// `mcap` crate's record parser trusts a corrupt length and allocates what it claims).
+struct Fields<'a> {
+    body: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Fields<'a> {
+    fn bytes(&mut self, n: u64, what: &str) -> Result<&'a [u8], String> {
+        let left = (self.body.len() - self.pos) as u64;
+        if n > left {
+            return Err(format!(
+                "its {what} claims {n} bytes, but the record has {left} left"
+            ));
+        }
+        let b = &self.body[self.pos..self.pos + n as usize];
+        self.pos += n as usize;
+        Ok(b)
+    }
+
+    fn u16(&mut self, what: &str) -> Result<u16, String> {
+        Ok(u16::from_le_bytes(
+            self.bytes(2, what)?.try_into().expect("2"),
+        ))
+    }
+
+    fn u32(&mut self, what: &str) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.bytes(4, what)?.try_into().expect("4"),
+        ))
+    }
+
+    fn u64(&mut self, what: &str) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.bytes(8, what)?.try_into().expect("8"),
+        ))
+    }
+
+    fn string(&mut self, what: &str) -> Result<String, String> {
+        let n = self.u32(what)?;
+        let b = self.bytes(n as u64, what)?;
+        String::from_utf8(b.to_vec()).map_err(|_| format!("its {what} is not UTF-8 text"))
+    }
+
+    fn rest(&mut self) -> &'a [u8] {
+        let b = &self.body[self.pos..];
+        self.pos = self.body.len();
+        b
+    }
+}
+
+/// Record opcodes the reader looks into.
+const OP_FOOTER: u8 = 0x02;
+const OP_SCHEMA: u8 = 0x03;
+const OP_CHANNEL: u8 = 0x04;
+const OP_MESSAGE: u8 = 0x05;
+const OP_CHUNK: u8 = 0x06;
+
 impl Walk<'_> {
     fn corrupt(&self, offset: u64, e: impl std::fmt::Display) -> BagError {
         BagError::Corrupt {
@@ -657,72 +717,131 @@ impl Walk<'_> {
 
     /// One top-level record at `offset`.
     fn record(&mut self, op: u8, body: &[u8], offset: u64) -> Result<(), BagError> {
-        use mcap::records::Record;
-        // Only the records that name channels or carry messages are parsed.
-        if !matches!(op, 0x03..=0x06) {
-            return Ok(());
+        if op != OP_CHUNK {
+            return self.inner(op, body, offset);
         }
-        let rec = mcap::read::parse_record(op, body).map_err(|e| self.corrupt(offset, e))?;
-        if let Record::Chunk { header, data } = rec {
-            if header.uncompressed_size > MAX_CHUNK_BYTES {
+        let records = self
+            .chunk(body)
+            .map_err(|e| self.corrupt(offset, format!("chunk: {e}")))?;
+        // The chunk's records, each with the same bounds checks as the file's.
+        let mut pos = 0usize;
+        while pos < records.len() {
+            let at = |e: String| format!("chunk, at byte {pos} of its records: {e}");
+            if records.len() - pos < 9 {
+                return Err(self.corrupt(offset, at("a record header is cut off".into())));
+            }
+            let op = records[pos];
+            let n = u64::from_le_bytes(records[pos + 1..pos + 9].try_into().expect("8"));
+            if n > (records.len() - pos - 9) as u64 {
                 return Err(self.corrupt(
                     offset,
-                    format!(
-                        "a chunk claims {} bytes uncompressed (at most {MAX_CHUNK_BYTES})",
-                        header.uncompressed_size
-                    ),
+                    at(format!(
+                        "record 0x{op:02x} of {n} bytes runs past the chunk's end"
+                    )),
                 ));
             }
-            let reader = mcap::read::ChunkReader::new(header, &data)
-                .map_err(|e| self.corrupt(offset, format!("in its chunk: {e}")))?;
-            for inner in reader {
-                let inner =
-                    inner.map_err(|e| self.corrupt(offset, format!("in its chunk: {e}")))?;
-                self.parsed(inner, offset)?;
-            }
-            return Ok(());
+            let body = &records[pos + 9..pos + 9 + n as usize];
+            self.inner(op, body, offset)?;
+            pos += 9 + n as usize;
         }
-        self.parsed(rec, offset)
+        Ok(())
     }
 
-    fn parsed(&mut self, rec: mcap::records::Record<'_>, offset: u64) -> Result<(), BagError> {
-        use mcap::records::Record;
-        match rec {
-            Record::Schema { header, .. } => {
-                self.schemas.insert(header.id, header.name);
+    /// The records of a chunk's body, decompressed and checked against its CRC.
+    fn chunk(&self, body: &[u8]) -> Result<Vec<u8>, String> {
+        use std::io::Read as _;
+        let mut f = Fields { body, pos: 0 };
+        let _start = f.u64("start time")?;
+        let _end = f.u64("end time")?;
+        let size = f.u64("uncompressed size")?;
+        let crc = f.u32("CRC")?;
+        let compression = f.string("compression")?;
+        let compressed_len = f.u64("compressed size")?;
+        let data = f.bytes(compressed_len, "records")?;
+        if size > MAX_CHUNK_BYTES {
+            return Err(format!(
+                "it claims {size} bytes uncompressed (at most {MAX_CHUNK_BYTES})"
+            ));
+        }
+        let records = match compression.as_str() {
+            "" => data.to_vec(),
+            "zstd" => {
+                let mut out = Vec::new();
+                zstd::stream::read::Decoder::new(data)
+                    .and_then(|d| d.take(size + 1).read_to_end(&mut out))
+                    .map_err(|e| format!("zstd: {e}"))?;
+                out
             }
-            Record::Channel(c) => {
-                let type_name = match c.schema_id {
+            other => {
+                return Err(format!(
+                    "compression `{other}` is not supported (only zstd or none)"
+                ));
+            }
+        };
+        if records.len() as u64 != size {
+            return Err(format!(
+                "it holds {} bytes uncompressed, not the {size} it claims",
+                records.len()
+            ));
+        }
+        if crc != 0 && crc32fast::hash(&records) != crc {
+            return Err("its CRC does not match its records".into());
+        }
+        Ok(records)
+    }
+
+    /// One schema, channel or message record (others are skipped).
+    fn inner(&mut self, op: u8, body: &[u8], offset: u64) -> Result<(), BagError> {
+        let mut f = Fields { body, pos: 0 };
+        let what = match op {
+            OP_SCHEMA => "schema",
+            OP_CHANNEL => "channel",
+            OP_MESSAGE => "message",
+            _ => return Ok(()),
+        };
+        let path = self.path;
+        let bad = |e: String| BagError::Corrupt {
+            path: path.into(),
+            offset,
+            message: format!("{what}: {e}"),
+        };
+        match op {
+            OP_SCHEMA => {
+                let id = f.u16("id").map_err(bad)?;
+                let name = f.string("name").map_err(bad)?;
+                self.schemas.insert(id, name);
+            }
+            OP_CHANNEL => {
+                let id = f.u16("id").map_err(bad)?;
+                let schema_id = f.u16("schema id").map_err(bad)?;
+                let topic = f.string("topic").map_err(bad)?;
+                let encoding = f.string("message encoding").map_err(bad)?;
+                let type_name = match schema_id {
                     0 => String::new(),
                     id => self.schemas.get(&id).cloned().ok_or_else(|| {
-                        self.corrupt(
-                            offset,
-                            format!(
-                                "channel {} names schema {id}, which comes nowhere before it",
-                                c.topic
-                            ),
-                        )
+                        bad(format!(
+                            "{topic} names schema {id}, which comes nowhere before it"
+                        ))
                     })?,
                 };
                 self.channels.info.insert(
-                    c.id,
+                    id,
                     TopicInfo {
-                        topic: c.topic,
+                        topic,
                         type_name,
-                        encoding: c.message_encoding,
+                        encoding,
                         messages: 0,
                     },
                 );
             }
-            Record::Message { header, data } => {
-                let Some(info) = self.channels.info.get_mut(&header.channel_id) else {
-                    return Err(self.corrupt(
-                        offset,
-                        format!(
-                            "a message of channel {}, which comes nowhere before it",
-                            header.channel_id
-                        ),
-                    ));
+            _ => {
+                let channel = f.u16("channel id").map_err(bad)?;
+                f.bytes(20, "sequence and times").map_err(bad)?;
+                let data = f.rest();
+                let Some(info) = self.channels.info.get_mut(&channel) else {
+                    return Err(bad(format!(
+                        "its channel {channel} comes nowhere before it"
+                    )));
                 };
                 info.messages += 1;
                 let read = [msg::LASER_SCAN, msg::ODOMETRY, msg::POSE_STAMPED]
@@ -731,12 +850,11 @@ impl Walk<'_> {
                 if read {
                     self.channels
                         .data
-                        .entry(header.channel_id)
+                        .entry(channel)
                         .or_default()
-                        .push(data.into_owned());
+                        .push(data.to_vec());
                 }
             }
-            _ => {}
         }
         Ok(())
     }
