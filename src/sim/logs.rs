@@ -210,7 +210,7 @@ struct OpenRun {
 /// A run's file in its format.
 enum RunFile {
     Carmen { file: AtomicFile, carmen: LapWriter },
-    Mcap(BagWriter<AtomicFile>),
+    Mcap(Box<BagWriter<AtomicFile>>),
 }
 
 /// Writes a simulation's folder lap by lap: laps arrive in run order, each appended to its run's
@@ -328,9 +328,9 @@ impl<'a> LogsWriter<'a> {
                     carmen: LapWriter::new(HOST),
                 }
             }
-            RunFormat::Mcap => RunFile::Mcap(
+            RunFormat::Mcap => RunFile::Mcap(Box::new(
                 BagWriter::new(file, run, scan_timing(self.scn)).map_err(|e| at(&p, e))?,
-            ),
+            )),
         };
         if self.laps.is_none() {
             let scratch = self.dir.join("manifest-laps");

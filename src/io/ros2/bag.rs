@@ -472,7 +472,7 @@ fn odometry_at(sorted: &[(f64, Pose2)], t: f64) -> Result<Pose2, f64> {
     let before = i.checked_sub(1).and_then(|j| sorted.get(j));
     let gap = |e: Option<&(f64, Pose2)>| e.map_or(f64::INFINITY, |e| (e.0 - t).abs());
     let nearest = gap(before).min(gap(after));
-    if !(nearest <= ODOM_MAX_GAP_S) {
+    if nearest.is_nan() || nearest > ODOM_MAX_GAP_S {
         return Err(nearest);
     }
     Ok(match (before, after) {
