@@ -139,8 +139,14 @@ fn load(args: &Args) -> Result<(Vec<RunLog>, RecognizerConfig)> {
     let Some(noise) = real::parse_noise_model("proportional").map_err(anyhow::Error::msg)? else {
         bail!("the default noise model has no parameters");
     };
-    let (run, _) =
-        real::load_real_run(path, false, TruthSource::Corrected, Some(&noise), args.seed)?;
+    let (run, _) = real::load_real_run(
+        path,
+        false,
+        TruthSource::Corrected,
+        Some(&noise),
+        args.seed,
+        &Default::default(),
+    )?;
     Ok((vec![run], RecognizerConfig::default()))
 }
 

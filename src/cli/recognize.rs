@@ -1,5 +1,5 @@
-//! `placewords recognize LOG`: the recognizer and evaluation on a real CARMEN log, with the same
-//! definitions and report schema as `run`.
+//! `placewords recognize LOG`: the recognizer and evaluation on a real CARMEN log or a ROS 2 bag
+//! (MCAP), with the same definitions and report schema as `run`.
 
 use super::common::{LevelsArg, print_and_write};
 use anyhow::bail;
@@ -21,8 +21,15 @@ pub enum TruthArg {
 
 #[derive(Debug, Args)]
 pub struct RecognizeArgs {
-    /// CARMEN log, plain or gzip.
+    /// CARMEN log (plain or gzip) or ROS 2 bag (`.mcap`, told by its first bytes), e.g.
+    /// `placewords recognize robot.mcap --scan-topic /scan --odom-topic /odom`.
     pub log: PathBuf,
+    /// A bag's `sensor_msgs/msg/LaserScan` topic (default: the only topic of that type).
+    #[arg(long, value_name = "TOPIC")]
+    pub scan_topic: Option<String>,
+    /// A bag's `nav_msgs/msg/Odometry` topic (default: the only topic of that type).
+    #[arg(long, value_name = "TOPIC")]
+    pub odom_topic: Option<String>,
     /// Where the ground truth comes from.
     #[arg(long, value_enum, default_value = "corrected")]
     pub truth: TruthArg,
@@ -101,6 +108,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
             n.to_string_lossy()
                 .trim_end_matches(".gz")
                 .trim_end_matches(".log")
+                .trim_end_matches(".mcap")
                 .to_string()
         })
         .unwrap_or_else(|| "log".into());
@@ -124,6 +132,10 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         noise,
         seed: args.seed,
         scan_step: args.scan_step as usize,
+        topics: placewords::io::ros2::bag::BagTopics {
+            scan: args.scan_topic.clone(),
+            odom: args.odom_topic.clone(),
+        },
     };
     let keep_runs = args.svg.is_some();
     let (exp, skipped) = experiment::real::recognize_log(

@@ -12,7 +12,8 @@ use std::process::ExitCode;
 
 #[derive(Debug, Args)]
 pub struct ScoreArgs {
-    /// Folder `placewords simulate -o` wrote (run-NNN.log files and manifest.json).
+    /// Folder `placewords simulate -o` wrote (run-NNN.log or run-NNN.mcap files and
+    /// manifest.json).
     pub logdir: PathBuf,
     /// Matches file: `query_run,query_scan,matched_run,matched_scan,score` (score optional).
     #[arg(long, value_name = "FILE")]
@@ -43,7 +44,7 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
         let mut files: Vec<PathBuf> = std::fs::read_dir(&args.logdir)
             .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
             .unwrap_or_default();
-        files.retain(|f| f.extension().is_some_and(|e| e == "log"));
+        files.retain(|f| f.extension().is_some_and(|e| e == "log" || e == "mcap"));
         files.sort();
         logs.extend(files);
         prov.add_inputs(logs.iter().map(|f| p::file_input("logs", f)));

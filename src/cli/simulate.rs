@@ -1,7 +1,8 @@
-//! `placewords simulate SCENARIO [--laps N] -o DIR [--quiet]`: one CARMEN log per run and a JSON
-//! manifest, all written atomically.
+//! `placewords simulate SCENARIO [--laps N] [--format carmen|mcap] -o DIR [--quiet]`: one CARMEN
+//! log (or ROS 2 bag) per run and a JSON manifest, all written atomically.
 
-use clap::Args;
+use clap::{Args, ValueEnum};
+use placewords::sim::logs::RunFormat;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -19,12 +20,25 @@ pub struct SimulateArgs {
     /// Output folder for the logs and manifest.
     #[arg(short, long)]
     pub out: PathBuf,
+    /// How each run is written: `carmen` (`run-NNN.log`) or `mcap`, a ROS 2 bag (`run-NNN.mcap`:
+    /// /scan, /odom, /tf, /ground_truth, /doors; docs/ros2.md). Example:
+    /// `placewords simulate scenarios/smoke.toml --format mcap -o sim/`.
+    #[arg(long, value_enum, default_value = "carmen")]
+    pub format: FormatArg,
     /// No progress bar.
     #[arg(short, long)]
     pub quiet: bool,
     /// Also draw each run (world, true path, odometry path) as `run-NNN.svg` in the output folder.
     #[arg(long)]
     pub svg: bool,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum FormatArg {
+    /// CARMEN text logs.
+    Carmen,
+    /// ROS 2 bags (MCAP, CDR).
+    Mcap,
 }
 
 pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
@@ -43,6 +57,10 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         &scn,
         args.laps,
         &args.out,
+        match args.format {
+            FormatArg::Carmen => RunFormat::Carmen,
+            FormatArg::Mcap => RunFormat::Mcap,
+        },
         args.svg,
         &super::progress::bar(args.quiet),
     )?;

@@ -1,4 +1,4 @@
-//! `simulate`'s output folder: the CARMEN logs, the manifest and optional pictures of one
+//! `simulate`'s output folder: the CARMEN logs (or ROS 2 bags), the manifest and optional pictures of one
 //! simulation, written beside the folder and renamed onto it whole ([`StagedDir`]), so the
 //! folder never mixes two runs and a failed run leaves it as it was. The logs are written lap
 //! by lap as the simulator makes them (`stream::with_laps`), so memory does not grow with laps.
@@ -11,14 +11,17 @@ use crate::sim::logs;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 
-/// Whether `dir` holds only what [`simulate_to_folder`] writes (a `manifest.json`, `run-NNN.log`
-/// and `run-NNN.svg` files, hidden temporary files), so a new simulation may replace it.
+/// Whether `dir` holds only what [`simulate_to_folder`] writes (a `manifest.json`, `run-NNN.log`,
+/// `run-NNN.mcap` and `run-NNN.svg` files, hidden temporary files), so a new simulation may replace it.
 pub fn is_simulation_folder(dir: &Path) -> bool {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return false;
     };
     let run_file = |n: &str| {
-        let stem = n.strip_suffix(".log").or_else(|| n.strip_suffix(".svg"));
+        let stem = n
+            .strip_suffix(".log")
+            .or_else(|| n.strip_suffix(".mcap"))
+            .or_else(|| n.strip_suffix(".svg"));
         stem.and_then(|s| s.strip_prefix("run-"))
             .is_some_and(|d| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit()))
     };
@@ -33,8 +36,8 @@ pub fn is_simulation_folder(dir: &Path) -> bool {
     manifest
 }
 
-/// Simulates `scn` (laps per run replaced by `laps`) and writes folder `out`: `run-NNN.log` per
-/// run, `manifest.json` and, with `svg`, `run-NNN.svg`. `out` is checked before the simulation
+/// Simulates `scn` (laps per run replaced by `laps`) and writes folder `out`: `run-NNN.log` (or
+/// `run-NNN.mcap`, by `format`) per run, `manifest.json` and, with `svg`, `run-NNN.svg`. `out` is checked before the simulation
 /// starts: it must be new, empty or an earlier simulation folder (which is replaced). Each lap is
 /// written as soon as it is simulated and then dropped (with `svg`, its poses are kept), so
 /// memory does not grow with the laps; the folder appears whole when every file is written.
@@ -43,6 +46,7 @@ pub fn simulate_to_folder(
     scn: &Scenario,
     laps: Option<usize>,
     out: &Path,
+    format: logs::RunFormat,
     svg: bool,
     progress: &super::ProgressSink,
 ) -> Result<Vec<PathBuf>, ExperimentError> {
@@ -50,7 +54,7 @@ pub fn simulate_to_folder(
     let laps_of = |run: usize| laps.unwrap_or(scn.sim.runs[run].laps);
     let total: usize = (0..scn.sim.runs.len()).map(laps_of).sum();
     progress.start("simulating", total as u64);
-    let mut writer = logs::LogsWriter::new(&scn.sim, laps, stage.path());
+    let mut writer = logs::LogsWriter::new(&scn.sim, laps, stage.path(), format);
     let mut paths: Vec<RunLog> = Vec::new();
     let keep = svg.then_some(&mut paths);
     let (sim, written) = with_laps(&scn.sim, &laps_of, |rx| {

@@ -13,7 +13,10 @@ use crate::eval::scores::LogSummary;
 use crate::eval::{GroundTruth, LapInfo};
 use crate::geom::{Pose2, wrap_angle};
 use crate::io::carmen::ReadOptions;
-use crate::io::real_log::{LogSurvey, RealLogError, TruthSource, load_run, stream_frames};
+use crate::io::real_log::{
+    LogSurvey, RealLogError, TruthSource, load_bag_run, load_run, stream_frames,
+};
+use crate::io::ros2::bag::{BagTopics, is_mcap};
 use crate::log::{Frame, RunLog};
 use crate::recognizer::RecognizerConfig;
 use crate::sim::odometry::{
@@ -107,19 +110,25 @@ pub fn parse_noise_model(s: &str) -> Result<Option<OdometryConfig>, String> {
 }
 
 /// Reads a log and turns it into one run, with odometry derived by `noise` (or exactly the
-/// corrected increments when `noise` is `None`) from the stream of `seed`.
+/// corrected increments when `noise` is `None`) from the stream of `seed`. A ROS 2 bag (MCAP,
+/// told by its first bytes) is read with `topics`.
 pub fn load_real_run(
     path: &Path,
     lenient: bool,
     truth: TruthSource,
     noise: Option<&OdometryConfig>,
     seed: u64,
+    topics: &BagTopics,
 ) -> Result<(RunLog, usize), RealLogError> {
     let mut rng = stream(seed, 0, 0, Purpose::Odometry);
-    let (run, readout) = load_run(path, ReadOptions { lenient }, truth, |inc| match noise {
+    let perturb = |inc| match noise {
         Some(cfg) => perturb_increment(cfg, inc, &mut rng),
         None => inc,
-    })?;
+    };
+    if is_mcap(path) {
+        return Ok((load_bag_run(path, topics, truth, perturb)?, 0));
+    }
+    let (run, readout) = load_run(path, ReadOptions { lenient }, truth, perturb)?;
     Ok((run, readout.skipped_lines))
 }
 
@@ -153,12 +162,14 @@ pub struct RealLogOptions {
     pub seed: u64,
     /// Keep every `scan_step`-th scan (1: all).
     pub scan_step: usize,
+    /// A bag's scan and odometry topics (found by type where `None`).
+    pub topics: BagTopics,
 }
 
 /// Recognizes the real log at `path` with every configuration of `opts`; returns the experiment
 /// and the lines skipped. With `keep_runs` (pictures need the scans) the log is loaded whole and
 /// `Experiment::runs` holds it; otherwise it is read as a stream ([`recognize_log_streamed`]).
-/// The report is the same either way.
+/// The report is the same either way. A ROS 2 bag (MCAP) is always loaded whole.
 pub fn recognize_log(
     path: &Path,
     log: &RealLogOptions,
@@ -168,11 +179,17 @@ pub fn recognize_log(
     opts: &ExperimentOptions,
     keep_runs: bool,
 ) -> Result<(Experiment, usize), ExperimentError> {
-    if !keep_runs {
+    if !keep_runs && !is_mcap(path) {
         return recognize_log_streamed(path, log, name, base, evaluation, opts);
     }
-    let (mut run, skipped) =
-        load_real_run(path, log.lenient, log.truth, log.noise.as_ref(), log.seed)?;
+    let (mut run, skipped) = load_real_run(
+        path,
+        log.lenient,
+        log.truth,
+        log.noise.as_ref(),
+        log.seed,
+        &log.topics,
+    )?;
     keep_every_nth_scan(&mut run, log.scan_step);
     let summary = LogSummary::of(&GroundTruth::from_runs(std::slice::from_ref(&run)));
     let mut exp = super::evaluate_runs(name, log.seed, vec![run], base, evaluation, opts)?;

@@ -31,6 +31,9 @@ pub enum ScoreError {
     Manifest { path: String, message: String },
     #[error(transparent)]
     Log(#[from] CarmenError),
+    /// A run's bag (`simulate --format mcap`).
+    #[error(transparent)]
+    Bag(#[from] crate::io::real_log::RealLogError),
     #[error(transparent)]
     Matches(#[from] MatchesCsvError),
     #[error(
@@ -111,7 +114,7 @@ pub fn export_rows(rec: &Recognition, run_frames: &[(usize, usize)]) -> Vec<Matc
     rows
 }
 
-/// Reads `dir/manifest.json` and every run's log in it.
+/// Reads `dir/manifest.json` and every run's log (CARMEN or ROS 2 bag) in it.
 pub fn load_logged_runs(dir: &Path) -> Result<LoggedRuns, ScoreError> {
     let mpath = dir.join("manifest.json");
     let bad = |message: String| ScoreError::Manifest {
@@ -170,8 +173,14 @@ pub fn load_logged_runs(dir: &Path) -> Result<LoggedRuns, ScoreError> {
 }
 
 /// The odometry and truth of every laser line of one log (a laser line's truth is the
-/// `TRUEPOS` line that follows it, as `simulate` writes them).
+/// `TRUEPOS` line that follows it, as `simulate` writes them); of a bag, every scan's odometry
+/// and the truth at its stamp.
 fn read_run(path: &Path) -> Result<(Vec<Pose2>, Vec<Pose2>), ScoreError> {
+    use crate::io::real_log::{TruthSource, load_bag_run, noise_free};
+    if crate::io::ros2::bag::is_mcap(path) {
+        let run = load_bag_run(path, &Default::default(), TruthSource::TruePos, noise_free)?;
+        return Ok(run.frames().map(|f| (f.odom.0, f.truth.0)).unzip());
+    }
     let readout = read_log(path, ReadOptions::default())?;
     let (mut odom, mut truth) = (Vec::new(), Vec::new());
     let mut pending: Option<Pose2> = None;

@@ -201,6 +201,13 @@ impl Write for AtomicFile {
     }
 }
 
+/// Seeking flushes the buffer first (writers such as MCAP's go back to patch a header).
+impl std::io::Seek for AtomicFile {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.out.as_mut().expect("not committed").seek(pos)
+    }
+}
+
 impl Drop for AtomicFile {
     fn drop(&mut self) {
         // A committed file was renamed; a failed commit or an abandoned one leaves the temporary.

@@ -159,15 +159,7 @@ impl LapWriter {
         );
         for f in &lap.frames {
             let odom = f.odom.0;
-            let (tv, rv) = match self.prev {
-                Some((t0, p0)) if f.time_s > t0 => {
-                    let dt = f.time_s - t0;
-                    let d = p0.between(&odom);
-                    let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
-                    (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
-                }
-                _ => (0.0, 0.0),
-            };
+            let (tv, rv) = odometry_speeds(self.prev, f.time_s, odom);
             self.prev = Some((f.time_s, odom));
             self.write_frame(out, f, (tv, rv));
         }
@@ -213,6 +205,34 @@ impl LapWriter {
             }),
         );
     }
+}
+
+/// The forward speed (m/s, negative backwards) and turn rate (rad/s) from the odometry pose
+/// `prev` (at its time, seconds) to `odom` at `time_s`; zero for the first frame or no time step.
+pub fn odometry_speeds(prev: Option<(f64, Pose2)>, time_s: f64, odom: Pose2) -> (f64, f64) {
+    match prev {
+        Some((t0, p0)) if time_s > t0 => {
+            let dt = time_s - t0;
+            let d = p0.between(&odom);
+            let dist = (d.x * d.x + d.y * d.y).sqrt() * d.x.signum();
+            (dist / dt, wrap_angle(odom.theta - p0.theta) / dt)
+        }
+        _ => (0.0, 0.0),
+    }
+}
+
+/// `v` as a CARMEN log holds it: printed with six decimals and read back (1 µm, 1 µrad).
+pub fn at_log_resolution(v: f64) -> f64 {
+    format!("{v:.6}").parse().unwrap_or(v)
+}
+
+/// [`at_log_resolution`] of each coordinate.
+pub fn pose_at_log_resolution(p: Pose2) -> Pose2 {
+    Pose2::new(
+        at_log_resolution(p.x),
+        at_log_resolution(p.y),
+        at_log_resolution(p.theta),
+    )
 }
 
 fn fmt_pose(p: &Pose2) -> String {

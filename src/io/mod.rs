@@ -1,8 +1,9 @@
-//! Reading and writing files the program exchanges with other tools: CARMEN logs, atomic output
-//! files, MobileSim maps.
+//! Reading and writing files the program exchanges with other tools: CARMEN logs, ROS 2 bags
+//! (MCAP), atomic output files, MobileSim maps.
 
 pub mod atomic;
 pub mod carmen;
 pub mod matches_csv;
 pub mod mobilesim;
 pub mod real_log;
+pub mod ros2;

@@ -1,4 +1,4 @@
-//! Turning a real CARMEN log into the shape the recognizer and evaluation consume
+//! Turning a real CARMEN log (or a ROS 2 bag, [`load_bag_run`]) into the shape the recognizer and evaluation consume
 //! ([`crate::log::RunLog`]): one run, one lap holding every laser frame, door configuration
 //! `"unknown"`.
 //!
@@ -31,7 +31,13 @@
 //!
 //! **Beam layout.** FLASER: n beams over 180°, right to left (CARMEN convention, whatever n);
 //! RLASER: the same, facing backwards (beam 0 at +90°); ROBOTLASER1: its own start angle and
-//! field of view. The sensor mount is the identity
+//! field of view.
+//!
+//! **Bags.** A ROS 2 bag (MCAP) is read by [`crate::io::ros2::bag::read_bag`] into the same
+//! laser and truth records (each scan's pose the odometry at its stamp, the truth topic as
+//! TRUEPOS, the maximum range the scans' `range_max`), then made into frames by the same rules.
+//!
+//! The sensor mount is the identity
 //! (the logged pose is already the laser's). Maximum range, see [`max_range_m`].
 
 use crate::geom::{OdomPose, Pose2, TruePose};
@@ -101,6 +107,9 @@ pub enum RealLogError {
     /// The log itself could not be read.
     #[error(transparent)]
     Read(#[from] crate::io::carmen::CarmenError),
+    /// The bag could not be read.
+    #[error(transparent)]
+    Bag(#[from] crate::io::ros2::bag::BagError),
     #[error(
         "{0}: the log holds no laser messages (FLASER, RLASER or ROBOTLASER1); check that it is a CARMEN laser log"
     )]
@@ -175,6 +184,22 @@ pub fn load_run(
     let run = log_to_run(&readout, &path.display().to_string(), truth, perturb)?;
     readout.records = Vec::new();
     Ok((run, readout))
+}
+
+/// Reads a ROS 2 bag (MCAP) and turns it into one run, by the rules of [`corrected_to_run`]
+/// (the bag's scan poses play the corrected poses, its truth topic the TRUEPOS messages).
+pub fn load_bag_run(
+    path: &std::path::Path,
+    topics: &crate::io::ros2::bag::BagTopics,
+    truth: TruthSource,
+    perturb: impl FnMut(Pose2) -> Pose2,
+) -> Result<RunLog, RealLogError> {
+    let bag = crate::io::ros2::bag::read_bag(path, topics)?;
+    let lasers: Vec<&LaserRecord> = bag.lasers.iter().collect();
+    let truepos: Vec<&TruePosRecord> = bag.truepos.iter().collect();
+    let max_range_m = max_range_or_default(None, bag.max_range_m);
+    let name = path.display().to_string();
+    corrected_to_run(&lasers, &truepos, &name, truth, max_range_m, perturb)
 }
 
 /// Turns a read log into one run; see the module documentation for every convention.

@@ -1,12 +1,16 @@
-//! Writing simulated runs as CARMEN logs, plus a JSON manifest.
+//! Writing simulated runs as CARMEN logs or ROS 2 bags ([`RunFormat`]), plus a JSON manifest.
 //!
-//! Each run's log is a header comment, then its laps as [`LapWriter`] writes them (a `#` line
-//! per lap naming its doors; `ODOM`, `FLASER` and `TRUEPOS` per frame). Timestamps are seconds
-//! since the run started; the host is `placewords-sim`. [`LogsWriter`] appends lap after lap to
+//! Each run's CARMEN log is a header comment and a `PARAM robot_front_laser_max` line (the
+//! laser's no-return range, so a reader tells no-returns from hits), then its laps as
+//! [`LapWriter`] writes them (a `#` line per lap naming its doors; `ODOM`, `FLASER` and
+//! `TRUEPOS` per frame). Timestamps are seconds since the run started; the host is
+//! `placewords-sim`. A run's bag (`run-NNN.mcap`) holds the same frames as
+//! [`crate::io::ros2::bag::BagWriter`] writes them. [`LogsWriter`] appends lap after lap to
 //! the open run's file, so a simulation of any length is written in the memory of a few laps.
 
 use crate::io::atomic::{AtomicFile, ScratchFile};
 use crate::io::carmen::LapWriter;
+use crate::io::ros2::bag::{BagWriter, ScanTiming};
 use crate::log::{LapLog, RunLog};
 use crate::sim::plan::SimPlan;
 use serde::ser::{Error as _, SerializeSeq, SerializeStruct, Serializer};
@@ -18,12 +22,38 @@ use std::path::{Path, PathBuf};
 /// Host name written in every record.
 pub const HOST: &str = "placewords-sim";
 
-/// The comment line that opens run `run`'s log.
+/// The comment and `PARAM` lines that open run `run`'s CARMEN log.
 fn header(scn: &SimPlan, run: usize) -> String {
     format!(
-        "# placewords simulation: scenario {}, seed {}, run {}, route {} of world {}\n",
-        scn.name, scn.seed, run, scn.route.id, scn.world.name
+        "# placewords simulation: scenario {}, seed {}, run {}, route {} of world {}\n\
+         PARAM robot_front_laser_max {} 0.000000 {HOST} 0.000000\n",
+        scn.name, scn.seed, run, scn.route.id, scn.world.name, scn.laser.max_range_m
     )
+}
+
+/// How `simulate` writes each run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RunFormat {
+    /// A CARMEN text log, `run-NNN.log`.
+    #[default]
+    Carmen,
+    /// A ROS 2 bag in MCAP, `run-NNN.mcap` (docs/ros2.md).
+    Mcap,
+}
+
+impl RunFormat {
+    /// The file name extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            RunFormat::Carmen => "log",
+            RunFormat::Mcap => "mcap",
+        }
+    }
+}
+
+/// How the simulated laser's beams are timed in a bag.
+fn scan_timing(scn: &SimPlan) -> ScanTiming {
+    ScanTiming::lms200(scn.laser.rate_hz, scn.laser.layout().step_rad)
 }
 
 /// The CARMEN text of one run (the text [`LogsWriter`] writes to its file).
@@ -113,9 +143,14 @@ impl Serialize for LapsOut<'_> {
     }
 }
 
-/// File name of run `run`'s log.
+/// File name of run `run`'s CARMEN log.
 pub fn log_file_name(run: usize) -> String {
-    format!("run-{run:03}.log")
+    run_file_name(run, RunFormat::Carmen)
+}
+
+/// File name of run `run`'s file in `format`.
+pub fn run_file_name(run: usize, format: RunFormat) -> String {
+    format!("run-{run:03}.{}", format.extension())
 }
 
 /// The manifest of a simulation whose runs are `runs`.
@@ -140,7 +175,7 @@ pub fn write_logs(
     laps_override: Option<usize>,
     dir: &Path,
 ) -> std::io::Result<Vec<PathBuf>> {
-    let mut writer = LogsWriter::new(scn, laps_override, dir);
+    let mut writer = LogsWriter::new(scn, laps_override, dir, RunFormat::Carmen);
     for r in runs {
         writer.start_run(r.run)?;
         for lap in &r.laps {
@@ -165,21 +200,28 @@ struct RunHead {
     laps: usize,
 }
 
-/// The log file of the run being written.
+/// The file of the run being written.
 struct OpenRun {
-    file: AtomicFile,
-    carmen: LapWriter,
+    file: RunFile,
+    path: PathBuf,
     head: RunHead,
 }
 
+/// A run's file in its format.
+enum RunFile {
+    Carmen { file: AtomicFile, carmen: LapWriter },
+    Mcap(Box<BagWriter<AtomicFile>>),
+}
+
 /// Writes a simulation's folder lap by lap: laps arrive in run order, each appended to its run's
-/// `run-NNN.log` (written under a temporary name, renamed when the run ends), its manifest
+/// `run-NNN.log` or `run-NNN.mcap` (written under a temporary name, renamed when the run ends), its manifest
 /// entry to a scratch file; [`Self::finish`] writes `manifest.json` from them. Holds one lap's
 /// text at a time, so memory does not grow with the laps.
 pub struct LogsWriter<'a> {
     scn: &'a SimPlan,
     laps_override: Option<usize>,
     dir: PathBuf,
+    format: RunFormat,
     open: Option<OpenRun>,
     runs: Vec<RunHead>,
     /// The manifest entries of the laps written, one JSON line each.
@@ -189,12 +231,18 @@ pub struct LogsWriter<'a> {
 }
 
 impl<'a> LogsWriter<'a> {
-    /// A writer of `scn`'s logs into `dir` (created if missing).
-    pub fn new(scn: &'a SimPlan, laps_override: Option<usize>, dir: &Path) -> Self {
+    /// A writer of `scn`'s runs in `format` into `dir` (created if missing).
+    pub fn new(
+        scn: &'a SimPlan,
+        laps_override: Option<usize>,
+        dir: &Path,
+        format: RunFormat,
+    ) -> Self {
         LogsWriter {
             scn,
             laps_override,
             dir: dir.to_path_buf(),
+            format,
             open: None,
             runs: Vec::new(),
             laps: None,
@@ -217,11 +265,15 @@ impl<'a> LogsWriter<'a> {
     pub fn push_lap(&mut self, run: usize, lap: &LapLog) -> std::io::Result<()> {
         self.start_run(run)?;
         let open = self.open.as_mut().expect("start_run opened the run");
-        self.text.clear();
-        open.carmen.write_lap(&mut self.text, lap);
-        open.file
-            .write_all(self.text.as_bytes())
-            .map_err(|e| at(open.file.path(), e))?;
+        match &mut open.file {
+            RunFile::Carmen { file, carmen } => {
+                self.text.clear();
+                carmen.write_lap(&mut self.text, lap);
+                file.write_all(self.text.as_bytes())
+            }
+            RunFile::Mcap(bag) => bag.write_lap(lap),
+        }
+        .map_err(|e| at(&open.path, e))?;
         open.head.frames += lap.frames.len();
         open.head.laps += 1;
         let entry = ManifestLap {
@@ -264,20 +316,32 @@ impl<'a> LogsWriter<'a> {
     }
 
     fn open_run(&mut self, run: usize) -> std::io::Result<()> {
-        let p = self.dir.join(log_file_name(run));
+        let name = run_file_name(run, self.format);
+        let p = self.dir.join(&name);
         let mut file = AtomicFile::create(&p).map_err(|e| at(&p, e))?;
-        file.write_all(header(self.scn, run).as_bytes())
-            .map_err(|e| at(&p, e))?;
+        let file = match self.format {
+            RunFormat::Carmen => {
+                file.write_all(header(self.scn, run).as_bytes())
+                    .map_err(|e| at(&p, e))?;
+                RunFile::Carmen {
+                    file,
+                    carmen: LapWriter::new(HOST),
+                }
+            }
+            RunFormat::Mcap => RunFile::Mcap(Box::new(
+                BagWriter::new(file, run, scan_timing(self.scn)).map_err(|e| at(&p, e))?,
+            )),
+        };
         if self.laps.is_none() {
             let scratch = self.dir.join("manifest-laps");
             self.laps = Some(ScratchFile::create(&scratch).map_err(|e| at(&scratch, e))?);
         }
         self.open = Some(OpenRun {
             file,
-            carmen: LapWriter::new(HOST),
+            path: p,
             head: RunHead {
                 run,
-                file: log_file_name(run),
+                file: name,
                 start_waypoint: self.scn.runs[run].start_waypoint,
                 frames: 0,
                 laps: 0,
@@ -288,8 +352,12 @@ impl<'a> LogsWriter<'a> {
 
     fn close_run(&mut self) -> std::io::Result<()> {
         if let Some(open) = self.open.take() {
-            let p = open.file.path().to_path_buf();
-            open.file.commit().map_err(|e| at(&p, e))?;
+            let p = open.path;
+            let file = match open.file {
+                RunFile::Carmen { file, .. } => file,
+                RunFile::Mcap(bag) => bag.finish().map_err(|e| at(&p, e))?,
+            };
+            file.commit().map_err(|e| at(&p, e))?;
             self.written.push(p);
             self.runs.push(open.head);
         }

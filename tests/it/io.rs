@@ -588,6 +588,7 @@ fn a_log_read_as_a_stream_gives_the_report_of_the_log_loaded_whole() {
             noise: placewords::experiment::real::parse_noise_model(noise).unwrap(),
             seed: 7,
             scan_step,
+            topics: Default::default(),
         };
         let exp = ExperimentOptions {
             icp: true,

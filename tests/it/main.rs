@@ -2,6 +2,7 @@
 
 mod architecture;
 mod authoring;
+mod bag;
 mod ci;
 mod cli;
 mod common;

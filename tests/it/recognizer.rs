@@ -1246,8 +1246,15 @@ fn real_log_scores_with(
     use placewords::io::real_log::TruthSource;
     // `recognize`'s default noise.
     let noise = real::parse_noise_model("proportional").unwrap().unwrap();
-    let (mut run, _) =
-        real::load_real_run(&log, false, TruthSource::Corrected, Some(&noise), seed).unwrap();
+    let (mut run, _) = real::load_real_run(
+        &log,
+        false,
+        TruthSource::Corrected,
+        Some(&noise),
+        seed,
+        &Default::default(),
+    )
+    .unwrap();
     real::keep_every_nth_scan(&mut run, step);
     let opts = ExperimentOptions {
         levels: vec![3],
