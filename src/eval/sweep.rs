@@ -138,7 +138,7 @@ pub struct PrPoint {
 /// A precision-recall curve: one threshold varied, the others fixed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PrCurve {
-    /// "1 level: τ = [t]" or "2 levels: τ = [6, t]" (`t` varies along the curve).
+    /// `1 level: τ = [t]` or `2 levels: τ = [6, t]` (`t` varies along the curve).
     pub label: String,
     pub levels: usize,
     /// Thresholds of the levels below the varied one (empty for one level).
@@ -199,7 +199,7 @@ pub fn pr_curves(results: &[SweepResult]) -> Vec<PrCurve> {
     curves
 }
 
-/// "1 level: τ = [t]" or "2 levels: τ = [6, t]": the thresholds in the tables' notation
+/// `1 level: τ = [t]` or `2 levels: τ = [6, t]`: the thresholds in the tables' notation
 /// (one per level), `t` the one the curve varies.
 fn curve_label(levels: usize, fixed: &[usize]) -> String {
     let mut th: Vec<String> = fixed.iter().map(|t| t.to_string()).collect();
