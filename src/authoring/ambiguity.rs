@@ -90,26 +90,13 @@ pub struct Drive {
 
 /// A simulation of one run of two laps over `route` with every noise and wander off.
 fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::sim::plan::SimPlan {
-    use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
-    use crate::sim::{laser, odometry, pedestrians, robot};
+    use crate::sim::plan::{DoorChoice, SimPlan};
+    use crate::sim::{laser, odometry};
+    let doors = DoorChoice {
+        name: "given".into(),
+        states: doors.clone(),
+    };
     SimPlan {
-        name: format!("{}-ambiguity", world.name),
-        path: Default::default(),
-        world_path: Default::default(),
-        world: world.clone(),
-        route: route.clone(),
-        seed: 0,
-        runs: vec![RunPlan {
-            start_waypoint: 0,
-            reverse: false,
-            laps: 2,
-            doors: DoorPlan::Fixed(DoorChoice {
-                name: "given".into(),
-                states: doors.clone(),
-            }),
-        }],
-        door_configs: Default::default(),
-        pedestrians: pedestrians::PedestrianConfig::default(),
         laser: laser::LaserConfig {
             range_noise_m: 0.0,
             angle_error_rad: 0.0,
@@ -122,7 +109,7 @@ fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::s
             },
             ..odometry::OdometryConfig::default()
         },
-        robot: robot::RobotConfig::default(),
+        ..SimPlan::one_run(format!("{}-ambiguity", world.name), world, route, 2, doors)
     }
 }
 

@@ -41,6 +41,39 @@ pub struct RunPlan {
     pub doors: DoorPlan,
 }
 
+impl SimPlan {
+    /// One run of `laps` laps of `route` from waypoint 0, forward, with the doors of `doors`,
+    /// seed 0, nobody about and the default robot, laser and odometry: the drive the world
+    /// checks and the authoring maps make (they change the models they need noise-free).
+    pub fn one_run(
+        name: String,
+        world: &World,
+        route: &Route,
+        laps: usize,
+        doors: DoorChoice,
+    ) -> Self {
+        SimPlan {
+            name,
+            path: PathBuf::new(),
+            world_path: PathBuf::new(),
+            world: world.clone(),
+            route: route.clone(),
+            seed: 0,
+            runs: vec![RunPlan {
+                start_waypoint: 0,
+                reverse: false,
+                laps,
+                doors: DoorPlan::Fixed(doors),
+            }],
+            door_configs: BTreeMap::new(),
+            pedestrians: PedestrianConfig::default(),
+            laser: LaserConfig::default(),
+            odometry: OdometryConfig::default(),
+            robot: RobotConfig::default(),
+        }
+    }
+}
+
 impl RunPlan {
     /// The route as this run drives it (reversed for a reverse run) and the index of its start
     /// waypoint in it (the same place as `start_waypoint` in the route's own order).

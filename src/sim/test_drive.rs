@@ -12,8 +12,6 @@
 //! ([`plan_problems`]).
 
 use crate::geom::{Segment, Vec2};
-use crate::sim::laser::LaserConfig;
-use crate::sim::odometry::OdometryConfig;
 use crate::sim::pedestrians::PedestrianConfig;
 use crate::sim::plan::{DoorChoice, DoorPlan, RunPlan, SimPlan};
 use crate::sim::robot::{RobotConfig, spin_waypoints, waypoint_room};
@@ -232,28 +230,11 @@ pub fn world_problems(world: &World) -> Vec<RouteProblem> {
         .iter()
         .enumerate()
         .flat_map(|(i, route)| {
-            let plan = SimPlan {
-                name: "test drive".into(),
-                path: Default::default(),
-                world_path: Default::default(),
-                world: world.clone(),
-                route: route.clone(),
-                seed: 0,
-                runs: vec![RunPlan {
-                    start_waypoint: 0,
-                    reverse: false,
-                    laps: 1,
-                    doors: DoorPlan::Fixed(DoorChoice {
-                        name: "all-closed".into(),
-                        states: DoorStates::all_closed(world),
-                    }),
-                }],
-                door_configs: BTreeMap::new(),
-                pedestrians: PedestrianConfig::default(),
-                laser: LaserConfig::default(),
-                odometry: OdometryConfig::default(),
-                robot: RobotConfig::default(),
+            let doors = DoorChoice {
+                name: "all-closed".into(),
+                states: DoorStates::all_closed(world),
             };
+            let plan = SimPlan::one_run("test drive".into(), world, route, 1, doors);
             plan_problems(&plan, i)
         })
         .collect()

@@ -262,6 +262,27 @@ pub const EXPECT_DIRECTION_KEYS: &[&str] = &[
 /// A key, its slot, the rule it must meet and the rule in words.
 type Check<'a> = (&'a str, &'a mut f64, fn(f64) -> bool, &'a str);
 
+/// Sets each `checks` key that `t` holds and that meets its rule; reports the others at their
+/// value.
+fn set_checked<'a>(
+    t: &DeTable<'_>,
+    checks: impl IntoIterator<Item = Check<'a>>,
+    ctx: &str,
+    d: &mut Diags,
+) {
+    for (key, slot, ok, what) in checks {
+        let Some((_, v)) = get(t, key) else { continue };
+        match number(v, key, ctx, d) {
+            Some(x) if ok(x) => *slot = x,
+            Some(x) => d.at(
+                v.span().start,
+                format!("{key} = {x} in {ctx} must be {what}"),
+            ),
+            None => {}
+        }
+    }
+}
+
 /// `[evaluation]` over [`EvaluationSpec::default`]; each bad value reported at its key.
 pub(crate) fn read_evaluation(top: &DeTable<'_>, d: &mut Diags) -> EvaluationSpec {
     let mut ev = EvaluationSpec::default();
@@ -280,17 +301,7 @@ pub(crate) fn read_evaluation(top: &DeTable<'_>, d: &mut Diags) -> EvaluationSpe
             "positive",
         ),
     ];
-    for (key, slot, ok, what) in checks {
-        let Some((_, v)) = get(t, key) else { continue };
-        match number(v, key, ctx, d) {
-            Some(x) if ok(x) => *slot = x,
-            Some(x) => d.at(
-                v.span().start,
-                format!("{key} = {x} in {ctx} must be {what}"),
-            ),
-            None => {}
-        }
-    }
+    set_checked(t, checks, ctx, d);
     if let Some((_, v)) = get(t, "sensitivity_radii_m") {
         let radii = numbers(v, "sensitivity_radii_m", ctx, d);
         ev.sensitivity_radii_m = radii.unwrap_or_default();
@@ -421,17 +432,7 @@ fn read_regression(expect: &DeTable<'_>, d: &mut Diags) -> Option<RegressionSpec
             "at least 1 (a factor on the time per lap, e.g. 1.5)",
         ),
     ];
-    for (key, slot, ok, what) in checks {
-        let Some((_, v)) = get(t, key) else { continue };
-        match number(v, key, ctx, d) {
-            Some(x) if ok(x) => *slot = x,
-            Some(x) => d.at(
-                v.span().start,
-                format!("{key} = {x} in {ctx} must be {what}"),
-            ),
-            None => {}
-        }
-    }
+    set_checked(t, checks, ctx, d);
     Some(r)
 }
 
