@@ -453,6 +453,7 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
                 color: color(*k),
                 a: *a,
                 b: *b,
+                dashed: false,
             });
         }
     }

@@ -1,8 +1,9 @@
 //! Pictures of an experiment: the world with the true and odometry paths (odometry placed at the
-//! run's true start); the true path coloured where revisits were recognized, recognized wrongly
-//! and missed, with the worst clusters of wrong pairs as lines and marks where verification
-//! turned down true revisits; and a strip of recall and precision per lap with the door
-//! configurations marked.
+//! run's true start, one colour per run, each run's start marked); the true path coloured where
+//! revisits were recognized, recognized wrongly and missed, with the worst clusters of wrong
+//! pairs as dashed lines and rings where verification turned down true revisits; and a strip of
+//! recall and precision per lap with the door configurations marked. Every picture draws the
+//! doors as the laps it shows had them, and says so when they differ between laps.
 
 use crate::eval::Recognition;
 use crate::eval::metrics::Scorer;
@@ -21,33 +22,151 @@ const TRUE_COLOR: &str = "#1f77b4";
 const ODOM_COLOR: &str = "#ff7f0e";
 const CORRECT_COLOR: &str = "#2ca02c";
 const WRONG_COLOR: &str = "#d62728";
-const MISSED_COLOR: &str = "#222222";
+/// Wrong-pair cluster lines: darker than the "most pairs wrong" path and dashed, so the two
+/// legend rows are told apart.
+const WRONG_LINE_COLOR: &str = "#7f0000";
+/// Missed revisits: a blue far from the walls' near-black and from every other status colour.
+const MISSED_COLOR: &str = "#1a9bd7";
 const PLAIN_COLOR: &str = "#c7c7c7";
 const TURNED_DOWN_COLOR: &str = "#9467bd";
+/// One colour per run in pictures of several runs (cycled past eight runs).
+const RUN_COLORS: [&str; 8] = [
+    "#1f77b4", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f",
+];
+/// Runs named one by one in a legend; later runs reuse the colours unnamed.
+const RUNS_IN_LEGEND: usize = 8;
+/// Laps listed one by one in a picture's door notes.
+const LAPS_IN_NOTES: usize = 12;
+/// Door ids listed per lap in the notes.
+const DOORS_PER_NOTE: usize = 12;
+/// Width of a status path drawn over the plain true path, pixels.
+const STATUS_WIDTH_PX: f64 = 2.5;
+const PLAIN_WIDTH_PX: f64 = 1.5;
+
+fn path(label: String, color: &str, points: Vec<crate::geom::Vec2>, dashed: bool) -> PathOverlay {
+    PathOverlay {
+        label,
+        color: color.into(),
+        points,
+        dashed,
+        width_px: PLAIN_WIDTH_PX,
+    }
+}
 
 fn true_paths(runs: &[RunLog], label: &str) -> Vec<PathOverlay> {
     runs.iter()
         .enumerate()
-        .map(|(i, r)| PathOverlay {
-            label: if i == 0 {
-                label.to_string()
-            } else {
-                String::new()
-            },
-            color: TRUE_COLOR.into(),
-            points: r.frames().map(|f| f.truth.0.position()).collect(),
-            dashed: false,
+        .map(|(i, r)| {
+            let label = if i == 0 { label } else { "" };
+            let points = r.frames().map(|f| f.truth.0.position()).collect();
+            path(label.to_string(), TRUE_COLOR, points, false)
         })
         .collect()
 }
 
-fn plain(world: &World, title: String) -> RenderOptions {
+/// The doors a picture spanning `runs` draws: a door is drawn open when it was open in some lap
+/// shown. When the laps' doors differ, the subtitle says so and the notes list each lap's open
+/// doors (the first [`LAPS_IN_NOTES`] laps), so the picture never shows a state no lap had
+/// without saying it.
+struct DoorsSeen {
+    states: crate::world::DoorStates,
+    summary: Option<String>,
+    notes: Vec<String>,
+}
+
+fn doors_seen(world: &World, runs: &[RunLog]) -> DoorsSeen {
+    let mut states = crate::world::DoorStates::all_closed(world);
+    let laps: Vec<&crate::log::LapLog> = runs.iter().flat_map(|r| &r.laps).collect();
+    for lap in &laps {
+        for id in &lap.open_doors {
+            if let Some(i) = world.doors.iter().position(|d| &d.id == id) {
+                states.open[i] = true;
+            }
+        }
+    }
+    let differ = laps.windows(2).any(|w| {
+        let key = |l: &crate::log::LapLog| {
+            let mut v = l.open_doors.clone();
+            v.sort();
+            v
+        };
+        key(w[0]) != key(w[1])
+    });
+    if !differ {
+        return DoorsSeen {
+            states,
+            summary: None,
+            notes: Vec::new(),
+        };
+    }
+    let n_open = states.open.iter().filter(|o| **o).count();
+    let summary = Some(format!(
+        "{} doors, {n_open} open in some lap (drawn open; each lap's open doors listed below)",
+        world.doors.len()
+    ));
+    let mut notes: Vec<String> = Vec::new();
+    for r in runs {
+        for lap in &r.laps {
+            if notes.len() == LAPS_IN_NOTES {
+                break;
+            }
+            let open = match lap.open_doors.len() {
+                0 => "every door closed".to_string(),
+                n if n <= DOORS_PER_NOTE => format!("open {}", lap.open_doors.join(", ")),
+                n => format!(
+                    "open {} and {} more",
+                    lap.open_doors[..DOORS_PER_NOTE].join(", "),
+                    n - DOORS_PER_NOTE
+                ),
+            };
+            notes.push(format!(
+                "run {} lap {} ({}): {open}",
+                r.run, lap.lap, lap.door_config
+            ));
+        }
+    }
+    if laps.len() > notes.len() {
+        notes.push(format!("... and {} more laps", laps.len() - notes.len()));
+    }
+    DoorsSeen {
+        states,
+        summary,
+        notes,
+    }
+}
+
+/// A picture of `runs` on the world: the doors as the laps had them (see [`DoorsSeen`]) and a
+/// mark at each run's start.
+fn plain(world: &World, runs: &[RunLog], title: String) -> RenderOptions {
+    let seen = doors_seen(world, runs);
+    let multi = runs.len() > 1;
+    let marks = runs
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| {
+            let first = r.frames().next()?;
+            Some(MarkOverlay {
+                at: first.truth.0.position(),
+                text: format!("run {} start", r.run),
+                color: if multi {
+                    RUN_COLORS[i % RUN_COLORS.len()]
+                } else {
+                    TRUE_COLOR
+                }
+                .into(),
+                class: "run-start".into(),
+            })
+        })
+        .collect();
     RenderOptions {
         title: Some(title),
         show_routes: false,
         show_areas: false,
         show_door_labels: false,
-        doors: crate::world::DoorStates::all_closed(world),
+        doors: seen.states,
+        door_summary: seen.summary,
+        notes: seen.notes,
+        marks,
         ..RenderOptions::default()
     }
 }
@@ -67,22 +186,50 @@ pub fn odometry_in_world(run: &RunLog) -> Vec<crate::geom::Vec2> {
         .collect()
 }
 
-/// The world with each run's true path and odometry path (drawn from the run's true start).
+/// The world with each run's true path and odometry path (drawn from the run's true start),
+/// each run's start marked. With several runs each run has its own colour (odometry dashed in
+/// it), so the laps of one run are told from another's.
 pub fn trajectory_svg(world: &World, runs: &[RunLog], title: &str) -> String {
-    let mut opts = plain(world, title.to_string());
-    opts.paths = true_paths(runs, "true path");
-    opts.paths
-        .extend(runs.iter().enumerate().map(|(i, r)| PathOverlay {
-            label: if i == 0 {
-                "odometry (from the true start)".into()
-            } else {
-                String::new()
-            },
-            color: ODOM_COLOR.into(),
-            points: odometry_in_world(r),
-            dashed: true,
+    let mut opts = plain(world, runs, title.to_string());
+    if runs.len() <= 1 {
+        opts.paths = true_paths(runs, "true path");
+        opts.paths.extend(runs.iter().map(|r| {
+            let label = "odometry (from the true start)".to_string();
+            path(label, ODOM_COLOR, odometry_in_world(r), true)
         }));
+        return render_world_svg(world, &opts);
+    }
+    for (i, r) in runs.iter().enumerate() {
+        let color = RUN_COLORS[i % RUN_COLORS.len()];
+        let laps = r.laps.len();
+        let label = if i < RUNS_IN_LEGEND {
+            format!("run {}: true path ({laps} lap{})", r.run, plural(laps))
+        } else {
+            String::new()
+        };
+        let truth = r.frames().map(|f| f.truth.0.position()).collect();
+        opts.paths.push(path(label, color, truth, false));
+        opts.paths
+            .push(path(String::new(), color, odometry_in_world(r), true));
+    }
+    opts.legend.push(LegendEntry {
+        label: "dashed: the run's odometry (from its true start)".into(),
+        color: "#555555".into(),
+        dashed: true,
+    });
+    if runs.len() > RUNS_IN_LEGEND {
+        opts.notes.push(format!(
+            "runs {}-{} reuse the colours above",
+            runs[RUNS_IN_LEGEND].run,
+            runs[runs.len() - 1].run
+        ));
+    }
     render_world_svg(world, &opts)
+}
+
+/// "s" unless `n` is 1.
+fn plural(n: usize) -> &'static str {
+    if n == 1 { "" } else { "s" }
 }
 
 /// The world with the true path coloured where revisits were recognized, recognized wrongly
@@ -99,19 +246,18 @@ pub fn matches_svg(
         ..EvaluationSpec::default()
     };
     let status = observation_status(rec, &spec);
-    let mut opts = plain(world, title.to_string());
+    let mut opts = plain(world, runs, title.to_string());
     opts.paths = true_paths(runs, "true path, no revisit");
     for p in &mut opts.paths {
         p.color = PLAIN_COLOR.into();
     }
     let counts = |k: Kind| status.kinds.iter().filter(|x| **x == k).count();
-    for kind in [Kind::Recognized, Kind::Missed, Kind::Wrong] {
+    // Missed first, so the recognized and the wrong stretches are drawn over it.
+    for kind in [Kind::Missed, Kind::Recognized, Kind::Wrong] {
         opts.paths
             .extend(status.runs_of(kind).into_iter().map(|points| PathOverlay {
-                label: String::new(),
-                color: kind.color().into(),
-                points,
-                dashed: false,
+                width_px: STATUS_WIDTH_PX,
+                ..path(String::new(), kind.color(), points, false)
             }));
     }
     let right_rejected = rec.rejected.iter().filter(|r| r.is_right(&spec)).count();
@@ -120,68 +266,73 @@ pub fn matches_svg(
         .as_ref()
         .map(|d| d.checks())
         .unwrap_or_default();
-    opts.marks = turned_down_marks(&rec.rejected, &checks, &spec, 2 * WORST_CLUSTERS);
+    opts.marks.extend(turned_down_marks(
+        &rec.rejected,
+        &checks,
+        &spec,
+        2 * WORST_CLUSTERS,
+    ));
     let clusters = worst_wrong_clusters(&status.wrong_pairs, WORST_CLUSTERS);
     let shown: usize = clusters.iter().map(|c| c.2).sum();
     opts.segments = clusters
         .iter()
         .map(|&(a, b, _)| SegmentOverlay {
-            color: WRONG_COLOR.into(),
+            color: WRONG_LINE_COLOR.into(),
             a,
             b,
+            dashed: true,
         })
         .collect();
-    let legend = |label: String, color: &str| LegendEntry {
+    let legend = |label: String, color: &str, dashed: bool| LegendEntry {
         label,
         color: color.into(),
-        dashed: false,
+        dashed,
     };
-    opts.legend = vec![
-        legend(
-            format!(
-                "recognized, most pairs correct ({} obs.)",
-                counts(Kind::Recognized)
-            ),
-            CORRECT_COLOR,
-        ),
-        legend(
-            format!(
-                "recognized, most pairs wrong ({} obs.)",
-                counts(Kind::Wrong)
-            ),
-            WRONG_COLOR,
-        ),
-        legend(
-            format!("revisit missed ({} obs.)", counts(Kind::Missed)),
-            MISSED_COLOR,
-        ),
-        legend(
-            format!(
-                "pairs: {} correct, {} wrong; lines: worst {} wrong clusters ({shown} pairs)",
-                status.correct_pairs,
-                status.wrong_pairs.len(),
-                clusters.len()
-            ),
-            WRONG_COLOR,
-        ),
+    // A legend row only for what the picture shows.
+    let rows = [
+        (Kind::Recognized, "recognized, most pairs correct"),
+        (Kind::Wrong, "recognized, most pairs wrong"),
+        (Kind::Missed, "revisit missed"),
     ];
+    for (kind, what) in rows {
+        let n = counts(kind);
+        if n > 0 {
+            let label = format!("{what} ({n} observation{})", plural(n));
+            opts.legend.push(legend(label, kind.color(), false));
+        }
+    }
+    if !clusters.is_empty() {
+        let label = format!(
+            "dashed lines: the worst {} wrong-pair cluster{} ({shown} pair{})",
+            clusters.len(),
+            plural(clusters.len()),
+            plural(shown)
+        );
+        opts.legend.push(legend(label, WRONG_LINE_COLOR, true));
+    }
+    let mut notes = vec![format!(
+        "pairs: {} correct, {} wrong",
+        status.correct_pairs,
+        status.wrong_pairs.len()
+    )];
     if !rec.rejected.is_empty() {
-        opts.legend.push(legend(
-            format!(
-                "verification turned down {right_rejected} true revisits, {} look-alikes \
-                 (candidates sampled)",
-                rec.rejected.len() - right_rejected
-            ),
-            TURNED_DOWN_COLOR,
+        let look_alikes = rec.rejected.len() - right_rejected;
+        notes.push(format!(
+            "verification turned down {right_rejected} true revisit{}, {look_alikes} \
+             look-alike{} (candidates sampled)",
+            plural(right_rejected),
+            plural(look_alikes)
         ));
         if right_rejected > 0 {
-            opts.notes.push(
-                "purple marks: true revisits turned down per 5 m, and the check that did most \
+            notes.push(
+                "purple rings: true revisits turned down per 5 m, and the check that did most \
                  (Tr travel, Tu turn, D density, S sides, St straight)"
                     .into(),
             );
         }
     }
+    notes.append(&mut opts.notes);
+    opts.notes = notes;
     render_world_svg(world, &opts)
 }
 
@@ -470,7 +621,8 @@ pub fn empty_world(runs: &[RunLog], name: &str) -> World {
     }
 }
 
-/// Writes an experiment's pictures into `dir`: `trajectory.svg` (true and odometry paths) and,
+/// Writes an experiment's pictures into `dir`: `trajectory.svg` (true and odometry paths; with
+/// several runs also `trajectory-run-NNN.svg` per run) and,
 /// per level configuration (and ICP), `matches-X.svg` (the true path coloured by what was
 /// recognized) and `laps-X.svg` (recall and precision per lap). Returns the files written.
 pub fn write_pictures(
@@ -484,6 +636,14 @@ pub fn write_pictures(
         "trajectory.svg".to_string(),
         trajectory_svg(world, &exp.runs, &format!("{name}: paths")),
     )];
+    // With several runs the overview is a bundle: each run also gets a picture of its own.
+    if exp.runs.len() > 1 {
+        for r in &exp.runs {
+            let title = format!("{name}: run {}, true path and odometry", r.run);
+            let svg = trajectory_svg(world, std::slice::from_ref(r), &title);
+            pictures.push((format!("trajectory-run-{:03}.svg", r.run), svg));
+        }
+    }
     let recognitions = exp
         .recognitions
         .iter()
@@ -580,6 +740,112 @@ mod tests {
             .collect();
         assert_eq!(firsts.len(), 2, "true path and odometry");
         assert_eq!(firsts[0], firsts[1]);
+    }
+
+    fn loop_small() -> World {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds/loop-small.toml");
+        crate::world::load::load_world(&path).expect("shipped world")
+    }
+
+    /// `run()` moved into `world`, as run `k`, with `open` doors open in its one lap.
+    fn run_in(world: &World, k: usize, open: &[usize]) -> RunLog {
+        let mut r = run();
+        r.run = k;
+        r.laps[0].open_doors = open.iter().map(|&i| world.doors[i].id.clone()).collect();
+        r
+    }
+
+    fn doc_texts(svg: &str) -> Vec<String> {
+        let doc = roxmltree::Document::parse(svg).expect("valid SVG");
+        doc.descendants()
+            .filter(|n| n.tag_name().name() == "text")
+            .filter_map(|n| n.text().map(str::to_string))
+            .collect()
+    }
+
+    /// Regression (issue 27): run pictures drew every door closed ("0 open") when the laps had
+    /// doors open, and marked only the robot's home. Now a door open in some lap is drawn open,
+    /// the subtitle and notes say which lap had which, and each run's start is marked.
+    #[test]
+    fn pictures_draw_the_laps_doors_and_each_runs_start() {
+        let world = loop_small();
+        let runs = [run_in(&world, 0, &[2]), run_in(&world, 1, &[])];
+        let svg = trajectory_svg(&world, &runs, "t");
+        let doc = roxmltree::Document::parse(&svg).expect("valid SVG");
+        let open: Vec<&str> = doc
+            .descendants()
+            .filter(|n| n.attribute("class") == Some("door open"))
+            .filter_map(|n| n.attribute("id"))
+            .collect();
+        assert_eq!(open, [format!("door-{}", world.doors[2].id)]);
+        let texts = doc_texts(&svg);
+        assert!(
+            texts.iter().any(|t| t.contains("1 open in some lap")),
+            "{texts:?}"
+        );
+        let lap0 = format!("run 0 lap 0 (all-closed): open {}", world.doors[2].id);
+        assert!(texts.contains(&lap0), "{texts:?}");
+        assert!(texts.contains(&"run 1 lap 0 (all-closed): every door closed".to_string()));
+        let starts = doc
+            .descendants()
+            .filter(|n| n.attribute("class") == Some("run-start"))
+            .count();
+        assert_eq!(starts, 2, "one start mark per run");
+        // One colour per run: the two true paths differ in colour.
+        let colours: HashSet<&str> = doc
+            .descendants()
+            .filter(|n| n.attribute("class") == Some("path"))
+            .filter_map(|n| n.attribute("stroke"))
+            .collect();
+        assert_eq!(colours.len(), 2, "{colours:?}");
+
+        // Laps with the same doors: the plain subtitle, no lap notes.
+        let same = [run_in(&world, 0, &[2]), run_in(&world, 1, &[2])];
+        let texts = doc_texts(&trajectory_svg(&world, &same, "t"));
+        assert!(
+            texts.iter().any(|t| t.contains("doors (1 open)")),
+            "{texts:?}"
+        );
+        assert!(!texts.iter().any(|t| t.starts_with("run 0 lap")));
+    }
+
+    /// The matches picture's legend has a row only for what it draws, with counts that say
+    /// what they count, and the wrong-pair lines are dashed in a colour of their own.
+    #[test]
+    fn matches_legend_rows_only_for_what_is_drawn() {
+        use crate::eval::{GroundTruth, Recognition};
+        let world = loop_small();
+        let runs = [run_in(&world, 0, &[])];
+        let rec = Recognition {
+            name: "none".into(),
+            observations: Vec::new(),
+            matches: Vec::new(),
+            seconds: 0.0,
+            wall_seconds: 0.0,
+            score_seconds: 0.0,
+            laps: 1,
+            truth: std::sync::Arc::new(GroundTruth::from_runs(&runs)),
+            diagnostics: None,
+            lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
+            rejected: Vec::new(),
+        };
+        let texts = doc_texts(&matches_svg(&world, &runs, &rec, 0.5, "t"));
+        for absent in [
+            "most pairs wrong",
+            "most pairs correct",
+            "revisit missed",
+            "dashed lines",
+        ] {
+            assert!(
+                !texts.iter().any(|t| t.contains(absent)),
+                "{absent}: {texts:?}"
+            );
+        }
+        assert!(texts.contains(&"pairs: 0 correct, 0 wrong".to_string()));
+        assert_eq!(plural(1), "");
+        assert_eq!(plural(2), "s");
     }
 
     #[test]

@@ -18,6 +18,8 @@ pub struct PathOverlay {
     pub color: String,
     pub points: Vec<Vec2>,
     pub dashed: bool,
+    /// Stroke width, pixels (1.5 for a plain trajectory; wider to show a status above it).
+    pub width_px: f64,
 }
 
 /// A single segment drawn over the world, e.g. a matched pair of positions.
@@ -26,6 +28,8 @@ pub struct SegmentOverlay {
     pub color: String,
     pub a: Vec2,
     pub b: Vec2,
+    /// Drawn dashed (so a pair line is not read as a path of the same colour).
+    pub dashed: bool,
 }
 
 /// An extra legend line (for overlays that carry no label themselves).
@@ -60,8 +64,9 @@ pub struct BandOverlay {
     pub width_px: f64,
 }
 
-/// A labelled marker: a filled circle with short text in it (a number), e.g. a problem or a
-/// waypoint. `class` becomes the element's SVG class.
+/// A labelled marker: a ring around the spot (translucent, so the path under it stays visible)
+/// with its short text beside it, e.g. a problem number or a waypoint. `class` becomes the
+/// element's SVG class.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MarkOverlay {
     pub at: Vec2,
@@ -112,6 +117,9 @@ pub struct RenderOptions {
     pub show_waypoints: bool,
     /// Lines of text under the legend (e.g. the numbered problems). Default none.
     pub notes: Vec<String>,
+    /// Replaces the subtitle's "N doors (k open)" when the picture spans laps whose doors
+    /// differ (e.g. "18 doors, 4 open in some lap"). Default none.
+    pub door_summary: Option<String>,
 }
 
 impl Default for RenderOptions {
@@ -133,6 +141,7 @@ impl Default for RenderOptions {
             show_grid: false,
             show_waypoints: false,
             notes: Vec::new(),
+            door_summary: None,
         }
     }
 }
@@ -245,13 +254,15 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
     let n_open = (0..world.doors.len())
         .filter(|i| opts.doors.is_open(*i))
         .count();
+    let doors = opts
+        .door_summary
+        .clone()
+        .unwrap_or_else(|| format!("{} doors ({n_open} open)", world.doors.len()));
     let sub = format!(
-        "{} - {:.0} m x {:.0} m, {} doors ({} open), {} route(s)",
+        "{} - {:.0} m x {:.0} m, {doors}, {} route(s)",
         world.name,
         w_m - 2.0 * margin_m,
         h_m - 2.0 * margin_m,
-        world.doors.len(),
-        n_open,
         world.routes.len()
     );
     svg.text((pad, 47.0), &sub, r##"font-size="13" fill="#555""##);
@@ -433,8 +444,9 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
                 &pts,
                 false,
                 &format!(
-                    r#"class="path" stroke="{}" stroke-width="1.5"{dash}"#,
-                    escape(&p.color)
+                    r#"class="path" stroke="{}" stroke-width="{}"{dash}"#,
+                    escape(&p.color),
+                    num(p.width_px)
                 ),
             );
         }
@@ -443,10 +455,15 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
     if !opts.segments.is_empty() {
         svg.open_group(r#"id="segments" stroke-width="1" stroke-opacity="0.7""#);
         for sg in &opts.segments {
+            let dash = if sg.dashed {
+                r#" stroke-dasharray="5 3""#
+            } else {
+                ""
+            };
             svg.line(
                 f.p(sg.a),
                 f.p(sg.b),
-                &format!(r#"class="pair" stroke="{}""#, escape(&sg.color)),
+                &format!(r#"class="pair" stroke="{}"{dash}"#, escape(&sg.color)),
             );
         }
         svg.close_group();
@@ -828,16 +845,19 @@ fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
     if list.is_empty() {
         return;
     }
-    svg.open_group(r#"id="marks" font-size="12" font-weight="bold" text-anchor="middle""#);
+    // A ring with a faint fill keeps the path under the spot visible; the text sits beside the
+    // ring on a white halo, so it reads over walls and paths alike.
+    svg.open_group(r#"id="marks" font-size="12" font-weight="bold""#);
     for m in list {
         let c = f.p(m.at);
-        let r = 6.0 + 3.5 * m.text.chars().count() as f64;
+        let r = 7.0;
         svg.raw(&format!(
-            r##"<g class="{class}"><circle cx="{x}" cy="{y}" r="{r}" fill="{color}" fill-opacity="0.9" stroke="white" stroke-width="1.5"/><text x="{x}" y="{ty}" fill="white">{text}</text></g>"##,
+            r##"<g class="{class}"><circle cx="{x}" cy="{y}" r="{r}" fill="{color}" fill-opacity="0.18" stroke="{color}" stroke-width="2"/><text x="{tx}" y="{ty}" fill="{color}" stroke="white" stroke-width="3" paint-order="stroke">{text}</text></g>"##,
             class = escape(&m.class),
             x = num(c.0),
             y = num(c.1),
-            ty = num(c.1 + 4.3),
+            tx = num(c.0 + r + 3.0),
+            ty = num(c.1 - r + 2.0),
             r = num(r),
             color = escape(&m.color),
             text = escape(&m.text),

@@ -378,11 +378,13 @@ fn rendered_svg_parses_and_holds_every_wall_and_door() {
                 color: "#d62728".into(),
                 points: w.route("lap").unwrap().waypoints.clone(),
                 dashed: true,
+                width_px: 1.5,
             }],
             segments: vec![SegmentOverlay {
                 color: "#000".into(),
                 a: w.home.position(),
                 b: w.home.position() + placewords::geom::Vec2::new(1.0, 1.0),
+                dashed: false,
             }],
             ..RenderOptions::default()
         };
