@@ -952,13 +952,12 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn revisit_search_is_fast_on_forty_long_laps() {
-        // 40 laps × 2000 observations = 80 000, the size of scenario B.
+    fn revisits_counted_on_forty_long_laps() {
+        // 40 laps × 2000 observations = 80 000, the size of scenario B (its cost: the scoring
+        // bench, benches/scoring.rs).
         let (obs, gt) = circle(40, 200.0);
-        let t = std::time::Instant::now();
         let m = score(&obs, &[], &gt, &EvaluationSpec::default(), 3.0);
         assert_eq!(m.revisits, 39 * 2000 + 30);
-        assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
     }
 
     #[test]

@@ -155,7 +155,8 @@ fn a_file_with_several_mistakes_reports_them_all() {
 }
 
 #[test]
-fn too_many_segments_are_refused_quickly() {
+/// Refused at the segment limit, located (how fast: `benches/world.rs`).
+fn too_many_segments_are_refused() {
     let mut src = String::from(
         "format_version = 1\nname = \"big\"\n[robot_home]\nx_m = 0.5\ny_m = 0.5\n\
          [[routes]]\nid = \"lap\"\nwaypoints_m = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]\n\
@@ -166,26 +167,10 @@ fn too_many_segments_are_refused_quickly() {
         src.push_str(&format!("[{x}, {y}],"));
     }
     src.push_str("]\n");
-    let t = std::time::Instant::now();
     let err = parse_world(&src, "big.toml").unwrap_err();
-    assert!(t.elapsed().as_secs_f64() < 10.0);
     let text = err.to_string();
     assert!(text.contains("limit 10000)"), "{text}");
     assert!(text.starts_with("big.toml:"), "{text}");
-}
-
-#[test]
-fn institute_floor_validates_in_milliseconds() {
-    let src = std::fs::read_to_string(root().join("worlds/institute-floor.toml")).unwrap();
-    let t = std::time::Instant::now();
-    let runs = 5;
-    for _ in 0..runs {
-        parse_world(&src, "institute-floor.toml").unwrap();
-    }
-    let ms = t.elapsed().as_secs_f64() * 1000.0 / runs as f64;
-    eprintln!("institute-floor: {ms:.2} ms per validation");
-    // Generous for debug builds on a busy CI machine; release takes a few milliseconds.
-    assert!(ms < 250.0, "validation took {ms:.1} ms");
 }
 
 fn assert_located(err: &SpecError, src_lines: usize) {
