@@ -1,11 +1,12 @@
 //! Recognizer costs: grid update per scan, density per observation, word building per lap,
 //! matching per lap (1, 2, 3 level configurations × 1, 10, 40 laps of history), and the whole
-//! recognizer per lap. Inputs are synthetic (see `recognizer::synth`); setup is outside the
+//! recognizer per lap. Inputs are synthetic (see `tests/support/synth.rs`); setup is outside the
 //! timed part. Figures and the machine are in BENCHMARKS.md.
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use placewords::geom::OdomPose;
-use placewords::recognizer::synth::{self, LoopFloor, SplitMix};
+#[path = "../tests/support/synth.rs"]
+mod synth;
 use placewords::recognizer::{
     DensityFrontEnd, DensityKernel, DensityObservation, LocalGrid, Recognizer, RecognizerConfig,
     WordLevels, WordMatcher,
@@ -13,6 +14,7 @@ use placewords::recognizer::{
 use placewords::scan::Scan;
 use std::hint::black_box;
 use std::time::Duration;
+use synth::{LoopFloor, SplitMix};
 
 const FLOOR_SEED: u64 = 42;
 

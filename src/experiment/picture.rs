@@ -6,8 +6,9 @@
 //! doors as the laps it shows had them, and says so when they differ between laps.
 
 use crate::eval::Recognition;
-use crate::eval::metrics::Scorer;
-use crate::eval::pair_recall::Facing;
+use crate::eval::observation_status::{
+    CLUSTER_CELL_M, ObservationKind, ObservationStatus, observation_status, worst_wrong_clusters,
+};
 use crate::log::RunLog;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
@@ -15,7 +16,7 @@ use crate::report::world_render::{
 };
 use crate::spec::evaluation::EvaluationSpec;
 use crate::world::World;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 const TRUE_COLOR: &str = "#1f77b4";
@@ -251,14 +252,21 @@ pub fn matches_svg(
     for p in &mut opts.paths {
         p.color = PLAIN_COLOR.into();
     }
-    let counts = |k: Kind| status.kinds.iter().filter(|x| **x == k).count();
+    let counts = |k: ObservationKind| status.kinds.iter().filter(|x| **x == k).count();
     // Missed first, so the recognized and the wrong stretches are drawn over it.
-    for kind in [Kind::Missed, Kind::Recognized, Kind::Wrong] {
-        opts.paths
-            .extend(status.runs_of(kind).into_iter().map(|points| PathOverlay {
-                width_px: STATUS_WIDTH_PX,
-                ..path(String::new(), kind.color(), points, false)
-            }));
+    for kind in [
+        ObservationKind::Missed,
+        ObservationKind::Recognized,
+        ObservationKind::Wrong,
+    ] {
+        opts.paths.extend(
+            runs_of(&status, kind)
+                .into_iter()
+                .map(|points| PathOverlay {
+                    width_px: STATUS_WIDTH_PX,
+                    ..path(String::new(), kind_color(kind), points, false)
+                }),
+        );
     }
     let right_rejected = rec.rejected.iter().filter(|r| r.is_right(&spec)).count();
     let checks = rec
@@ -290,15 +298,18 @@ pub fn matches_svg(
     };
     // A legend row only for what the picture shows.
     let rows = [
-        (Kind::Recognized, "recognized, most pairs correct"),
-        (Kind::Wrong, "recognized, most pairs wrong"),
-        (Kind::Missed, "revisit missed"),
+        (
+            ObservationKind::Recognized,
+            "recognized, most pairs correct",
+        ),
+        (ObservationKind::Wrong, "recognized, most pairs wrong"),
+        (ObservationKind::Missed, "revisit missed"),
     ];
     for (kind, what) in rows {
         let n = counts(kind);
         if n > 0 {
             let label = format!("{what} ({n} observation{})", plural(n));
-            opts.legend.push(legend(label, kind.color(), false));
+            opts.legend.push(legend(label, kind_color(kind), false));
         }
     }
     if !clusters.is_empty() {
@@ -394,178 +405,46 @@ fn turned_down_marks(
 
 /// Wrong-pair clusters drawn as lines in the matches picture.
 pub const WORST_CLUSTERS: usize = 8;
-/// Cell size of wrong-pair clustering, metres.
-const CLUSTER_CELL_M: f64 = 5.0;
-
-/// What happened at one observation.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// No revisit and no pair.
-    Plain,
-    /// The query of pairs, at least half of them correct.
-    Recognized,
-    /// The query of pairs, most of them wrong.
-    Wrong,
-    /// A revisit with no pair at all.
-    Missed,
-}
-
-impl Kind {
-    fn color(self) -> &'static str {
-        match self {
-            Kind::Plain => PLAIN_COLOR,
-            Kind::Recognized => CORRECT_COLOR,
-            Kind::Wrong => WRONG_COLOR,
-            Kind::Missed => MISSED_COLOR,
-        }
+/// The colour the matches picture gives an observation's kind.
+fn kind_color(kind: ObservationKind) -> &'static str {
+    match kind {
+        ObservationKind::Plain => PLAIN_COLOR,
+        ObservationKind::Recognized => CORRECT_COLOR,
+        ObservationKind::Wrong => WRONG_COLOR,
+        ObservationKind::Missed => MISSED_COLOR,
     }
 }
 
-/// Per observation (creation order): its kind, true position, lap slot and revisit; and the
-/// wrong pairs' true positions.
-pub struct ObsStatus {
-    pub kinds: Vec<Kind>,
-    pub positions: Vec<Option<crate::geom::Vec2>>,
-    pub lap_slots: Vec<Option<usize>>,
-    pub revisits: Vec<bool>,
-    /// Per observation: (correct pairs, pairs) it is the query of.
-    pub pair_counts: Vec<(usize, usize)>,
-    pub correct_pairs: usize,
-    pub wrong_pairs: Vec<(crate::geom::Vec2, crate::geom::Vec2)>,
-}
-
-/// Classifies every observation of `rec` (a pair is correct within `tp_radius_m` with agreeing
-/// headings, as the evaluation says).
-pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> ObsStatus {
-    let revisits = Scorer::new(&rec.observations, &rec.truth, spec).revisits(spec.tp_radius_m);
-    let index_of: HashMap<usize, usize> = rec
-        .observations
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.id, i))
-        .collect();
-    let pose = |i: usize| {
-        rec.truth
-            .frame(rec.observations[i].frame_id)
-            .map(|f| f.pose.0)
-    };
-    let n = rec.observations.len();
-    let mut pair_counts = vec![(0usize, 0usize); n];
-    let (mut correct_pairs, mut wrong_pairs) = (0, Vec::new());
-    let mut seen = HashSet::new();
-    let tol = spec.heading_tolerance_deg.to_radians();
-    let claimed = rec.matches.iter().flat_map(|m| {
-        let claim = Facing::of(m.direction);
-        m.pairs().map(move |p| (p, claim))
-    });
-    for ((query, past), claim) in claimed {
-        let (Some(&q), Some(&pa)) = (index_of.get(&query), index_of.get(&past)) else {
-            continue;
-        };
-        let (Some(a), Some(b)) = (pose(q), pose(pa)) else {
-            continue;
-        };
-        if !seen.insert((q, pa)) {
-            continue;
-        }
-        let ok = a.distance(&b) <= spec.tp_radius_m && claim.agrees(a.theta, b.theta, tol);
-        pair_counts[q].1 += 1;
-        if ok {
-            pair_counts[q].0 += 1;
-            correct_pairs += 1;
-        } else {
-            wrong_pairs.push((a.position(), b.position()));
-        }
-    }
-    let kinds = (0..n)
-        .map(|i| match pair_counts[i] {
-            (c, t) if c > 0 && 2 * c >= t => Kind::Recognized,
-            (_, t) if t > 0 => Kind::Wrong,
-            _ if revisits[i] => Kind::Missed,
-            _ => Kind::Plain,
-        })
-        .collect();
-    ObsStatus {
-        kinds,
-        positions: (0..n).map(|i| pose(i).map(|p| p.position())).collect(),
-        lap_slots: rec
-            .observations
-            .iter()
-            .map(|o| rec.truth.frame(o.frame_id).map(|f| f.lap_slot))
-            .collect(),
-        revisits,
-        pair_counts,
-        correct_pairs,
-        wrong_pairs,
-    }
-}
-
-impl ObsStatus {
-    /// Polylines of consecutive observations of `kind` (in the same lap, at most 1 m apart).
-    fn runs_of(&self, kind: Kind) -> Vec<Vec<crate::geom::Vec2>> {
-        let mut out: Vec<Vec<crate::geom::Vec2>> = Vec::new();
-        let mut cur: Vec<crate::geom::Vec2> = Vec::new();
-        let mut last_slot = None;
-        for i in 0..self.kinds.len() {
-            let (Some(p), true) = (self.positions[i], self.kinds[i] == kind) else {
-                if cur.len() > 1 {
-                    out.push(std::mem::take(&mut cur));
-                }
-                cur.clear();
-                continue;
-            };
-            let broken = last_slot != self.lap_slots[i]
-                || cur
-                    .last()
-                    .is_some_and(|q: &crate::geom::Vec2| (p - q).norm() > 1.0);
-            if broken && !cur.is_empty() {
-                let done = std::mem::take(&mut cur);
-                if done.len() > 1 {
-                    out.push(done);
-                }
+/// Polylines of consecutive observations of `kind` (in the same lap, at most 1 m apart).
+fn runs_of(status: &ObservationStatus, kind: ObservationKind) -> Vec<Vec<crate::geom::Vec2>> {
+    let mut out: Vec<Vec<crate::geom::Vec2>> = Vec::new();
+    let mut cur: Vec<crate::geom::Vec2> = Vec::new();
+    let mut last_slot = None;
+    for i in 0..status.kinds.len() {
+        let (Some(p), true) = (status.positions[i], status.kinds[i] == kind) else {
+            if cur.len() > 1 {
+                out.push(std::mem::take(&mut cur));
             }
-            last_slot = self.lap_slots[i];
-            cur.push(p);
+            cur.clear();
+            continue;
+        };
+        let broken = last_slot != status.lap_slots[i]
+            || cur
+                .last()
+                .is_some_and(|q: &crate::geom::Vec2| (p - q).norm() > 1.0);
+        if broken && !cur.is_empty() {
+            let done = std::mem::take(&mut cur);
+            if done.len() > 1 {
+                out.push(done);
+            }
         }
-        if cur.len() > 1 {
-            out.push(cur);
-        }
-        out
+        last_slot = status.lap_slots[i];
+        cur.push(p);
     }
-}
-
-/// The `k` largest clusters of wrong pairs (query cell, past cell on a 5 m grid), each as the
-/// mean query position, the mean past position and its size, largest first.
-pub fn worst_wrong_clusters(
-    wrong: &[(crate::geom::Vec2, crate::geom::Vec2)],
-    k: usize,
-) -> Vec<(crate::geom::Vec2, crate::geom::Vec2, usize)> {
-    let cell = |p: crate::geom::Vec2| {
-        (
-            (p.x / CLUSTER_CELL_M).floor() as i64,
-            (p.y / CLUSTER_CELL_M).floor() as i64,
-        )
-    };
-    type Acc = (crate::geom::Vec2, crate::geom::Vec2, usize);
-    type Cells = ((i64, i64), (i64, i64));
-    let mut groups: HashMap<Cells, Acc> = HashMap::new();
-    for &(a, b) in wrong {
-        let g = groups.entry((cell(a), cell(b))).or_insert((
-            crate::geom::Vec2::zeros(),
-            crate::geom::Vec2::zeros(),
-            0,
-        ));
-        g.0 += a;
-        g.1 += b;
-        g.2 += 1;
+    if cur.len() > 1 {
+        out.push(cur);
     }
-    let mut list: Vec<(Cells, Acc)> = groups.into_iter().collect();
-    // Largest first; ties by cell so the picture does not depend on hash order.
-    list.sort_by(|x, y| y.1.2.cmp(&x.1.2).then(x.0.cmp(&y.0)));
-    list.into_iter()
-        .take(k)
-        .map(|(_, (a, b, n))| (a / n as f64, b / n as f64, n))
-        .collect()
+    out
 }
 
 /// Per lap (in driving order): recall of its observations with a revisit and precision of the
@@ -792,7 +671,7 @@ mod tests {
             .count();
         assert_eq!(starts, 2, "one start mark per run");
         // One colour per run: the two true paths differ in colour.
-        let colours: HashSet<&str> = doc
+        let colours: std::collections::HashSet<&str> = doc
             .descendants()
             .filter(|n| n.attribute("class") == Some("path"))
             .filter_map(|n| n.attribute("stroke"))
@@ -846,17 +725,6 @@ mod tests {
         assert!(texts.contains(&"pairs: 0 correct, 0 wrong".to_string()));
         assert_eq!(plural(1), "");
         assert_eq!(plural(2), "s");
-    }
-
-    #[test]
-    fn worst_clusters_are_largest_first() {
-        let v = crate::geom::Vec2::new;
-        let mut wrong = vec![(v(1.0, 1.0), v(30.0, 1.0)); 5];
-        wrong.extend(vec![(v(12.0, 1.0), v(40.0, 1.0)); 2]);
-        wrong.push((v(50.0, 50.0), v(0.0, 0.0)));
-        let c = worst_wrong_clusters(&wrong, 2);
-        assert_eq!(c.iter().map(|c| c.2).collect::<Vec<_>>(), [5, 2]);
-        assert_eq!(c[0].0, v(1.0, 1.0));
     }
 
     /// True revisits that verification turned down are marked per 5 m cell with their count

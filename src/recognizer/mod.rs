@@ -20,7 +20,6 @@ mod index;
 pub(crate) mod matcher;
 /// Synthetic inputs for tests and benchmarks; not part of the API.
 #[doc(hidden)]
-pub mod synth;
 pub(crate) mod types;
 pub(crate) mod words;
 

@@ -21,5 +21,7 @@ mod scan_context;
 mod settings;
 mod sim;
 mod spec;
+#[path = "../support/synth.rs"]
+mod synth;
 mod tour;
 mod world;

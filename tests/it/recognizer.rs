@@ -1,8 +1,8 @@
 //! The recognizer: density against the authors' oracle, words (Fig. 2), multi-level words
 //! (Fig. 4), matching, alignment, and property tests.
 
+use crate::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::geom::{OdomPose, Pose2};
-use placewords::recognizer::synth::{self, SplitMix, Stretch, class_psi};
 use placewords::recognizer::{
     CellState, DenseGrid, DensityFrontEnd, DensityKernel, DensityObservation, Direction,
     MatchDiagnostics, MultiLevelRule, Observation, Recognizer, RecognizerConfig, Rejection,

@@ -1,10 +1,13 @@
 //! Synthetic inputs for the recognizer's tests and benchmarks (no simulator needed):
 //! observation sequences laid out word by word, analytic scans of a few wall segments, and a
-//! 200 m loop floor with side rooms whose doors open and close.
+//! 200 m loop floor with side rooms whose doors open and close. A test fixture, outside the
+//! library: `tests/it` and `benches/recognizer.rs` include it by path (not every user uses every
+//! item, hence the `dead_code` allowance).
+#![allow(dead_code)]
 
-use super::types::{DensityObservation, Observation};
-use crate::geom::{OdomPose, Pose2, Segment, Vec2, wrap_angle};
-use crate::scan::{BeamLayout, Scan};
+use placewords::geom::{OdomPose, Pose2, Segment, Vec2, wrap_angle};
+use placewords::recognizer::{DensityObservation, Observation};
+use placewords::scan::{BeamLayout, Scan};
 
 /// A small deterministic generator (SplitMix64), so tests and benches need no RNG crate.
 #[derive(Clone, Debug)]
