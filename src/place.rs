@@ -345,3 +345,101 @@ pub trait PlaceRecognizer {
         false
     }
 }
+
+/// Odometric travel along a recognizer's input and a fixed schedule of observations on it, one
+/// per `spacing_m` of travel, the first at the first frame of the recognizer's input: frame
+/// spacing does not stretch the observation spacing, and a long jump skips the slots it passed
+/// (one observation, not a burst). Travel carries across runs (it orders a recognizer's whole
+/// history); a run's first frame adds none. For any recognizer that observes by travel (the
+/// baselines do).
+#[derive(Clone, Debug)]
+pub struct TravelSchedule {
+    spacing_m: f64,
+    travel_m: f64,
+    last_pose: Option<crate::geom::Pose2>,
+    /// Travel at which the next observation is due (`None`: at the next frame).
+    next_m: Option<f64>,
+}
+
+impl TravelSchedule {
+    /// A schedule of one observation per `spacing_m` (clamped to at least 1 µm) of travel.
+    pub fn new(spacing_m: f64) -> Self {
+        TravelSchedule {
+            spacing_m: spacing_m.max(1e-6),
+            travel_m: 0.0,
+            last_pose: None,
+            next_m: None,
+        }
+    }
+
+    /// A new run: its first frame adds no travel and is due.
+    pub fn start_run(&mut self) {
+        self.last_pose = None;
+        self.next_m = None;
+    }
+
+    /// Adds the travel from the last frame's odometric pose to `pose`; returns the travel.
+    pub fn advance(&mut self, pose: crate::geom::Pose2) -> f64 {
+        if let Some(last) = self.last_pose {
+            self.travel_m += last.distance(&pose);
+        }
+        self.last_pose = Some(pose);
+        self.travel_m
+    }
+
+    /// Travel so far, metres.
+    pub fn travel_m(&self) -> f64 {
+        self.travel_m
+    }
+
+    /// Whether an observation is due at the travel reached; when it is, the next slot is
+    /// scheduled past it.
+    pub fn take_due(&mut self) -> bool {
+        if self.next_m.is_some_and(|t| self.travel_m < t) {
+            return false;
+        }
+        let spacing = self.spacing_m;
+        let mut next = self.next_m.unwrap_or(self.travel_m) + spacing;
+        // Skip the passed slots by arithmetic when there are many (a jump of kilometres at a
+        // fine spacing), one by one otherwise (the usual case, so the slots stay as they were).
+        let behind = (self.travel_m - next) / spacing;
+        if behind > 64.0 {
+            next += (behind.floor() - 1.0) * spacing;
+        }
+        while next <= self.travel_m {
+            next += spacing;
+        }
+        self.next_m = Some(next);
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TravelSchedule;
+    use crate::geom::Pose2;
+
+    #[test]
+    fn observations_fall_on_a_fixed_schedule_of_travel() {
+        let mut s = TravelSchedule::new(1.0);
+        let due: Vec<bool> = [0.0, 0.4, 1.0, 1.5, 2.2, 7.9, 8.0, 8.5]
+            .iter()
+            .map(|&x| {
+                s.advance(Pose2::new(x, 0.0, 0.0));
+                s.take_due()
+            })
+            .collect();
+        // Slots at 0, 1, 2, then the jump to 7.9 takes one and skips 3..7; 8 is the next slot.
+        assert_eq!(due, [true, false, true, false, true, true, true, false]);
+        // A new run's first frame is due and adds no travel.
+        s.start_run();
+        s.advance(Pose2::new(100.0, 0.0, 0.0));
+        assert!(s.take_due());
+        assert_eq!(s.travel_m(), 8.5);
+        // A jump of a million slots is skipped at once, to the slot after it.
+        s.advance(Pose2::new(1e6 + 100.25, 0.0, 0.0));
+        assert!(s.take_due());
+        s.advance(Pose2::new(1e6 + 100.9, 0.0, 0.0));
+        assert!(!s.take_due());
+    }
+}

@@ -33,7 +33,7 @@
 
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::PlaceRecognizer;
-use crate::place::{FrameId, Match, Observation};
+use crate::place::{FrameId, Match, Observation, TravelSchedule};
 use crate::scan::Scan;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -385,10 +385,8 @@ pub struct IcpRecognizer {
     /// Occupied cells of the local grid, odometry frame.
     cells: HashSet<(i64, i64)>,
     run: Option<usize>,
-    travel_m: f64,
-    last_pose: Option<Pose2>,
-    /// Travel at which the next observation is due (`None`: at the next frame).
-    next_obs_travel_m: Option<f64>,
+    /// Travel and the observation slots on it.
+    schedule: TravelSchedule,
     /// Observations of the current run not yet in a region.
     pending: Vec<usize>,
     stats: IcpStats,
@@ -407,15 +405,14 @@ pub struct IcpStats {
 
 impl IcpRecognizer {
     pub fn new(cfg: IcpConfig) -> Self {
+        let schedule = TravelSchedule::new(cfg.observation_spacing_m);
         IcpRecognizer {
             cfg,
             observations: Vec::new(),
             regions: Vec::new(),
             cells: HashSet::new(),
             run: None,
-            travel_m: 0.0,
-            last_pose: None,
-            next_obs_travel_m: None,
+            schedule,
             pending: Vec::new(),
             stats: IcpStats::default(),
         }
@@ -575,8 +572,7 @@ impl PlaceRecognizer for IcpRecognizer {
     fn start_run(&mut self) -> Vec<Match> {
         self.run = Some(self.run.map_or(0, |r| r + 1));
         self.cells.clear();
-        self.last_pose = None;
-        self.next_obs_travel_m = None;
+        self.schedule.start_run();
         self.pending.clear();
         Vec::new()
     }
@@ -586,23 +582,11 @@ impl PlaceRecognizer for IcpRecognizer {
             self.start_run();
         }
         let pose = odom.0;
-        if let Some(last) = self.last_pose {
-            self.travel_m += last.distance(&pose);
-        }
-        self.last_pose = Some(pose);
+        let travel_m = self.schedule.advance(pose);
         self.insert_scan(&pose, scan);
-        let due = self.next_obs_travel_m.is_none_or(|t| self.travel_m >= t);
-        if !due {
+        if !self.schedule.take_due() {
             return Vec::new();
         }
-        // Observations fall on a fixed schedule of travel, so frame spacing does not stretch
-        // the observation spacing; a long jump skips the missed slots.
-        let spacing = self.cfg.observation_spacing_m.max(1e-6);
-        let mut next = self.next_obs_travel_m.unwrap_or(self.travel_m) + spacing;
-        while next <= self.travel_m {
-            next += spacing;
-        }
-        self.next_obs_travel_m = Some(next);
         self.forget_far_cells(&pose);
         let id = self.observations.len();
         self.observations.push(Observation::new(
@@ -610,7 +594,7 @@ impl PlaceRecognizer for IcpRecognizer {
             self.run.unwrap_or(0),
             frame_id,
             odom,
-            self.travel_m,
+            travel_m,
         ));
         self.pending.push(id);
         if self.pending.len() >= self.cfg.region_observations {

@@ -34,7 +34,7 @@
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::{
     AlignedRun, CandidateCounts, Diagnostics, Direction, FrameId, Match, ObsId, Observation,
-    PlaceRecognizer, RejectedCandidate,
+    PlaceRecognizer, RejectedCandidate, TravelSchedule,
 };
 use crate::scan::Scan;
 use kiddo::{KdTree, SquaredEuclidean};
@@ -431,9 +431,8 @@ pub struct ScanContextRecognizer {
     /// travel at their last hit.
     cells: HashMap<(i64, i64), f64>,
     run: Option<usize>,
-    travel_m: f64,
-    last_pose: Option<Pose2>,
-    next_obs_travel_m: Option<f64>,
+    /// Travel and the observation slots on it.
+    schedule: TravelSchedule,
     counts: Counts,
     rejected: Vec<RejectedCandidate>,
 }
@@ -445,6 +444,7 @@ impl ScanContextRecognizer {
         if !problems.is_empty() {
             return Err(problems);
         }
+        let schedule = TravelSchedule::new(cfg.observation_spacing_m);
         Ok(ScanContextRecognizer {
             cfg,
             observations: Vec::new(),
@@ -455,9 +455,7 @@ impl ScanContextRecognizer {
             waiting: VecDeque::new(),
             cells: HashMap::new(),
             run: None,
-            travel_m: 0.0,
-            last_pose: None,
-            next_obs_travel_m: None,
+            schedule,
             counts: Counts::default(),
             rejected: Vec::new(),
         })
@@ -564,8 +562,7 @@ impl PlaceRecognizer for ScanContextRecognizer {
     fn start_run(&mut self) -> Vec<Match> {
         self.run = Some(self.run.map_or(0, |r| r + 1));
         self.cells.clear();
-        self.last_pose = None;
-        self.next_obs_travel_m = None;
+        self.schedule.start_run();
         Vec::new()
     }
 
@@ -574,37 +571,26 @@ impl PlaceRecognizer for ScanContextRecognizer {
             self.start_run();
         }
         let pose = odom.0;
-        if let Some(last) = self.last_pose {
-            self.travel_m += last.distance(&pose);
-        }
-        self.last_pose = Some(pose);
-        let (cell, travel_m) = (self.cfg.cell_m, self.travel_m);
+        let (cell, travel_m) = (self.cfg.cell_m, self.schedule.advance(pose));
         for p in scan_points(&pose, scan) {
             let key = ((p.x / cell).floor() as i64, (p.y / cell).floor() as i64);
             self.cells.insert(key, travel_m);
         }
-        if self.next_obs_travel_m.is_some_and(|t| self.travel_m < t) {
+        if !self.schedule.take_due() {
             return Vec::new();
         }
-        // Observations fall on a fixed schedule of travel (as ICP's); a long jump skips slots.
-        let spacing = self.cfg.observation_spacing_m;
-        let mut next = self.next_obs_travel_m.unwrap_or(self.travel_m) + spacing;
-        while next <= self.travel_m {
-            next += spacing;
-        }
-        self.next_obs_travel_m = Some(next);
         let id = self.observations.len();
         self.observations.push(Observation::new(
             id,
             self.run.unwrap_or(0),
             frame_id,
             odom,
-            self.travel_m,
+            travel_m,
         ));
         self.counts.observations += 1;
-        let keep_from = self.travel_m - self.cfg.history_m;
+        let keep_from = travel_m - self.cfg.history_m;
         self.cells.retain(|_, t| *t >= keep_from);
-        self.index_up_to(self.travel_m);
+        self.index_up_to(travel_m);
         let d = self.describe(&pose);
         let found = if d.is_empty() {
             self.counts.empty += 1;
