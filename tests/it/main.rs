@@ -3,6 +3,8 @@
 mod architecture;
 mod authoring;
 mod bag;
+#[path = "../support/big_world.rs"]
+mod big_world;
 mod ci;
 mod cli;
 mod common;

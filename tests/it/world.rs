@@ -154,19 +154,10 @@ fn a_file_with_several_mistakes_reports_them_all() {
     assert!(err.diagnostics().len() >= 3, "{err}");
 }
 
-#[test]
 /// Refused at the segment limit, located (how fast: `benches/world.rs`).
+#[test]
 fn too_many_segments_are_refused() {
-    let mut src = String::from(
-        "format_version = 1\nname = \"big\"\n[robot_home]\nx_m = 0.5\ny_m = 0.5\n\
-         [[routes]]\nid = \"lap\"\nwaypoints_m = [[1.0, 1.0], [2.0, 1.0], [2.0, 2.0]]\n\
-         [[walls]]\nid = \"zigzag\"\npoints_m = [",
-    );
-    for i in 0..10_002 {
-        let (x, y) = ((i % 1000) as f64 * 0.01, (i / 1000) as f64 * 0.01);
-        src.push_str(&format!("[{x}, {y}],"));
-    }
-    src.push_str("]\n");
+    let src = crate::big_world::zigzag_wall_world();
     let err = parse_world(&src, "big.toml").unwrap_err();
     let text = err.to_string();
     assert!(text.contains("limit 10000)"), "{text}");
