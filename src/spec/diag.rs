@@ -46,6 +46,14 @@ impl Diagnostic {
             severity: Severity::Error,
         }
     }
+
+    /// A warning at `(line, col)` (1-based) of `path`: the file is used as repaired or read.
+    pub fn warning(path: &str, at: (usize, usize), message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(path, at, message)
+        }
+    }
 }
 
 /// Longest piece of a file echoed in a message, characters: a 10 MB key is not printed back.
