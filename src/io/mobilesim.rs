@@ -1116,7 +1116,7 @@ mod tests {
     /// noise and a large open square (the shape that took a minute).
     #[test]
     fn thinning_revisits_only_changed_neighbourhoods_with_the_same_skeleton() {
-        use rand::{Rng, SeedableRng};
+        use rand::{RngExt, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         for (nx, ny, fill) in [
             (40, 30, 0.9),
