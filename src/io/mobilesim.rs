@@ -121,6 +121,32 @@ fn numbers<const N: usize>(
     Ok(v)
 }
 
+/// The first coordinate (millimetres) among `toks` farther than the world's
+/// [`crate::spec::world::MAX_ABS_COORD_M`] from the origin, as an error at its column.
+fn far_coordinate(
+    (name, line_no): (&str, usize),
+    toks: &[(usize, &str)],
+    values: &[f64],
+    names: &[&str],
+) -> Result<(), MapError> {
+    let limit_mm = crate::spec::world::MAX_ABS_COORD_M * 1000.0;
+    match values.iter().position(|v| v.abs() > limit_mm) {
+        None => Ok(()),
+        Some(k) => Err(malformed(
+            name,
+            line_no,
+            toks.get(k).map_or(1, |t| t.0),
+            format!(
+                "{} = {} mm is more than {} km from the origin; the map is in millimetres: \
+                 check this value",
+                names[k],
+                crate::spec::diag::fmt_number(values[k]),
+                crate::spec::world::MAX_ABS_COORD_M / 1000.0
+            ),
+        )),
+    }
+}
+
 fn malformed(path: &str, line: usize, col: usize, message: impl Into<String>) -> MapError {
     MapError::Malformed(Diagnostic::error(path, (line, col), message))
 }
@@ -211,6 +237,7 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                             )
                         },
                     )?;
+                    far_coordinate((name, line_no), &toks[2..], &v[..2], &["x", "y"])?;
                     if home.is_none() {
                         home = Some((v[0] / 1000.0, v[1] / 1000.0, v[2]));
                         home_line = line_no;
@@ -234,6 +261,7 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                         )
                     },
                 )?;
+                far_coordinate((name, line_no), &toks, &v, &["x1", "y1", "x2", "y2"])?;
                 if let Some(&(c, s)) = toks.get(4) {
                     return Err(malformed(
                         name,
@@ -1190,7 +1218,21 @@ mod tests {
         let e = parse_map("hello\n", "m.map").unwrap_err();
         assert!(e.to_string().starts_with("m.map:1:1:"), "{e}");
         let e = import_mobilesim("2D-Map\nLINES\n0 0 1 1\n", "m.map").unwrap_err();
+        assert!(e.to_string().starts_with("m.map:1:1: "), "{e}");
         assert!(e.to_string().contains("RobotHome"), "{e}");
+        // Coordinates past the world's limit at their column, in exponent form (they were
+        // printed as 300 digits, or overflowed to a span of `inf` m).
+        let e = parse_map("2D-Map\nCairn: RobotHome 1e300 0 0\n", "m.map").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "m.map:2:18: x = 1e300 mm is more than 1000 km from the origin; the map is in \
+             millimetres: check this value"
+        );
+        let e = parse_map("2D-Map\nLINES\n0 0 6000 -1e300\n", "m.map").unwrap_err();
+        assert!(
+            e.to_string().starts_with("m.map:3:10: y2 = -1e300 mm"),
+            "{e}"
+        );
     }
 
     #[test]

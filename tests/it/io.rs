@@ -178,9 +178,12 @@ fn truncated_gzip_gives_a_located_error() {
             unreachable!()
         };
         let at = if line == 0 {
-            "cut.log.gz:1:1: the gzip stream is truncated or corrupt before its first complete line".to_string()
+            "cut.log.gz:1:1: the gzip stream is truncated or corrupt before its first complete line"
+                .to_string()
         } else {
-            format!("cut.log.gz:{line}:1: the gzip stream is truncated or corrupt after this line, the last complete one")
+            format!(
+                "cut.log.gz:{line}:1: the gzip stream is truncated or corrupt after this line, the last complete one"
+            )
         };
         assert!(msg.starts_with(&at), "{msg}");
     }
