@@ -457,8 +457,9 @@ pub struct ImportedMap {
 ///   check takes headings within ±360 only.
 pub fn repair_map(map: &mut MobileSimMap, name: &str) -> Vec<Diagnostic> {
     let mut repairs = Vec::new();
-    let key = |p: Vec2| ((p.x * 1000.0).round() as i64, (p.y * 1000.0).round() as i64);
-    let mut first: HashMap<((i64, i64), (i64, i64)), usize> = HashMap::new();
+    type Mm = (i64, i64);
+    let key = |p: Vec2| -> Mm { ((p.x * 1000.0).round() as i64, (p.y * 1000.0).round() as i64) };
+    let mut first: HashMap<(Mm, Mm), usize> = HashMap::new();
     let mut keep = Vec::with_capacity(map.segments.len());
     for (s, &line) in map.segments.iter().zip(&map.segment_lines) {
         let (a, b) = (key(s.a), key(s.b));
@@ -1152,13 +1153,13 @@ mod tests {
             (17, 90, 0.97),
             (120, 120, 1.0),
         ] {
-            let mut img: Vec<bool> = (0..nx * ny).map(|_| rng.random_bool(fill)).collect();
-            for k in 0..nx * ny {
-                let (i, j) = (k % nx, k / nx);
-                if i == 0 || j == 0 || i == nx - 1 || j == ny - 1 {
-                    img[k] = false;
-                }
-            }
+            let img: Vec<bool> = (0..nx * ny)
+                .map(|k| {
+                    let (i, j) = (k % nx, k / nx);
+                    let edge = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+                    rng.random_bool(fill) && !edge
+                })
+                .collect();
             let want = zhang_suen_full_passes(img.clone(), nx, ny);
             assert_eq!(zhang_suen(img, nx, ny), want, "{nx}x{ny} at {fill}");
         }
