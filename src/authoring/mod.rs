@@ -7,6 +7,7 @@
 pub mod ambiguity;
 pub mod density;
 pub mod generate;
+pub mod import;
 pub mod problems;
 
 pub use ambiguity::{AmbiguityReport, AmbiguousStretch, ambiguity, ambiguity_svg};

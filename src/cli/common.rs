@@ -186,7 +186,7 @@ fn parse_max_drop(s: &str) -> Result<f64, String> {
         Ok(x)
     } else {
         Err(format!(
-            "{x} is outside 0..1; a drop of precision or recall, e.g. 0.01"
+            "{s} is outside 0..1; a drop of precision or recall, e.g. 0.01"
         ))
     }
 }
@@ -197,7 +197,7 @@ fn parse_max_slowdown(s: &str) -> Result<f64, String> {
         Ok(x)
     } else {
         Err(format!(
-            "{x} is less than 1; a factor on the time per lap, e.g. 1.5"
+            "{s} is less than 1; a factor on the time per lap, e.g. 1.5"
         ))
     }
 }

@@ -90,7 +90,10 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         ("--min-gap-m", args.min_gap_m),
     ] {
         if !(v.is_finite() && v > 0.0) {
-            bail!("{flag} {v}: must be a positive distance in metres");
+            bail!(
+                "{flag} {}: must be a positive distance in metres",
+                placewords::spec::diag::fmt_number(v)
+            );
         }
     }
     let truth = match args.truth {

@@ -2,7 +2,6 @@
 //! against the logs `placewords simulate` wrote (docs/scoring.md).
 
 use super::common::write_file;
-use anyhow::Context;
 use clap::Args;
 use placewords::experiment::score;
 use placewords::io::matches_csv;
@@ -31,10 +30,9 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     super::common::check_outputs([args.report.as_deref()])?;
     let logs = score::load_logged_runs(&args.logdir)?;
     let name = args.matches.display().to_string();
-    let text =
-        std::fs::read_to_string(&args.matches).with_context(|| format!("{name}: cannot read"))?;
-    let rows = matches_csv::parse_matches(&text, &name)?;
-    let report = score::score_rows(&logs, &rows, &name, &EvaluationSpec::default(), args.levels)?;
+    let text = placewords::spec::diag::read_text(&args.matches)?;
+    let file = matches_csv::read_matches(&text, &name)?;
+    let report = score::score_file(&logs, &file, &name, &EvaluationSpec::default(), args.levels)?;
     out!("{}", placewords::report::table::text_table(&report))?;
     if let Some(path) = &args.report {
         use placewords::eval::provenance::{self as p, Input};

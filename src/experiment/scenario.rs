@@ -354,7 +354,7 @@ fn bounded(d: &mut Diags, s: &Settings, key: &str, default: f64, max: f64) -> f6
         Some(x) if v > max => {
             d.at(
                 x.span().start,
-                format!("{key} = {v} is above {max}; use 0-{max}"),
+                format!("{key} = {} is above {max}; use 0-{max}", fmt_number(v)),
             );
             default
         }

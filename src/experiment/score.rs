@@ -15,7 +15,7 @@ use crate::eval::scores::Report;
 use crate::eval::{GroundTruth, LapInfo, Recognition};
 use crate::geom::{OdomPose, Pose2, TruePose};
 use crate::io::carmen::{CarmenError, LogRecord, ReadOptions, read_log};
-use crate::io::matches_csv::{MatchRow, MatchesCsvError};
+use crate::io::matches_csv::{MatchRow, MatchesCsvError, MatchesFile};
 use crate::place::{Match, Observation};
 use crate::recognizer::ObservationClock;
 use crate::sim::RunLog;
@@ -36,6 +36,10 @@ pub enum ScoreError {
     Bag(#[from] crate::io::real_log::RealLogError),
     #[error(transparent)]
     Matches(#[from] MatchesCsvError),
+    /// A located problem of the manifest or the matches file (invalid UTF-8, bad JSON, a row
+    /// naming a scan the logs do not hold).
+    #[error("{}", .0.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n"))]
+    Located(Vec<crate::spec::diag::Diagnostic>),
     #[error(
         "{path}: match {row} names run {run} scan {scan}, which the logs do not hold ({what}); \
          check the run and 0-based scan numbers against manifest.json"
@@ -121,12 +125,20 @@ pub fn load_logged_runs(dir: &Path) -> Result<LoggedRuns, ScoreError> {
         path: mpath.display().to_string(),
         message,
     };
-    let text = std::fs::read_to_string(&mpath).map_err(|e| {
-        bad(format!(
-            "cannot read: {e}; give the folder `placewords simulate -o` wrote"
-        ))
+    let text = crate::spec::diag::read_text(&mpath).map_err(|e| match e {
+        crate::spec::SpecError::Io { source, .. } => bad(format!(
+            "cannot read: {source}; give the folder `placewords simulate -o` wrote"
+        )),
+        crate::spec::SpecError::Invalid(d) => ScoreError::Located(d),
     })?;
-    let manifest: Manifest = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+        let file = mpath.display().to_string();
+        ScoreError::Located(vec![crate::spec::diag::json_diagnostic(
+            &file,
+            &e,
+            "not the manifest `placewords simulate -o` writes",
+        )])
+    })?;
     let mut truth = GroundTruth::default();
     let mut odom = Vec::new();
     let mut runs = Vec::new();
@@ -303,6 +315,43 @@ impl LoggedRuns {
             rejected: Vec::new(),
         })
     }
+}
+
+/// [`score_rows`] on a matches file read with [`crate::io::matches_csv::read_matches`]: a row
+/// naming a scan the logs do not hold is reported at its line of `path`.
+pub fn score_file(
+    logs: &LoggedRuns,
+    file: &MatchesFile,
+    path: &str,
+    spec: &EvaluationSpec,
+    levels: usize,
+) -> Result<Report, ScoreError> {
+    score_rows(logs, &file.rows, path, spec, levels).map_err(|e| match e {
+        ScoreError::UnknownScan {
+            path,
+            row,
+            run,
+            scan,
+            what,
+        } => match file.lines.get(row.wrapping_sub(1)) {
+            Some(&line) => ScoreError::Located(vec![crate::spec::diag::Diagnostic::error(
+                &path,
+                (line, 1),
+                format!(
+                    "run {run} scan {scan} is not in the logs ({what}); check the run and \
+                     0-based scan numbers against manifest.json"
+                ),
+            )]),
+            None => ScoreError::UnknownScan {
+                path,
+                row,
+                run,
+                scan,
+                what,
+            },
+        },
+        e => e,
+    })
 }
 
 /// Scores `rows` against the logs as a report with one `levels` entry labelled `levels`.

@@ -267,15 +267,28 @@ pub enum StressError {
 /// `what` saying in the error what the file should have been.
 pub fn read_suite(path: &Path, what: &str) -> Result<SuiteReport, StressError> {
     let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| StressError::Read {
-        path: file.clone(),
-        source,
+    // Invalid UTF-8 is located at its first bad byte, as in every text file.
+    let text = crate::spec::diag::read_text(path).map_err(|e| match e {
+        crate::spec::SpecError::Io { source, .. } => StressError::Read {
+            path: file.clone(),
+            source,
+        },
+        crate::spec::SpecError::Invalid(d) => StressError::Parse(
+            d.into_iter()
+                .next()
+                .unwrap_or_else(|| crate::spec::diag::Diagnostic::error(&file, (1, 1), "not text")),
+        ),
     })?;
     let located = |at: (usize, usize), msg: String| {
         StressError::Parse(crate::spec::diag::Diagnostic::error(&file, at, msg))
     };
-    let suite = SuiteReport::from_json(&text)
-        .map_err(|e| located((e.line(), e.column()), format!("not {what}: {e}")))?;
+    let suite = SuiteReport::from_json(&text).map_err(|e| {
+        StressError::Parse(crate::spec::diag::json_diagnostic(
+            &file,
+            &e,
+            &format!("not {what}"),
+        ))
+    })?;
     if suite.format != crate::eval::suite::FORMAT {
         return Err(located(
             (1, 1),

@@ -290,10 +290,13 @@ pub enum CarmenError {
     /// A line that is not a valid message of its type.
     #[error("{0}")]
     Malformed(Diagnostic),
-    /// The gzip stream ended early or is corrupt.
+    /// The gzip stream ended early or is corrupt; located at the last complete line read
+    /// (line 1 when none was).
     #[error(
-        "{path}: the gzip stream is truncated or corrupt after line {line} ({source}); \
-         re-download or re-compress the log (`gzip -t` tests it), or unpack what is readable with `zcat`"
+        "{path}:{}:1: the gzip stream is truncated or corrupt {} ({source}); \
+         re-download or re-compress the log (`gzip -t` tests it), or unpack what is readable with `zcat`",
+        (*line).max(1),
+        if *line == 0 { "before its first complete line" } else { "after this line, the last complete one" }
     )]
     Decompress {
         path: String,

@@ -79,12 +79,27 @@ pub fn write_matches(rows: &[MatchRow]) -> String {
     out
 }
 
+/// A matches file as read: its rows and the 1-based line each came from (so a later check of
+/// a row, e.g. a scan the logs do not hold, can name its line).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MatchesFile {
+    pub rows: Vec<MatchRow>,
+    /// `lines[k]` is the line of `rows[k]`.
+    pub lines: Vec<usize>,
+}
+
 /// Parses a matches file; `path` names it in errors.
 pub fn parse_matches(src: &str, path: &str) -> Result<Vec<MatchRow>, MatchesCsvError> {
+    read_matches(src, path).map(|f| f.rows)
+}
+
+/// [`parse_matches`] keeping each row's line.
+pub fn read_matches(src: &str, path: &str) -> Result<MatchesFile, MatchesCsvError> {
     let err = |line: usize, col: usize, message: String| {
         MatchesCsvError(Diagnostic::error(path, (line, col), message))
     };
     let mut rows = Vec::new();
+    let mut lines = Vec::new();
     let mut layout: Option<Vec<Optional>> = None;
     for (i, text) in src.lines().enumerate() {
         let line = i + 1;
@@ -94,7 +109,10 @@ pub fn parse_matches(src: &str, path: &str) -> Result<Vec<MatchRow>, MatchesCsvE
         }
         match &layout {
             None => layout = Some(parse_header(text).map_err(|(col, m)| err(line, col, m))?),
-            Some(cols) => rows.push(parse_row(text, cols).map_err(|(col, m)| err(line, col, m))?),
+            Some(cols) => {
+                rows.push(parse_row(text, cols).map_err(|(col, m)| err(line, col, m))?);
+                lines.push(line);
+            }
         }
     }
     if layout.is_none() {
@@ -104,7 +122,7 @@ pub fn parse_matches(src: &str, path: &str) -> Result<Vec<MatchRow>, MatchesCsvE
             format!("empty file; the first line must be `{HEADER}`"),
         ));
     }
-    Ok(rows)
+    Ok(MatchesFile { rows, lines })
 }
 
 /// Comma-separated fields, trimmed, with their 1-based columns.

@@ -74,10 +74,13 @@ pub enum MapError {
     /// The map parsed but no drivable route could be generated.
     ///
     /// `partial` holds the world without a route when walls and home were imported; a caller
-    /// may write it so the user only has to add the `[[routes]]` block.
-    #[error("{path}: {message}")]
+    /// may write it so the user only has to add the `[[routes]]` block. `line` is where the
+    /// problem shows: the home (the route grows from it), the first segment past the limit,
+    /// the segment farthest out, or line 1 for what the file lacks.
+    #[error("{path}:{line}:1: {message}")]
     NoRoute {
         path: String,
+        line: usize,
         message: String,
         partial: Option<Box<WorldSpec>>,
     },
@@ -87,8 +90,12 @@ pub enum MapError {
 #[derive(Clone, Debug, PartialEq)]
 pub struct MobileSimMap {
     pub segments: Vec<Segment>,
+    /// The 1-based line of each segment.
+    pub segment_lines: Vec<usize>,
     /// (x m, y m, heading degrees).
     pub home: Option<(f64, f64, f64)>,
+    /// The 1-based line of the `RobotHome` cairn used (0 with none).
+    pub home_line: usize,
 }
 
 /// The first N tokens of a line as finite numbers. A missing one is reported at the line's end
@@ -112,6 +119,32 @@ fn numbers<const N: usize>(
         };
     }
     Ok(v)
+}
+
+/// The first coordinate (millimetres) among `toks` farther than the world's
+/// [`crate::spec::world::MAX_ABS_COORD_M`] from the origin, as an error at its column.
+fn far_coordinate(
+    (name, line_no): (&str, usize),
+    toks: &[(usize, &str)],
+    values: &[f64],
+    names: &[&str],
+) -> Result<(), MapError> {
+    let limit_mm = crate::spec::world::MAX_ABS_COORD_M * 1000.0;
+    match values.iter().position(|v| v.abs() > limit_mm) {
+        None => Ok(()),
+        Some(k) => Err(malformed(
+            name,
+            line_no,
+            toks.get(k).map_or(1, |t| t.0),
+            format!(
+                "{} = {} mm is more than {} km from the origin; the map is in millimetres: \
+                 check this value",
+                names[k],
+                crate::spec::diag::fmt_number(values[k]),
+                crate::spec::world::MAX_ABS_COORD_M / 1000.0
+            ),
+        )),
+    }
 }
 
 fn malformed(path: &str, line: usize, col: usize, message: impl Into<String>) -> MapError {
@@ -147,7 +180,9 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
     }
     let mut section = Section::Header;
     let mut segments = Vec::new();
+    let mut segment_lines = Vec::new();
     let mut home = None;
+    let mut home_line = 0;
     let mut seen_magic = false;
     for (idx, raw) in src.lines().enumerate() {
         let line_no = idx + 1;
@@ -202,8 +237,10 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                             )
                         },
                     )?;
+                    far_coordinate((name, line_no), &toks[2..], &v[..2], &["x", "y"])?;
                     if home.is_none() {
                         home = Some((v[0] / 1000.0, v[1] / 1000.0, v[2]));
+                        home_line = line_no;
                     }
                 }
                 // Other header lines (Resolution, LineMinPos, NumLines, other cairns…) are not needed.
@@ -224,6 +261,7 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                         )
                     },
                 )?;
+                far_coordinate((name, line_no), &toks, &v, &["x1", "y1", "x2", "y2"])?;
                 if let Some(&(c, s)) = toks.get(4) {
                     return Err(malformed(
                         name,
@@ -238,6 +276,7 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
                     Vec2::new(v[0] / 1000.0, v[1] / 1000.0),
                     Vec2::new(v[2] / 1000.0, v[3] / 1000.0),
                 ));
+                segment_lines.push(line_no);
             }
         }
     }
@@ -249,7 +288,12 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, MapError> {
             "the file is empty; expected a MobileSim map starting with `2D-Map`",
         ));
     }
-    Ok(MobileSimMap { segments, home })
+    Ok(MobileSimMap {
+        segments,
+        segment_lines,
+        home,
+        home_line,
+    })
 }
 
 /// Chains touching segments into polylines (zero-length segments dropped). Returns
@@ -393,14 +437,92 @@ pub fn import_mobilesim_with(
     name: &str,
     opts: &ImportOptions,
 ) -> Result<WorldSpec, MapError> {
-    let map = parse_map(src, name)?;
-    let no_route = |message: String| MapError::NoRoute {
+    import_mobilesim_repaired(src, name, opts).map(|m| m.spec)
+}
+
+/// A map imported as a world, with what the import repaired on the way.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedMap {
+    pub spec: WorldSpec,
+    /// Warnings at the map's lines, one per repair (see [`repair_map`]).
+    pub repairs: Vec<Diagnostic>,
+}
+
+/// The repairs the import makes so that a map drawn carelessly still gives a world `world
+/// check` accepts, each a warning at its line of the map:
+///
+/// - a segment drawn twice (the same two end points, in millimetres, in either order) is kept
+///   once: the world check refuses a wall that overlaps itself;
+/// - a RobotHome heading outside -180..180 degrees is brought into it (1000 → -80): the world
+///   check takes headings within ±360 only.
+pub fn repair_map(map: &mut MobileSimMap, name: &str) -> Vec<Diagnostic> {
+    let mut repairs = Vec::new();
+    type Mm = (i64, i64);
+    let key = |p: Vec2| -> Mm { ((p.x * 1000.0).round() as i64, (p.y * 1000.0).round() as i64) };
+    let mut first: HashMap<(Mm, Mm), usize> = HashMap::new();
+    let mut keep = Vec::with_capacity(map.segments.len());
+    for (s, &line) in map.segments.iter().zip(&map.segment_lines) {
+        let (a, b) = (key(s.a), key(s.b));
+        let k = (a.min(b), a.max(b));
+        match first.get(&k) {
+            Some(&was) if a != b => {
+                repairs.push(Diagnostic::warning(
+                    name,
+                    (line, 1),
+                    format!(
+                        "this segment repeats line {was} (the same wall drawn twice); imported once"
+                    ),
+                ));
+                keep.push(false);
+            }
+            _ => {
+                first.entry(k).or_insert(line);
+                keep.push(true);
+            }
+        }
+    }
+    let mut it = keep.iter();
+    map.segments.retain(|_| *it.next().unwrap_or(&true));
+    let mut it = keep.iter();
+    map.segment_lines.retain(|_| *it.next().unwrap_or(&true));
+    if let Some((_, _, h)) = map.home.as_mut()
+        && !(-180.0..=180.0).contains(h)
+    {
+        let mut w = h.rem_euclid(360.0);
+        if w > 180.0 {
+            w -= 360.0;
+        }
+        repairs.push(Diagnostic::warning(
+            name,
+            (map.home_line.max(1), 1),
+            format!(
+                "RobotHome heading {} degrees is outside -180..180; imported as {}",
+                crate::spec::diag::fmt_number(*h),
+                crate::spec::diag::fmt_number(w)
+            ),
+        ));
+        *h = w;
+    }
+    repairs
+}
+
+/// [`import_mobilesim_with`] keeping the repairs it made ([`repair_map`]).
+pub fn import_mobilesim_repaired(
+    src: &str,
+    name: &str,
+    opts: &ImportOptions,
+) -> Result<ImportedMap, MapError> {
+    let mut map = parse_map(src, name)?;
+    let repairs = repair_map(&mut map, name);
+    let no_route = |line: usize, message: String| MapError::NoRoute {
         path: name.to_string(),
+        line: line.max(1),
         message,
         partial: None,
     };
     let Some((hx, hy, hdeg)) = map.home else {
         return Err(no_route(
+            1,
             "the map has no `Cairn: RobotHome x y heading` line, so there is no home pose; \
              add one to the header (millimetres and degrees)"
                 .into(),
@@ -408,11 +530,14 @@ pub fn import_mobilesim_with(
     };
     // The world checks' limits, reported here with the map's own numbers.
     if map.segments.len() > MAX_SEGMENTS {
-        return Err(no_route(format!(
-            "the map has {} wall segments, more than a world may hold ({MAX_SEGMENTS}); \
+        return Err(no_route(
+            map.segment_lines[MAX_SEGMENTS],
+            format!(
+                "the map has {} wall segments, more than a world may hold ({MAX_SEGMENTS}); \
              split the map or merge collinear segments",
-            map.segments.len()
-        )));
+                map.segments.len()
+            ),
+        ));
     }
     home_inside_walls(src, name, &map.segments, Vec2::new(hx, hy))?;
     let (mut lo, mut hi) = (Vec2::new(hx, hy), Vec2::new(hx, hy));
@@ -423,16 +548,31 @@ pub fn import_mobilesim_with(
         }
     }
     if (hi - lo).norm() > MAX_EXTENT_M {
-        return Err(no_route(format!(
-            "the map (with its home) spans {:.0} m corner to corner, more than a world may ({MAX_EXTENT_M} m); \
-             check the units (the format is in millimetres) or remove stray far-away lines",
-            (hi - lo).norm()
-        )));
+        let home = Vec2::new(hx, hy);
+        let farthest = map
+            .segments
+            .iter()
+            .zip(&map.segment_lines)
+            .map(|(s, &l)| ((s.a - home).norm().max((s.b - home).norm()), l))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or(1, |(_, l)| l);
+        return Err(no_route(
+            farthest,
+            format!(
+                "the map (with its home) spans {:.0} m corner to corner, more than a world may ({MAX_EXTENT_M} m); \
+             check the units (the format is in millimetres) or remove stray far-away lines \
+             (this one is the farthest from the home)",
+                (hi - lo).norm()
+            ),
+        ));
     }
     let chains = chain_segments(&map.segments);
     if chains.is_empty() {
         return Err(no_route(
-            "the map has no wall segments after `LINES`".into(),
+            1,
+            "the map has no wall segments after `LINES`; add one `x1 y1 x2 y2` line (millimetres) \
+             per wall segment after a `LINES` line"
+                .into(),
         ));
     }
     let walls: Vec<Segment> = map
@@ -485,10 +625,11 @@ pub fn import_mobilesim_with(
                 id: "loop".into(),
                 waypoints_m: route.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
             });
-            Ok(spec)
+            Ok(ImportedMap { spec, repairs })
         }
         Err(message) => Err(MapError::NoRoute {
             path: name.to_string(),
+            line: map.home_line.max(1),
             message,
             partial: Some(Box::new(spec)),
         }),
@@ -852,66 +993,202 @@ fn simplify(pts: &[Vec2], tol: f64, leg_ok: &dyn Fn(Vec2, Vec2) -> bool) -> Vec<
 }
 
 /// Zhang–Suen thinning of a binary image (row-major, `nx` wide).
+///
+/// Each sub-iteration decides every pixel from the image as it stood at the sub-iteration's
+/// start, and a pixel's decision depends only on its 3×3 neighbourhood. So after the first
+/// full pass only pixels next to one deleted since their last look under the same rule (north-
+/// east or south-west) are looked at again: the same deletions, in work proportional to the
+/// image plus the pixels removed, not to the image times the passes (a 350 m open map thinned
+/// in thousands of full passes took a minute).
 fn zhang_suen(mut img: Vec<bool>, nx: usize, ny: usize) -> Vec<bool> {
     if nx < 3 || ny < 3 {
         return img;
     }
-    let mut changed = true;
-    let mut del = Vec::new();
-    while changed {
-        changed = false;
-        for step in 0..2 {
-            del.clear();
-            for j in 1..ny - 1 {
-                for i in 1..nx - 1 {
-                    let k = j * nx + i;
-                    if !img[k] {
-                        continue;
-                    }
-                    // P2..P9 clockwise from north (north = +y row, direction does not matter).
-                    let p = [
-                        img[k + nx],
-                        img[k + nx + 1],
-                        img[k + 1],
-                        img[k - nx + 1],
-                        img[k - nx],
-                        img[k - nx - 1],
-                        img[k - 1],
-                        img[k + nx - 1],
-                    ];
-                    let b = p.iter().filter(|&&x| x).count();
-                    if !(2..=6).contains(&b) {
-                        continue;
-                    }
-                    let a = (0..8).filter(|&t| !p[t] && p[(t + 1) % 8]).count();
-                    if a != 1 {
-                        continue;
-                    }
-                    let (p2, p4, p6, p8) = (p[0], p[2], p[4], p[6]);
-                    let cond = if step == 0 {
-                        !(p4 && p6 && (p2 || p8))
-                    } else {
-                        !(p2 && p8 && (p4 || p6))
-                    };
-                    if cond {
-                        del.push(k);
-                    }
-                }
-            }
-            if !del.is_empty() {
-                changed = true;
-                for &k in &del {
-                    img[k] = false;
-                }
+    let interior = |k: usize| {
+        let (i, j) = (k % nx, k / nx);
+        i >= 1 && i + 1 < nx && j >= 1 && j + 1 < ny
+    };
+    let ring = |k: usize| {
+        [
+            k + nx,
+            k + nx + 1,
+            k + 1,
+            k - nx + 1,
+            k - nx,
+            k - nx - 1,
+            k - 1,
+            k + nx - 1,
+        ]
+    };
+    // Pixels to look at under each rule, and whether they are queued already. At first the
+    // foreground pixels on its border: one whose 8 neighbours are all foreground is kept by
+    // both rules until a neighbour goes (and then it is queued).
+    // The image's edge is never looked at: marked queued for good, it is never queued.
+    let mut todo: [Vec<usize>; 2] = [Vec::new(), Vec::new()];
+    let edge: Vec<bool> = (0..nx * ny).map(|k| !interior(k)).collect();
+    let mut queued = [edge.clone(), edge];
+    for k in 0..nx * ny {
+        if img[k] && interior(k) && ring(k).iter().any(|&q| !img[q]) {
+            for step in 0..2 {
+                todo[step].push(k);
+                queued[step][k] = true;
             }
         }
     }
-    img
+    let mut del = Vec::new();
+    loop {
+        let mut changed = false;
+        for step in 0..2 {
+            del.clear();
+            let mut look = std::mem::take(&mut todo[step]);
+            for &k in &look {
+                queued[step][k] = false;
+                if !img[k] {
+                    continue;
+                }
+                // P2..P9 clockwise from north (north = +y row, direction does not matter).
+                let p = ring(k).map(|q| img[q]);
+                let b = p.iter().filter(|&&x| x).count();
+                if !(2..=6).contains(&b) {
+                    continue;
+                }
+                let a = (0..8).filter(|&t| !p[t] && p[(t + 1) % 8]).count();
+                if a != 1 {
+                    continue;
+                }
+                let (p2, p4, p6, p8) = (p[0], p[2], p[4], p[6]);
+                let cond = if step == 0 {
+                    !(p4 && p6 && (p2 || p8))
+                } else {
+                    !(p2 && p8 && (p4 || p6))
+                };
+                if cond {
+                    del.push(k);
+                }
+            }
+            look.clear();
+            todo[step] = look;
+            if del.is_empty() {
+                continue;
+            }
+            changed = true;
+            for &k in &del {
+                img[k] = false;
+            }
+            for &k in &del {
+                for q in ring(k) {
+                    if img[q] {
+                        for rule in 0..2 {
+                            if !queued[rule][q] {
+                                queued[rule][q] = true;
+                                todo[rule].push(q);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if !changed {
+            return img;
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Zhang–Suen as first written: every pixel every sub-iteration.
+    fn zhang_suen_full_passes(mut img: Vec<bool>, nx: usize, ny: usize) -> Vec<bool> {
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for step in 0..2 {
+                let mut del = Vec::new();
+                for j in 1..ny - 1 {
+                    for i in 1..nx - 1 {
+                        let k = j * nx + i;
+                        if !img[k] {
+                            continue;
+                        }
+                        let p = [
+                            img[k + nx],
+                            img[k + nx + 1],
+                            img[k + 1],
+                            img[k - nx + 1],
+                            img[k - nx],
+                            img[k - nx - 1],
+                            img[k - 1],
+                            img[k + nx - 1],
+                        ];
+                        let b = p.iter().filter(|&&x| x).count();
+                        let a = (0..8).filter(|&t| !p[t] && p[(t + 1) % 8]).count();
+                        let (p2, p4, p6, p8) = (p[0], p[2], p[4], p[6]);
+                        let cond = if step == 0 {
+                            !(p4 && p6 && (p2 || p8))
+                        } else {
+                            !(p2 && p8 && (p4 || p6))
+                        };
+                        if (2..=6).contains(&b) && a == 1 && cond {
+                            del.push(k);
+                        }
+                    }
+                }
+                changed |= !del.is_empty();
+                del.iter().for_each(|&k| img[k] = false);
+            }
+        }
+        img
+    }
+
+    /// Looking again only where a neighbour went gives the skeleton of full passes, on blobs,
+    /// noise and a large open square (the shape that took a minute).
+    #[test]
+    fn thinning_revisits_only_changed_neighbourhoods_with_the_same_skeleton() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for (nx, ny, fill) in [
+            (40, 30, 0.9),
+            (64, 64, 0.6),
+            (17, 90, 0.97),
+            (120, 120, 1.0),
+        ] {
+            let img: Vec<bool> = (0..nx * ny)
+                .map(|k| {
+                    let (i, j) = (k % nx, k / nx);
+                    let edge = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+                    rng.random_bool(fill) && !edge
+                })
+                .collect();
+            let want = zhang_suen_full_passes(img.clone(), nx, ny);
+            assert_eq!(zhang_suen(img, nx, ny), want, "{nx}x{ny} at {fill}");
+        }
+    }
+
+    /// A segment drawn twice is imported once and a heading of 1000 degrees as -80, each said
+    /// at its line.
+    #[test]
+    fn duplicate_segments_and_wild_headings_are_repaired_at_their_lines() {
+        let src = "2D-Map\nCairn: RobotHome 1000 1000 1000\nLINES\n0 0 6000 0\n6000 0 0 0\n\
+                   6000 0 6000 6000\n6000 6000 0 6000\n0 6000 0 0\n\
+                   2500 2500 3500 2500\n3500 2500 3500 3500\n3500 3500 2500 3500\n2500 3500 2500 2500\n";
+        let m = import_mobilesim_repaired(src, "r.map", &ImportOptions::default()).unwrap();
+        let said: Vec<String> = m.repairs.iter().map(ToString::to_string).collect();
+        assert_eq!(
+            said,
+            [
+                "r.map:5:1: warning: this segment repeats line 4 (the same wall drawn twice); imported once",
+                "r.map:2:1: warning: RobotHome heading 1000 degrees is outside -180..180; imported as -80",
+            ]
+        );
+        assert_eq!(m.spec.robot_home.heading_deg, -80.0);
+        assert!(
+            m.spec
+                .walls
+                .iter()
+                .all(|w| w.closed && w.points_m.len() == 4)
+        );
+    }
 
     #[test]
     fn square_room_with_pillar_gets_a_loop() {
@@ -942,7 +1219,21 @@ mod tests {
         let e = parse_map("hello\n", "m.map").unwrap_err();
         assert!(e.to_string().starts_with("m.map:1:1:"), "{e}");
         let e = import_mobilesim("2D-Map\nLINES\n0 0 1 1\n", "m.map").unwrap_err();
+        assert!(e.to_string().starts_with("m.map:1:1: "), "{e}");
         assert!(e.to_string().contains("RobotHome"), "{e}");
+        // Coordinates past the world's limit at their column, in exponent form (they were
+        // printed as 300 digits, or overflowed to a span of `inf` m).
+        let e = parse_map("2D-Map\nCairn: RobotHome 1e300 0 0\n", "m.map").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "m.map:2:18: x = 1e300 mm is more than 1000 km from the origin; the map is in \
+             millimetres: check this value"
+        );
+        let e = parse_map("2D-Map\nLINES\n0 0 6000 -1e300\n", "m.map").unwrap_err();
+        assert!(
+            e.to_string().starts_with("m.map:3:10: y2 = -1e300 mm"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -485,7 +485,13 @@ impl RecognizerConfig {
             ("chain_alignment_tie", self.chain_alignment_tie),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                bad(field, format!("must be a number of at least 0, got {v}"));
+                bad(
+                    field,
+                    format!(
+                        "must be a number of at least 0, got {}",
+                        crate::spec::diag::fmt_number(v)
+                    ),
+                );
             }
         }
         if !(self.max_interpolation_m.is_finite()

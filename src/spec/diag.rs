@@ -46,6 +46,14 @@ impl Diagnostic {
             severity: Severity::Error,
         }
     }
+
+    /// A warning at `(line, col)` (1-based) of `path`: the file is used as repaired or read.
+    pub fn warning(path: &str, at: (usize, usize), message: impl Into<String>) -> Self {
+        Diagnostic {
+            severity: Severity::Warning,
+            ..Diagnostic::error(path, at, message)
+        }
+    }
 }
 
 /// Longest piece of a file echoed in a message, characters: a 10 MB key is not printed back.
@@ -101,6 +109,17 @@ impl fmt::Display for Diagnostic {
             self.path, self.line, self.col, self.message
         )
     }
+}
+
+/// A JSON parse error of `path` at serde_json's line and column, `what` before its message;
+/// serde_json's own " at line L column C" is dropped so the place is said once.
+pub fn json_diagnostic(path: &str, e: &serde_json::Error, what: &str) -> Diagnostic {
+    let text = e.to_string();
+    let suffix = format!(" at line {} column {}", e.line(), e.column());
+    let message = text.strip_suffix(&suffix).unwrap_or(&text);
+    let at = (e.line().max(1), e.column().max(1));
+    let sep = if what.is_empty() { "" } else { ": " };
+    Diagnostic::error(path, at, format!("{what}{sep}{message}"))
 }
 
 /// 1-based (line, column) of a byte offset in `src`; the column counts characters.

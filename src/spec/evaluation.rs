@@ -1,7 +1,7 @@
 //! The `[evaluation]` and `[expect]` blocks of a scenario file: how matches are scored, and the
 //! CI gate a scenario must pass.
 
-use crate::spec::diag::Diags;
+use crate::spec::diag::{Diags, fmt_number};
 use crate::spec::read::{Val, get, number, table, table_array, unknown_keys};
 use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
@@ -276,7 +276,7 @@ fn set_checked<'a>(
             Some(x) if ok(x) => *slot = x,
             Some(x) => d.at(
                 v.span().start,
-                format!("{key} = {x} in {ctx} must be {what}"),
+                format!("{key} = {} in {ctx} must be {what}", fmt_number(x)),
             ),
             None => {}
         }
@@ -404,7 +404,10 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
         } else {
             d.at(
                 v.span().start,
-                format!("quantile = {q} is outside 0..1; use 0.1 for the 10th percentile"),
+                format!(
+                    "quantile = {} is outside 0..1; use 0.1 for the 10th percentile",
+                    fmt_number(q)
+                ),
             );
         }
     }
@@ -524,7 +527,10 @@ fn expectation(t: &DeTable<'_>, ctx: &str, d: &mut Diags) -> Expectation {
         };
         if !ok {
             let range = if unit { "outside 0..1" } else { "not positive" };
-            d.at(v.span().start, format!("{key} = {x} in {ctx} is {range}"));
+            d.at(
+                v.span().start,
+                format!("{key} = {} in {ctx} is {range}", fmt_number(x)),
+            );
         }
         ok.then_some(x)
     };

@@ -676,7 +676,7 @@ fn open_probability(v: &Val<'_>, ctx: &str, d: &mut Diags) -> Option<S<f64>> {
     if !(0.0..=1.0).contains(&x) {
         d.at(
             p.span().start,
-            format!("open_probability {x} is outside 0..1"),
+            format!("open_probability {} is outside 0..1", fmt_number(x)),
         );
         return None;
     }

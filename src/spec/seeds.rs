@@ -145,6 +145,17 @@ impl Shard {
                 })?
             }
         };
+        // JOB_COMPLETION_INDEX counts from 0: part index + 1 (checked: u64::MAX must not wrap
+        // to part 0).
+        if count == 0 || count > MAX_SHARDS {
+            return Shard::new(1, count);
+        }
+        if index >= count {
+            return Err(format!(
+                "JOB_COMPLETION_INDEX = {index} is not a part of {count}: it counts from 0 to {}",
+                count - 1
+            ));
+        }
         Shard::new(index + 1, count)
     }
 

@@ -248,8 +248,9 @@ fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
                 d.at(
                     at,
                     format!(
-                        "door '{}' has {key} = {h}, outside -360..360; give the heading in degrees",
-                        door.id
+                        "door '{}' has {key} = {}, outside -360..360; give the heading in degrees",
+                        door.id,
+                        fmt_number(h)
                     ),
                 );
                 ok = false;

@@ -464,6 +464,25 @@ fn check_without_expect_is_an_error_unless_allowed() {
         report_of(&part)["shard"],
         serde_json::json!({"index": 3, "count": 4})
     );
+    // An index past the parts (u64::MAX used to wrap to "part 0 of 3") is refused in the
+    // variable's own 0-based terms, before any work.
+    for index in ["3", "18446744073709551615"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_placewords"))
+            .args(["check", "-q", "--allow-no-expect", "--shard", "auto", bare])
+            .args(["--report", part.to_str().unwrap()])
+            .env("JOB_COMPLETION_INDEX", index)
+            .env("PLACEWORDS_SHARD_COUNT", "3")
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{index}: {stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "JOB_COMPLETION_INDEX = {index} is not a part of 3: it counts from 0 to 2"
+            )),
+            "{index}: {stderr}"
+        );
+    }
 }
 
 /// `placewords COMMAND | head`: the reader leaves before the output is written. Output stops

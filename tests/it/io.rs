@@ -173,10 +173,19 @@ fn truncated_gzip_gives_a_located_error() {
         let e = read_log_from(&gz[..cut], "cut.log.gz", ReadOptions { lenient: true }).unwrap_err();
         let msg = e.to_string();
         assert!(matches!(e, CarmenError::Decompress { .. }), "{msg}");
-        assert!(
-            msg.starts_with("cut.log.gz: the gzip stream is truncated or corrupt after line"),
-            "{msg}"
-        );
+        // At the last complete line: `file:line:col` like every other error.
+        let CarmenError::Decompress { line, .. } = e else {
+            unreachable!()
+        };
+        let at = if line == 0 {
+            "cut.log.gz:1:1: the gzip stream is truncated or corrupt before its first complete line"
+                .to_string()
+        } else {
+            format!(
+                "cut.log.gz:{line}:1: the gzip stream is truncated or corrupt after this line, the last complete one"
+            )
+        };
+        assert!(msg.starts_with(&at), "{msg}");
     }
     // On a real file, the line reached is named.
     if let Some(dir) = shared("carmen") {

@@ -122,3 +122,39 @@ fn parts_of_edited_inputs_are_refused_naming_the_input() {
         "{err}"
     );
 }
+
+/// A part or a baseline that is not UTF-8 is refused at the first bad byte's line and column,
+/// and bad JSON says its place once (serde_json's "at line L column C" is not repeated).
+#[test]
+fn parts_and_baselines_that_do_not_read_are_located_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let bin = dir.path().join("part.json");
+    std::fs::write(&bin, b"{\"format\":\n  \"placewords-suite/1\xff\"}").unwrap();
+    let comma = dir.path().join("comma.json");
+    std::fs::write(&comma, "{\"format\":\n 1,}").unwrap();
+    let (bin, comma) = (bin.to_str().unwrap(), comma.to_str().unwrap());
+    for (args, at) in [
+        (
+            vec!["merge", bin, "-o", out.to_str().unwrap()],
+            format!("{bin}:2:22: the file is not valid UTF-8"),
+        ),
+        (
+            vec!["compare", bin, bin],
+            format!("{bin}:2:22: the file is not valid UTF-8"),
+        ),
+        (
+            vec!["merge", comma, "-o", out.to_str().unwrap()],
+            format!("{comma}:2:2: not a part"),
+        ),
+    ] {
+        let o = placewords(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(&at), "{args:?}: {err}");
+        assert!(
+            !err.contains(" at line "),
+            "{args:?}: the place twice: {err}"
+        );
+    }
+}

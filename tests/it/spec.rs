@@ -17,11 +17,16 @@ fn problems(shown: &Path) -> Option<String> {
             .err()?
             .render(MessageFormat::Human)
     } else if name.ends_with(".map") {
-        let e = match read_text(shown) {
+        // `world import`: its repairs (warnings) and its error; `None` for a clean import.
+        let src = match read_text(shown) {
             Err(e) => return Some(e.render(MessageFormat::Human).join("\n")),
-            Ok(src) => placewords::io::mobilesim::import_mobilesim(&src, &name).err()?,
+            Ok(src) => src,
         };
-        vec![e.to_string()]
+        match placewords::authoring::import::import_map(&src, &name, "imported.toml") {
+            Ok(w) if w.repairs.is_empty() => return None,
+            Ok(w) => w.repairs.iter().map(ToString::to_string).collect(),
+            Err(e) => vec![e.to_string()],
+        }
     } else if name.ends_with(".world.toml") {
         placewords::world::load_world(shown)
             .err()?
@@ -99,7 +104,92 @@ fn fuzz_finds_give_located_messages() {
 /// checks and then panicked, aborted or never ended in the simulator or the recognizer.
 #[test]
 fn fuzz_finds_of_december_give_located_messages() {
-    check_folder("tests/fixtures/fuzz-finds", 9);
+    check_folder("tests/fixtures/fuzz-finds", 15);
+}
+
+/// The December `.map` finds through the binary: a map with a segment drawn twice or a home
+/// heading of 1000 degrees imports (exit 0, the repair said at its line) to a world `world
+/// check` accepts; the map with a line stretched 350 m out (a minute before) is refused with
+/// `world check`'s reason, exit 2, and nothing is written.
+#[test]
+fn december_maps_import_to_worlds_that_check_or_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("w.toml");
+    let out_arg = out.to_str().unwrap();
+    for (map, repair) in [
+        ("dup-line", "10:1: warning: this segment repeats line 9"),
+        ("heading", "7:1: warning: RobotHome heading 1000 degrees"),
+    ] {
+        let map = format!("tests/fixtures/fuzz-finds/INCONSISTENT-import-ok-check-fails-{map}.map");
+        let o = super::common::placewords(&["world", "import", &map, "-o", out_arg]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{map}: {err}");
+        assert!(err.contains(&format!("{map}:{repair}")), "{map}: {err}");
+        let o = super::common::placewords(&["world", "check", out_arg]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{map}: the import fails its check: {err}"
+        );
+        std::fs::remove_file(&out).unwrap();
+    }
+    let map = "tests/fixtures/fuzz-finds/SLOW-map-import-60s-far-line.map";
+    let o = super::common::placewords(&["world", "import", map, "-o", out_arg]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!(
+            "{map}:1:1: error: the world this map gives fails `world check`"
+        )) && err.contains("outside every wall loop"),
+        "{err}"
+    );
+    assert!(!out.exists(), "nothing is written");
+}
+
+/// The December CSV find and its kin: invalid UTF-8 in a matches file, and a row naming a scan
+/// the logs do not hold, are refused at the file's line and column with exit 2.
+#[test]
+fn matches_files_are_refused_at_their_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let logs = dir.path().join("logs");
+    let o = super::common::placewords(&[
+        "simulate",
+        "scenarios/smoke.toml",
+        "--laps",
+        "1",
+        "-q",
+        "-o",
+        logs.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let far = dir.path().join("far.csv");
+    std::fs::write(
+        &far,
+        "query_run,query_scan,matched_run,matched_scan\n0,1,0,0\n\n0,5,7,3\n",
+    )
+    .unwrap();
+    let far = far.to_str().unwrap().to_string();
+    for (csv, at) in [
+        (
+            "tests/fixtures/fuzz-finds/UNLOCATED-score-invalid-utf8.csv".to_string(),
+            ":2:7: the file is not valid UTF-8 (byte 0xff)",
+        ),
+        (
+            far.clone(),
+            ":4:1: run 7 scan 3 is not in the logs (runs are 0, 1)",
+        ),
+    ] {
+        let o = super::common::placewords(&["score", logs.to_str().unwrap(), "--matches", &csv]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{csv}: {err}");
+        assert!(err.contains(&format!("{csv}{at}")), "{csv}: {err}");
+    }
 }
 
 /// Fuzz find 8: a world of 99,000 wall segments passed the checks, then a lap never ended.
