@@ -33,7 +33,9 @@ use super::site_tree::Site;
 use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 // foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
-// profile of scoring as matches arrive (BENCHMARKS.md, issue 30).
+// profile of scoring as matches arrive (BENCHMARKS.md, issue 30). The maps keyed by packed
+// pairs hash them so that a run of pairs lands in neighbouring buckets (`pair_set::PairMap`).
+use super::pair_set::PairMap;
 use foldhash::{HashMap, HashSet};
 
 /// What a tally counts.
@@ -105,13 +107,13 @@ pub struct Tally {
     /// Distinct resolved pairs at or after the horizon, packed `(query, past)` observation
     /// indices → bits: seen by facing (0 either, 1 same, 2 opposite), found for pair recall by
     /// facing (3 + the same).
-    window: HashMap<u64, u8>,
+    window: PairMap<u8>,
     /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
     /// recognizer that names unknown observations is broken, not long-running).
     unresolved: HashMap<u64, u8>,
     /// (query index, lap) → claims (bit 0 same, bit 1 opposite) of the correct pairs joining
     /// them, for queries at or after the horizon.
-    visits_window: HashMap<u64, u8>,
+    visits_window: PairMap<u8>,
     /// The same behind the horizon: `query << 32 | lap << 2 | claims`.
     visits: Vec<u64>,
     /// Query indices below this were forgotten.
@@ -158,9 +160,9 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            window: HashMap::default(),
+            window: PairMap::default(),
             unresolved: HashMap::default(),
-            visits_window: HashMap::default(),
+            visits_window: PairMap::default(),
             visits: Vec::new(),
             evicted_below: 0,
             late_pairs: 0,
@@ -237,6 +239,19 @@ impl Tally {
             let entry = self.window.entry(pack(qi, pi)).or_insert(0);
             let before = *entry;
             let cfg = self.scorer.config(qi);
+            if before & (1 << claim_bit) != 0 {
+                // Seen with this claim: every figure counting it has counted it, its pair
+                // recall and visit were recorded then (the same test of the same pair), so
+                // only the match's own tally is left.
+                if new_in_match {
+                    for s in self.slots.iter_mut().filter(|s| counts(s)) {
+                        s.n += 1;
+                        s.ok += usize::from(d2 <= s.radius_m * s.radius_m && agrees);
+                        s.cfg.get_or_insert(cfg);
+                    }
+                }
+                continue;
+            }
             let mut recalls = false;
             for s in self.slots.iter_mut().filter(|s| counts(s)) {
                 let correct = d2 <= s.radius_m * s.radius_m && agrees;
