@@ -23,9 +23,10 @@
 //!
 //! What needs every observation's truth (which observations have a revisit, which earlier laps
 //! pass there, how many pairs could have been found) is computed at [`Tally::finish`] from the
-//! truth sites: the earlier laps at `tp_radius_m` in one sweep of [`super::lap_grid`], which
-//! also gives the revisits at that radius of every facing, and the revisits at the other radii
-//! and the possible pairs from the k-d tree of [`super::site_tree`]. So memory grows with the observations and with the
+//! truth sites: the earlier laps at `tp_radius_m` in one sweep of the lap grid
+//! (`eval::lap_grid`), which also gives the revisits at that radius of every facing, and the
+//! revisits at the other radii and the possible pairs from the k-d tree of
+//! [`super::site_tree`]. So memory grows with the observations and with the
 //! (observation, lap) pairs found, never with the aligned pairs: `placewords run` and
 //! `recognize` score a thousand-lap run this way while it is recognized ([`super::Recording`]),
 //! and [`super::evaluate`] scores a finished recognition by feeding its matches in order.
