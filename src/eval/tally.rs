@@ -18,9 +18,15 @@
 //!   packed `u64` per (observation, lap), not per pair.
 //! - **Pair recall.** The count of distinct correct pairs.
 //!
+//! A pair that comes again with the claim it was counted with (later matches of a chain repeat
+//! most of the earlier ones' pairs) only counts in its match: its map entry is the one lookup.
+//!
 //! What needs every observation's truth (which observations have a revisit, which earlier laps
 //! pass there, how many pairs could have been found) is computed at [`Tally::finish`] from the
-//! truth sites ([`super::site_tree`]). So memory grows with the observations and with the
+//! truth sites: the earlier laps at `tp_radius_m` in one sweep of the lap grid
+//! (`eval::lap_grid`), which also gives the revisits at that radius of every facing, and the
+//! revisits at the other radii and the possible pairs from the k-d tree of
+//! [`super::site_tree`]. So memory grows with the observations and with the
 //! (observation, lap) pairs found, never with the aligned pairs: `placewords run` and
 //! `recognize` score a thousand-lap run this way while it is recognized ([`super::Recording`]),
 //! and [`super::evaluate`] scores a finished recognition by feeding its matches in order.
@@ -33,7 +39,9 @@ use super::site_tree::Site;
 use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 // foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
-// profile of scoring as matches arrive (BENCHMARKS.md, issue 30).
+// profile of scoring as matches arrive (BENCHMARKS.md, issue 30). The maps keyed by packed
+// pairs hash them so that a run of pairs lands in neighbouring buckets (`pair_set::PairMap`).
+use super::pair_set::PairMap;
 use foldhash::{HashMap, HashSet};
 
 /// What a tally counts.
@@ -105,13 +113,13 @@ pub struct Tally {
     /// Distinct resolved pairs at or after the horizon, packed `(query, past)` observation
     /// indices → bits: seen by facing (0 either, 1 same, 2 opposite), found for pair recall by
     /// facing (3 + the same).
-    window: HashMap<u64, u8>,
+    window: PairMap<u8>,
     /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
     /// recognizer that names unknown observations is broken, not long-running).
     unresolved: HashMap<u64, u8>,
     /// (query index, lap) → claims (bit 0 same, bit 1 opposite) of the correct pairs joining
     /// them, for queries at or after the horizon.
-    visits_window: HashMap<u64, u8>,
+    visits_window: PairMap<u8>,
     /// The same behind the horizon: `query << 32 | lap << 2 | claims`.
     visits: Vec<u64>,
     /// Query indices below this were forgotten.
@@ -158,9 +166,9 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            window: HashMap::default(),
+            window: PairMap::default(),
             unresolved: HashMap::default(),
-            visits_window: HashMap::default(),
+            visits_window: PairMap::default(),
             visits: Vec::new(),
             evicted_below: 0,
             late_pairs: 0,
@@ -212,6 +220,9 @@ impl Tally {
             (s.n, s.ok, s.cfg) = (0, 0, None);
         }
         self.in_match.clear();
+        // Pairs repeat within a match only where its runs' queries overlap (a run's queries are
+        // distinct), so the set of the match's pairs is kept only then.
+        let may_repeat = !queries_disjoint(m);
         for (query, past) in m.pairs() {
             let resolved = self.scorer.resolve(query, past);
             let Some((qi, pi, q, pa)) = resolved else {
@@ -230,10 +241,23 @@ impl Tally {
             }
             let d2 = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2);
             let agrees = claim.agrees(q.theta, pa.theta, tol);
-            let new_in_match = self.in_match.insert((query, past));
-            let key = pack(qi, pi);
-            let before = self.window.get(&key).copied().unwrap_or(0);
+            let new_in_match = !may_repeat || self.in_match.insert((query, past));
+            let entry = self.window.entry(pack(qi, pi)).or_insert(0);
+            let before = *entry;
             let cfg = self.scorer.config(qi);
+            if before & (1 << claim_bit) != 0 {
+                // Seen with this claim: every figure counting it has counted it, its pair
+                // recall and visit were recorded then (the same test of the same pair), so
+                // only the match's own tally is left.
+                if new_in_match {
+                    for s in self.slots.iter_mut().filter(|s| counts(s)) {
+                        s.n += 1;
+                        s.ok += usize::from(d2 <= s.radius_m * s.radius_m && agrees);
+                        s.cfg.get_or_insert(cfg);
+                    }
+                }
+                continue;
+            }
             let mut recalls = false;
             for s in self.slots.iter_mut().filter(|s| counts(s)) {
                 let correct = d2 <= s.radius_m * s.radius_m && agrees;
@@ -258,7 +282,9 @@ impl Tally {
                 }
             }
             let mut after = before | 1 | (1 << claim_bit);
-            if recalls && self.could_be_found((qi, &q), (pi, &pa), claim, truth) {
+            if recalls
+                && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim, truth)
+            {
                 for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
                     let bit = 1 << (3 + facing_bit(s.facing));
                     if before & bit == 0 {
@@ -267,7 +293,7 @@ impl Tally {
                     }
                 }
             }
-            self.window.insert(key, after);
+            *entry = after;
             if recalls && d2 <= r_main * r_main && agrees {
                 let claims = if claim == Facing::Same { 1 } else { 2 };
                 *self.visits_window.entry(pack(qi, pa.lap)).or_insert(0) |= claims;
@@ -282,28 +308,6 @@ impl Tally {
                 s.per_cfg[c].correct_matches += usize::from(good);
             }
         }
-    }
-
-    /// Pair recall's test of a pair claimed `claim`: the two frames' true positions within
-    /// `tp_radius_m`, at least `min_gap_m` of true travel apart, facing as claimed
-    /// (`pair_recall::pair_recall`'s rule).
-    fn could_be_found(
-        &self,
-        (qi, qs): (usize, &Site),
-        (pi, ps): (usize, &Site),
-        claim: Facing,
-        truth: &GroundTruth,
-    ) -> bool {
-        let r = self.spec.tp_radius_m;
-        if r <= 0.0 || !r.is_finite() {
-            return false;
-        }
-        let (fq, fp) = (self.scorer.frame_of(qi), self.scorer.frame_of(pi));
-        let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
-        // A site's travel is its frame's.
-        qs.travel_m - ps.travel_m >= self.spec.min_gap_m
-            && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
-            && claim.agrees(q.theta, p.theta, self.scorer.heading_tol_rad())
     }
 
     /// Forgets the pairs whose query index is below `query_index` (a recognizer's query horizon:
@@ -402,19 +406,31 @@ impl Tally {
         let sites = self.frame_sites(truth);
         let mut possible_of = Vec::new();
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
-        // Every figure with visit recall is at `tp_radius_m`.
-        let mut visit_recalls = None;
+        // Every figure with visit recall is at `tp_radius_m`; its sweep of the earlier laps
+        // also tells which observations have a revisit there, of every facing.
+        let mut visit_recalls: Option<(f64, VisitSweep)> = None;
         for s in &self.slots {
             let scorer = self.scorer.with_facing(s.facing);
-            let revisits = scorer.revisits(s.radius_m);
-            let (mut m, cfgs) = s.metrics(&revisits, &scorer);
+            if s.recalls && visit_recalls.as_ref().is_none_or(|(r, _)| *r != s.radius_m) {
+                visit_recalls = Some((s.radius_m, self.visit_recalls(s.radius_m)));
+            }
+            let bit = usize::from(facing_bit(s.facing));
+            let swept = visit_recalls
+                .as_ref()
+                .filter(|(r, _)| *r == s.radius_m)
+                .and_then(|(_, v)| v.revisits.as_ref());
+            let computed;
+            let revisits = match swept {
+                Some(by_facing) => &by_facing[bit],
+                None => {
+                    computed = scorer.revisits(s.radius_m);
+                    &computed
+                }
+            };
+            let (mut m, cfgs) = s.metrics(revisits, &scorer);
             if s.recalls {
-                let recalls = match visit_recalls {
-                    Some((r, v)) if r == s.radius_m => v,
-                    _ => self.visit_recalls(s.radius_m),
-                };
-                visit_recalls = Some((s.radius_m, recalls));
-                m.visit_recall = recalls[usize::from(facing_bit(s.facing))];
+                let recalls = visit_recalls.as_ref().map_or([0.0; 3], |(_, v)| v.recall);
+                m.visit_recall = recalls[bit];
                 let possible = self.possible(&sites, s.radius_m, s.facing, &mut possible_of);
                 m.pair_recall = PairRecall {
                     possible,
@@ -477,20 +493,36 @@ impl Tally {
     /// Visit recall at radius `r` of each facing, indexed as [`facing_bit`]: the earlier laps
     /// each observation was correctly paired with ÷ the earlier laps that revisit it. The laps
     /// of either facing are the union of those of the same and the opposite facing, found in
-    /// one sweep of the lap grid ([`Scorer::sweep_laps`]).
-    fn visit_recalls(&self, r: f64) -> [f64; 3] {
+    /// one sweep of the lap grid ([`Scorer::sweep_laps`]), which also tells which observations
+    /// have a revisit of each facing (an earlier lap revisits them so): the revisits at `r`
+    /// need no search of their own.
+    fn visit_recalls(&self, r: f64) -> VisitSweep {
         if r <= 0.0 || !r.is_finite() {
-            return [0.0; 3];
+            return VisitSweep {
+                recall: [0.0; 3],
+                revisits: None,
+            };
         }
         if self.by_site_tree {
-            return [Facing::Either, Facing::Same, Facing::Opposite]
-                .map(|f| self.visit_recall_by_site_tree(r, f));
+            // The reference counts the revisits apart ([`Scorer::revisits`]).
+            return VisitSweep {
+                recall: [Facing::Either, Facing::Same, Facing::Opposite]
+                    .map(|f| self.visit_recall_by_site_tree(r, f)),
+                revisits: None,
+            };
         }
         // Per lap: bit 0 revisits the query the same way, bit 1 the opposite way.
         let mut mark: Vec<u8> = Vec::new();
         let mut at = 0usize;
         let (mut visits, mut found) = ([0usize; 3], [0usize; 3]);
+        // An observation has a revisit of a facing when an earlier lap revisits it so (either:
+        // the same or the opposite way); those without truth have none.
+        let n = self.scorer.observation_count();
+        let mut revisits = [vec![false; n], vec![false; n], vec![false; n]];
         self.scorer.sweep_laps(r, |i, [same, opposite]| {
+            revisits[0][i] = !same.is_empty() || !opposite.is_empty();
+            revisits[1][i] = !same.is_empty();
+            revisits[2][i] = !opposite.is_empty();
             for (laps, bit) in [(same, 1), (opposite, 2)] {
                 for &l in laps {
                     if mark.len() <= l {
@@ -513,7 +545,10 @@ impl Tally {
                 mark[l] = 0;
             }
         });
-        [0, 1, 2].map(|f| super::metrics::ratio(found[f], visits[f]))
+        VisitSweep {
+            recall: [0, 1, 2].map(|f| super::metrics::ratio(found[f], visits[f])),
+            revisits: Some(revisits),
+        }
     }
 
     /// Visit recall at radius `r` of one facing, the laps from the k-d tree of every earlier
@@ -611,6 +646,47 @@ impl Slot {
     }
 }
 
+/// Pair recall's test of a pair claimed `claim`: the two frames' true positions within
+/// `tp_radius_m`, at least `min_gap_m` of true travel apart, facing as claimed
+/// (`pair_recall::pair_recall`'s rule). A free function so that it can run while the tally's
+/// pair map is borrowed.
+fn could_be_found(
+    scorer: &Scorer,
+    spec: &EvaluationSpec,
+    (qi, qs): (usize, &Site),
+    (pi, ps): (usize, &Site),
+    claim: Facing,
+    truth: &GroundTruth,
+) -> bool {
+    let r = spec.tp_radius_m;
+    if r <= 0.0 || !r.is_finite() {
+        return false;
+    }
+    let (fq, fp) = (scorer.frame_of(qi), scorer.frame_of(pi));
+    let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
+    // A site's travel is its frame's.
+    qs.travel_m - ps.travel_m >= spec.min_gap_m
+        && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
+        && claim.agrees(q.theta, p.theta, scorer.heading_tol_rad())
+}
+
+/// Whether the query ranges of `m`'s runs are in increasing order and do not overlap (then no
+/// pair of `m` repeats: a run's queries are distinct).
+fn queries_disjoint(m: &Match) -> bool {
+    m.runs
+        .windows(2)
+        .all(|w| w[0].query_start + w[0].len as usize <= w[1].query_start)
+}
+
+/// What one sweep of the earlier laps at a radius gives, per facing indexed as [`facing_bit`].
+struct VisitSweep {
+    /// Visit recall.
+    recall: [f64; 3],
+    /// Per observation: whether it has a revisit (`None` from the reference searches, which
+    /// count them apart).
+    revisits: Option<[Vec<bool>; 3]>,
+}
+
 /// The mark of the lap of `visits` entry `v` (`query << 32 | lap << 2 | claims`), 0 when unmarked.
 fn lap_mark(mark: &[u8], v: u64) -> u8 {
     mark.get(((v & 0xffff_ffff) >> 2) as usize)
@@ -658,7 +734,102 @@ pub fn gain(here: &[u64], fewer: &[u64], correct: impl Fn(usize, usize) -> bool)
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::LapInfo;
     use crate::eval::metrics::tests::circle;
+    use crate::geom::{OdomPose, Pose2, TruePose};
+    use crate::place::Direction;
+    use proptest::prelude::*;
+
+    /// Laps of a short route, each `(run, reversed, offset)`: driven one way or the other, moved
+    /// sideways, with a heading wobble; some frames without an observation.
+    fn laps_of(laps: &[(usize, bool, f64)], wobble: &[f64]) -> (Vec<Observation>, GroundTruth) {
+        let (mut obs, mut gt) = (Vec::new(), GroundTruth::default());
+        let per_lap = wobble.len();
+        for (lap, &(run, reversed, offset)) in laps.iter().enumerate() {
+            gt.start_lap(LapInfo {
+                run,
+                lap,
+                door_config: format!("c{}", lap % 3),
+                open_doors: vec![],
+            });
+            for k in 0..per_lap {
+                let u = if reversed { per_lap - 1 - k } else { k };
+                // A corner halfway: along x, then along y.
+                let t = u as f64 * 0.25;
+                let (x, y, along) = if t < 5.0 {
+                    (t, offset, 0.0)
+                } else {
+                    (5.0 + offset, t - 5.0, std::f64::consts::FRAC_PI_2)
+                };
+                let back = if reversed { std::f64::consts::PI } else { 0.0 };
+                let pose = Pose2::new(x, y, along + back + wobble[(k + lap) % per_lap]);
+                let frame = gt.frames.len();
+                gt.push_frame(TruePose(pose), OdomPose(pose));
+                if k % 7 != 3 {
+                    let id = obs.len();
+                    obs.push(Observation::new(
+                        id,
+                        run,
+                        frame,
+                        OdomPose(pose),
+                        frame as f64,
+                    ));
+                }
+            }
+        }
+        (obs, gt)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        /// Every figure of the searches in use equals that of the reference searches (the k-d
+        /// tree of every earlier site, `by_site_tree`), on small random runs and matches.
+        #[test]
+        fn figures_equal_the_reference_searches(
+            laps in proptest::collection::vec((0usize..3, any::<bool>(), -0.6f64..0.6), 1..6),
+            wobble in proptest::collection::vec(-0.9f64..0.9, 40..60),
+            picks in proptest::collection::vec((any::<u16>(), any::<u16>(), 1u32..6, any::<bool>()), 0..40),
+            gap_m in prop_oneof![Just(0.0), Just(2.0), 0.0f64..30.0],
+            tp_radius_m in prop_oneof![Just(1.0), 0.1f64..3.0],
+            tol_deg in prop_oneof![Just(45.0), 5.0f64..120.0],
+        ) {
+            let mut laps = laps;
+            laps.sort_by_key(|l| l.0);
+            let (obs, gt) = laps_of(&laps, &wobble);
+            let n = obs.len();
+            // Each match two runs of pairs, whose queries may overlap (pairs may repeat).
+            let matches: Vec<Match> = picks
+                .chunks(2)
+                .filter(|_| n > 1)
+                .map(|two| {
+                    let runs = two.iter().flat_map(|&(a, b, len, _)| {
+                        let (a, b) = (a as usize % n, b as usize % n);
+                        let (q, p) = (a.max(b), a.min(b));
+                        let len = (len as usize).min(n - q);
+                        Match::from_pairs((0..len).map(move |d| (q + d, p + d)), 1.0).runs
+                    });
+                    let direction = if two[0].3 { Direction::Opposite } else { Direction::Same };
+                    Match::new(runs.collect(), direction, 1.0)
+                })
+                .collect();
+            let spec = EvaluationSpec {
+                min_gap_m: gap_m,
+                tp_radius_m,
+                heading_tolerance_deg: tol_deg,
+                ..EvaluationSpec::default()
+            };
+            let score = |reference: bool| {
+                let mut t = Tally::new(&spec, Scope::Full);
+                if reference {
+                    t.by_site_tree();
+                }
+                t.sync(&obs, &gt);
+                matches.iter().for_each(|m| t.add(m, &gt));
+                t.finish(&gt)
+            };
+            prop_assert_eq!(score(false), score(true));
+        }
+    }
 
     /// Observation ids need not be positions: the same observations and match with every id
     /// moved by 1000 score the same, and a match naming ids never reported is not scored.
