@@ -321,3 +321,48 @@ impl LapCache {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, SystemTime};
+
+    /// With a bound, storing an entry removes the oldest others (by modification time) until
+    /// the entries fit, never the one just stored; files that are not entries stay.
+    #[test]
+    fn the_bound_removes_the_oldest_entries_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let old = SystemTime::now() - Duration::from_secs(3600);
+        let put = |name: &str, age_s: u64| {
+            let p = dir.path().join(name);
+            std::fs::write(&p, vec![0u8; 1000]).unwrap();
+            let f = std::fs::File::options().write(true).open(&p).unwrap();
+            f.set_modified(old + Duration::from_secs(age_s)).unwrap();
+            p
+        };
+        let (a, b, c) = (put("a.laps", 0), put("b.laps", 10), put("c.laps", 20));
+        let other = put("notes.txt", 0);
+        let cache = LapCache::open(dir.path(), Some(2500e-9)).unwrap();
+        cache.evict(&a);
+        assert!(a.exists(), "the entry just stored stays, old as it is");
+        assert!(!b.exists(), "the oldest other goes first");
+        assert!(c.exists() && other.exists());
+        let unbounded = LapCache::open(dir.path(), None).unwrap();
+        unbounded.evict(&c);
+        assert!(a.exists() && c.exists());
+        assert!(LapCache::open(dir.path(), Some(-1.0)).is_err());
+    }
+
+    /// The key follows the seed and the lap counts, and names this build's simulator.
+    #[test]
+    fn the_key_follows_seed_and_laps() {
+        let scn = crate::experiment::load_scenario(Path::new("scenarios/smoke.toml")).unwrap();
+        let k = LapCache::key(&scn.sim, &[3, 2]);
+        assert_eq!(k, LapCache::key(&scn.sim.clone(), &[3, 2]));
+        assert_ne!(k, LapCache::key(&scn.sim, &[3, 1]));
+        let mut other = scn.sim.clone();
+        other.seed += 1;
+        assert_ne!(k, LapCache::key(&other, &[3, 2]));
+        assert_eq!(SIM_SOURCES.len(), 32);
+    }
+}

@@ -38,7 +38,7 @@ const ZSTD_LEVEL: i32 = 1;
 const END: u32 = u32::MAX;
 
 /// Most raw bytes one lap may claim (a lap of the longest route is a few tens of MB).
-const MAX_RAW_LAP: u64 = 1 << 32;
+const MAX_RAW_LAP: u64 = 1 << 30;
 
 /// Why a lap file could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -255,9 +255,15 @@ impl<R: Read> LapFileReader<R> {
         read_exact(&mut self.inp, &mut lens, &mut self.left, &place)?;
         let packed_len = u64::from_le_bytes(lens[..8].try_into().expect("8"));
         let raw_len = u64::from_le_bytes(lens[8..16].try_into().expect("8"));
-        if packed_len > self.left || raw_len > MAX_RAW_LAP {
+        if packed_len > self.left {
             return Err(corrupt(format!(
-                "{place} claims {packed_len} bytes ({raw_len} unpacked), more than the file holds"
+                "truncated in {place}: it claims {packed_len} bytes, the file holds {} more",
+                self.left
+            )));
+        }
+        if raw_len > MAX_RAW_LAP {
+            return Err(corrupt(format!(
+                "{place} claims {raw_len} bytes unpacked, more than a lap may hold"
             )));
         }
         let mut packed = vec![0u8; packed_len as usize];

@@ -3,6 +3,7 @@
 mod architecture;
 mod authoring;
 mod bag;
+mod cache;
 mod ci;
 mod cli;
 mod common;
