@@ -1,6 +1,12 @@
 //! Records the git commit the crate is built from as `PLACEWORDS_GIT_COMMIT`, for the
 //! provenance every report carries (`eval::provenance`). Outside a git checkout, or without
 //! git, it is `unknown`: the build never fails for it and never touches the network.
+//!
+//! Also records `PLACEWORDS_SIM_SOURCES`, a fingerprint of the sources simulated laps depend on
+//! (`src/sim`, `src/world`, `src/geom.rs`, `src/scan.rs`, `src/log.rs`, `Cargo.lock`, the
+//! target), which the lap cache (`experiment::cache`) keys its entries with beside the
+//! simulation key: a binary whose simulator differs never reads another's laps, even when
+//! `SIMULATOR_VERSION` was not raised.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -50,4 +56,56 @@ fn main() {
         watch(common.join("packed-refs"));
     }
     println!("cargo:rustc-env=PLACEWORDS_GIT_COMMIT={commit}");
+    println!(
+        "cargo:rustc-env=PLACEWORDS_SIM_SOURCES={}",
+        sim_sources(&dir)
+    );
+}
+
+/// The files under `p` (or `p` itself), sorted, recursively.
+fn files(p: &Path, out: &mut Vec<PathBuf>) {
+    match std::fs::read_dir(p) {
+        Ok(entries) => {
+            let mut v: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+            v.sort();
+            v.iter().for_each(|e| files(e, out));
+        }
+        Err(_) if p.is_file() => out.push(p.to_path_buf()),
+        Err(_) => {}
+    }
+}
+
+/// 32 hex digits of two FNV-1a hashes over the simulator's source files (name and bytes) and
+/// the target triple: a fingerprint, not a security hash.
+fn sim_sources(dir: &Path) -> String {
+    let mut paths = Vec::new();
+    for p in [
+        "src/sim",
+        "src/world",
+        "src/geom.rs",
+        "src/scan.rs",
+        "src/log.rs",
+        "Cargo.lock",
+    ] {
+        println!("cargo:rerun-if-changed={p}");
+        files(&dir.join(p), &mut paths);
+    }
+    let mut h = [0xcbf2_9ce4_8422_2325u64, 0x6c62_272e_07bb_0142u64];
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            for x in &mut h {
+                *x = (*x ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+        }
+    };
+    eat(std::env::var("TARGET").unwrap_or_default().as_bytes());
+    for p in paths {
+        eat(p
+            .strip_prefix(dir)
+            .unwrap_or(&p)
+            .to_string_lossy()
+            .as_bytes());
+        eat(&std::fs::read(&p).unwrap_or_default());
+    }
+    format!("{:016x}{:016x}", h[0], h[1])
 }

@@ -1,6 +1,7 @@
 //! Simulator benchmarks: one 181-beam scan on an institute-floor-sized world at both laser
 //! presets, one simulation step (physics, controller, odometry, and a scan every other step),
-//! and one full lap. Setup stays outside the timed part.
+//! and one full lap; writing and reading one lap as a lap cache entry (`io::lap_file`). Setup
+//! stays outside the timed part.
 //!
 //! The world is `worlds/institute-floor.toml` through `scenarios/B.toml`.
 
@@ -86,7 +87,44 @@ fn bench_lap(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_scan, bench_step, bench_lap);
+/// One lap of the institute floor stored in and read from a lap cache entry (in memory).
+fn bench_lap_file(c: &mut Criterion) {
+    use placewords::io::lap_file::{LapFileReader, LapFileWriter};
+    let scn = scenario();
+    let lap = RunSim::new(&scn.sim, 0).run_lap(0).expect("not blocked");
+    let key = "0".repeat(64);
+    let write = || {
+        let mut w = LapFileWriter::new(Vec::new(), &key, &[1]).expect("in memory");
+        w.push(0, &lap).expect("in memory");
+        w.finish().expect("in memory")
+    };
+    let bytes = write();
+    eprintln!(
+        "lap file: {} frames, {} bytes ({:.0} % of the ranges' 8 bytes each)",
+        lap.frames.len(),
+        bytes.len(),
+        100.0 * bytes.len() as f64
+            / (8 * lap
+                .frames
+                .iter()
+                .map(|f| f.scan.ranges_m.len())
+                .sum::<usize>()) as f64
+    );
+    let mut g = c.benchmark_group("lap_file");
+    g.sample_size(10);
+    g.bench_function("write_one_lap_institute_floor", |b| {
+        b.iter(|| black_box(write().len()))
+    });
+    g.bench_function("read_one_lap_institute_floor", |b| {
+        b.iter(|| {
+            let r = LapFileReader::open(&bytes[..], bytes.len() as u64).expect("intact");
+            black_box(r.read_runs().expect("intact").len())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_scan, bench_step, bench_lap, bench_lap_file);
 
 fn main() {
     benches();

@@ -133,7 +133,7 @@ fn load(args: &Args) -> Result<(Vec<RunLog>, RecognizerConfig)> {
         // Its errors name the file, line and column.
         let mut scn = load_scenario(path)?;
         scn.sim.seed = args.seed;
-        let (runs, _) = simulate(&scn, &ExperimentOptions::default())?;
+        let (runs, _, _) = simulate(&scn, &ExperimentOptions::default())?;
         return Ok((runs, scn.recognizer.clone()));
     }
     let Some(noise) = real::parse_noise_model("proportional").map_err(anyhow::Error::msg)? else {

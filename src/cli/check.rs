@@ -23,6 +23,8 @@ pub struct CheckArgs {
     pub seeds: SeedsArg,
     #[command(flatten)]
     pub external: super::common::ExternalArg,
+    #[command(flatten)]
+    pub cache: super::common::CacheArg,
     /// Replace every run's lap count (for a quick look: the bounds were set at the scenario's
     /// own laps, so fewer laps may miss them, exit 1).
     #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
@@ -92,11 +94,13 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
             progress: super::progress::bar(args.quiet),
             external: args.external.specs(),
             laps: args.laps,
+            cache: args.cache.open()?,
             ..ExperimentOptions::default()
         },
         command_line: super::common::command_line(),
     };
     let suite = stress::run_stress(&args.scenarios, &opts);
+    super::common::report_cache(opts.experiment.cache.as_deref());
     let w = placewords::clock::Stopwatch::start();
     if let Some(path) = &args.report {
         stress::write_file(path, suite.to_json().as_bytes())?;

@@ -201,3 +201,46 @@ fn parse_max_slowdown(s: &str) -> Result<f64, String> {
         ))
     }
 }
+
+/// `--cache DIR` and `--cache-max-gb N`: the lap cache (`experiment::cache`), shared by
+/// `simulate`, `run`, `check`, `table` and `sweep`.
+#[derive(Debug, Args)]
+pub struct CacheArg {
+    /// Keep simulated laps in DIR under their simulation key and read them back when the key
+    /// matches, so a change of `[recognizer]`, `[evaluation]` or `[expect]` re-runs only
+    /// recognition and scoring (docs/ci.md, "Cached laps"). Clear it by removing DIR.
+    /// Example: placewords check scenarios/B.toml --cache ~/.cache/placewords
+    #[arg(long, value_name = "DIR", env = "PLACEWORDS_CACHE")]
+    pub cache: Option<std::path::PathBuf>,
+    /// Keep the cache's entries within this many GB (10⁹ bytes), removing the oldest first
+    /// (by modification time; a hit counts as use). Default: unbounded.
+    /// Example: --cache-max-gb 5
+    #[arg(
+        long,
+        value_name = "GB",
+        env = "PLACEWORDS_CACHE_MAX_GB",
+        requires = "cache"
+    )]
+    pub cache_max_gb: Option<f64>,
+}
+
+impl CacheArg {
+    /// The cache asked for, opened (its folder created and checked writable before any work).
+    pub fn open(
+        &self,
+    ) -> anyhow::Result<Option<std::sync::Arc<placewords::experiment::cache::LapCache>>> {
+        match &self.cache {
+            None => Ok(None),
+            Some(dir) => Ok(Some(std::sync::Arc::new(
+                placewords::experiment::cache::LapCache::open(dir, self.cache_max_gb)?,
+            ))),
+        }
+    }
+}
+
+/// Prints what the lap cache did (`lap cache DIR: 9 hits, 1 miss`, and each corrupt entry).
+pub fn report_cache(cache: Option<&placewords::experiment::cache::LapCache>) {
+    for line in cache.map(|c| c.used().lines()).unwrap_or_default() {
+        errln!("{line}");
+    }
+}

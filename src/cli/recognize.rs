@@ -128,6 +128,7 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         external: args.external.specs(),
         laps: None,
         progress: super::progress::bar(args.quiet),
+        cache: None,
     };
     let log = experiment::real::RealLogOptions {
         lenient: args.lenient,

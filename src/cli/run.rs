@@ -20,6 +20,8 @@ pub struct RunArgs {
     pub seeds: SeedsArg,
     #[command(flatten)]
     pub external: ExternalArg,
+    #[command(flatten)]
+    pub cache: super::common::CacheArg,
     /// Also run the ICP baseline (slow: every region is aligned with every past region).
     #[arg(long)]
     pub icp: bool,
@@ -63,7 +65,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
+        cache: args.cache.open()?,
     };
+    let cache = opts.cache.clone();
     if let Some(seeds) = args.seeds.seeds {
         let stress_opts = StressOptions {
             seeds: Some(seeds),
@@ -72,6 +76,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
             ..StressOptions::default()
         };
         let suite = stress::run_stress(std::slice::from_ref(&args.scenario), &stress_opts);
+        super::common::report_cache(cache.as_deref());
         let w = Stopwatch::start();
         out!("{}", placewords::report::suite::text_table(&suite))?;
         if let Some(path) = &args.report {
@@ -102,8 +107,10 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
         super::score::export(path, rec, &exp.runs)?;
     }
-    let provenance =
+    super::common::report_cache(cache.as_deref());
+    let mut provenance =
         experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line());
+    provenance.lap_cache = cache.map(|c| c.used());
     print_and_write(
         &exp,
         &scn.sim.world,

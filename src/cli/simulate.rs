@@ -31,6 +31,8 @@ pub struct SimulateArgs {
     /// Also draw each run (world, true path, odometry path) as `run-NNN.svg` in the output folder.
     #[arg(long)]
     pub svg: bool,
+    #[command(flatten)]
+    pub cache: super::common::CacheArg,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -52,6 +54,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|r| args.laps.unwrap_or(r.laps))
         .sum();
+    let cache = args.cache.open()?;
     let started = std::time::Instant::now();
     let files = placewords::experiment::output::simulate_to_folder(
         &scn,
@@ -63,7 +66,9 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         },
         args.svg,
         &super::progress::bar(args.quiet),
+        cache.as_deref(),
     )?;
+    super::common::report_cache(cache.as_deref());
     if !args.quiet {
         errln!(
             "simulated {total} laps and wrote {} files in {:.2} s",

@@ -26,6 +26,8 @@ pub struct SweepArgs {
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
+    #[command(flatten)]
+    pub cache: super::common::CacheArg,
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
@@ -38,9 +40,11 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let opts = ExperimentOptions {
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
+        cache: args.cache.open()?,
         ..ExperimentOptions::default()
     };
-    let (runs, _) = experiment::simulate(&scn, &opts)?;
+    let (runs, _, _) = experiment::simulate(&scn, &opts)?;
+    super::common::report_cache(opts.cache.as_deref());
     let laps = runs.iter().map(|r| r.laps.len()).sum();
     let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), &opts.progress)?;
     let report = SweepReport::new(
@@ -53,10 +57,12 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     out!("{}", curves_table(&report.curves))?;
     write_file(
         &stage.path().join("sweep.json"),
-        placewords::report::json::to_json_with(
-            &report,
-            &experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line()),
-        )
+        placewords::report::json::to_json_with(&report, &{
+            let mut p =
+                experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line());
+            p.lap_cache = opts.cache.as_ref().map(|c| c.used());
+            p
+        })
         .as_bytes(),
     )?;
     let title = format!("{}: precision / recall (Fig. 8)", scn.sim.name);

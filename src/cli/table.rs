@@ -30,6 +30,8 @@ pub struct TableArgs {
     pub laps: Option<usize>,
     #[command(flatten)]
     pub external: super::common::ExternalArg,
+    #[command(flatten)]
+    pub cache: super::common::CacheArg,
     /// No progress bars.
     #[arg(long, short)]
     pub quiet: bool,
@@ -51,6 +53,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         external: args.external.specs(),
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
+        cache: args.cache.open()?,
     };
     // Load every scenario first, so a broken file is reported before minutes of simulation.
     let scenarios = args
@@ -63,7 +66,17 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     for scn in &scenarios {
         errln!("scenario {}", scn.sim.name);
         let exp = experiment::run_scenario(scn, &opts)?;
-        let provenance = experiment::scenario_provenance(&[scn], args.laps, command_line.clone());
+        let mut provenance =
+            experiment::scenario_provenance(&[scn], args.laps, command_line.clone());
+        provenance.lap_cache = opts.cache.as_ref().map(|c| {
+            let mut u = c.used();
+            // This scenario's seed alone: its source, not the counts so far.
+            (u.hits, u.misses) = match exp.lap_source {
+                Some(placewords::eval::provenance::LapSource::Hit) => (1, 0),
+                _ => (0, 1),
+            };
+            u
+        });
         write_file(
             &stage.path().join(format!("report-{}.json", scn.sim.name)),
             placewords::report::json::to_json_with(&exp.report, &provenance).as_bytes(),
@@ -79,7 +92,9 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     out!("{md}")?;
     write_file(&stage.path().join("table.md"), md.as_bytes())?;
     let all: Vec<_> = scenarios.iter().collect();
-    let provenance = experiment::scenario_provenance(&all, args.laps, command_line);
+    let mut provenance = experiment::scenario_provenance(&all, args.laps, command_line);
+    provenance.lap_cache = opts.cache.as_ref().map(|c| c.used());
+    super::common::report_cache(opts.cache.as_deref());
     let json = placewords::report::json::to_json_with(&TableReport { reports }, &provenance);
     write_file(&stage.path().join("table.json"), json.as_bytes())?;
     stage

@@ -102,6 +102,72 @@ pub struct Provenance {
     pub seeds: Vec<u64>,
     /// Every input, in the order the command met them.
     pub inputs: Vec<Input>,
+    /// With `--cache DIR`: how many seeds' laps came from the lap cache and how many were
+    /// simulated (absent without a cache). Not an input: the figures are the same either way.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lap_cache: Option<LapCacheUse>,
+}
+
+/// Where a simulated seed's laps came from, with a lap cache (`experiment::cache`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LapSource {
+    /// Read from the cache: an intact entry under the seed's key.
+    Hit,
+    /// Simulated: no entry under the key (and then stored).
+    Miss,
+    /// Simulated again: the entry under the key was corrupt or truncated (and then replaced).
+    Corrupt,
+}
+
+/// What a lap cache did for one command (`provenance.lap_cache`).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LapCacheUse {
+    /// The cache folder, as given.
+    pub dir: String,
+    /// Seeds (scenario × seed) whose laps were read from the cache.
+    pub hits: usize,
+    /// Seeds simulated (no entry, or a corrupt one), corrupt ones included.
+    pub misses: usize,
+    /// Every corrupt entry found, with why (`FILE: record 3: its checksum differs`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub corrupt: Vec<String>,
+    /// Entries that could not be stored, with why (the run went on without storing them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub not_stored: Vec<String>,
+}
+
+impl LapCacheUse {
+    /// Adds `other`'s counts and notes (the parts of a sharded run).
+    pub fn add(&mut self, other: &LapCacheUse) {
+        self.hits += other.hits;
+        self.misses += other.misses;
+        self.corrupt.extend(other.corrupt.iter().cloned());
+        self.not_stored.extend(other.not_stored.iter().cloned());
+    }
+
+    /// `lap cache DIR: 9 hits, 1 miss`, then a line per corrupt entry and per entry not stored.
+    pub fn lines(&self) -> Vec<String> {
+        let s =
+            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+        let mut out = vec![format!(
+            "lap cache {}: {}, {}",
+            self.dir,
+            s(self.hits, "hit", "hits"),
+            s(self.misses, "miss", "misses")
+        )];
+        out.extend(
+            self.corrupt
+                .iter()
+                .map(|c| format!("lap cache: corrupt entry simulated again: {c}")),
+        );
+        out.extend(
+            self.not_stored
+                .iter()
+                .map(|c| format!("lap cache: laps not stored: {c}")),
+        );
+        out
+    }
 }
 
 impl Default for Provenance {
@@ -115,6 +181,7 @@ impl Default for Provenance {
             command_line: Vec::new(),
             seeds: Vec::new(),
             inputs: Vec::new(),
+            lap_cache: None,
         }
     }
 }
@@ -130,6 +197,7 @@ impl Provenance {
             command_line,
             seeds: Vec::new(),
             inputs: Vec::new(),
+            lap_cache: None,
         }
     }
 

@@ -30,6 +30,9 @@ pub struct SeedResult {
     /// from a report older than provenance.
     #[serde(default)]
     pub simulation_key: String,
+    /// With `--cache`: whether the seed's laps came from the lap cache (absent without one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lap_cache: Option<provenance::LapSource>,
 }
 
 /// One scenario over its seeds.
@@ -340,10 +343,21 @@ pub fn merge(parts: Vec<(String, SuiteReport)>) -> Result<SuiteReport, MergeErro
         seeds: Vec::new(),
         ..first.provenance.clone()
     };
+    whole.provenance.lap_cache = None;
     for (_, p) in &parts {
         whole
             .provenance
             .add_seeds(p.provenance.seeds.iter().copied());
+        if let Some(c) = &p.provenance.lap_cache {
+            whole
+                .provenance
+                .lap_cache
+                .get_or_insert_with(|| provenance::LapCacheUse {
+                    dir: c.dir.clone(),
+                    ..Default::default()
+                })
+                .add(c);
+        }
     }
     Ok(whole)
 }
@@ -525,6 +539,7 @@ mod tests {
                         report: Some(r),
                         error: None,
                         simulation_key: format!("key{seed}"),
+                        lap_cache: None,
                     }
                 })
                 .collect(),

@@ -3,6 +3,7 @@
 //! truth, and gathered in one [`Report`]. The commands `run`, `check`, `table`, `sweep` and
 //! `recognize` are thin layers over this module.
 
+pub mod cache;
 pub mod output;
 pub mod picture;
 pub(crate) mod progress;
@@ -51,6 +52,9 @@ pub enum ExperimentError {
     RealLog(#[from] crate::io::real_log::RealLogError),
     #[error("{0}")]
     External(String),
+    /// A lap cache entry that failed after it was verified.
+    #[error("lap cache: {0}")]
+    Cache(String),
 }
 
 /// What to run.
@@ -72,6 +76,9 @@ pub struct ExperimentOptions {
     pub laps: Option<usize>,
     /// Where progress goes. Default: nowhere.
     pub progress: ProgressSink,
+    /// The lap cache to read simulated laps from and store them in (`--cache DIR`). Default
+    /// none: every lap is simulated.
+    pub cache: Option<std::sync::Arc<cache::LapCache>>,
 }
 
 impl Default for ExperimentOptions {
@@ -84,6 +91,7 @@ impl Default for ExperimentOptions {
             external: Vec::new(),
             laps: None,
             progress: ProgressSink::none(),
+            cache: None,
         }
     }
 }
@@ -122,6 +130,8 @@ pub struct Experiment {
     /// The external subjects' recognitions, by name, in the order of
     /// `ExperimentOptions::external`.
     pub external: Vec<(String, Recognition)>,
+    /// Where the laps came from with a lap cache (`None` without one, or for a real log).
+    pub lap_source: Option<crate::eval::provenance::LapSource>,
 }
 
 /// Which subject a recognition belongs to while an experiment runs.
@@ -180,9 +190,22 @@ pub fn config_for_levels(base: &RecognizerConfig, levels: usize) -> RecognizerCo
 
 pub use crate::recognizer::thresholds;
 
-/// Simulates a scenario, telling its progress per lap; returns the runs and the CPU seconds
-/// the laps cost.
-pub fn simulate(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
+/// Simulates a scenario (or reads its laps from `opts.cache`), telling its progress per lap;
+/// returns the runs, the CPU seconds the laps cost, and where they came from with a cache.
+pub fn simulate(
+    scn: &Scenario,
+    opts: &ExperimentOptions,
+) -> Result<(Vec<RunLog>, f64, Option<crate::eval::provenance::LapSource>), SimError> {
+    match &opts.cache {
+        Some(cache) => cache
+            .runs(&scn.sim, opts.laps, || simulate_here(scn, opts))
+            .map(|(runs, s, source)| (runs, s, Some(source))),
+        None => simulate_here(scn, opts).map(|(runs, s)| (runs, s, None)),
+    }
+}
+
+/// [`simulate`] without a cache.
+fn simulate_here(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog>, f64), SimError> {
     let laps: usize = scn
         .sim
         .runs
@@ -223,7 +246,7 @@ pub fn run_scenario(
 ) -> Result<Experiment, ExperimentError> {
     let opts = &options_for_scenario(scn, opts);
     let base = recognizer_config(scn)?;
-    let (runs, sim_s) = simulate(scn, opts)?;
+    let (runs, sim_s, lap_source) = simulate(scn, opts)?;
     let mut exp = evaluate_runs(
         &scn.sim.name,
         scn.sim.seed,
@@ -234,6 +257,7 @@ pub fn run_scenario(
     )?;
     let laps = exp.report.laps.max(1);
     exp.report.simulate_seconds_per_lap = sim_s / laps as f64;
+    exp.lap_source = lap_source;
     Ok(exp)
 }
 
@@ -365,6 +389,7 @@ fn assemble(
         icp,
         scan_context,
         external,
+        lap_source: None,
     }
 }
 

@@ -41,6 +41,7 @@ pub fn is_simulation_folder(dir: &Path) -> bool {
 /// starts: it must be new, empty or an earlier simulation folder (which is replaced). Each lap is
 /// written as soon as it is simulated and then dropped (with `svg`, its poses are kept), so
 /// memory does not grow with the laps; the folder appears whole when every file is written.
+/// With `cache`, the laps are read from it when it holds them and stored in it when not.
 /// Returns the files written, under `out`; progress is told once per lap simulated.
 pub fn simulate_to_folder(
     scn: &Scenario,
@@ -49,6 +50,7 @@ pub fn simulate_to_folder(
     format: logs::RunFormat,
     svg: bool,
     progress: &super::ProgressSink,
+    cache: Option<&super::cache::LapCache>,
 ) -> Result<Vec<PathBuf>, ExperimentError> {
     let stage = StagedDir::begin(out, &is_simulation_folder)?;
     let laps_of = |run: usize| laps.unwrap_or(scn.sim.runs[run].laps);
@@ -57,7 +59,7 @@ pub fn simulate_to_folder(
     let mut writer = logs::LogsWriter::new(&scn.sim, laps, stage.path(), format);
     let mut paths: Vec<RunLog> = Vec::new();
     let keep = svg.then_some(&mut paths);
-    let (sim, written) = with_laps(&scn.sim, &laps_of, |rx| {
+    let (sim, written) = with_laps(&scn.sim, &laps_of, cache, |rx| {
         write_laps(&mut writer, rx, keep, progress)
     });
     progress.done();

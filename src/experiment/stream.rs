@@ -14,7 +14,9 @@
 
 use super::{ExperimentError, ExperimentOptions, ProgressSink, SubjectId, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
+use crate::eval::provenance::LapSource;
 use crate::eval::{GroundTruth, LapInfo, PlaceRecognizer, Recognition, Recording};
+use crate::experiment::cache::LapCache;
 use crate::external::ExternalRecognizer;
 use crate::log::LapLog;
 use crate::recognizer::{Recognizer, RecognizerConfig};
@@ -47,11 +49,11 @@ pub fn run_scenario_streamed(
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
     opts.progress.start("laps", total as u64);
     let mut truth = GroundTruth::default();
-    let (sim_s, ()) = with_laps(plan, &laps_of, |rx| {
+    let (sim, ()) = with_laps(plan, &laps_of, opts.cache.as_deref(), |rx| {
         feed(&mut jobs, &mut truth, rx, &opts.progress)
     });
     opts.progress.done();
-    let sim_s = sim_s?;
+    let (sim_s, lap_source) = sim?;
     let results = finish_jobs(jobs, truth)?;
     let mut exp = assemble(
         &plan.name,
@@ -63,20 +65,24 @@ pub fn run_scenario_streamed(
         Vec::new(),
     );
     exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
+    exp.lap_source = lap_source;
     Ok(exp)
 }
 
-/// Simulates `plan` (`laps_of(run)` laps per run) on a thread of its own while `consume` takes
-/// the laps, in order, from the receiver it is given; returns the simulation's outcome (seconds
-/// spent simulating) and `consume`'s. Dropping the receiver early stops the simulation.
+/// Simulates `plan` (`laps_of(run)` laps per run) on a thread of its own, or reads its laps
+/// from `cache` when it holds them (storing them there when it does not), while `consume`
+/// takes the laps, in order, from the receiver it is given; returns the simulation's outcome
+/// (CPU seconds spent simulating or reading, and with a cache where the laps came from) and
+/// `consume`'s. Dropping the receiver early stops the simulation (and stores nothing).
 pub(super) fn with_laps<T>(
     plan: &SimPlan,
     laps_of: &(dyn Fn(usize) -> usize + Sync),
+    cache: Option<&LapCache>,
     consume: impl FnOnce(Receiver<(usize, LapLog)>) -> T,
-) -> (Result<f64, SimError>, T) {
+) -> (Result<(f64, Option<LapSource>), ExperimentError>, T) {
     let (tx, rx) = sync_channel::<(usize, LapLog)>(LAPS_AHEAD);
     std::thread::scope(|s| {
-        let producer = s.spawn(move || simulate_laps(plan, laps_of, &tx));
+        let producer = s.spawn(move || produce_laps(plan, laps_of, cache, &tx));
         let out = consume(rx);
         let sim = producer
             .join()
@@ -85,27 +91,72 @@ pub(super) fn with_laps<T>(
     })
 }
 
-/// Simulates every lap of every run in order, sending each as it is made (blocks while
-/// [`LAPS_AHEAD`] laps wait); returns the CPU seconds spent simulating. Stops early when the
-/// receiver is gone.
+/// The laps of `plan`, sent in order: from `cache`'s intact entry when there is one, else
+/// simulated (and stored in `cache`); the CPU seconds spent and where they came from.
+fn produce_laps(
+    plan: &SimPlan,
+    laps_of: &dyn Fn(usize) -> usize,
+    cache: Option<&LapCache>,
+    tx: &SyncSender<(usize, LapLog)>,
+) -> Result<(f64, Option<LapSource>), ExperimentError> {
+    let Some(cache) = cache else {
+        return Ok((simulate_laps(plan, laps_of, tx, &mut |_, _| {})?.0, None));
+    };
+    let counts: Vec<usize> = (0..plan.runs.len()).map(laps_of).collect();
+    let key = LapCache::key(plan, &counts);
+    let w = crate::clock::Stopwatch::start();
+    let source = match cache.open_entry(&key, &counts) {
+        Ok(Some(mut entry)) => {
+            loop {
+                match entry.next_lap() {
+                    Ok(Some(lap)) => {
+                        if tx.send(lap).is_err() {
+                            break;
+                        }
+                    }
+                    Ok(None) => break,
+                    Err(why) => return Err(ExperimentError::Cache(why)),
+                }
+            }
+            cache.count(LapSource::Hit);
+            return Ok((w.cpu_s(), Some(LapSource::Hit)));
+        }
+        Ok(None) => LapSource::Miss,
+        Err(_) => LapSource::Corrupt,
+    };
+    let mut pending = cache.begin(&key, &counts);
+    let (seconds, complete) =
+        simulate_laps(plan, laps_of, tx, &mut |run, lap| pending.push(run, lap))?;
+    if complete {
+        cache.store(pending);
+    }
+    cache.count(source);
+    Ok((seconds, Some(source)))
+}
+
+/// Simulates every lap of every run in order, handing each to `keep` and then sending it
+/// (blocks while [`LAPS_AHEAD`] laps wait); returns the CPU seconds spent simulating (and
+/// keeping) and whether every lap was sent. Stops early when the receiver is gone.
 fn simulate_laps(
     plan: &SimPlan,
     laps_of: &dyn Fn(usize) -> usize,
     tx: &SyncSender<(usize, LapLog)>,
-) -> Result<f64, SimError> {
+    keep: &mut dyn FnMut(usize, &LapLog),
+) -> Result<(f64, bool), SimError> {
     let mut seconds = 0.0;
     for run in 0..plan.runs.len() {
         let mut sim = RunSim::new(plan, run);
         for lap in 0..laps_of(run) {
             let w = crate::clock::Stopwatch::start();
             let log = sim.run_lap(lap)?;
+            keep(run, &log);
             seconds += w.cpu_s();
             if tx.send((run, log)).is_err() {
-                return Ok(seconds);
+                return Ok((seconds, false));
             }
         }
     }
-    Ok(seconds)
+    Ok((seconds, true))
 }
 
 /// One job per level configuration, in order, then ICP's and Scan Context's if asked (with the
@@ -312,7 +363,7 @@ mod tests {
         let laps_of = |run: usize| [30, 10][run];
         let mut held_at = Vec::new();
         let mut truth = GroundTruth::default();
-        let (sim, ()) = with_laps(&scn.sim, &laps_of, |rx| {
+        let (sim, ()) = with_laps(&scn.sim, &laps_of, None, |rx| {
             let mut current = None;
             for (run, lap) in rx {
                 if current != Some(run) {

@@ -163,6 +163,7 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
         }
     }
     prov.add_seeds(results.iter().map(|r| r.seed));
+    prov.lap_cache = opts.experiment.cache.as_ref().map(|c| c.used());
     let mut suite = SuiteReport::new(opts.shard, opts.gate, assemble(planned, items, results));
     suite.provenance = prov;
     suite.wall_seconds = started.elapsed().as_secs_f64();
@@ -178,9 +179,9 @@ pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedR
         progress: ProgressSink::none(),
         ..options.clone()
     };
-    let (report, error) = match run_scenario(&scn, &options) {
-        Ok(exp) => (Some(exp.report), None),
-        Err(e) => (None, Some(e.to_string())),
+    let (report, error, lap_cache) = match run_scenario(&scn, &options) {
+        Ok(exp) => (Some(exp.report), None, exp.lap_source),
+        Err(e) => (None, Some(e.to_string()), None),
     };
     SeedResult {
         seed,
@@ -188,6 +189,7 @@ pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedR
         report,
         error,
         simulation_key: provenance::simulation_key(&scn.sim, options.laps),
+        lap_cache,
     }
 }
 

@@ -177,6 +177,27 @@ impl AtomicFile {
         })
     }
 
+    /// [`AtomicFile::create`] with a temporary name no other writer of this process uses
+    /// (`.NAME.tmpPID-N`), for files several threads may write at once under one name (a lap
+    /// cache entry): each writes its own, and the last rename wins.
+    pub fn create_unique(path: &Path) -> std::io::Result<AtomicFile> {
+        static WRITERS: AtomicUsize = AtomicUsize::new(0);
+        create_parent(path)?;
+        remove_stale_temps(path);
+        let n = WRITERS.fetch_add(1, Ordering::SeqCst);
+        let tmp = path.with_file_name(format!(
+            ".{}.tmp{}-{n}",
+            file_name(path),
+            std::process::id()
+        ));
+        let file = std::fs::File::create(&tmp)?;
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            tmp,
+            out: Some(std::io::BufWriter::with_capacity(1 << 16, file)),
+        })
+    }
+
     /// The final path.
     pub fn path(&self) -> &Path {
         &self.path

@@ -348,6 +348,7 @@ mod tests {
                     report: Some(r),
                     error: None,
                     simulation_key: String::new(),
+                    lap_cache: None,
                 }
             })
             .collect();

@@ -204,6 +204,75 @@ proptest! {
     }
 }
 
+/// A small lap file of two runs (layouts, ranges and names of every kind), for the lap file
+/// target.
+fn lap_file() -> Vec<u8> {
+    use placewords::geom::{OdomPose, Pose2, TruePose};
+    use placewords::log::{Frame, LapLog};
+    use placewords::scan::{BeamLayout, Scan};
+    let lap = |lap: usize, frames: usize| LapLog {
+        lap,
+        door_config: "north-pair".into(),
+        open_doors: vec!["n-03".into()],
+        frames: (0..frames)
+            .map(|i| Frame {
+                time_s: i as f64 * 0.1,
+                odom: OdomPose(Pose2 {
+                    x: i as f64,
+                    y: 0.5,
+                    theta: -0.25,
+                }),
+                truth: TruePose(Pose2 {
+                    x: i as f64 + 0.01,
+                    y: 0.49,
+                    theta: -0.2,
+                }),
+                scan: Scan {
+                    layout: BeamLayout::centered(3 + i % 2, 3.0, 32.767, Pose2::IDENTITY),
+                    ranges_m: (0..3 + i % 2).map(|k| 1.0 + k as f64 / 7.0).collect(),
+                    time_s: i as f64 * 0.1,
+                },
+            })
+            .collect(),
+    };
+    let mut w =
+        placewords::io::lap_file::LapFileWriter::new(Vec::new(), &"7".repeat(64), &[2, 1]).unwrap();
+    w.push(0, &lap(0, 3)).unwrap();
+    w.push(0, &lap(1, 2)).unwrap();
+    w.push(1, &lap(0, 4)).unwrap();
+    w.finish().unwrap()
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: cases(), failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Lap cache entries (`io::lap_file`, issue 25 point 3): bytes flipped, set to extremes
+    /// (a length or count of 0, 2^32, 2^64 − 1), cut or inserted anywhere give laps or an
+    /// error, never a panic, from reading and from verifying alike.
+    #[test]
+    fn lap_files_never_panic(muts in prop::collection::vec((0u8..4, any::<u32>(), any::<u8>()), 1..6)) {
+        let mut b = lap_file();
+        for (what, at, v) in muts {
+            let pos = at as usize % (b.len() + 1);
+            match what {
+                0 => if let Some(x) = b.get_mut(pos) { *x = v },
+                1 => {
+                    let extreme = [0u64, 1 << 32, u64::MAX, u64::from(v)][v as usize % 4];
+                    let end = (pos + 8).min(b.len());
+                    let bytes = extreme.to_le_bytes();
+                    b[pos..end].copy_from_slice(&bytes[..end - pos]);
+                }
+                2 => b.truncate(pos),
+                _ => b.insert(pos, v),
+            }
+        }
+        use placewords::io::lap_file::LapFileReader;
+        let len = b.len() as u64;
+        let _ = LapFileReader::open(&b[..], len).and_then(|r| r.read_runs());
+        let _ = LapFileReader::open(&b[..], len).and_then(|r| r.verify());
+    }
+}
+
 /// The mutator reaches numbers: a corpus file comes back changed where a number stood.
 #[test]
 fn the_mutator_replaces_numbers() {

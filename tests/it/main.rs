@@ -5,6 +5,7 @@ mod authoring;
 mod bag;
 #[path = "../support/big_world.rs"]
 mod big_world;
+mod cache;
 mod ci;
 mod cli;
 mod common;
