@@ -529,14 +529,14 @@ fn split_row(line: &str) -> Vec<String> {
     };
     let mut cells = Vec::new();
     let mut cell = String::new();
-    for i in 0..chars.len() {
+    for (i, &c) in chars.iter().enumerate() {
         if bar(i) {
             if i > 0 {
                 cells.push(cell.trim().to_string());
             }
             cell.clear();
         } else {
-            cell.push(chars[i]);
+            cell.push(c);
         }
     }
     if !cell.trim().is_empty() {
