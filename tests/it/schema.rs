@@ -96,6 +96,9 @@ fn tables(schema: &Value) -> Vec<(String, BTreeSet<String>)> {
     out
 }
 
+/// A table's path in a schema and the keys it holds.
+type Table<'a> = (&'a str, BTreeSet<String>);
+
 fn set(keys: &[&str]) -> BTreeSet<String> {
     keys.iter().map(|k| k.to_string()).collect()
 }
@@ -112,7 +115,7 @@ fn each_schema_table_holds_the_readers_keys() {
         .filter(|k| !sc::RECOGNIZER_HARNESS_KEYS.contains(&k.as_str()))
         .cloned()
         .collect::<BTreeSet<_>>();
-    let expected: [(FileKind, Vec<(&str, BTreeSet<String>)>); 2] = [
+    let expected: [(FileKind, Vec<Table>); 2] = [
         (
             FileKind::World,
             vec![
