@@ -21,6 +21,7 @@ pub mod place;
 pub mod recognizer;
 pub mod report;
 pub mod scan;
+pub mod schema;
 pub mod sim;
 pub mod spec;
 pub mod world;

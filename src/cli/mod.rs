@@ -29,6 +29,7 @@ pub mod progress;
 pub mod recognize;
 pub mod run;
 pub mod scenario;
+pub mod schema;
 pub mod score;
 pub mod simulate;
 pub mod sweep;
@@ -94,6 +95,11 @@ pub enum Command {
         after_help = "Example:\n  placewords simulate scenarios/smoke.toml -o logs/\n  placewords run scenarios/smoke.toml --export-matches m.csv\n  placewords score logs/ --matches m.csv --report s.json"
     )]
     Score(score::ScoreArgs),
+    /// Print the JSON Schema (draft-07) of a world or scenario file, for editors (docs/editors.md).
+    #[command(
+        after_help = "Example:\n  placewords schema world\n  placewords schema scenario -o scenario.schema.json\n  # then start a TOML file with:  #:schema ./scenario.schema.json"
+    )]
+    Schema(schema::SchemaArgs),
 }
 
 pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
@@ -109,6 +115,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Sweep(a) => sweep::run(a),
         Command::Recognize(a) => recognize::run(a),
         Command::Score(a) => score::run(a),
+        Command::Schema(a) => schema::run(a),
     }
 }
 

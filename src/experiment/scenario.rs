@@ -475,9 +475,8 @@ fn scan_context(s: &Settings, d: &mut Diags) -> ScanContextConfig {
     c
 }
 
-/// `RecognizerConfig` fields the harness sets itself, never a file: `levels` (each level
-/// configuration is run; `--levels` and `[[expect.subjects]]` (`subject = "words-N"`) choose).
-const HARNESS_KEYS: &[&str] = &["levels"];
+/// `RecognizerConfig` fields the harness sets itself, never a file.
+const HARNESS_KEYS: &[&str] = crate::spec::scenario::RECOGNIZER_HARNESS_KEYS;
 
 /// Recognizer settings from a file holding a `[recognizer]` table alone (`recognize --config`),
 /// read and checked as a scenario's `[recognizer]`: every problem at its `file:line:col`, unknown

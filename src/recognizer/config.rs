@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// Settings of the whole recognizer (front end and back end). Missing keys take their default.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(default, deny_unknown_fields)]
 pub struct RecognizerConfig {
     /// Odometric travel between two observations, metres. Default 0.10.
@@ -221,7 +221,7 @@ impl Default for RecognizerConfig {
 }
 
 /// Where the fine alignment may place the smaller word's window (`alignment` setting).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum AlignmentMode {
     /// Eq. 2 as written: shifts d ∈ (−Δmax, Δmax) from both words' starts.
@@ -236,7 +236,7 @@ pub enum AlignmentMode {
 }
 
 /// How upper-level words are built (`multi_level` setting); see the `words` module.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "kebab-case")]
 pub enum MultiLevelRule {
     /// Algorithm 2 as written: level l fuses the l + 2 level-0 words w_{j−l−1} … w_j when

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
 
 /// How matches are scored against ground truth (docs/design.md, Evaluation).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct EvaluationSpec {
     /// A pair is correct when its two true positions are within this distance, metres. Default 1.0.
@@ -39,7 +39,7 @@ impl Default for EvaluationSpec {
 ///
 /// An entry may also bound the figures of one direction alone in its sub-tables
 /// `[expect.subjects.same]` and `[expect.subjects.opposite]` (the report's `directions`).
-#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct ExpectSpec {
     pub subjects: Vec<SubjectExpectation>,
@@ -56,7 +56,7 @@ pub struct ExpectSpec {
 /// `[expect.regression]`: the tolerance of a comparison with a baseline report. A metric is a
 /// regression when, over the compared seeds, it got worse by more than this with confidence
 /// (`eval::compare`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct RegressionSpec {
     /// How much precision and each recall may drop (new − baseline, a ratio in [0, 1)).
@@ -143,7 +143,7 @@ pub fn is_builtin_subject_name(name: &str) -> bool {
 }
 
 /// What one subject must achieve.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SubjectExpectation {
     /// The subject bounded: `words-1`, `words-2`, `words-3` (the paper's recognizer at that
@@ -177,16 +177,16 @@ pub struct SubjectExpectation {
 
 /// Bounds on the figures of one direction: those of [`Expectation`] but time, which is not
 /// counted per direction.
-#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct DirectionExpectation {
-    /// Minimum precision of this direction's pairs in [0, 1].
+    /// Minimum precision of this direction's pairs in [0, 1]. Default: none.
     pub min_precision: Option<f64>,
-    /// Minimum recall of this direction's revisits in [0, 1].
+    /// Minimum recall of this direction's revisits in [0, 1]. Default: none.
     pub min_recall: Option<f64>,
-    /// Minimum visit recall in [0, 1].
+    /// Minimum visit recall in [0, 1]. Default: none.
     pub min_visit_recall: Option<f64>,
-    /// Minimum pair recall in [0, 1].
+    /// Minimum pair recall in [0, 1]. Default: none.
     pub min_pair_recall: Option<f64>,
 }
 
@@ -217,7 +217,7 @@ impl SubjectExpectation {
 }
 
 /// Minimum precision and recall, and optionally a time budget.
-#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct Expectation {
     /// Minimum pair precision in [0, 1].

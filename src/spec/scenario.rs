@@ -295,6 +295,10 @@ pub const ROBOT_KEYS: &[&str] = &[
     "spin_spacing_m",
     "spin_angle_deg",
 ];
+/// Keys of the recognizer's settings that the harness sets itself, never a file's
+/// `[recognizer]` table: `levels` (each level configuration is run; `--levels` and
+/// `[[expect.subjects]]` (`subject = "words-N"`) choose). A file that sets one is refused.
+pub const RECOGNIZER_HARNESS_KEYS: &[&str] = &["levels"];
 /// Keys whose value is a word rather than a number (besides a table's `model`/`preset`).
 pub const WORD_KEYS: &[&str] = &["proportional_error"];
 

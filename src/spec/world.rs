@@ -54,7 +54,7 @@ use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
 
 /// A whole world file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSpec {
     /// Must be 1.
@@ -74,7 +74,7 @@ pub struct WorldSpec {
 }
 
 /// The robot's home pose.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct HomeSpec {
     pub x_m: f64,
@@ -84,7 +84,7 @@ pub struct HomeSpec {
 }
 
 /// A wall: a polyline of at least two points with a thickness.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
     pub id: String,
@@ -99,7 +99,7 @@ pub struct WallSpec {
 }
 
 /// A hinged door panel. Closed, it spans a gap in a wall; open, it swings into its room.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DoorSpec {
     pub id: String,
@@ -117,7 +117,7 @@ pub struct DoorSpec {
 }
 
 /// A closed loop of waypoints the robot drives, in order; the last leg returns to the first.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RouteSpec {
     pub id: String,
@@ -125,7 +125,7 @@ pub struct RouteSpec {
 }
 
 /// An axis-aligned rectangle where people may walk (back and forth along its longer side).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AreaSpec {
     pub id: String,

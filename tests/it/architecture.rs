@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 /// only; modules on one layer do not import each other. Keep in step with ARCHITECTURE.md.
 const LAYERS: &[&[&str]] = &[
     &["cli"],
-    &["experiment", "authoring"],
+    &["experiment", "authoring", "schema"],
     &["report"],
     &["eval"],
     &["baseline", "sim", "external"],

@@ -21,6 +21,7 @@ mod provenance;
 mod recognizer;
 mod routes;
 mod scan_context;
+mod schema;
 mod settings;
 mod sim;
 mod spec;
