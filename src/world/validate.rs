@@ -232,10 +232,25 @@ fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             .map(|r| r.waypoints_m.len())
             .sum::<usize>();
     if segments > MAX_SEGMENTS {
+        // Reported on the wall that holds most of them, when one does.
+        let biggest = spec
+            .walls
+            .iter()
+            .zip(&loc.walls)
+            .map(|(w, l)| (w.points_m.len(), w, l))
+            .max_by_key(|(n, _, _)| *n)
+            .filter(|(n, _, _)| *n > segments / 2);
+        let (at, which) = match biggest {
+            Some((n, w, l)) => (
+                l.points_key,
+                format!(", {n} of them points of wall '{}'", w.id),
+            ),
+            None => (loc.walls_key, String::new()),
+        };
         d.at(
-            loc.walls_key,
+            at,
             format!(
-                "the world has {segments} wall segments, door panels and route legs (limit {MAX_SEGMENTS}); simplify the walls or split the world into smaller ones"
+                "the world has {segments} wall segments, door panels and route legs (limit {MAX_SEGMENTS}){which}; simplify the walls or split the world into smaller ones"
             ),
         );
         return false;
