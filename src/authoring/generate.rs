@@ -1,14 +1,21 @@
 //! A world generator for stress tests and examples: a corridor loop (a rectangle with corners
 //! cut away, so 4, 6, 8, 10 or 12 corridors), offices outside the loop each with one door that
 //! swings into it, niches in the courtyard wall at random places so that stretches of corridor
-//! differ, and a lap route along the corridors' centre lines.
+//! differ, a walking area along each corridor, and a lap route along the corridors' centre
+//! lines.
+//!
+//! Options: `double_loaded` puts offices on both sides of every corridor (inside the loop too,
+//! their doors in the courtyard wall, which then has no niches), as in a hospital ward or an
+//! office floor; `look_alike` makes the corridors look alike on purpose (every office the same
+//! width with its door at the same place, no niches), the recognizer's hardest case. Asking for
+//! more offices than fit is refused with the number that fits.
 //!
 //! Deterministic per seed: every draw comes from one ChaCha stream keyed by the seed
 //! ([`crate::sim::rng::stream`] with [`Purpose::WorldGenerator`]).
 
 use crate::geom::Vec2;
 use crate::sim::rng::{Purpose, SimRng, stream};
-use crate::spec::world::{DoorSpec, HomeSpec, RouteSpec, WallSpec, WorldSpec};
+use crate::spec::world::{AreaSpec, DoorSpec, HomeSpec, RouteSpec, WallSpec, WorldSpec};
 use rand::RngExt;
 
 /// Corridor width, metres.
@@ -32,7 +39,17 @@ pub struct GenerateOptions {
     pub doors: usize,
     /// Corridors of the loop: 4, 6, 8, 10 or 12. Default 4.
     pub corridors: usize,
+    /// Offices on both sides of every corridor. Default false (outside the loop only).
+    pub double_loaded: bool,
+    /// Every office [`LOOK_ALIKE_ROOM_M`] wide with its door at the same place, and no niches:
+    /// stretches of corridor that look alike. Default false.
+    pub look_alike: bool,
 }
+
+/// Office width along the corridor with `look_alike`, metres.
+pub const LOOK_ALIKE_ROOM_M: f64 = 4.0;
+/// Where the door's gap starts in a look-alike office, metres from the office's start.
+const LOOK_ALIKE_DOOR_AT_M: f64 = 0.5;
 
 impl Default for GenerateOptions {
     fn default() -> Self {
@@ -41,6 +58,8 @@ impl Default for GenerateOptions {
             size_m: (40.0, 30.0),
             doors: 12,
             corridors: 4,
+            double_loaded: false,
+            look_alike: false,
         }
     }
 }
@@ -55,9 +74,14 @@ pub enum GenerateError {
     #[error("--size-m {0}x{1}: the floor must be between 24 m and 2000 m on each side")]
     Size(f64, f64),
     #[error(
-        "--doors {asked}: only {fit} offices fit along the corridors of this floor; ask for fewer doors or a larger --size-m"
+        "--doors {asked}: only {fit} offices fit along the corridors of this floor{more}; ask for fewer doors or a larger --size-m"
     )]
-    Doors { asked: usize, fit: usize },
+    Doors {
+        asked: usize,
+        fit: usize,
+        /// What would fit more (`, {n} with --double-loaded`), or empty.
+        more: String,
+    },
     #[error(
         "the generated floor does not pass the checks (a generator bug, please report it with the seed):\n{0}"
     )]
@@ -103,23 +127,30 @@ fn centre_loop(rng: &mut SimRng, w: f64, h: f64, cuts: usize) -> Vec<Vec2> {
         .collect()
 }
 
-/// One office slot: corridor edge, start and end along it (metres from the edge's start).
+/// One office slot: corridor edge, start and end along it (metres from the edge's start), and
+/// side (1 outside the loop, -1 inside).
 #[derive(Clone, Copy, Debug)]
 struct Slot {
     edge: usize,
     from: f64,
     to: f64,
+    side: f64,
 }
 
-/// Office slots of 3.5-5 m along every edge, clear of the corners.
-fn slots(rng: &mut SimRng, loop_pts: &[Vec2]) -> Vec<Slot> {
+/// Office slots along every edge on `side`, clear of the corners: 3.5-5 m wide, or all
+/// [`LOOK_ALIKE_ROOM_M`] with `look_alike`.
+fn slots(rng: &mut SimRng, loop_pts: &[Vec2], side: f64, look_alike: bool) -> Vec<Slot> {
     let n = loop_pts.len();
     let mut out = Vec::new();
     for e in 0..n {
         let len = (loop_pts[(e + 1) % n] - loop_pts[e]).norm();
         let mut at = ROOM_END_MARGIN_M;
         loop {
-            let w = round_cm(rng.random_range(3.5..5.0));
+            let w = if look_alike {
+                LOOK_ALIKE_ROOM_M
+            } else {
+                round_cm(rng.random_range(3.5..5.0))
+            };
             if at + w > len - ROOM_END_MARGIN_M {
                 break;
             }
@@ -127,11 +158,52 @@ fn slots(rng: &mut SimRng, loop_pts: &[Vec2]) -> Vec<Slot> {
                 edge: e,
                 from: at,
                 to: at + w,
+                side,
             });
             at += w;
         }
     }
     out
+}
+
+/// The office of `slot` as a rectangle (min, max corners), grown by `grow_m`.
+fn room_box(loop_pts: &[Vec2], slot: &Slot, grow_m: f64) -> (Vec2, Vec2) {
+    let (a, d, out) = edge_frame(loop_pts, slot.edge);
+    let o = out * slot.side;
+    let (front, back) = (CORRIDOR_M / 2.0, CORRIDOR_M / 2.0 + ROOM_DEPTH_M);
+    let c = [a + d * slot.from + o * front, a + d * slot.to + o * back];
+    let lo = Vec2::new(c[0].x.min(c[1].x), c[0].y.min(c[1].y));
+    let hi = Vec2::new(c[0].x.max(c[1].x), c[0].y.max(c[1].y));
+    let g = Vec2::new(grow_m, grow_m);
+    (lo - g, hi + g)
+}
+
+/// Inside slots whose office would come within 0.3 m of another corridor (in a small or
+/// notched courtyard) or of an inside office of another edge are left out.
+fn inside_slots_that_fit(loop_pts: &[Vec2], inner: Vec<Slot>) -> Vec<Slot> {
+    let n = loop_pts.len();
+    let mut kept: Vec<Slot> = Vec::new();
+    let overlaps = |(alo, ahi): (Vec2, Vec2), (blo, bhi): (Vec2, Vec2)| {
+        alo.x < bhi.x && blo.x < ahi.x && alo.y < bhi.y && blo.y < ahi.y
+    };
+    for s in inner {
+        let grown = room_box(loop_pts, &s, 0.3);
+        let hits_corridor = (0..n).filter(|&e| e != s.edge).any(|e| {
+            let (a, b) = (loop_pts[e], loop_pts[(e + 1) % n]);
+            let band = CORRIDOR_M / 2.0;
+            let lo = Vec2::new(a.x.min(b.x) - band, a.y.min(b.y) - band);
+            let hi = Vec2::new(a.x.max(b.x) + band, a.y.max(b.y) + band);
+            overlaps(grown, (lo, hi))
+        });
+        let hits_room = kept
+            .iter()
+            .filter(|k| k.edge != s.edge)
+            .any(|k| overlaps(grown, room_box(loop_pts, k, 0.0)));
+        if !hits_corridor && !hits_room {
+            kept.push(s);
+        }
+    }
+    kept
 }
 
 /// A frame along edge `e`: its start, unit direction and outward (right-hand) normal.
@@ -194,15 +266,21 @@ fn office(
     slot: Slot,
     shares_right: bool,
     index: usize,
+    look_alike: bool,
 ) -> (WallSpec, DoorSpec, f64) {
     let (a, d, out) = edge_frame(loop_pts, slot.edge);
+    let out = out * slot.side;
     let at = |t: f64, o: f64| pt(a + d * t + out * o);
     let (front, back) = (CORRIDOR_M / 2.0, CORRIDOR_M / 2.0 + ROOM_DEPTH_M);
     let mut points = vec![at(slot.from, front), at(slot.from, back), at(slot.to, back)];
     if !shares_right {
         points.push(at(slot.to, front));
     }
-    let g0 = round_cm(rng.random_range(slot.from + 0.3..slot.to - DOOR_M - 0.3));
+    let g0 = if look_alike {
+        slot.from + LOOK_ALIKE_DOOR_AT_M
+    } else {
+        round_cm(rng.random_range(slot.from + 0.3..slot.to - DOOR_M - 0.3))
+    };
     let heading = |v: Vec2| round_cm(v.y.atan2(v.x).to_degrees());
     let wall = WallSpec {
         id: format!("office-{:02}", index + 1),
@@ -221,13 +299,19 @@ fn office(
     (wall, door, g0)
 }
 
-/// The corridor's outer wall, cut at the door gaps `(edge, from)` (sorted): one closed wall
-/// without doors, else one open polyline from each gap's end to the next gap's start.
-fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)]) -> Vec<WallSpec> {
-    let outer = offset(loop_pts, -CORRIDOR_M / 2.0);
+/// A corridor wall on `side` (1: the outer wall, -1: the courtyard wall), cut at the door
+/// gaps `(edge, from)` (sorted): one closed wall without doors, else one open polyline from
+/// each gap's end to the next gap's start. Walls are named `{name}-{k}` (`{name}` alone when
+/// closed).
+fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)], side: f64, name: &str) -> Vec<WallSpec> {
+    let outer = offset(loop_pts, -side * CORRIDOR_M / 2.0);
     let n = outer.len();
     let wall = |k: usize, points_m: Vec<[f64; 2]>, closed: bool| WallSpec {
-        id: format!("corridor-{k}"),
+        id: if closed && side < 0.0 {
+            name.to_string()
+        } else {
+            format!("{name}-{k}")
+        },
         points_m,
         closed,
         thickness_m: crate::spec::world::default_wall_thickness_m(),
@@ -237,7 +321,7 @@ fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)]) -> Vec<WallSpec> {
     }
     let on = |e: usize, t: f64| {
         let (a, d, o) = edge_frame(loop_pts, e);
-        pt(a + d * t + o * (CORRIDOR_M / 2.0))
+        pt(a + d * t + o * (side * CORRIDOR_M / 2.0))
     };
     let mut walls = Vec::new();
     for (k, &(e, g)) in gaps.iter().enumerate() {
@@ -267,11 +351,29 @@ pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError>
     }
     let mut rng = stream(opts.seed, 0, 0, Purpose::WorldGenerator);
     let loop_pts = centre_loop(&mut rng, w, h, (opts.corridors - 4) / 2);
-    let all = slots(&mut rng, &loop_pts);
+    let mut all = slots(&mut rng, &loop_pts, 1.0, opts.look_alike);
+    let outside = all.len();
+    // The inside slots are drawn from a copy of the stream when not used, so a single-loaded
+    // floor is the one earlier versions generated from the same seed.
+    let inner = if opts.double_loaded {
+        slots(&mut rng, &loop_pts, -1.0, opts.look_alike)
+    } else {
+        slots(&mut rng.clone(), &loop_pts, -1.0, opts.look_alike)
+    };
+    let inner = inside_slots_that_fit(&loop_pts, inner);
+    if opts.double_loaded {
+        all.extend(inner.iter().copied());
+    }
     if all.len() < opts.doors {
+        let more = if opts.double_loaded {
+            String::new()
+        } else {
+            format!(", {} with --double-loaded", outside + inner.len())
+        };
         return Err(GenerateError::Doors {
             asked: opts.doors,
             fit: all.len(),
+            more,
         });
     }
     // Which slots get an office: a seeded shuffle, then back in loop order.
@@ -281,31 +383,52 @@ pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError>
     }
     let mut chosen: Vec<usize> = order[..opts.doors].to_vec();
     chosen.sort_unstable();
-    let mut walls = vec![WallSpec {
-        id: "courtyard".into(),
-        points_m: courtyard_wall(&mut rng, &loop_pts),
-        closed: true,
-        thickness_m: crate::spec::world::default_wall_thickness_m(),
-    }];
-    let (mut doors, mut gaps) = (Vec::new(), Vec::new());
+    let plain_courtyard = opts.double_loaded || opts.look_alike;
+    let mut walls = Vec::new();
+    if !plain_courtyard {
+        walls.push(WallSpec {
+            id: "courtyard".into(),
+            points_m: courtyard_wall(&mut rng, &loop_pts),
+            closed: true,
+            thickness_m: crate::spec::world::default_wall_thickness_m(),
+        });
+    }
+    let (mut doors, mut gaps, mut inner_gaps) = (Vec::new(), Vec::new(), Vec::new());
     for (k, &i) in chosen.iter().enumerate() {
-        let shares = chosen
-            .get(k + 1)
-            .is_some_and(|&j| j == i + 1 && all[j].edge == all[i].edge);
-        let (wall, door, g0) = office(&mut rng, &loop_pts, all[i], shares, k);
+        let shares = chosen.get(k + 1).is_some_and(|&j| {
+            j == i + 1 && all[j].edge == all[i].edge && all[j].side == all[i].side
+        });
+        let (wall, door, g0) = office(&mut rng, &loop_pts, all[i], shares, k, opts.look_alike);
         walls.push(wall);
         doors.push(door);
-        gaps.push((all[i].edge, g0));
+        if all[i].side > 0.0 {
+            gaps.push((all[i].edge, g0));
+        } else {
+            inner_gaps.push((all[i].edge, g0));
+        }
     }
-    walls.extend(corridor_wall(&loop_pts, &gaps));
+    if plain_courtyard {
+        walls.extend(corridor_wall(&loop_pts, &inner_gaps, -1.0, "courtyard"));
+    }
+    walls.extend(corridor_wall(&loop_pts, &gaps, 1.0, "corridor"));
     let (a, d, _) = edge_frame(&loop_pts, 0);
     let home = a + d * 1.0;
     Ok(WorldSpec {
         format_version: 1,
         name: format!("generated-{}", opts.seed),
         description: Some(format!(
-            "generated: seed {}, {} x {} m, {} doors, {} corridors",
-            opts.seed, w, h, opts.doors, opts.corridors
+            "generated: seed {}, {} x {} m, {} doors, {} corridors{}{}",
+            opts.seed,
+            w,
+            h,
+            opts.doors,
+            opts.corridors,
+            if opts.double_loaded {
+                ", double-loaded"
+            } else {
+                ""
+            },
+            if opts.look_alike { ", look-alike" } else { "" }
         )),
         robot_home: HomeSpec {
             x_m: round_cm(home.x),
@@ -318,8 +441,29 @@ pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError>
             id: "lap".into(),
             waypoints_m: loop_pts.iter().map(|p| pt(*p)).collect(),
         }],
-        areas: Vec::new(),
+        areas: walking_areas(&loop_pts),
     })
+}
+
+/// Where people walk: along the centre of each corridor at least 6 m long, 1.2 m across,
+/// keeping 2 m from the corners.
+fn walking_areas(loop_pts: &[Vec2]) -> Vec<AreaSpec> {
+    let n = loop_pts.len();
+    (0..n)
+        .filter_map(|e| {
+            let (a, d, out) = edge_frame(loop_pts, e);
+            let len = (loop_pts[(e + 1) % n] - a).norm();
+            if len < 6.0 {
+                return None;
+            }
+            let (p, q) = (a + d * 2.0 + out * 0.6, a + d * (len - 2.0) - out * 0.6);
+            Some(AreaSpec {
+                id: format!("walk-{e}"),
+                min_m: pt(Vec2::new(p.x.min(q.x), p.y.min(q.y))),
+                max_m: pt(Vec2::new(p.x.max(q.x), p.y.max(q.y))),
+            })
+        })
+        .collect()
 }
 
 /// Generates a floor as the text of a world file, checked by the world file checks.
@@ -327,10 +471,30 @@ pub fn generate_toml(opts: &GenerateOptions) -> Result<String, GenerateError> {
     let spec = generate_spec(opts)?;
     let body = toml::to_string(&spec).map_err(|e| GenerateError::Invalid(e.to_string()))?;
     let text = format!(
-        "# A generated floor: placewords world generate --seed {} --size-m {},{} --doors {} --corridors {}\n\
-         # A corridor loop (route \"lap\" along its centre line), offices outside it with one door\n\
-         # each (swinging into the office), niches in the courtyard wall.\n{body}",
-        opts.seed, opts.size_m.0, opts.size_m.1, opts.doors, opts.corridors
+        "# A generated floor: placewords world generate --seed {} --size-m {},{} --doors {} --corridors {}{}{}\n\
+         # A corridor loop (route \"lap\" along its centre line), offices {} with one door\n\
+         # each (swinging into the office), {}; people walk in the areas \"walk-N\".\n{body}",
+        opts.seed,
+        opts.size_m.0,
+        opts.size_m.1,
+        opts.doors,
+        opts.corridors,
+        if opts.double_loaded {
+            " --double-loaded"
+        } else {
+            ""
+        },
+        if opts.look_alike { " --look-alike" } else { "" },
+        if opts.double_loaded {
+            "on both sides of it"
+        } else {
+            "outside it"
+        },
+        if opts.double_loaded || opts.look_alike {
+            "no niches"
+        } else {
+            "niches in the courtyard wall"
+        }
     );
     crate::world::load::parse_world_spec(
         &text,

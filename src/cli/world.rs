@@ -36,9 +36,9 @@ pub enum WorldCommand {
         after_help = "Example:\n  placewords world ambiguity worlds/institute-floor.toml --route lap -o a.svg --json"
     )]
     Ambiguity(AmbiguityArgs),
-    /// Write a random valid floor (corridor loop, offices with doors, niches, a lap route).
+    /// Write a random valid floor (corridor loop, offices with doors, niches, walking areas, a lap route).
     #[command(
-        after_help = "Example:\n  placewords world generate --seed 1 -o floor.toml\n  placewords world generate --seed 2 --size-m 60,40 --doors 20 -o big.toml"
+        after_help = "Example:\n  placewords world generate --seed 1 -o floor.toml\n  placewords world generate --seed 2 --size-m 60,40 --doors 20 -o big.toml\n  placewords world generate --seed 3 --size-m 60,30 --double-loaded --rooms 30 -o ward.toml"
     )]
     Generate(GenerateArgs),
 }
@@ -64,12 +64,19 @@ pub struct GenerateArgs {
     /// Floor size in metres, x and y (each 24-2000): `50,40` or `"50 40"`.
     #[arg(long = "size-m", value_name = "W,H", default_value = "40,30", value_parser = size_m)]
     pub size_m: (f64, f64),
-    /// Number of offices, each with one door.
-    #[arg(long, default_value_t = 12)]
+    /// Number of offices, each with one door (more than fit is refused with the number that fits).
+    #[arg(long, visible_alias = "rooms", default_value_t = 12)]
     pub doors: usize,
     /// Corridors of the loop: 4, 6, 8, 10 or 12.
     #[arg(long, default_value_t = 4)]
     pub corridors: usize,
+    /// Offices on both sides of every corridor (inside the loop too), as in a hospital ward.
+    #[arg(long)]
+    pub double_loaded: bool,
+    /// Make the corridors look alike on purpose: offices of one width, doors at one place, no
+    /// niches (the recognizer's hardest case).
+    #[arg(long)]
+    pub look_alike: bool,
     /// Output world file (TOML).
     #[arg(short = 'o', long = "out", alias = "output", value_name = "WORLD.toml")]
     pub output: PathBuf,
@@ -323,6 +330,8 @@ fn generate(args: GenerateArgs) -> anyhow::Result<ExitCode> {
         size_m: args.size_m,
         doors: args.doors,
         corridors: args.corridors,
+        double_loaded: args.double_loaded,
+        look_alike: args.look_alike,
     };
     let text = generate_toml(&opts)?;
     super::common::write_file(&args.output, text.as_bytes())?;

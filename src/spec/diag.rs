@@ -12,6 +12,9 @@ pub enum Severity {
     Error,
     /// The file is used, but probably not as its author meant.
     Warning,
+    /// Not a problem itself: a check that was skipped, and why (it depends on a part of the
+    /// file that did not read).
+    Note,
 }
 
 impl Severity {
@@ -20,6 +23,7 @@ impl Severity {
         match self {
             Severity::Error => "error",
             Severity::Warning => "warning",
+            Severity::Note => "note",
         }
     }
 }
@@ -102,6 +106,7 @@ impl fmt::Display for Diagnostic {
         let tag = match self.severity {
             Severity::Error => "",
             Severity::Warning => "warning: ",
+            Severity::Note => "note: ",
         };
         write!(
             f,
@@ -175,7 +180,8 @@ pub enum MessageFormat {
     /// count.
     #[default]
     Human,
-    /// `{"path":..,"line":..,"col":..,"severity":"error"|"warning","message":..}`, every problem.
+    /// `{"path":..,"line":..,"col":..,"severity":"error"|"warning"|"note","message":..}`, every
+    /// problem.
     Json,
 }
 
@@ -279,6 +285,11 @@ impl<'a> Diags<'a> {
     /// Records a warning at byte `offset`: the file stays usable.
     pub fn warn(&mut self, offset: usize, message: String) {
         self.push(offset, message, Severity::Warning);
+    }
+
+    /// Records a note at byte `offset`: a check skipped, and why.
+    pub fn note(&mut self, offset: usize, message: String) {
+        self.push(offset, message, Severity::Note);
     }
 
     fn push(&mut self, offset: usize, message: String, severity: Severity) {

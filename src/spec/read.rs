@@ -455,14 +455,18 @@ pub(crate) fn req_points(
 }
 
 /// Reads every table of an array of entries (walls, doors, ...) with `read`, keeping the
-/// locations of those that read cleanly; `ok` turns false when one does not. `None` when the
-/// problem list is full.
-pub(crate) fn read_entries<T, L>(
+/// locations of those that read cleanly; `ok` turns false when one does not, and
+/// `on_fail(index, table offset, table)` of it goes to `failed`. `None` when the problem list is
+/// full.
+#[allow(clippy::too_many_arguments)] // private helper; each argument is one piece of context
+pub(crate) fn read_entries_with<T, L, F>(
     tables: Vec<(usize, &DeTable<'_>)>,
     d: &mut Diags,
     ok: &mut bool,
     read: fn(&DeTable<'_>, usize, usize, &mut Diags, &mut L) -> Option<T>,
     new_loc: impl Fn(usize) -> L,
+    failed: &mut Vec<F>,
+    on_fail: impl Fn(usize, usize, &DeTable<'_>) -> F,
 ) -> Option<(Vec<T>, Vec<L>)> {
     let (mut items, mut locs) = (Vec::new(), Vec::new());
     for (i, (at, t)) in tables.into_iter().enumerate() {
@@ -472,7 +476,10 @@ pub(crate) fn read_entries<T, L>(
                 items.push(x);
                 locs.push(l);
             }
-            None => *ok = false,
+            None => {
+                *ok = false;
+                failed.push(on_fail(i, at, t));
+            }
         }
         if d.is_full() {
             return None;

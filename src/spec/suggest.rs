@@ -10,8 +10,16 @@ where
         return None;
     }
     let lower = word.to_lowercase();
-    candidates
-        .into_iter()
+    // By meaning first: a word that names what a known key means (a wall's `width_m` is its
+    // `thickness_m`), when that key is a candidate here.
+    let all: Vec<&'a str> = candidates.into_iter().collect();
+    if let Some(&(_, meant)) = MEANINGS
+        .iter()
+        .find(|(w, m)| *w == lower && all.contains(m))
+    {
+        return all.into_iter().find(|c| *c == meant);
+    }
+    all.into_iter()
         .map(|c| {
             let jw = strsim::jaro_winkler(&lower, &c.to_lowercase());
             let lev = strsim::normalized_damerau_levenshtein(&lower, &c.to_lowercase());
@@ -21,6 +29,26 @@ where
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(c, _)| c)
 }
+
+/// Words people write for a known key that spelling alone does not lead to: (word, key).
+/// Each applies only where the key is allowed (a wall's `width_m` is its `thickness_m`; a
+/// door has a `width_m` of its own).
+const MEANINGS: &[(&str, &str)] = &[
+    ("width_m", "thickness_m"),
+    ("width", "thickness_m"),
+    ("thick_m", "thickness_m"),
+    ("length_m", "width_m"),
+    ("size_m", "width_m"),
+    ("points", "points_m"),
+    ("vertices_m", "points_m"),
+    ("waypoints", "waypoints_m"),
+    ("points_m", "waypoints_m"),
+    ("hinge", "hinge_m"),
+    ("position_m", "hinge_m"),
+    ("theta_deg", "heading_deg"),
+    ("yaw_deg", "heading_deg"),
+    ("angle_deg", "heading_deg"),
+];
 
 /// `; did you mean `x`?` or, with no close candidate, a list of what is allowed.
 pub fn hint<'a, I>(word: &str, candidates: I, what: &str) -> String
@@ -51,5 +79,14 @@ mod tests {
         assert_eq!(closest("widht_m", keys), Some("width_m"));
         assert_eq!(closest("hinge", keys), Some("hinge_m"));
         assert_eq!(closest("colour", keys), None);
+    }
+
+    #[test]
+    fn suggests_by_meaning_where_the_key_is_allowed() {
+        let wall = ["id", "points_m", "closed", "thickness_m"];
+        assert_eq!(closest("width_m", wall), Some("thickness_m"));
+        let door = ["id", "hinge_m", "width_m", "thickness_m"];
+        assert_eq!(closest("length_m", door), Some("width_m"));
+        assert_eq!(closest("widht_m", door), Some("width_m"));
     }
 }

@@ -47,8 +47,9 @@
 
 use crate::spec::diag::Diags;
 use crate::spec::read::{
-    boolean, ctx_of, get, id, missing, number, opt_number, parse_int, read_entries, req_number,
-    req_point, req_points, string, table_array, type_name, unknown_keys,
+    boolean, ctx_of, get, id, missing, number, opt_number, parse_int, point, points,
+    read_entries_with, req_number, req_point, req_points, string, table_array, type_name,
+    unknown_keys,
 };
 use serde::{Deserialize, Serialize};
 use toml::de::{DeTable, DeValue};
@@ -179,9 +180,29 @@ pub struct WorldLoc {
     pub areas: Vec<AreaLoc>,
     /// Where `walls` starts (for whole-file limits).
     pub walls_key: usize,
-    /// Whether every entity read cleanly (no missing or mistyped value); geometric checks run
-    /// only then, so one mistake does not cascade into misleading ones.
+    /// Whether every entity read cleanly (no missing or mistyped value). The geometric checks
+    /// run on the entities that did read; those that did not are in `unread`.
     pub all_read: bool,
+    /// The walls, doors, routes and areas that did not read cleanly, in file order, with what
+    /// could be read of their geometry: a check that depends on one of them is skipped with a
+    /// note rather than reported wrongly or hidden.
+    pub unread: Vec<Unread>,
+}
+
+/// An entity of the file that did not read cleanly (a missing key, a wrong type, a bad number)
+/// or whose values are out of range, with what could be read of its geometry.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Unread {
+    /// `wall`, `door`, `route` or `area`.
+    pub kind: &'static str,
+    /// How messages name it: `wall 'room'`, or `wall #1` (its place among the walls, from 0)
+    /// when its id did not read.
+    pub name: String,
+    /// Byte offset of its table.
+    pub at: usize,
+    /// Its points, metres, as far as they read: a wall's points, a door's hinge (and tip when
+    /// its width and closed heading read), a route's waypoints, an area's corners.
+    pub points_m: Vec<[f64; 2]>,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -374,27 +395,111 @@ fn read_sections(
         "a `[[routes]]` section with `id` and `waypoints_m` (a closed loop)",
         d,
     );
-    let (walls, wall_locs) = read_entries(wall_tables, d, ok, read_wall, |table| WallLoc {
-        table,
-        ..Default::default()
-    })?;
-    let (doors, door_locs) = read_entries(door_tables, d, ok, read_door, |table| DoorLoc {
-        table,
-        ..Default::default()
-    })?;
-    let (routes, route_locs) = read_entries(route_tables, d, ok, read_route, |table| RouteLoc {
-        table,
-        ..Default::default()
-    })?;
-    let (areas, area_locs) = read_entries(area_tables, d, ok, read_area, |table| AreaLoc {
-        table,
-        ..Default::default()
-    })?;
+    let mut unread = Vec::new();
+    let on_fail =
+        |kind: &'static str| move |i: usize, at: usize, t: &DeTable<'_>| unread_of(kind, i, at, t);
+    let (walls, wall_locs) = read_entries_with(
+        wall_tables,
+        d,
+        ok,
+        read_wall,
+        |table| WallLoc {
+            table,
+            ..Default::default()
+        },
+        &mut unread,
+        on_fail("wall"),
+    )?;
+    let (doors, door_locs) = read_entries_with(
+        door_tables,
+        d,
+        ok,
+        read_door,
+        |table| DoorLoc {
+            table,
+            ..Default::default()
+        },
+        &mut unread,
+        on_fail("door"),
+    )?;
+    let (routes, route_locs) = read_entries_with(
+        route_tables,
+        d,
+        ok,
+        read_route,
+        |table| RouteLoc {
+            table,
+            ..Default::default()
+        },
+        &mut unread,
+        on_fail("route"),
+    )?;
+    let (areas, area_locs) = read_entries_with(
+        area_tables,
+        d,
+        ok,
+        read_area,
+        |table| AreaLoc {
+            table,
+            ..Default::default()
+        },
+        &mut unread,
+        on_fail("area"),
+    )?;
+    loc.unread = unread;
     loc.walls.extend(wall_locs);
     loc.doors.extend(door_locs);
     loc.routes.extend(route_locs);
     loc.areas.extend(area_locs);
     Some((walls, doors, routes, areas))
+}
+
+/// What could be read of an entity that did not read cleanly, read again without reporting
+/// (its problems are reported already).
+fn unread_of(kind: &'static str, i: usize, at: usize, t: &DeTable<'_>) -> Unread {
+    let mut quiet = Diags::new("", "");
+    let d = &mut quiet;
+    let id = get(t, "id").and_then(|(_, v)| string(v, "id", "", d));
+    let point_of = |key: &str, d: &mut Diags| get(t, key).and_then(|(_, v)| point(v, key, "", d));
+    let number_of = |key: &str, d: &mut Diags| get(t, key).and_then(|(_, v)| number(v, key, "", d));
+    let points_m = match kind {
+        "wall" | "route" => {
+            let key = if kind == "wall" {
+                "points_m"
+            } else {
+                "waypoints_m"
+            };
+            let mut spans = Vec::new();
+            get(t, key)
+                .and_then(|(_, v)| points(v, key, "", d, &mut spans))
+                .unwrap_or_default()
+        }
+        "door" => {
+            let hinge = point_of("hinge_m", d);
+            let tip = match (
+                hinge,
+                number_of("width_m", d),
+                number_of("closed_heading_deg", d),
+            ) {
+                (Some(h), Some(w), Some(c)) => {
+                    let c = c.to_radians();
+                    Some([h[0] + w * c.cos(), h[1] + w * c.sin()])
+                }
+                _ => None,
+            };
+            hinge.into_iter().chain(tip).collect()
+        }
+        _ => ["min_m", "max_m"]
+            .into_iter()
+            .filter_map(|k| point_of(k, d))
+            .collect(),
+    };
+    Unread {
+        kind,
+        name: ctx_of(kind, &id, i),
+        at,
+        points_m,
+    }
 }
 
 /// Whether section `key` is present and not empty; reports it with `add` (what to add) if not.

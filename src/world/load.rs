@@ -48,7 +48,13 @@ pub fn parse_world_spec_checked(
     let mut d = Diags::new(src, path);
     let spec = read_world(src, &mut d).map(|(spec, loc)| {
         validate::validate(&spec, &loc, check, &mut d);
-        if let Some(more) = more.filter(|_| !d.has_errors()) {
+        if more.is_some() && d.has_errors() {
+            let at = loc.routes.first().map_or(loc.walls_key, |l| l.table);
+            d.note(
+                at,
+                "the routes were not test-driven: the robot drives a world only once it has no errors; fix them and check again".into(),
+            );
+        } else if let Some(more) = more {
             for p in more(&World::from_spec(&spec)) {
                 let at = loc.routes.get(p.route).map_or(0, |l| {
                     l.waypoints

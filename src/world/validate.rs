@@ -10,7 +10,7 @@
 
 use crate::geom::{Segment, Vec2, wrap_angle};
 use crate::spec::diag::{Diags, fmt_number};
-use crate::spec::world::{WorldLoc, WorldSpec};
+use crate::spec::world::{Unread, WorldLoc, WorldSpec};
 use crate::world::geometry::{SegmentIndex, ThickSegment};
 use std::collections::HashMap;
 
@@ -90,12 +90,93 @@ pub fn validate(spec: &WorldSpec, loc: &WorldLoc, check: &WorldCheck, d: &mut Di
         return;
     }
     // Numbers and shapes of single entities.
-    let walls_ok = walls_ok(spec, loc, d);
-    let doors_ok = doors_ok(spec, loc, d);
+    let good_walls = walls_ok(spec, loc, d);
+    let good_doors = doors_ok(spec, loc, d);
     routes_and_areas(spec, loc, d);
-    if loc.all_read && walls_ok && doors_ok && !d.is_full() {
-        geometry(spec, loc, check.robot_radius_m, d);
+    if d.is_full() {
+        return;
     }
+    // The geometry of what read and is in range; what did not is set aside, and each check
+    // that depends on it says so.
+    let mut unread = loc.unread.clone();
+    let (spec, loc) = usable(spec, loc, &good_walls, &good_doors, &mut unread);
+    geometry(&spec, &loc, &unread, check.robot_radius_m, d);
+}
+
+/// The world without the walls and doors whose values are out of range (`good` false), which
+/// join `unread`.
+fn usable(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    good_walls: &[bool],
+    good_doors: &[bool],
+    unread: &mut Vec<Unread>,
+) -> (WorldSpec, WorldLoc) {
+    let (mut spec, mut loc) = (spec.clone(), loc.clone());
+    for (w, (l, _)) in spec
+        .walls
+        .iter()
+        .zip(loc.walls.iter().zip(good_walls))
+        .filter(|(_, (_, g))| !**g)
+    {
+        unread.push(Unread {
+            kind: "wall",
+            name: format!("wall '{}'", w.id),
+            at: l.table,
+            points_m: w.points_m.clone(),
+        });
+    }
+    for (door, (l, _)) in spec
+        .doors
+        .iter()
+        .zip(loc.doors.iter().zip(good_doors))
+        .filter(|(_, (_, g))| !**g)
+    {
+        unread.push(Unread {
+            kind: "door",
+            name: format!("door '{}'", door.id),
+            at: l.table,
+            points_m: vec![door.hinge_m],
+        });
+    }
+    let keep = |good: &[bool], i: usize| good.get(i).copied().unwrap_or(true);
+    let mut i = 0;
+    spec.walls.retain(|_| (keep(good_walls, i), i += 1).0);
+    i = 0;
+    loc.walls.retain(|_| (keep(good_walls, i), i += 1).0);
+    i = 0;
+    spec.doors.retain(|_| (keep(good_doors, i), i += 1).0);
+    i = 0;
+    loc.doors.retain(|_| (keep(good_doors, i), i += 1).0);
+    (spec, loc)
+}
+
+/// The centre-line segments of what read of an unread wall or door (a closed wall's closing
+/// segment included, as it may be closed); a single point as a zero-length segment.
+fn unread_segments(u: &Unread) -> Vec<Segment> {
+    let p: Vec<Vec2> = u.points_m.iter().map(v).collect();
+    match p.len() {
+        0 => Vec::new(),
+        1 => vec![Segment::new(p[0], p[0])],
+        n => (0..n).map(|k| Segment::new(p[k], p[(k + 1) % n])).collect(),
+    }
+}
+
+/// The first unread wall (`kind`) that may lie within `within_m` of `s`: one whose points did
+/// not read may lie anywhere.
+fn unread_near<'u>(
+    unread: &'u [Unread],
+    kind: &str,
+    s: Segment,
+    within_m: f64,
+) -> Option<&'u Unread> {
+    unread.iter().filter(|u| u.kind == kind).find(|u| {
+        let segs = unread_segments(u);
+        segs.is_empty()
+            || segs
+                .iter()
+                .any(|t| crate::geom::segment_distance(s, *t) <= within_m)
+    })
 }
 
 /// Ids used twice among walls, doors, routes or areas.
@@ -151,10 +232,25 @@ fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             .map(|r| r.waypoints_m.len())
             .sum::<usize>();
     if segments > MAX_SEGMENTS {
+        // Reported on the wall that holds most of them, when one does.
+        let biggest = spec
+            .walls
+            .iter()
+            .zip(&loc.walls)
+            .map(|(w, l)| (w.points_m.len(), w, l))
+            .max_by_key(|(n, _, _)| *n)
+            .filter(|(n, _, _)| *n > segments / 2);
+        let (at, which) = match biggest {
+            Some((n, w, l)) => (
+                l.points_key,
+                format!(", {n} of them points of wall '{}'", w.id),
+            ),
+            None => (loc.walls_key, String::new()),
+        };
         d.at(
-            loc.walls_key,
+            at,
             format!(
-                "the world has {segments} wall segments, door panels and route legs (limit {MAX_SEGMENTS}); simplify the walls or split the world into smaller ones"
+                "the world has {segments} wall segments, door panels and route legs (limit {MAX_SEGMENTS}){which}; simplify the walls or split the world into smaller ones"
             ),
         );
         return false;
@@ -162,11 +258,12 @@ fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
     true
 }
 
-/// Wall thicknesses, point counts and repeated points; `false` when the geometry cannot be
+/// Wall thicknesses, point counts and repeated points; per wall, whether its geometry can be
 /// checked.
-fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
-    let mut ok = true;
+fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
+    let mut good = Vec::with_capacity(spec.walls.len());
     for (w, l) in spec.walls.iter().zip(&loc.walls) {
+        let mut ok = true;
         if !(w.thickness_m > 0.0 && w.thickness_m < MAX_WALL_THICKNESS_M) {
             d.at(
                 l.thickness,
@@ -188,9 +285,10 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
                     if w.closed { " closed" } else { "" }
                 ),
             );
-            ok = false;
+            good.push(false);
             continue;
         }
+        good.push(ok);
         let m = if w.closed { n } else { n - 1 };
         for j in 0..m {
             let (a, b) = (w.points_m[j], w.points_m[(j + 1) % n]);
@@ -208,13 +306,15 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             }
         }
     }
-    ok
+    good
 }
 
-/// Door widths, thicknesses, headings and swings; `false` when the geometry cannot be checked.
-fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
-    let mut ok = true;
+/// Door widths, thicknesses, headings and swings; per door, whether its geometry can be
+/// checked.
+fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
+    let mut good = Vec::with_capacity(spec.doors.len());
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
+        let mut ok = true;
         let (lo, hi) = DOOR_WIDTH_RANGE_M;
         if !(door.width_m >= lo && door.width_m <= hi) {
             d.at(
@@ -269,8 +369,9 @@ fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             );
             ok = false;
         }
+        good.push(ok);
     }
-    ok
+    good
 }
 
 /// Route waypoints, area corners and the home heading.
@@ -439,18 +540,89 @@ impl Obstacles {
     }
 }
 
-fn geometry(spec: &WorldSpec, loc: &WorldLoc, robot_radius_m: f64, d: &mut Diags) {
+/// The geometric checks of what read (`unread`: what did not, for the notes of the checks
+/// that depend on it).
+fn geometry(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    unread: &[Unread],
+    robot_radius_m: f64,
+    d: &mut Diags,
+) {
     let walls = wall_obstacles(spec);
     let closed = door_obstacles(spec, false);
     let open = door_obstacles(spec, true);
     let all = [(&walls, ""), (&closed, "closed"), (&open, "open")];
-    doors_span_their_gaps(spec, loc, &walls, d);
+    doors_span_their_gaps(spec, loc, &walls, unread, d);
     home_in_free_space(spec, loc, &all, robot_radius_m, d);
     doors_fit_their_gaps(spec, loc, &walls, d);
     walls_do_not_overlap(spec, loc, d);
-    home_inside_the_building(spec, loc, d);
+    home_inside_the_building(spec, loc, unread, d);
     routes_are_drivable(spec, loc, &all, robot_radius_m, d);
+    routes_near_unread(spec, loc, unread, robot_radius_m, d);
     areas_are_walkable(spec, loc, &walls, d);
+}
+
+/// A note per route leg that passes within the robot's radius of a wall or door that did not
+/// read (or per route, when where it lies is unknown): the leg was not checked against it.
+fn routes_near_unread(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    unread: &[Unread],
+    robot_radius_m: f64,
+    d: &mut Diags,
+) {
+    for u in unread.iter().filter(|u| matches!(u.kind, "wall" | "door")) {
+        // A door reaches its width around its hinge whichever way it swings: the hinge to
+        // tip distance when both read, the widest door otherwise.
+        let (segs, reach) = match (u.kind, u.points_m.as_slice()) {
+            ("door", [h, tip, ..]) => (
+                vec![Segment::new(v(h), v(h))],
+                robot_radius_m + (v(tip) - v(h)).norm(),
+            ),
+            ("door", [h]) => (
+                vec![Segment::new(v(h), v(h))],
+                robot_radius_m + DOOR_WIDTH_RANGE_M.1,
+            ),
+            _ => (unread_segments(u), robot_radius_m),
+        };
+        for (r, l) in spec.routes.iter().zip(&loc.routes) {
+            let n = r.waypoints_m.len();
+            if n < 3 {
+                continue;
+            }
+            let near = (0..n).find(|&k| {
+                let leg = Segment::new(v(&r.waypoints_m[k]), v(&r.waypoints_m[(k + 1) % n]));
+                segs.is_empty()
+                    || segs
+                        .iter()
+                        .any(|t| crate::geom::segment_distance(leg, *t) <= reach)
+            });
+            let Some(k) = near else { continue };
+            let line = d.line_of(u.at);
+            let (at, message) = if segs.is_empty() {
+                (
+                    l.waypoints_key,
+                    format!(
+                        "route '{}' was not checked against {}, whose place did not read (line {line}); fix it and check again",
+                        r.id, u.name
+                    ),
+                )
+            } else {
+                (
+                    l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
+                    format!(
+                        "route '{}' leg from waypoint {k} to {} passes near {} and was not checked against it: that {} has errors (line {line}); fix them and check again",
+                        r.id,
+                        (k + 1) % n,
+                        u.name,
+                        u.kind
+                    ),
+                )
+            };
+            d.note(at, message);
+        }
+    }
 }
 
 /// Every segment of every wall (closed walls include the closing one), zero-length ones too:
@@ -515,11 +687,18 @@ fn nearest_of<'a>(
 }
 
 /// Doors: closed they fill a wall gap; open they do not cut through a wall.
-fn doors_span_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
+fn doors_span_their_gaps(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    walls: &Obstacles,
+    unread: &[Unread],
+    d: &mut Diags,
+) {
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
         let panel = door_panel(door, false);
         let point = |p: Vec2| Segment::new(p, p);
         let probe = 1.0;
+        let mut noted = false;
         for (end, at, which, fix) in [
             (
                 panel.a,
@@ -535,7 +714,23 @@ fn doors_span_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d:
             ),
         ] {
             let c = walls.nearest(point(end), probe).map(|(_, c)| c);
-            if c.is_none_or(|c| c > DOOR_GAP_TOLERANCE_M) {
+            if c.is_none_or(|c| c > DOOR_GAP_TOLERANCE_M)
+                && let Some(u) = unread_near(unread, "wall", point(end), probe)
+            {
+                // Its wall may be the one that did not read: not checked, said once.
+                if !noted {
+                    d.note(
+                        l.hinge,
+                        format!(
+                            "closed door '{}' not checked for spanning a wall gap: its wall may be {}, which has errors (line {}); fix them and check again",
+                            door.id,
+                            u.name,
+                            d.line_of(u.at)
+                        ),
+                    );
+                }
+                noted = true;
+            } else if c.is_none_or(|c| c > DOOR_GAP_TOLERANCE_M) {
                 let dist = c
                     .map(|c| format!("{c:.2} m"))
                     .unwrap_or_else(|| format!("more than {probe} m"));
@@ -857,7 +1052,7 @@ fn overlap(a: &ThickSegment, b: &ThickSegment) -> Option<(f64, Vec2, Vec2)> {
 /// The robot's home must lie inside the building (free space around it does not reach past
 /// the walls) and in the part of it the routes drive through (not in a room closed off all
 /// round). Doors are taken open: a home behind a door is fine.
-fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, unread: &[Unread], d: &mut Diags) {
     let Some(first) = spec.routes.iter().find_map(|r| r.waypoints_m.first()) else {
         return;
     };
@@ -882,6 +1077,18 @@ fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     } else {
         return;
     };
+    // A wall (or route) that did not read may close the loop (or pass by the home).
+    if let Some(u) = unread.iter().find(|u| matches!(u.kind, "wall" | "route")) {
+        d.note(
+            loc.home.x,
+            format!(
+                "robot home not checked for lying inside the building beside a route: {} has errors (line {}); fix them and check again",
+                u.name,
+                d.line_of(u.at)
+            ),
+        );
+        return;
+    }
     d.at(
         loc.home.x,
         format!(

@@ -193,12 +193,85 @@ fn a_hundred_generated_floors_pass_the_checks() {
             ),
             doors: 2 + (seed % 3) as usize,
             corridors: 4 + 2 * (seed % 5) as usize,
+            double_loaded: seed % 4 == 1,
+            look_alike: seed % 7 == 3,
         };
         let text = generate_toml(&opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let w = parse_world(&text, "generated").unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         assert_eq!(w.doors.len(), opts.doors);
         assert_eq!(w.route("lap").unwrap().waypoints.len(), opts.corridors);
     }
+}
+
+/// Issue 26's done-when on a few seeds (the report has 20): a double-loaded 60 x 30 m floor with
+/// 30 offices passes `world check`, test drive included, with a walking area per corridor.
+#[test]
+fn double_loaded_floors_with_thirty_rooms_pass_world_check() {
+    for seed in [0u64, 7, 19] {
+        let opts = GenerateOptions {
+            seed,
+            size_m: (60.0, 30.0),
+            doors: 30,
+            double_loaded: true,
+            ..GenerateOptions::default()
+        };
+        let text = generate_toml(&opts).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let w = placewords::sim::test_drive::check_world_text(&text, "ward")
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        assert_eq!(w.doors.len(), 30);
+        assert_eq!(w.areas.len(), 4, "seed {seed}: a walking area per corridor");
+        // Both sides: some doors open into the courtyard side of the loop, some outwards.
+        let lap = w.route("lap").unwrap();
+        let (lo, hi) = lap.waypoints.iter().fold(
+            (Vec2::new(f64::MAX, f64::MAX), Vec2::new(f64::MIN, f64::MIN)),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let inside = w
+            .doors
+            .iter()
+            .filter(|d| {
+                let h = d.hinge;
+                h.x > lo.x && h.x < hi.x && h.y > lo.y && h.y < hi.y
+            })
+            .count();
+        assert!(
+            inside > 0 && inside < 30,
+            "seed {seed}: {inside} doors inside the loop"
+        );
+    }
+}
+
+/// `--look-alike` makes every office the same width with its door at the same place.
+#[test]
+fn look_alike_floors_repeat_one_office() {
+    let opts = GenerateOptions {
+        seed: 4,
+        size_m: (60.0, 30.0),
+        doors: 20,
+        double_loaded: true,
+        look_alike: true,
+        ..GenerateOptions::default()
+    };
+    let spec = placewords::authoring::generate::generate_spec(&opts).unwrap();
+    let offices: Vec<_> = spec
+        .walls
+        .iter()
+        .filter(|w| w.id.starts_with("office-"))
+        .collect();
+    assert_eq!(offices.len(), 20);
+    for (w, d) in offices.iter().zip(&spec.doors) {
+        let (a, b) = (w.points_m[1], w.points_m[2]);
+        let width = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+        assert!((width - 4.0).abs() < 1e-6, "{}: {width} m wide", w.id);
+        let f = w.points_m[0];
+        let at = ((d.hinge_m[0] - f[0]).powi(2) + (d.hinge_m[1] - f[1]).powi(2)).sqrt();
+        assert!(
+            (at - 0.5).abs() < 1e-6,
+            "{}: door {at} m from the office's side",
+            d.id
+        );
+    }
+    assert!(generate_toml(&opts).is_ok());
 }
 
 #[test]
@@ -218,6 +291,48 @@ fn generate_cli_is_deterministic_and_refuses_impossible_floors() {
         ]);
         assert!(out.status.success());
     }
+    // `--size-m` in the form its default shows and in the spaced form (issue 27) give the same.
+    let c = dir.path().join("c.toml");
+    let spaced = placewords(&[
+        "world",
+        "generate",
+        "--seed",
+        "3",
+        "--size-m",
+        "50 40",
+        "-o",
+        c.to_str().unwrap(),
+    ]);
+    assert!(
+        spaced.status.success(),
+        "{}",
+        String::from_utf8_lossy(&spaced.stderr)
+    );
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&c).unwrap());
+    let help = placewords(&["world", "generate", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    let shown = help
+        .split("[default: ")
+        .nth(1)
+        .and_then(|t| t.split(']').next())
+        .unwrap_or_else(|| panic!("no default in:\n{help}"))
+        .to_string();
+    let d = dir.path().join("d.toml");
+    let default_form = placewords(&[
+        "world",
+        "generate",
+        "--seed",
+        "3",
+        "--size-m",
+        &shown,
+        "-o",
+        d.to_str().unwrap(),
+    ]);
+    assert!(
+        default_form.status.success(),
+        "--size-m {shown}: {}",
+        String::from_utf8_lossy(&default_form.stderr)
+    );
     assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     let check = placewords(&["world", "check", a.to_str().unwrap()]);
     assert!(check.status.success());

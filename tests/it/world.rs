@@ -154,6 +154,63 @@ fn a_file_with_several_mistakes_reports_them_all() {
     assert!(err.diagnostics().len() >= 3, "{err}");
 }
 
+/// A key typo, a number error and a geometric mistake in one file: all three are reported,
+/// each at its place (the parts that read are checked geometrically).
+#[test]
+fn three_mistakes_of_different_kinds_are_all_reported() {
+    use placewords::spec::diag::Severity;
+    let src = std::fs::read_to_string(root().join(INVALID).join("three-kinds.toml")).unwrap();
+    let err = parse_world(&src, "x.toml").unwrap_err();
+    let errors: Vec<_> = err
+        .diagnostics()
+        .iter()
+        .filter(|d| d.severity == Severity::Error)
+        .map(|d| (d.line, d.col, d.message.as_str()))
+        .collect();
+    assert_eq!(errors.len(), 3, "{err}");
+    assert!(
+        errors[0]
+            .2
+            .contains("`thickness_m` in wall 'room' is not a finite number"),
+        "{err}"
+    );
+    assert_eq!((errors[0].0, errors[0].1), (17, 15));
+    assert!(errors[1].2.contains("unknown key `widht_m`"), "{err}");
+    assert_eq!((errors[1].0, errors[1].1), (23, 1));
+    assert!(
+        errors[2]
+            .2
+            .contains("waypoint 3 is 0.05 m from wall 'outer'"),
+        "{err}"
+    );
+    assert_eq!((errors[2].0, errors[2].1), (29, 54));
+}
+
+/// A check that depends on a part that did not read is skipped with a note at its place, not
+/// reported wrongly (the door does not "fail to span a gap" because its wall is missing).
+#[test]
+fn a_check_on_a_broken_part_is_skipped_with_a_note() {
+    use placewords::spec::diag::Severity;
+    let src = std::fs::read_to_string(root().join(INVALID).join("door-wall-unread.toml")).unwrap();
+    let err = parse_world(&src, "x.toml").unwrap_err();
+    let d = err.diagnostics();
+    assert_eq!(
+        d.iter().filter(|d| d.severity == Severity::Error).count(),
+        1,
+        "{err}"
+    );
+    assert!(
+        !err.to_string().contains("does not span a wall gap"),
+        "{err}"
+    );
+    let note = d
+        .iter()
+        .find(|d| d.severity == Severity::Note && d.message.contains("door 'd-1' not checked"))
+        .unwrap_or_else(|| panic!("no note for the door: {err}"));
+    assert_eq!((note.line, note.col), (21, 11), "{note}");
+    assert!(note.message.contains("wall 'room'"), "{note}");
+}
+
 /// Refused at the segment limit, located (how fast: `benches/world.rs`).
 #[test]
 fn too_many_segments_are_refused() {
@@ -395,7 +452,14 @@ fn cli_check_reports_located_problems_and_exits_2() {
         std::fs::read_to_string(root().join(INVALID).join("unknown-key-typo.expected")).unwrap();
     // The command prints the fixture's messages with their severity, as compilers do.
     let expected = expected.replacen(": unknown key", ": error: unknown key", 1);
-    assert_eq!(err.trim_end(), expected.trim_end());
+    for line in expected.lines() {
+        assert!(err.contains(line), "missing {line:?} in:\n{err}");
+    }
+    // A world with errors is not test-driven, and `world check` says so.
+    assert!(
+        err.contains(&format!("{f}:26:1: note: the routes were not test-driven")),
+        "{err}"
+    );
     assert!(
         err.contains(&format!("{f}:22:1: error: unknown key `widht_m`")),
         "{err}"
