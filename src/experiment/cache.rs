@@ -79,7 +79,7 @@ impl Entry {
     }
 }
 
-/// An entry being written lap by lap; [`Pending::store`] puts it in place.
+/// An entry being written lap by lap; [`LapCache::store`] puts it in place.
 pub struct Pending {
     writer: Option<LapFileWriter<AtomicFile>>,
     path: PathBuf,
@@ -87,7 +87,7 @@ pub struct Pending {
 }
 
 impl Pending {
-    /// Adds lap `lap` of run `run` (a write error is kept for [`Pending::store`] and the rest
+    /// Adds lap `lap` of run `run` (a write error is kept for [`LapCache::store`] and the rest
     /// is not written).
     pub fn push(&mut self, run: usize, lap: &LapLog) {
         if let Some(w) = self.writer.as_mut()

@@ -234,7 +234,7 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// The world with the true path coloured where revisits were recognized, recognized wrongly
-/// and missed (see [`ObsStatus`]), and the worst clusters of wrong pairs as lines.
+/// and missed (see [`ObservationStatus`]), and the worst clusters of wrong pairs as lines.
 pub fn matches_svg(
     world: &World,
     runs: &[RunLog],
