@@ -80,11 +80,12 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     }
     // Read now, so a bad baseline is refused before the work rather than after it.
     let baseline = read_baseline(&args.baseline)?;
-    super::common::check_outputs([args.report.as_deref(), args.junit.as_deref()])?;
-    if let Some(dir) = &args.out {
-        // Refused now (another output there, or a live writer) rather than after the work.
-        drop(stress::stage_dir(dir)?);
-    }
+    // Begun now, so another output there or a live writer is refused before the work.
+    let outputs = CheckOutputs::begin(
+        args.report.as_deref(),
+        args.junit.as_deref(),
+        args.out.as_deref(),
+    )?;
     let opts = StressOptions {
         seeds: args.seeds.range(),
         shard,
@@ -102,13 +103,9 @@ pub fn run(args: CheckArgs) -> anyhow::Result<ExitCode> {
     let suite = stress::run_stress(&args.scenarios, &opts);
     super::common::report_cache(opts.experiment.cache.as_deref());
     let w = placewords::clock::Stopwatch::start();
-    if let Some(path) = &args.report {
-        stress::write_file(path, suite.to_json().as_bytes())?;
-    }
     let code = finish(
         &suite,
-        args.out.as_deref(),
-        args.junit.as_deref(),
+        outputs,
         args.json,
         baseline
             .as_ref()
@@ -145,13 +142,45 @@ pub fn step_summary(md: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What `check` and `merge` write — `--report FILE`, `--junit FILE`, `-o DIR` — begun before
+/// the work (a path another live process writes is refused then) and written as one
+/// ([`placewords::io::atomic::OutputSet`]): a kill leaves the old outputs or the new ones.
+pub struct CheckOutputs {
+    set: placewords::io::atomic::OutputSet,
+    report: Option<PathBuf>,
+    junit: Option<PathBuf>,
+    out: Option<PathBuf>,
+}
+
+impl CheckOutputs {
+    /// Checks the paths and begins the set; `out` must be new, empty or an earlier output.
+    pub fn begin(
+        report: Option<&Path>,
+        junit: Option<&Path>,
+        out: Option<&Path>,
+    ) -> anyhow::Result<CheckOutputs> {
+        super::common::check_outputs([report, junit])?;
+        let files: Vec<&Path> = [report, junit].into_iter().flatten().collect();
+        let replaceable: &dyn Fn(&Path) -> bool = &stress::is_check_output;
+        let folders: Vec<(&Path, &dyn Fn(&Path) -> bool)> =
+            out.into_iter().map(|d| (d, replaceable)).collect();
+        let set = placewords::io::atomic::OutputSet::begin(&files, &[], &folders)
+            .map_err(stress::StressError::from)?;
+        Ok(CheckOutputs {
+            set,
+            report: report.map(Path::to_path_buf),
+            junit: junit.map(Path::to_path_buf),
+            out: out.map(Path::to_path_buf),
+        })
+    }
+}
+
 /// Prints a stress run's verdict (and its comparison with a baseline, if given), writes the
 /// outputs asked for, and gives the exit code (a part exits 0 unless something failed to run:
 /// its seeds are not the distribution).
 pub fn finish(
     suite: &SuiteReport,
-    out: Option<&Path>,
-    junit_path: Option<&Path>,
+    outputs: CheckOutputs,
     json: bool,
     baseline: Option<(&Path, &SuiteReport, &super::common::ToleranceArg)>,
 ) -> anyhow::Result<ExitCode> {
@@ -166,13 +195,24 @@ pub fn finish(
         None => None,
     };
     let cmp = cmp.as_ref();
-    if let Some(dir) = out {
-        stress::write_dir_with(suite, cmp, dir).with_context(|| "writing the outputs")?;
+    let set = &outputs.set;
+    let staged = |path: &Path, e: std::io::Error| {
+        anyhow::Error::new(e).context(format!("{}: cannot write", path.display()))
+    };
+    if let Some(path) = &outputs.report {
+        set.write(path, suite.to_json().as_bytes())
+            .map_err(|e| staged(path, e))?;
     }
-    if let Some(path) = junit_path {
+    if let Some(dir) = &outputs.out {
+        let at = set.dir(dir).expect("begun with this folder");
+        stress::write_dir_files(suite, cmp, at).with_context(|| "writing the outputs")?;
+    }
+    if let Some(path) = &outputs.junit {
         let xml = junit::document_with(suite, cmp);
-        stress::write_file(path, xml.as_bytes())?;
+        set.write(path, xml.as_bytes())
+            .map_err(|e| staged(path, e))?;
     }
+    outputs.set.commit().with_context(|| "writing the outputs")?;
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
         errln!("error: {e}");
     }

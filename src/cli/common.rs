@@ -101,29 +101,89 @@ pub fn command_line() -> Vec<String> {
         .collect()
 }
 
-/// Prints the experiment's table, then writes its JSON report (with `provenance`) and pictures
-/// where asked: the true and odometry paths, and the matched pairs of each level configuration
-/// (and ICP).
-pub fn print_and_write(
-    exp: &placewords::experiment::Experiment,
-    world: &placewords::world::World,
-    radius_m: f64,
-    report: Option<(&Path, &placewords::eval::provenance::Provenance)>,
-    svg_dir: Option<&Path>,
-) -> anyhow::Result<()> {
-    out!("{}", placewords::report::table::text_table(&exp.report))?;
-    if let Some((path, provenance)) = report {
-        write_file(
-            path,
-            placewords::report::json::to_json_with(&exp.report, provenance).as_bytes(),
-        )?;
-        errln!("report: {}", path.display());
+/// The outputs of one experiment (`run`, `recognize`): JSON report, exported matches and
+/// pictures, begun before the work so a path another live process writes is refused then, and
+/// written as one ([`placewords::io::atomic::OutputSet`]): a kill leaves the old set or the new.
+pub struct ExperimentOutputs {
+    set: placewords::io::atomic::OutputSet,
+    report: Option<std::path::PathBuf>,
+    matches: Option<std::path::PathBuf>,
+    svg: Option<std::path::PathBuf>,
+}
+
+impl ExperimentOutputs {
+    /// Checks the paths (as [`check_outputs`] and [`check_output_dirs`]) and begins the set.
+    pub fn begin(
+        report: Option<&Path>,
+        matches: Option<&Path>,
+        svg: Option<&Path>,
+    ) -> anyhow::Result<ExperimentOutputs> {
+        check_outputs([report, matches])?;
+        check_output_dirs([svg])?;
+        let files: Vec<&Path> = [report, matches].into_iter().flatten().collect();
+        let dirs: Vec<&Path> = svg.into_iter().collect();
+        Ok(ExperimentOutputs {
+            set: placewords::io::atomic::OutputSet::begin(&files, &dirs, &[])?,
+            report: report.map(Path::to_path_buf),
+            matches: matches.map(Path::to_path_buf),
+            svg: svg.map(Path::to_path_buf),
+        })
     }
-    if let Some(dir) = svg_dir {
-        placewords::experiment::picture::write_pictures(exp, world, radius_m, dir)?;
-        errln!("pictures: {}", dir.display());
+
+    /// Prints the experiment's table, then writes its JSON report (with `provenance`), the
+    /// matched pairs of its last level configuration (on `runs`' scans) and its pictures
+    /// where asked — the true and odometry paths, and the matched pairs of each level
+    /// configuration (and ICP) — all put in place at once at the end.
+    pub fn print_and_write(
+        self,
+        exp: &placewords::experiment::Experiment,
+        world: &placewords::world::World,
+        radius_m: f64,
+        provenance: &placewords::eval::provenance::Provenance,
+    ) -> anyhow::Result<()> {
+        out!("{}", placewords::report::table::text_table(&exp.report))?;
+        let staged = |path: &Path, e: std::io::Error| {
+            anyhow::Error::new(e).context(format!("{}: cannot write", path.display()))
+        };
+        if let Some(path) = &self.report {
+            let json = placewords::report::json::to_json_with(&exp.report, provenance);
+            self.set
+                .write(path, json.as_bytes())
+                .map_err(|e| staged(path, e))?;
+        }
+        let mut pairs = None;
+        if let (Some(path), Some((_, rec))) = (&self.matches, exp.recognitions.last()) {
+            use placewords::experiment::score;
+            let rows = score::export_rows(rec, &score::run_frames(&exp.runs));
+            let csv = placewords::io::matches_csv::write_matches(&rows);
+            self.set
+                .write(path, csv.as_bytes())
+                .map_err(|e| staged(path, e))?;
+            pairs = Some(rows.len());
+        }
+        if let Some(dir) = &self.svg {
+            let staging = self.set.dir(dir).expect("begun with this folder");
+            placewords::experiment::picture::write_pictures(exp, world, radius_m, staging)?;
+        }
+        let written: Vec<String> = [&self.report, &self.matches, &self.svg]
+            .into_iter()
+            .flatten()
+            .map(|p| p.display().to_string())
+            .collect();
+        self.set
+            .commit()
+            .with_context(|| format!("{}: cannot write", written.join(", ")))?;
+        if let Some(path) = &self.report {
+            errln!("report: {}", path.display());
+        }
+        if let (Some(path), Some(n)) = (&self.matches, pairs) {
+            errln!("matches: {} ({n} pairs)", path.display());
+        }
+        if let Some(dir) = &self.svg {
+            errln!("pictures: {}", dir.display());
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// `--seeds A..B` or `--seed N`: which seeds to run.

@@ -22,14 +22,13 @@ pub struct MergeArgs {
 }
 
 pub fn run(args: MergeArgs) -> anyhow::Result<ExitCode> {
-    super::common::check_output_dirs([Some(args.out.as_path())])?;
+    let outputs = super::check::CheckOutputs::begin(None, None, Some(&args.out))?;
     let baseline = super::check::read_baseline(&args.baseline)?;
     let suite =
         placewords::experiment::stress::merge_files(&args.parts, super::common::command_line())?;
     super::check::finish(
         &suite,
-        Some(&args.out),
-        None,
+        outputs,
         args.json,
         baseline
             .as_ref()

@@ -1,7 +1,7 @@
 //! `placewords recognize LOG`: the recognizer and evaluation on a real CARMEN log or a ROS 2 bag
 //! (MCAP), with the same definitions and report schema as `run`.
 
-use super::common::{LevelsArg, print_and_write};
+use super::common::{ExperimentOutputs, LevelsArg};
 use anyhow::bail;
 use clap::{Args, ValueEnum};
 use placewords::experiment::{self, ExperimentOptions, picture};
@@ -81,8 +81,7 @@ pub struct RecognizeArgs {
 }
 
 pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
-    super::common::check_outputs([args.report.as_deref()])?;
-    super::common::check_output_dirs([args.svg.as_deref()])?;
+    let outputs = ExperimentOutputs::begin(args.report.as_deref(), None, args.svg.as_deref())?;
     let noise = experiment::real::parse_noise_model(&args.odometry_noise)
         .map_err(|e| anyhow::anyhow!("--odometry-noise {}: {e}", args.odometry_noise))?;
     for (flag, v) in [
@@ -177,12 +176,6 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         ]);
         prov
     };
-    print_and_write(
-        &exp,
-        &world,
-        args.tp_radius_m,
-        args.report.as_deref().map(|p| (p, &provenance)),
-        args.svg.as_deref(),
-    )?;
+    outputs.print_and_write(&exp, &world, args.tp_radius_m, &provenance)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -1,7 +1,7 @@
 //! `placewords run SCENARIO`: simulate, recognize at 1, 2 and 3 levels, evaluate, report; over
 //! a range of seeds with `--seeds A..B` (mean and worst per configuration).
 
-use super::common::{ExternalArg, LevelsArg, SeedsArg, print_and_write, write_file};
+use super::common::{ExperimentOutputs, ExternalArg, LevelsArg, SeedsArg, write_file};
 use clap::Args;
 use placewords::clock::Stopwatch;
 use placewords::experiment::stress::{self, StressOptions};
@@ -55,8 +55,18 @@ pub struct RunArgs {
 }
 
 pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
-    super::common::check_outputs([args.report.as_deref(), args.export_matches.as_deref()])?;
-    super::common::check_output_dirs([args.svg.as_deref()])?;
+    // With --seeds only the report is written (pictures and matches are of one seed).
+    if args.seeds.seeds.is_some() {
+        super::common::check_outputs([args.report.as_deref()])?;
+    }
+    let outputs = match args.seeds.seeds {
+        Some(_) => None,
+        None => Some(ExperimentOutputs::begin(
+            args.report.as_deref(),
+            args.export_matches.as_deref(),
+            args.svg.as_deref(),
+        )?),
+    };
     let opts = ExperimentOptions {
         levels: args.levels.levels(),
         icp: args.icp,
@@ -104,19 +114,15 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         experiment::run_scenario(&scn, &opts)?
     };
     let w = Stopwatch::start();
-    if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
-        super::score::export(path, rec, &exp.runs)?;
-    }
     super::common::report_cache(cache.as_deref());
     let mut provenance =
         experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line());
     provenance.lap_cache = cache.map(|c| c.used());
-    print_and_write(
+    outputs.expect("begun for one seed").print_and_write(
         &exp,
         &scn.sim.world,
         scn.evaluation.tp_radius_m,
-        args.report.as_deref().map(|p| (p, &provenance)),
-        args.svg.as_deref(),
+        &provenance,
     )?;
     if args.profile {
         eprint!("{}", profile_text([&exp.report], w.wall_s()));

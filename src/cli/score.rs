@@ -6,7 +6,7 @@ use clap::Args;
 use placewords::experiment::score;
 use placewords::io::matches_csv;
 use placewords::spec::evaluation::EvaluationSpec;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Debug, Args)]
@@ -30,6 +30,8 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     super::common::check_outputs([args.report.as_deref()])?;
     let logs = score::load_logged_runs(&args.logdir)?;
     let name = args.matches.display().to_string();
+    // A `run --export-matches` a kill interrupted after its commit is finished first.
+    placewords::io::atomic::settle(&args.matches);
     let text = placewords::spec::diag::read_text(&args.matches)?;
     let file = matches_csv::read_matches(&text, &name)?;
     let report = score::score_file(&logs, &file, &name, &EvaluationSpec::default(), args.levels)?;
@@ -63,14 +65,3 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// Writes `rec`'s matched pairs as a matches file.
-pub fn export(
-    path: &Path,
-    rec: &placewords::eval::Recognition,
-    runs: &[placewords::sim::RunLog],
-) -> anyhow::Result<()> {
-    let rows = score::export_rows(rec, &score::run_frames(runs));
-    write_file(path, matches_csv::write_matches(&rows).as_bytes())?;
-    errln!("matches: {} ({} pairs)", path.display(), rows.len());
-    Ok(())
-}

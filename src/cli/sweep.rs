@@ -20,8 +20,8 @@ pub struct SweepArgs {
     /// Output folder for sweep.json and pr-curves.svg.
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Replace every run's lap count (for a quick look).
-    #[arg(long, value_name = "N")]
+    /// Replace every run's lap count (for a quick look; 1 to 1000).
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     /// No progress bars.
     #[arg(long, short)]
@@ -36,17 +36,14 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
         placewords::io::atomic::holds_only(d, &|n| matches!(n, "sweep.json" | "pr-curves.svg"))
     })?;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
-    let base = experiment::recognizer_config(&scn)?;
     let opts = ExperimentOptions {
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
         cache: args.cache.open()?,
         ..ExperimentOptions::default()
     };
-    let (runs, _, _) = experiment::simulate(&scn, &opts)?;
+    let (results, laps) = experiment::sweep(&scn, &opts, &fig8_grid())?;
     super::common::report_cache(opts.cache.as_deref());
-    let laps = runs.iter().map(|r| r.laps.len()).sum();
-    let results = experiment::sweep(&runs, &base, &scn.evaluation, &fig8_grid(), &opts.progress)?;
     let report = SweepReport::new(
         &scn.sim.name,
         scn.sim.seed,

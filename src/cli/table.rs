@@ -25,8 +25,8 @@ pub struct TableArgs {
     /// Leave out the Scan Context baseline (settings: each scenario's `[scan_context]` table).
     #[arg(long)]
     pub no_scan_context: bool,
-    /// Replace every run's lap count (for a quick look).
-    #[arg(long, value_name = "N")]
+    /// Replace every run's lap count (for a quick look; 1 to 1000).
+    #[arg(long, value_name = "N", value_parser = super::scenario::laps_flag)]
     pub laps: Option<usize>,
     #[command(flatten)]
     pub external: super::common::ExternalArg,
@@ -65,7 +65,8 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     let command_line = super::common::command_line();
     for scn in &scenarios {
         errln!("scenario {}", scn.sim.name);
-        let exp = experiment::run_scenario(scn, &opts)?;
+        // Streamed: nothing here needs the scans after the recognizers saw them.
+        let exp = experiment::run_scenario_streamed(scn, &opts)?;
         let mut provenance =
             experiment::scenario_provenance(&[scn], args.laps, command_line.clone());
         provenance.lap_cache = opts.cache.as_ref().map(|c| {

@@ -17,11 +17,11 @@ use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::baseline::scan_context::{ScanContextConfig, ScanContextRecognizer};
 use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
-use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
+use crate::eval::{Recognition, recognize_runs_with_progress};
 use crate::external::{ExternalRecognizer, ExternalSpec};
 use crate::place::{Match, PlaceRecognizer};
 use crate::recognizer::{
-    DensityFrontEnd, DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher,
+    DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher,
 };
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
@@ -32,7 +32,6 @@ pub use scenario::{
     Scenario, check_scenario, load_recognizer_config, load_scenario, parse_recognizer_config,
     parse_scenario,
 };
-use std::time::Instant;
 pub use stream::run_scenario_streamed;
 
 /// Why an experiment could not be carried out.
@@ -393,27 +392,6 @@ fn assemble(
     }
 }
 
-/// The observations of `runs` under `cfg`'s front end, computed once (for sweeps), with the
-/// wall-clock seconds it took.
-pub fn observe(
-    runs: &[RunLog],
-    cfg: &RecognizerConfig,
-) -> Result<(Vec<DensityObservation>, f64), ExperimentError> {
-    let mut front =
-        DensityFrontEnd::new(cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
-    let t = Instant::now();
-    let mut out = Vec::new();
-    for (i, run) in runs.iter().enumerate() {
-        if i > 0 {
-            front.start_run();
-        }
-        for f in run.frames() {
-            out.extend(front.push(f.odom, &f.scan));
-        }
-    }
-    Ok((out, t.elapsed().as_secs_f64()))
-}
-
 /// The matches the back end finds in `observations` with the levels and thresholds of `point`.
 pub fn back_end_matches(
     observations: &[DensityObservation],
@@ -443,31 +421,33 @@ pub fn back_end_matches(
     Ok(out.iter().map(WordMatch::to_place).collect())
 }
 
-/// The paper's Fig. 8 sweep: observations computed once, then every grid point's back end in
-/// parallel; results in grid order whatever the thread count.
+/// The paper's Fig. 8 sweep of `scn` (laps per run replaced by `opts.laps`): the laps are
+/// simulated (or read from `opts.cache`) and turned into observations as they come, each lap's
+/// scans dropped once observed ([`stream::observe_scenario`]), so memory holds the observations
+/// and the truth, not the scans; then every grid point's back end runs in parallel. Results in
+/// grid order whatever the thread count, with the laps driven.
 pub fn sweep(
-    runs: &[RunLog],
-    base: &RecognizerConfig,
-    evaluation: &EvaluationSpec,
+    scn: &Scenario,
+    opts: &ExperimentOptions,
     grid: &[GridPoint],
-    progress: &ProgressSink,
-) -> Result<Vec<SweepResult>, ExperimentError> {
-    let (densities, _) = observe(runs, base)?;
-    let observations: Vec<_> = densities.iter().map(|d| d.observation).collect();
-    let truth = GroundTruth::from_runs(runs);
-    // Check every grid point's settings before the parallel part, so errors are reported once.
+) -> Result<(Vec<SweepResult>, usize), ExperimentError> {
+    let base = recognizer_config(scn)?;
+    // Check every grid point's settings before any work, so errors are reported once.
     for p in grid {
-        back_end_matches(&[], base, p)?;
+        back_end_matches(&[], &base, p)?;
     }
+    let (densities, truth) = stream::observe_scenario(scn, &base, opts)?;
+    let observations: Vec<_> = densities.iter().map(|d| d.observation).collect();
+    let progress = &opts.progress;
     progress.start("sweeping", grid.len() as u64);
     let results = sweep_matches(
         grid,
         &observations,
         &truth,
-        evaluation,
-        |p| back_end_matches(&densities, base, p).unwrap_or_default(),
+        &scn.evaluation,
+        |p| back_end_matches(&densities, &base, p).unwrap_or_default(),
         &|| progress.step(),
     );
     progress.done();
-    Ok(results)
+    Ok((results, truth.laps.len()))
 }

@@ -19,7 +19,7 @@ use crate::eval::{GroundTruth, LapInfo, PlaceRecognizer, Recognition, Recording}
 use crate::experiment::cache::LapCache;
 use crate::external::ExternalRecognizer;
 use crate::log::LapLog;
-use crate::recognizer::{Recognizer, RecognizerConfig};
+use crate::recognizer::{DensityFrontEnd, DensityObservation, Recognizer, RecognizerConfig};
 use crate::sim::runner::RunSim;
 use crate::sim::{SimError, SimPlan};
 use crate::spec::evaluation::EvaluationSpec;
@@ -67,6 +67,43 @@ pub fn run_scenario_streamed(
     exp.report.simulate_seconds_per_lap = sim_s / total.max(1) as f64;
     exp.lap_source = lap_source;
     Ok(exp)
+}
+
+/// The observations `base`'s front end makes of `scn`'s laps (laps per run replaced by
+/// `opts.laps`), and the truth of every frame: each lap is observed as it is simulated (or read
+/// from `opts.cache`) and its scans dropped, a new run starting the front end's next run, as
+/// feeding the held runs would (progress: a step per lap).
+pub(super) fn observe_scenario(
+    scn: &Scenario,
+    base: &RecognizerConfig,
+    opts: &ExperimentOptions,
+) -> Result<(Vec<DensityObservation>, GroundTruth), ExperimentError> {
+    let mut front =
+        DensityFrontEnd::new(base).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+    let plan = &scn.sim;
+    let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
+    let total: usize = (0..plan.runs.len()).map(laps_of).sum();
+    opts.progress.start("laps", total as u64);
+    let mut truth = GroundTruth::default();
+    let mut out = Vec::new();
+    let (sim, ()) = with_laps(plan, &laps_of, opts.cache.as_deref(), |rx| {
+        let mut current = None;
+        for (run, lap) in rx {
+            if current.is_some_and(|c| c != run) {
+                front.start_run();
+            }
+            current = Some(run);
+            truth.start_lap(LapInfo::of(run, &lap));
+            truth.push_frames(&lap.frames);
+            for f in &lap.frames {
+                out.extend(front.push(f.odom, &f.scan));
+            }
+            opts.progress.step();
+        }
+    });
+    opts.progress.done();
+    sim?;
+    Ok((out, truth))
 }
 
 /// Simulates `plan` (`laps_of(run)` laps per run) on a thread of its own, or reads its laps

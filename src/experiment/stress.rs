@@ -11,11 +11,10 @@
 use crate::eval::provenance::{self, Provenance};
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
-use crate::experiment::{ExperimentOptions, ProgressSink, run_scenario};
-use crate::io::atomic::{StagedDir, holds_only};
+use crate::experiment::{ExperimentOptions, ProgressSink};
+use crate::io::atomic::holds_only;
 use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -137,18 +136,24 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
         .collect();
     let progress = &opts.experiment.progress;
     progress.start("seeds", items.len() as u64);
-    let results: Vec<SeedResult> = items
-        .par_iter()
-        .map(|&(i, seed)| {
-            let p = &planned[i];
-            let (Ok(scn), Some(options)) = (&p.scenario, &p.options) else {
-                unreachable!("only runnable scenarios are planned")
-            };
+    let runnable = |i: usize| match (&planned[i].scenario, &planned[i].options) {
+        (Ok(scn), Some(options)) => (scn, options),
+        _ => unreachable!("only runnable scenarios are planned"),
+    };
+    let results: Vec<SeedResult> = run_bounded(
+        &items,
+        &|&(i, _)| {
+            let (scn, options) = runnable(i);
+            seed_memory_mb(scn, options)
+        },
+        SEEDS_IN_FLIGHT_MB,
+        &|&(i, seed)| {
+            let (scn, options) = runnable(i);
             let r = run_seed(scn, seed, options);
             progress.step();
             r
-        })
-        .collect();
+        },
+    );
     progress.done();
     let mut prov = Provenance::new(opts.command_line.clone());
     for p in &planned {
@@ -170,7 +175,95 @@ pub fn run_stress(paths: &[PathBuf], opts: &StressOptions) -> SuiteReport {
     suite
 }
 
-/// Runs `scn` at `seed`, timing it.
+/// Memory the seeds in flight may be estimated to hold together, MB ([`seed_memory_mb`]): with
+/// the process's own and the finished seeds' reports, the peak of `check scenarios/*.toml`
+/// stays under 1.5 GB.
+const SEEDS_IN_FLIGHT_MB: f64 = 900.0;
+
+/// What one seed of `scn` is estimated to hold at its peak, MB. A seed is run streamed
+/// ([`run_seed`]): at most a few laps of scans, plus per lap and per subject the truth, the
+/// recognizer's words and the pairs the scoring keeps (about 0.3 MB per lap for one subject of
+/// the 1000-lap scenario, BENCHMARKS.md), plus a fixed part (world, grids, buffers).
+pub fn seed_memory_mb(scn: &Scenario, options: &ExperimentOptions) -> f64 {
+    let laps: usize = scn
+        .sim
+        .runs
+        .iter()
+        .map(|r| options.laps.unwrap_or(r.laps))
+        .sum();
+    let subjects = options.levels.len()
+        + usize::from(options.icp)
+        + usize::from(options.scan_context)
+        + options.external.len();
+    40.0 + 0.4 * (laps * subjects.max(1)) as f64
+}
+
+/// Runs `work` on every item, as many at once as there are cores, but no more than the memory
+/// `budget_mb` admits by `estimate_mb` (an item that alone exceeds it runs alone); results in
+/// item order. Items go to threads of their own rather than to rayon's tasks: a rayon task that
+/// waits for the parallel part of its own work steals the next item, so seeds in flight would
+/// not be bounded by the cores (each holding its laps); the work inside an item still runs on
+/// rayon's pool, so the cores stay busy.
+fn run_bounded<T: Sync, R: Send>(
+    items: &[T],
+    estimate_mb: &(dyn Fn(&T) -> f64 + Sync),
+    budget_mb: f64,
+    work: &(dyn Fn(&T) -> R + Sync),
+) -> Vec<R> {
+    use std::sync::{Condvar, Mutex};
+    struct State {
+        next: usize,
+        running: usize,
+        held_mb: f64,
+    }
+    let state = Mutex::new(State {
+        next: 0,
+        running: 0,
+        held_mb: 0.0,
+    });
+    let freed = Condvar::new();
+    let results: Mutex<Vec<Option<R>>> = Mutex::new(items.iter().map(|_| None).collect());
+    let workers = rayon::current_num_threads().clamp(1, items.len().max(1));
+    std::thread::scope(|s| {
+        for _ in 0..workers {
+            s.spawn(|| {
+                loop {
+                    let mut st = state.lock().expect("no worker panics holding the lock");
+                    let (k, need) = loop {
+                        let Some(item) = items.get(st.next) else {
+                            return;
+                        };
+                        let need = estimate_mb(item);
+                        if st.running == 0 || st.held_mb + need <= budget_mb {
+                            break (st.next, need);
+                        }
+                        st = freed.wait(st).expect("no worker panics holding the lock");
+                    };
+                    st.next += 1;
+                    st.running += 1;
+                    st.held_mb += need;
+                    drop(st);
+                    let r = work(&items[k]);
+                    results.lock().expect("no worker panics holding the lock")[k] = Some(r);
+                    let mut st = state.lock().expect("no worker panics holding the lock");
+                    st.running -= 1;
+                    st.held_mb -= need;
+                    freed.notify_all();
+                }
+            });
+        }
+    });
+    results
+        .into_inner()
+        .expect("no worker panics holding the lock")
+        .into_iter()
+        .map(|r| r.expect("every item ran"))
+        .collect()
+}
+
+/// Runs `scn` at `seed`, timing it. The laps are streamed to the recognizers and scored as
+/// they come ([`super::run_scenario_streamed`], the same report as holding them): a seed holds
+/// a few laps of scans, not all of them.
 pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedResult {
     let t = Instant::now();
     let mut scn = scn.clone();
@@ -179,7 +272,7 @@ pub fn run_seed(scn: &Scenario, seed: u64, options: &ExperimentOptions) -> SeedR
         progress: ProgressSink::none(),
         ..options.clone()
     };
-    let (report, error, lap_cache) = match run_scenario(&scn, &options) {
+    let (report, error, lap_cache) = match super::run_scenario_streamed(&scn, &options) {
         Ok(exp) => (Some(exp.report), None, exp.lap_source),
         Err(e) => (None, Some(e.to_string()), None),
     };
@@ -269,6 +362,13 @@ pub enum StressError {
 /// `what` saying in the error what the file should have been.
 pub fn read_suite(path: &Path, what: &str) -> Result<SuiteReport, StressError> {
     let file = path.display().to_string();
+    // An output set (`check --report`, `-o DIR`) a kill interrupted after its commit is
+    // finished first.
+    crate::io::atomic::settle(path);
+    let parent = path.parent().filter(|d| !d.as_os_str().is_empty());
+    if let Some(dir) = parent.filter(|_| path.ends_with(DIR_FILES[0])) {
+        crate::io::atomic::settle(dir);
+    }
     // Invalid UTF-8 is located at its first bad byte, as in every text file.
     let text = crate::spec::diag::read_text(path).map_err(|e| match e {
         crate::spec::SpecError::Io { source, .. } => StressError::Read {
@@ -388,34 +488,25 @@ pub fn append_markdown(md: &str, path: &Path) -> Result<(), StressError> {
         })
 }
 
-/// The files [`write_dir`] writes.
+/// The files [`write_dir_files`] writes.
 pub const DIR_FILES: [&str; 3] = ["report.json", "table.md", "junit.xml"];
 
-/// Stages output folder `dir` for [`write_dir`]: it must be new, empty or an earlier output of
-/// it, and no other live process may be writing it. Dropping the stage leaves `dir` as it was,
-/// so this also checks the folder before the work starts.
-pub fn stage_dir(dir: &Path) -> Result<StagedDir, StressError> {
-    Ok(StagedDir::begin(dir, &|d| {
-        holds_only(d, &|n| DIR_FILES.contains(&n))
-    })?)
+/// Whether folder `dir` is an earlier output of [`write_dir_files`] (only its files, and hidden
+/// ones), which a new output may replace whole.
+pub fn is_check_output(dir: &Path) -> bool {
+    holds_only(dir, &|n| DIR_FILES.contains(&n))
 }
 
-/// Writes `DIR/report.json` (the whole report), `DIR/table.md` and `DIR/junit.xml`, staged and
-/// put in place in one step: `DIR` holds the old three or the new three, never a mix.
-pub fn write_dir(suite: &SuiteReport, dir: &Path) -> Result<(), StressError> {
-    write_dir_with(suite, None, dir)
-}
-
-/// [`write_dir`] with a comparison with a baseline: its Markdown section follows the table in
+/// Writes `report.json` (the whole report), `table.md` and `junit.xml` into folder `at` (the
+/// staging folder of the output, put in place whole by the caller: `crate::io::atomic`), with
+/// a comparison with a baseline if given: its Markdown section follows the table in
 /// `table.md`, its test cases follow the gate's in `junit.xml`.
-pub fn write_dir_with(
+pub fn write_dir_files(
     suite: &SuiteReport,
     baseline: Option<&crate::eval::compare::Comparison>,
-    dir: &Path,
+    at: &Path,
 ) -> Result<(), StressError> {
     use crate::report::{junit, suite as format};
-    let stage = stage_dir(dir)?;
-    let at = stage.path().to_path_buf();
     write_file(&at.join(DIR_FILES[0]), suite.to_json().as_bytes())?;
     let mut md = format::markdown(suite);
     if let Some(c) = baseline {
@@ -424,9 +515,5 @@ pub fn write_dir_with(
     }
     write_file(&at.join(DIR_FILES[1]), md.as_bytes())?;
     let xml = junit::document_with(suite, baseline);
-    write_file(&at.join(DIR_FILES[2]), xml.as_bytes())?;
-    stage.commit().map_err(|source| StressError::Write {
-        path: dir.display().to_string(),
-        source,
-    })
+    write_file(&at.join(DIR_FILES[2]), xml.as_bytes())
 }

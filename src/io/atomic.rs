@@ -500,3 +500,319 @@ pub fn holds_only(dir: &Path, named: &dyn Fn(&str) -> bool) -> bool {
     }
     any
 }
+
+/// Several outputs at paths of the user's choosing (`run --report R.json --export-matches M.csv
+/// --svg DIR`, `check --report … --junit … -o DIR`) written as one: a kill at any instant leaves
+/// the old set or the new set, as every placewords reader and writer of those paths sees them.
+///
+/// No single rename can swap files in different folders, so the set commits by a journal
+/// ("write-ahead"): every file is first written in full beside its place (`.NAME.tmpPID`; a
+/// picture folder's files in `.DIR.tmpPID/`, a replaced folder as [`StagedDir`] stages it);
+/// then a journal naming every move is left beside each output (`.NAME.pendingPID`); then the
+/// commit marker (`.FIRST.commitPID`, the journal again) is written with one rename — the
+/// instant the new set is the result; then the moves are made and the journals removed, the
+/// marker last. A process killed before the marker leaves the old set (its temporaries are
+/// removed later as any killed writer's); killed after it, the new set is complete on disk and
+/// [`settle`], which every reader of these outputs (`score --matches`, `compare`, `merge`,
+/// `check --baseline`) and every writer of them calls first, finishes the moves. While the set
+/// is written, `.NAME.lock` beside each output holds the pid, as for a staged folder, and
+/// another writer is refused ([`StageError::Busy`]).
+#[derive(Debug)]
+pub struct OutputSet {
+    /// Output files, each with where it is staged.
+    files: Vec<(PathBuf, PathBuf)>,
+    /// Picture folders (files added to the folder, others left), with their staging folder.
+    dirs: Vec<(PathBuf, PathBuf)>,
+    /// Folders replaced whole.
+    replaced: Vec<StagedDir>,
+    locks: Vec<PathBuf>,
+    finished: bool,
+}
+
+/// What a set's journal and marker hold.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+struct Journal {
+    /// The writing process.
+    pid: u32,
+    /// The commit marker: the set is committed once it exists.
+    marker: PathBuf,
+    /// File moves, staged → final.
+    moves: Vec<(PathBuf, PathBuf)>,
+    /// Folders replaced whole, staged → final (the staged one holds [`SET_TAG`] naming the
+    /// marker until it is in place, so a repeated move is never made twice).
+    folders: Vec<(PathBuf, PathBuf)>,
+    /// The journals beside each output, and the staging folders to remove after the moves.
+    pendings: Vec<PathBuf>,
+    staging: Vec<PathBuf>,
+}
+
+impl Journal {
+    /// The journal with every path absolute, so a reader in another folder finds them.
+    fn absolute(self) -> std::io::Result<Journal> {
+        let abs = |p: &PathBuf| std::path::absolute(p);
+        let pair = |(a, b): &(PathBuf, PathBuf)| Ok::<_, std::io::Error>((abs(a)?, abs(b)?));
+        Ok(Journal {
+            pid: self.pid,
+            marker: abs(&self.marker)?,
+            moves: self.moves.iter().map(pair).collect::<Result<_, _>>()?,
+            folders: self.folders.iter().map(pair).collect::<Result<_, _>>()?,
+            pendings: self.pendings.iter().map(abs).collect::<Result<_, _>>()?,
+            staging: self.staging.iter().map(abs).collect::<Result<_, _>>()?,
+        })
+    }
+}
+
+/// The file inside a staged replacement folder naming its set's marker (removed once in place).
+const SET_TAG: &str = ".placewords-set";
+
+impl OutputSet {
+    /// Begins a set of output `files`, picture folders `dirs` (created if missing; the set's files
+    /// are added to them) and folders `replaced`, each replaced whole when it is empty, new or,
+    /// by its test, an earlier output of the same kind. Finishes first any set a killed process
+    /// committed at these paths ([`settle`]); refuses paths another live process writes.
+    pub fn begin(
+        files: &[&Path],
+        dirs: &[&Path],
+        replaced: &[(&Path, &dyn Fn(&Path) -> bool)],
+    ) -> Result<OutputSet, StageError> {
+        let io = |path: &Path, source| StageError::Io {
+            path: path.display().to_string(),
+            source,
+        };
+        let mut set = OutputSet {
+            files: Vec::new(),
+            dirs: Vec::new(),
+            replaced: Vec::new(),
+            locks: Vec::new(),
+            finished: false,
+        };
+        for &path in files.iter().chain(dirs) {
+            settle(path);
+            let lock = lock_path(path);
+            if let Some(pid) = take_lock(&lock).map_err(|e| io(&lock, e))? {
+                return Err(StageError::Busy {
+                    path: path.display().to_string(),
+                    pid,
+                    lock: lock.display().to_string(),
+                });
+            }
+            set.locks.push(lock);
+        }
+        for &file in files {
+            remove_stale_temps(file);
+            set.files.push((file.to_path_buf(), temp_path(file)));
+        }
+        for &dir in dirs {
+            std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
+            remove_stale_temps(dir);
+            let staging = temp_path(dir);
+            let _ = std::fs::remove_dir_all(&staging);
+            std::fs::create_dir(&staging).map_err(|e| io(dir, e))?;
+            set.dirs.push((dir.to_path_buf(), staging));
+        }
+        for &(dir, replaceable) in replaced {
+            settle(dir);
+            set.replaced.push(StagedDir::begin(dir, replaceable)?);
+        }
+        Ok(set)
+    }
+
+    /// Writes output file `path` (one of the set's files) in full, staged until the commit.
+    pub fn write(&self, path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+        let (_, staged) = self
+            .files
+            .iter()
+            .find(|(f, _)| f == path)
+            .ok_or_else(|| std::io::Error::other("not an output of this set"))?;
+        let mut f = std::fs::File::create(staged)?;
+        f.write_all(bytes)?;
+        f.sync_all()
+    }
+
+    /// Where to write the files of folder `dir` (one of the set's picture or replaced folders)
+    /// until the commit.
+    pub fn dir(&self, dir: &Path) -> Option<&Path> {
+        self.dirs
+            .iter()
+            .find(|(d, _)| d == dir)
+            .map(|(_, s)| s.as_path())
+            .or_else(|| {
+                self.replaced
+                    .iter()
+                    .find(|s| s.target() == dir)
+                    .map(StagedDir::path)
+            })
+    }
+
+    /// Puts every output written in its place, as one (see the type's doc). Outputs of the set
+    /// never written are left as they were.
+    pub fn commit(mut self) -> std::io::Result<()> {
+        let pid = std::process::id();
+        let mut moves: Vec<(PathBuf, PathBuf)> = self
+            .files
+            .iter()
+            .filter(|(_, staged)| staged.exists())
+            .cloned()
+            .collect();
+        for (dir, staging) in &self.dirs {
+            for e in std::fs::read_dir(staging)? {
+                let e = e?;
+                moves.push((e.path(), dir.join(e.file_name())));
+            }
+        }
+        let folders: Vec<(PathBuf, PathBuf)> = self
+            .replaced
+            .iter()
+            .map(|s| (s.path().to_path_buf(), s.target().to_path_buf()))
+            .collect();
+        let outputs: Vec<&Path> = self
+            .files
+            .iter()
+            .map(|(f, _)| f.as_path())
+            .chain(self.dirs.iter().map(|(d, _)| d.as_path()))
+            .chain(folders.iter().map(|(_, d)| d.as_path()))
+            .collect();
+        let Some(first) = outputs.first() else {
+            self.finished = true;
+            return Ok(());
+        };
+        let marker = first.with_file_name(format!(".{}.commit{pid}", file_name(first)));
+        let pendings = outputs
+            .iter()
+            .map(|p| p.with_file_name(format!(".{}.pending{pid}", file_name(p))))
+            .collect();
+        let journal = Journal {
+            pid,
+            marker,
+            moves,
+            folders,
+            pendings,
+            staging: self.dirs.iter().map(|(_, s)| s.clone()).collect(),
+        };
+        let journal = journal.absolute()?;
+        for (staged, _) in &journal.folders {
+            std::fs::write(staged.join(SET_TAG), journal.marker.display().to_string())?;
+        }
+        let text = serde_json::to_vec(&journal).map_err(std::io::Error::other)?;
+        for p in &journal.pendings {
+            let mut f = std::fs::File::create(p)?;
+            f.write_all(&text)?;
+            f.sync_all()?;
+        }
+        // The commit: from here the new set is the result, whatever happens to this process.
+        write_atomic(&journal.marker, &text)?;
+        self.finished = true;
+        for s in &mut self.replaced {
+            s.committed = true; // its move is the journal's now
+        }
+        apply(&journal)
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        if !self.finished {
+            for (_, staged) in &self.files {
+                let _ = std::fs::remove_file(staged);
+            }
+            for (_, staging) in &self.dirs {
+                let _ = std::fs::remove_dir_all(staging);
+            }
+        }
+        for lock in &self.locks {
+            let _ = std::fs::remove_file(lock);
+        }
+    }
+}
+
+/// Makes a committed journal's moves (those not made yet), then removes the journals, the
+/// staging folders and the marker, in that order, so a kill anywhere here leaves a journal to
+/// finish from.
+fn apply(journal: &Journal) -> std::io::Result<()> {
+    for (from, to) in &journal.moves {
+        if from.exists() {
+            rename(from, to)?;
+        }
+    }
+    let tag = journal.marker.display().to_string();
+    for (from, to) in &journal.folders {
+        let ours = std::fs::read_to_string(from.join(SET_TAG)).is_ok_and(|t| t == tag);
+        if ours && to.exists() {
+            if !exchange(from, to)? {
+                let old = from.with_file_name(format!("{}-old", file_name(from)));
+                rename(to, &old)?;
+                rename(from, to)?;
+                let _ = std::fs::remove_dir_all(&old);
+            }
+        } else if ours {
+            rename(from, to)?;
+        }
+        // What is left at `from` is the old folder (or nothing).
+        let _ = std::fs::remove_dir_all(from);
+        let _ = std::fs::remove_file(to.join(SET_TAG));
+    }
+    for p in &journal.pendings {
+        let _ = std::fs::remove_file(p);
+    }
+    for s in &journal.staging {
+        let _ = std::fs::remove_dir_all(s);
+    }
+    let _ = std::fs::remove_file(&journal.marker);
+    Ok(())
+}
+
+/// Finishes or drops an output set a process left at `path` ([`OutputSet`]): a journal whose
+/// marker exists is committed, and its moves are made; one without a marker whose process is
+/// gone was never committed, and is removed (the old output stays). A set whose process still
+/// runs is waited for, a few seconds at most, as its moves take milliseconds. Every reader of
+/// an output a set may write calls this before reading.
+pub fn settle(path: &Path) {
+    let dir = match path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(d) => d.to_path_buf(),
+        None => PathBuf::from("."),
+    };
+    let name = file_name(path);
+    let (pending, commit) = (format!(".{name}.pending"), format!(".{name}.commit"));
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        return;
+    };
+    let journals: Vec<PathBuf> = entries
+        .flatten()
+        .filter(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            [&pending, &commit].iter().any(|p| {
+                n.strip_prefix(p.as_str())
+                    .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()))
+            })
+        })
+        .map(|e| e.path())
+        .collect();
+    for j in journals {
+        for _ in 0..100 {
+            let Ok(bytes) = std::fs::read(&j) else {
+                break; // finished meanwhile
+            };
+            let journal: Option<Journal> = serde_json::from_slice(&bytes).ok();
+            let pid = j
+                .to_string_lossy()
+                .rsplit(|c: char| !c.is_ascii_digit())
+                .next()
+                .and_then(|p| p.parse::<u32>().ok());
+            let live = pid.is_some_and(|p| p != std::process::id() && may_be_running(p));
+            if live {
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                continue;
+            }
+            match journal {
+                Some(journal) if journal.marker.exists() => {
+                    let _ = apply(&journal);
+                }
+                // Never committed (or half-written before the marker): the old output stands.
+                _ => {
+                    let _ = std::fs::remove_file(&j);
+                }
+            }
+            break;
+        }
+    }
+}

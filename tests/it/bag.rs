@@ -268,13 +268,6 @@ fn recognize_on_a_bad_bag_exits_2_naming_the_problem() {
     assert!(err.contains("cut.mcap: truncated"), "{err}");
 }
 
-/// Inputs per fuzz target (`PLACEWORDS_FUZZ_CASES`, as tests/it/fuzz.rs).
-fn cases() -> u32 {
-    std::env::var("PLACEWORDS_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(48)
-}
 
 /// A bag with one scan, chunked and compressed as `simulate` writes them.
 fn simulated_bag() -> Vec<u8> {
@@ -311,26 +304,6 @@ fn simulated_bag() -> Vec<u8> {
     w.finish().unwrap().into_inner()
 }
 
-/// The slowest input a fuzz target met so far, printed when it changes (shown with
-/// `--nocapture`): what a campaign reports besides "no panic". A measurement, never asserted.
-fn note_if_slowest(
-    slowest: &std::sync::Mutex<std::time::Duration>,
-    target: &str,
-    took: std::time::Duration,
-    input: &dyn Fn() -> String,
-) {
-    let mut s = slowest.lock().unwrap_or_else(|e| e.into_inner());
-    if took > *s {
-        *s = took;
-        eprintln!("{target}: slowest input so far {took:?}: {}", input());
-    }
-}
-
-static SLOWEST_MCAP: std::sync::Mutex<std::time::Duration> =
-    std::sync::Mutex::new(std::time::Duration::ZERO);
-static SLOWEST_CDR: std::sync::Mutex<std::time::Duration> =
-    std::sync::Mutex::new(std::time::Duration::ZERO);
-
 /// One byte mutation: where (a fraction of the length) and what.
 fn mutate(bytes: &mut Vec<u8>, muts: &[(u8, u32, u8)]) {
     for &(kind, at, v) in muts {
@@ -353,7 +326,7 @@ fn mutate(bytes: &mut Vec<u8>, muts: &[(u8, u32, u8)]) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: super::common::fuzz_cases(), ..ProptestConfig::default() })]
 
     /// The MCAP reader returns a bag or an error, never panics, on mutated bags (chunked and
     /// compressed, or plain).
@@ -368,10 +341,10 @@ proptest! {
             simulated_bag()
         };
         mutate(&mut bytes, &muts);
-        let t = std::time::Instant::now();
-        let _ = read_bag_bytes(&bytes, "f.mcap", &BagTopics::default());
         let input = || format!("plain {plain}, {} bytes, mutations {muts:?}", bytes.len());
-        note_if_slowest(&SLOWEST_MCAP, "fuzz_mcap_reader", t.elapsed(), &input);
+        super::common::fuzz_timed("fuzz_mcap_reader", &input, || {
+            let _ = read_bag_bytes(&bytes, "f.mcap", &BagTopics::default());
+        });
     }
 
     /// The CDR decoders return a message or an error, never panic, on any bytes.
@@ -398,16 +371,16 @@ proptest! {
             _ => PoseStamped { header, pose: Pose2::new(1.0, 2.0, 0.5) }.encode(),
         };
         mutate(&mut bytes, &muts);
-        let t = std::time::Instant::now();
-        for input in [&bytes, &raw] {
-            let _ = LaserScan::decode(input);
-            let _ = Odometry::decode(input);
-            let _ = msg::decode_tf(input);
-            let _ = PoseStamped::decode(input);
-            let _ = msg::decode_string(input);
-        }
         let input = || format!("message {seed_msg}, mutations {muts:?}, raw {raw:?}");
-        note_if_slowest(&SLOWEST_CDR, "fuzz_cdr_decoder", t.elapsed(), &input);
+        super::common::fuzz_timed("fuzz_cdr_decoder", &input, || {
+            for input in [&bytes, &raw] {
+                let _ = LaserScan::decode(input);
+                let _ = Odometry::decode(input);
+                let _ = msg::decode_tf(input);
+                let _ = PoseStamped::decode(input);
+                let _ = msg::decode_string(input);
+            }
+        });
     }
 }
 

@@ -33,3 +33,37 @@ pub fn smoke_variant(dir: &Path, name: &str, extra: &str) -> PathBuf {
     std::fs::write(&path, format!("{src}\n{extra}")).unwrap();
     path
 }
+
+/// Inputs per fuzz target: `PLACEWORDS_FUZZ_CASES` (default 48, to keep the suite short).
+pub fn fuzz_cases() -> u32 {
+    std::env::var("PLACEWORDS_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(48)
+}
+
+/// Per fuzz target: inputs run and the slowest so far.
+static FUZZ_CAMPAIGN: std::sync::Mutex<
+    std::collections::BTreeMap<&'static str, (u32, std::time::Duration)>,
+> = std::sync::Mutex::new(std::collections::BTreeMap::new());
+
+/// Runs one fuzz input of `target` and keeps the campaign's record: a new slowest input is
+/// printed (with `input`, to reproduce it), and after the last input of a campaign
+/// ([`fuzz_cases`]) one line says how many ran and how long the slowest took (seen with
+/// `--nocapture`; speed is reported, not asserted).
+pub fn fuzz_timed<T>(target: &'static str, input: &dyn Fn() -> String, run: impl FnOnce() -> T) -> T {
+    let t = std::time::Instant::now();
+    let out = run();
+    let took = t.elapsed();
+    let mut campaign = FUZZ_CAMPAIGN.lock().unwrap_or_else(|e| e.into_inner());
+    let (count, slowest) = campaign.entry(target).or_default();
+    *count += 1;
+    if took > *slowest {
+        *slowest = took;
+        eprintln!("{target}: slowest input so far {took:?}: {}", input());
+    }
+    if *count == fuzz_cases() {
+        eprintln!("fuzz campaign {target}: {count} inputs, 0 panics, slowest {slowest:?}");
+    }
+    out
+}

@@ -5,18 +5,12 @@
 //! deeper than random text.
 //!
 //! Each target runs `PLACEWORDS_FUZZ_CASES` inputs (default 48, to keep the suite short); a
-//! long campaign: `PLACEWORDS_FUZZ_CASES=5000 cargo test --release --test it fuzz::`.
+//! long campaign, with each target's count and slowest input printed:
+//! `PLACEWORDS_FUZZ_CASES=5000 cargo test --release --test it fuzz -- --nocapture`.
 
-use super::common::root;
+use super::common::{fuzz_cases as cases, fuzz_timed, root};
 use proptest::prelude::*;
 
-/// Inputs per target.
-fn cases() -> u32 {
-    std::env::var("PLACEWORDS_FUZZ_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(48)
-}
 
 /// Values that broke parsers and models before: huge, tiny, out of integer range, not numbers.
 const EXTREMES: &[&str] = &[
@@ -138,7 +132,8 @@ proptest! {
     #[test]
     fn world_files_never_panic(which in 0usize..3, muts in mutations()) {
         let c = corpus(&["worlds/loop-small.toml", "worlds/two-loops.toml", "tests/fixtures/valid-base.toml"]);
-        let _ = placewords::world::parse_world(&mutate(&c[which], &muts), "fuzz.toml");
+        let text = mutate(&c[which], &muts);
+        fuzz_timed("world", &|| text.clone(), || placewords::world::parse_world(&text, "fuzz.toml").is_ok());
     }
 
     #[test]
@@ -150,30 +145,60 @@ proptest! {
             "tests/fixtures/fuzz-corpus/scan-context.toml",
         ]);
         let path = root().join("scenarios/fuzz.toml");
-        let _ = placewords::experiment::parse_scenario(
-            &mutate(&c[which], &muts),
-            &path,
-            &placewords::world::load_world_for,
-        );
+        let text = mutate(&c[which], &muts);
+        fuzz_timed("scenario", &|| text.clone(), || {
+            placewords::experiment::parse_scenario(&text, &path, &placewords::world::load_world_for)
+                .is_ok()
+        });
     }
 
     #[test]
     fn carmen_logs_never_panic(which in 0usize..2, muts in mutations(), lenient in any::<bool>()) {
         let c = corpus(&["tests/fixtures/carmen/mixed.log", "tests/fixtures/carmen/malformed.log"]);
         let opts = placewords::io::carmen::ReadOptions { lenient };
-        let _ = placewords::io::carmen::parse_log_str(&mutate(&c[which], &muts), "fuzz.log", opts);
+        let text = mutate(&c[which], &muts);
+        fuzz_timed("carmen", &|| text.clone(), || {
+            placewords::io::carmen::parse_log_str(&text, "fuzz.log", opts).is_ok()
+        });
     }
 
     #[test]
     fn mobilesim_maps_never_panic(muts in mutations()) {
         let c = corpus(&["tests/fixtures/fuzz-corpus/box.map"]);
-        let _ = placewords::io::mobilesim::import_mobilesim(&mutate(&c[0], &muts), "fuzz.map");
+        let text = mutate(&c[0], &muts);
+        fuzz_timed("mobilesim", &|| text.clone(), || {
+            placewords::io::mobilesim::import_mobilesim(&text, "fuzz.map").is_ok()
+        });
+    }
+
+    /// Issue 31 point 4: a world `world import` writes passes `world check` (run on the
+    /// written file, as a user would, test drive included), whatever the map; an import that
+    /// cannot give such a world is refused (or gives no route), never written wrong.
+    #[test]
+    fn imported_worlds_pass_world_check(which in 0usize..2, muts in mutations()) {
+        let c = corpus(&["tests/fixtures/fuzz-corpus/box.map", "../shared/data/mobilesim/corridors.map"]);
+        let text = mutate(&c[which], &muts);
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("imported.toml");
+        let out_name = out.display().to_string();
+        fuzz_timed("import_then_check", &|| text.clone(), || {
+            let imported = placewords::authoring::import::import_map(&text, "fuzz.map", &out_name);
+            if let Ok(w) = &imported {
+                std::fs::write(&out, &w.text).unwrap();
+                let checked = placewords::sim::test_drive::check_world(&out);
+                prop_assert!(checked.is_ok(), "imported, then refused by world check: {}\n{}", checked.err().unwrap(), w.text);
+            }
+            Ok(imported.is_ok())
+        })?;
     }
 
     #[test]
     fn matches_csv_never_panics(muts in mutations()) {
         let c = corpus(&["tests/fixtures/fuzz-corpus/matches.csv"]);
-        let _ = placewords::io::matches_csv::parse_matches(&mutate(&c[0], &muts), "fuzz.csv");
+        let text = mutate(&c[0], &muts);
+        fuzz_timed("matches_csv", &|| text.clone(), || {
+            placewords::io::matches_csv::parse_matches(&text, "fuzz.csv").is_ok()
+        });
     }
 }
 
@@ -186,8 +211,11 @@ proptest! {
         let c = corpus(&["tests/fixtures/fuzz-corpus/part-1-of-2.json"]);
         let dir = tempfile::tempdir().unwrap();
         let part = dir.path().join("part.json");
-        std::fs::write(&part, mutate(&c[0], &muts)).unwrap();
-        let _ = placewords::experiment::stress::merge_files(&[part.clone(), part], Vec::new());
+        let text = mutate(&c[0], &muts);
+        std::fs::write(&part, &text).unwrap();
+        fuzz_timed("merge_part", &|| text.clone(), || {
+            placewords::experiment::stress::merge_files(&[part.clone(), part], Vec::new()).is_ok()
+        });
     }
 
     /// Baselines are read and compared by `check --baseline` and `compare` (issue 25): a
@@ -197,10 +225,13 @@ proptest! {
         let c = corpus(&["tests/fixtures/fuzz-corpus/baseline-smoke.json"]);
         let dir = tempfile::tempdir().unwrap();
         let mutated = dir.path().join("mutated.json");
-        std::fs::write(&mutated, mutate(&c[0], &muts)).unwrap();
+        let text = mutate(&c[0], &muts);
+        std::fs::write(&mutated, &text).unwrap();
         let good = root().join("tests/fixtures/fuzz-corpus/baseline-smoke.json");
         let (base, new) = if mutated_is_base { (&mutated, &good) } else { (&good, &mutated) };
-        let _ = placewords::experiment::stress::compare_files(base, new, Default::default());
+        fuzz_timed("baseline", &|| text.clone(), || {
+            placewords::experiment::stress::compare_files(base, new, Default::default()).is_ok()
+        });
     }
 }
 
@@ -268,8 +299,10 @@ proptest! {
         }
         use placewords::io::lap_file::LapFileReader;
         let len = b.len() as u64;
-        let _ = LapFileReader::open(&b[..], len).and_then(|r| r.read_runs());
-        let _ = LapFileReader::open(&b[..], len).and_then(|r| r.verify());
+        fuzz_timed("lap_file", &|| format!("{b:?}"), || {
+            let _ = LapFileReader::open(&b[..], len).and_then(|r| r.read_runs());
+            let _ = LapFileReader::open(&b[..], len).and_then(|r| r.verify());
+        });
     }
 }
 

@@ -337,3 +337,136 @@ fn a_folder_another_live_process_writes_is_refused() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(!tmp.path().join(".out.lock").exists());
 }
+
+/// The files of an output set: each file's bytes, and each file in each folder's
+/// (`folder/name`), hidden files left out.
+fn set_snapshot(files: &[&Path], dirs: &[&Path]) -> std::collections::BTreeMap<String, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    for f in files {
+        if let Ok(b) = std::fs::read(f) {
+            out.insert(f.file_name().unwrap().to_string_lossy().into_owned(), b);
+        }
+    }
+    for d in dirs {
+        for (name, b) in snapshot(d) {
+            out.insert(format!("{}/{name}", d.file_name().unwrap().to_string_lossy()), b);
+        }
+    }
+    out
+}
+
+/// Issue 31 point 3: `run --report R --export-matches M --svg DIR` (three outputs in places of
+/// the user's choosing, no one rename can swap) puts them in place as one. Killed at its first
+/// rename, then its second, and so on, over an earlier run's outputs: once the next placewords
+/// reader or writer has settled what the kill left (`io::atomic::settle`), every output is the
+/// old one or every one is new and whole — never a new report beside old matches — and the run
+/// that goes through leaves nothing hidden behind.
+#[test]
+fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (r, m, d) = (
+        tmp.path().join("r.json"),
+        tmp.path().join("m.csv"),
+        tmp.path().join("pics"),
+    );
+    let args = |laps: &str| -> Vec<String> {
+        let a = [
+            "run", "scenarios/smoke.toml", "--laps", laps, "--levels", "1", "-q",
+            "--report", r.to_str().unwrap(), "--export-matches", m.to_str().unwrap(),
+            "--svg", d.to_str().unwrap(),
+        ];
+        a.iter().map(|s| s.to_string()).collect()
+    };
+    let run = |args: &[String], kill_at: Option<usize>| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_placewords"));
+        c.args(args).current_dir(root());
+        if let Some(n) = kill_at {
+            c.env(placewords::io::atomic::TEST_KILL_AT_ENV, n.to_string());
+        }
+        c.output().unwrap()
+    };
+    let o = run(&args("1"), None);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let old = set_snapshot(&[&r, &m], &[&d]);
+    assert_eq!(old.len(), 2 + names(&d).len());
+    let laps_of = |snap: &std::collections::BTreeMap<String, Vec<u8>>| {
+        let v: serde_json::Value = serde_json::from_slice(&snap["r.json"]).unwrap();
+        v["laps"].as_u64().unwrap()
+    };
+    let mut kills = 0;
+    let mut committed_by_settle = 0;
+    for n in 1..200 {
+        let o = run(&args("2"), Some(n));
+        if o.status.code().is_some() {
+            assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+            break;
+        }
+        kills += 1;
+        for p in [&r, &m, &d] {
+            placewords::io::atomic::settle(p);
+        }
+        let now = set_snapshot(&[&r, &m], &[&d]);
+        assert!(now.keys().eq(old.keys()), "killed at rename {n}: {:?}", now.keys());
+        let changed: Vec<&String> = now.keys().filter(|k| now[*k] != old[*k]).collect();
+        if changed.is_empty() {
+            continue;
+        }
+        // The new set, whole: every output changed, the report of the 2-lap run.
+        committed_by_settle += 1;
+        assert_eq!(changed.len(), now.len(), "killed at rename {n}: only {changed:?} changed");
+        assert_eq!(laps_of(&now), 2 * laps_of(&old), "killed at rename {n}");
+    }
+    assert!(kills >= 3, "{kills} renames before the run went through");
+    assert!(committed_by_settle >= 1, "no kill fell after the commit");
+    let new = set_snapshot(&[&r, &m], &[&d]);
+    assert_eq!(laps_of(&new), 2 * laps_of(&old));
+    assert_eq!(names(tmp.path()), ["m.csv", "pics", "r.json"], "nothing hidden left");
+    assert!(names(&d).iter().all(|n| !n.starts_with('.')), "{:?}", names(&d));
+}
+
+/// An output file another live process writes is refused, naming it and that process, before
+/// the work; the earlier file stays.
+#[test]
+fn an_output_file_another_live_process_writes_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let r = tmp.path().join("r.json");
+    std::fs::write(&r, "{}").unwrap();
+    std::fs::write(tmp.path().join(".r.json.lock"), std::process::id().to_string()).unwrap();
+    for args in [
+        vec!["run", "scenarios/smoke.toml", "--laps", "1", "--levels", "1"],
+        vec!["check", "scenarios/smoke.toml", "--seed", "1"],
+    ] {
+        let mut a = args.clone();
+        a.extend(["-q", "--report", r.to_str().unwrap()]);
+        let o = placewords(&a);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        let pid = format!("pid {}", std::process::id());
+        assert!(e.contains("another placewords") && e.contains(&pid), "{e}");
+        assert!(o.stdout.is_empty(), "{args:?} did the work first");
+        assert_eq!(std::fs::read_to_string(&r).unwrap(), "{}");
+    }
+}
+
+/// Issue 31: a zero that means "nothing to do" is refused, exit 2, naming the flag, before
+/// any output folder is made.
+#[test]
+fn zero_laps_is_refused_by_every_command_that_takes_laps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let out = out.to_str().unwrap();
+    let smoke = "scenarios/smoke.toml";
+    for args in [
+        vec!["table", smoke, "--laps", "0", "--no-icp", "-o", out],
+        vec!["sweep", smoke, "--laps", "0", "-o", out],
+        vec!["run", smoke, "--laps", "0"],
+        vec!["check", smoke, "--laps", "0"],
+        vec!["simulate", smoke, "--laps", "0", "-o", out],
+    ] {
+        let o = placewords(&args);
+        let e = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {e}");
+        assert!(e.contains("--laps") && e.contains("1 lap or more"), "{args:?}: {e}");
+        assert!(names(tmp.path()).is_empty(), "{args:?} left {:?}", names(tmp.path()));
+    }
+}
