@@ -212,7 +212,10 @@ pub fn finish(
         set.write(path, xml.as_bytes())
             .map_err(|e| staged(path, e))?;
     }
-    outputs.set.commit().with_context(|| "writing the outputs")?;
+    outputs
+        .set
+        .commit()
+        .with_context(|| "writing the outputs")?;
     for e in suite.scenarios.iter().flat_map(|s| s.errors()) {
         errln!("error: {e}");
     }

@@ -64,4 +64,3 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     }
     Ok(ExitCode::SUCCESS)
 }
-

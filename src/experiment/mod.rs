@@ -20,9 +20,7 @@ use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{Recognition, recognize_runs_with_progress};
 use crate::external::{ExternalRecognizer, ExternalSpec};
 use crate::place::{Match, PlaceRecognizer};
-use crate::recognizer::{
-    DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher,
-};
+use crate::recognizer::{DensityObservation, Recognizer, RecognizerConfig, WordMatch, WordMatcher};
 use crate::sim::{RunLog, SimError};
 use crate::spec::SpecError;
 use crate::spec::evaluation::EvaluationSpec;

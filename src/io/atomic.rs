@@ -331,8 +331,8 @@ pub enum StageError {
     )]
     Foreign(String),
     #[error(
-        "{path}: another placewords (pid {pid}) is writing this folder; wait for it to finish \
-         or choose another folder (if no such process runs, remove {lock})"
+        "{path}: another placewords (pid {pid}) is writing this output; wait for it to finish \
+         or choose another path (if no such process runs, remove {lock})"
     )]
     Busy {
         path: String,
@@ -652,7 +652,7 @@ impl OutputSet {
             .files
             .iter()
             .filter(|(_, staged)| staged.exists())
-            .cloned()
+            .map(|(target, staged)| (staged.clone(), target.clone()))
             .collect();
         for (dir, staging) in &self.dirs {
             for e in std::fs::read_dir(staging)? {

@@ -268,7 +268,6 @@ fn recognize_on_a_bad_bag_exits_2_naming_the_problem() {
     assert!(err.contains("cut.mcap: truncated"), "{err}");
 }
 
-
 /// A bag with one scan, chunked and compressed as `simulate` writes them.
 fn simulated_bag() -> Vec<u8> {
     use placewords::geom::Pose2;

@@ -51,7 +51,11 @@ static FUZZ_CAMPAIGN: std::sync::Mutex<
 /// printed (with `input`, to reproduce it), and after the last input of a campaign
 /// ([`fuzz_cases`]) one line says how many ran and how long the slowest took (seen with
 /// `--nocapture`; speed is reported, not asserted).
-pub fn fuzz_timed<T>(target: &'static str, input: &dyn Fn() -> String, run: impl FnOnce() -> T) -> T {
+pub fn fuzz_timed<T>(
+    target: &'static str,
+    input: &dyn Fn() -> String,
+    run: impl FnOnce() -> T,
+) -> T {
     let t = std::time::Instant::now();
     let out = run();
     let took = t.elapsed();

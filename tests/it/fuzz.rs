@@ -11,7 +11,6 @@
 use super::common::{fuzz_cases as cases, fuzz_timed, root};
 use proptest::prelude::*;
 
-
 /// Values that broke parsers and models before: huge, tiny, out of integer range, not numbers.
 const EXTREMES: &[&str] = &[
     "0",
