@@ -400,7 +400,7 @@ fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
     };
     let o = run(&args("1"), None);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    let old = set_snapshot(&[&r, &m], &[&d]);
+    let old = set_snapshot(&[r.as_path(), m.as_path()], &[d.as_path()]);
     assert_eq!(old.len(), 2 + names(&d).len());
     let laps_of = |snap: &std::collections::BTreeMap<String, Vec<u8>>| {
         let v: serde_json::Value = serde_json::from_slice(&snap["r.json"]).unwrap();
@@ -416,14 +416,14 @@ fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
         for p in [&r, &m, &d] {
             placewords::io::atomic::settle(p);
         }
-        after_kills.push((n, set_snapshot(&[&r, &m], &[&d])));
+        after_kills.push((n, set_snapshot(&[r.as_path(), m.as_path()], &[d.as_path()])));
     }
     assert!(
         after_kills.len() >= 3,
         "{} renames before the run went through",
         after_kills.len()
     );
-    let new = set_snapshot(&[&r, &m], &[&d]);
+    let new = set_snapshot(&[r.as_path(), m.as_path()], &[d.as_path()]);
     assert_eq!(laps_of(&new), 2 * laps_of(&old));
     let mut committed_by_settle = 0;
     for (n, now) in &after_kills {
