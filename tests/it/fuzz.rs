@@ -167,7 +167,7 @@ proptest! {
     #[test]
     fn mobilesim_maps_never_panic(muts in mutations()) {
         let c = corpus(&["tests/fixtures/fuzz-corpus/box.map"]);
-        let _ = placewords::io::mobilesim::import_mobilesim(&mutate(&c[0], &muts), "fuzz.map");
+        let _ = placewords::authoring::mobilesim::import_mobilesim(&mutate(&c[0], &muts), "fuzz.map");
     }
 
     #[test]
