@@ -104,8 +104,8 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         experiment::run_scenario(&scn, &opts)?
     };
     let w = Stopwatch::start();
-    if let (Some(path), Some((_, rec))) = (&args.export_matches, exp.recognitions.last()) {
-        super::score::export(path, rec, &exp.runs)?;
+    if let (Some(path), Some((levels, rec))) = (&args.export_matches, exp.recognitions.last()) {
+        super::score::export(path, rec, &exp.runs, *levels)?;
     }
     super::common::report_cache(cache.as_deref());
     let mut provenance =
