@@ -504,7 +504,10 @@ mod tests {
         let (_, rec) = &exp.recognitions[0];
         let rows = export_rows(rec, &run_frames(&exp.runs));
         let scored = score_rows(&logs, &rows, "run.csv", &spec, Some(3)).unwrap();
-        assert_eq!(scored.subjects[0].name, exp.report.subjects[0].name, "words-3 as run says");
+        assert_eq!(
+            scored.subjects[0].name, exp.report.subjects[0].name,
+            "words-3 as run says"
+        );
         let (a, b) = (&exp.report.subjects[0].scores, &scored.subjects[0].scores);
         assert!(a.pairs > 100, "smoke should match: {a:?}");
         assert_eq!(exp.report.revisits, scored.revisits);
