@@ -1,13 +1,15 @@
 //! `world import`: a MobileSim map as a world file that `world check` accepts, or the reason it
 //! cannot be one.
 //!
-//! [`crate::io::mobilesim`] reads the map, repairs what it can (a segment drawn twice kept
-//! once, a home heading brought into -180..180: [`crate::io::mobilesim::repair_map`]) and
-//! generates a route; here the world file it gives is checked as `world check` checks it (the
+//! [`crate::io::mobilesim`] reads the map, [`crate::authoring::mobilesim`] repairs what it can
+//! (a segment drawn twice kept once, a home heading brought into -180..180:
+//! [`crate::authoring::mobilesim::repair_map`]) and generates a route
+//! ([`crate::authoring::route`]); here the world file it gives is checked as `world check` checks it (the
 //! same checks and test drive, [`crate::sim::test_drive::check_world_text`]) before anything
 //! is written, so an import never writes a world that `world check` then rejects.
 
-use crate::io::mobilesim::{self, ImportOptions, MapError};
+use crate::authoring::mobilesim::{self, MapError};
+use crate::authoring::route::RouteOptions;
 use crate::spec::SpecError;
 use crate::spec::diag::{Diagnostic, Severity};
 use crate::spec::world::WorldSpec;
@@ -45,7 +47,7 @@ pub enum ImportError {
 /// Imports the map text `src` (`map_name` in messages) as a world file to be written at
 /// `out_name`, checked as `world check` would check that file.
 pub fn import_map(src: &str, map_name: &str, out_name: &str) -> Result<ImportedWorld, ImportError> {
-    let imported = mobilesim::import_mobilesim_repaired(src, map_name, &ImportOptions::default())?;
+    let imported = mobilesim::import_mobilesim_repaired(src, map_name, &RouteOptions::default())?;
     let text = mobilesim::world_to_toml(&imported.spec, map_name)?;
     match crate::sim::test_drive::check_world_text(&text, out_name) {
         Ok(_) => Ok(ImportedWorld {

@@ -8,7 +8,9 @@ pub mod ambiguity;
 pub mod density;
 pub mod generate;
 pub mod import;
+pub mod mobilesim;
 pub mod problems;
+pub mod route;
 
 pub use ambiguity::{AmbiguityReport, AmbiguousStretch, ambiguity, ambiguity_svg};
 pub use density::{DensityMap, density_map, density_svg};

@@ -152,14 +152,14 @@ impl ExperimentOutputs {
                 .map_err(|e| staged(path, e))?;
         }
         let mut pairs = None;
-        if let (Some(path), Some((_, rec))) = (&self.matches, exp.recognitions.last()) {
+        if let (Some(path), Some((levels, rec))) = (&self.matches, exp.recognitions.last()) {
             use placewords::experiment::score;
             let rows = score::export_rows(rec, &score::run_frames(&exp.runs));
             let csv = placewords::io::matches_csv::write_matches(&rows);
             self.set
                 .write(path, csv.as_bytes())
                 .map_err(|e| staged(path, e))?;
-            pairs = Some(rows.len());
+            pairs = Some((rows.len(), *levels));
         }
         if let Some(dir) = &self.svg {
             let staging = self.set.dir(dir).expect("begun with this folder");
@@ -176,8 +176,11 @@ impl ExperimentOutputs {
         if let Some(path) = &self.report {
             errln!("report: {}", path.display());
         }
-        if let (Some(path), Some(n)) = (&self.matches, pairs) {
-            errln!("matches: {} ({n} pairs)", path.display());
+        if let (Some(path), Some((n, levels))) = (&self.matches, pairs) {
+            errln!(
+                "matches: {} ({n} pairs of words-{levels}; `score --levels {levels}` labels them so)",
+                path.display()
+            );
         }
         if let Some(dir) = &self.svg {
             errln!("pictures: {}", dir.display());

@@ -18,7 +18,7 @@ pub struct ImportArgs {
 pub fn run(args: ImportArgs) -> anyhow::Result<ExitCode> {
     use anyhow::Context;
     use placewords::authoring::import::{ImportError, import_map};
-    use placewords::io::mobilesim::{self, MapError};
+    use placewords::authoring::mobilesim::{self, MapError};
     let name = args.map.display().to_string();
     let out_name = args.out.display().to_string();
     let src = match placewords::spec::diag::read_text(&args.map) {

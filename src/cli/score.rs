@@ -20,10 +20,11 @@ pub struct ScoreArgs {
     /// Write the JSON report here (the schema of `run`'s).
     #[arg(long, value_name = "OUT.json")]
     pub report: Option<PathBuf>,
-    /// Label the result as this level configuration in the table and report (the row reads `N`:
-    /// the tool's thresholds are unknown).
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub levels: usize,
+    /// Label the result `words-N`, the paper's recognizer at N levels, as `run` labels it: for
+    /// matches `run --export-matches` wrote (its last level configuration, the most levels).
+    /// Without it the row is `external`: any other tool's matches.
+    #[arg(long, value_name = "N")]
+    pub levels: Option<usize>,
 }
 
 pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {

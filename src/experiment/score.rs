@@ -324,7 +324,7 @@ pub fn score_file(
     file: &MatchesFile,
     path: &str,
     spec: &EvaluationSpec,
-    levels: usize,
+    levels: Option<usize>,
 ) -> Result<Report, ScoreError> {
     score_rows(logs, &file.rows, path, spec, levels).map_err(|e| match e {
         ScoreError::UnknownScan {
@@ -354,17 +354,26 @@ pub fn score_file(
     })
 }
 
-/// Scores `rows` against the logs as a report with one `levels` entry labelled `levels`.
+/// Scores `rows` against the logs as a report with one subject: `external` (kind `external`),
+/// or `words-N` with `levels` `Some(N)` (matches `run --export-matches` wrote, compared with
+/// `run`'s own row).
 pub fn score_rows(
     logs: &LoggedRuns,
     rows: &[MatchRow],
     path: &str,
     spec: &EvaluationSpec,
-    levels: usize,
+    levels: Option<usize>,
 ) -> Result<Report, ScoreError> {
     let rec = logs.recognition(rows, path)?;
     let mut report = Report::new(&logs.scenario, logs.seed, logs.laps, spec.clone());
-    report.add_level(levels, &[], &rec);
+    match levels {
+        Some(levels) => {
+            report.add_level(levels, &[], &rec);
+        }
+        None => {
+            report.add_subject(&rec.name, crate::eval::scores::SubjectKind::External, &rec);
+        }
+    }
     report.finish();
     Ok(report)
 }
@@ -471,12 +480,18 @@ mod tests {
         let spec = EvaluationSpec::default();
         let text = write_matches(&oracle_rows(&logs, &spec, 0, Direction::Same));
         let perfect = parse_matches(&text, "perfect.csv").expect("parses");
-        let r = score_rows(&logs, &perfect, "perfect.csv", &spec, 1).unwrap();
+        let r = score_rows(&logs, &perfect, "perfect.csv", &spec, None).unwrap();
+        // Another tool's matches are not labelled as the paper's recognizer (they read `1 []`,
+        // then `words-1`, beside `run`'s own words-1 row).
+        assert_eq!(
+            (r.subjects[0].name.as_str(), r.subjects[0].kind),
+            ("external", crate::eval::scores::SubjectKind::External)
+        );
         let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.recall), (1.0, 1.0), "{s:?}");
         let shifted = oracle_rows(&logs, &spec, 125, Direction::Same);
         assert!(shifted.len() > perfect.len() / 2);
-        let r = score_rows(&logs, &shifted, "shifted.csv", &spec, 1).unwrap();
+        let r = score_rows(&logs, &shifted, "shifted.csv", &spec, None).unwrap();
         let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.recall), (0.0, 0.0), "{s:?}");
 
@@ -488,7 +503,11 @@ mod tests {
         let exp = evaluate_runs("smoke", scn.sim.seed, runs, &base, &spec, &opts).unwrap();
         let (_, rec) = &exp.recognitions[0];
         let rows = export_rows(rec, &run_frames(&exp.runs));
-        let scored = score_rows(&logs, &rows, "run.csv", &spec, 3).unwrap();
+        let scored = score_rows(&logs, &rows, "run.csv", &spec, Some(3)).unwrap();
+        assert_eq!(
+            scored.subjects[0].name, exp.report.subjects[0].name,
+            "words-3 as run says"
+        );
         let (a, b) = (&exp.report.subjects[0].scores, &scored.subjects[0].scores);
         assert!(a.pairs > 100, "smoke should match: {a:?}");
         assert_eq!(exp.report.revisits, scored.revisits);
@@ -510,7 +529,7 @@ mod tests {
         assert!(rows.len() > 100, "a reverse run revisits: {}", rows.len());
         let text = write_matches(&rows);
         let parsed = parse_matches(&text, "opposite.csv").expect("parses");
-        let r = score_rows(&logs, &parsed, "opposite.csv", &spec, 1).unwrap();
+        let r = score_rows(&logs, &parsed, "opposite.csv", &spec, None).unwrap();
         let s = &r.subjects[0].scores;
         let opp = s.of_direction(Direction::Opposite);
         assert_eq!((opp.precision, opp.recall), (1.0, 1.0), "{opp:?}");
@@ -524,7 +543,7 @@ mod tests {
                 ..*r
             })
             .collect();
-        let r = score_rows(&logs, &as_same, "same.csv", &spec, 1).unwrap();
+        let r = score_rows(&logs, &as_same, "same.csv", &spec, None).unwrap();
         let s = &r.subjects[0].scores;
         assert_eq!((s.precision, s.correct_pairs), (0.0, 0), "{s:?}");
     }
@@ -541,7 +560,7 @@ mod tests {
             score: None,
             direction: Direction::Same,
         };
-        let e = score_rows(&logs, &[row], "m.csv", &EvaluationSpec::default(), 1).unwrap_err();
+        let e = score_rows(&logs, &[row], "m.csv", &EvaluationSpec::default(), None).unwrap_err();
         assert!(
             e.to_string()
                 .starts_with("m.csv: match 1 names run 7 scan 0"),

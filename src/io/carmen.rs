@@ -611,174 +611,171 @@ fn parse_line(line: &str, out: &mut LogReadout) -> Result<Option<StreamedRecord>
     if first.s.starts_with('#') {
         return Ok(None);
     }
-    let end_col = line.trim_end().chars().count() + 1;
     let f = Fields {
         toks: &toks,
         kind: first.s,
-        end_col,
+        end_col: line.trim_end().chars().count() + 1,
     };
-    let rec = match first.s {
-        "FLASER" | "RLASER" => {
-            let n = f.count(1, "number of readings")?;
-            if toks.len() < n.saturating_add(2) {
-                return Err((
-                    end_col,
-                    format!(
-                        "{} announces {n} readings but the line has only {} values after the count; \
-                         the line is truncated or the count is wrong",
-                        first.s,
-                        toks.len() - 2
-                    ),
-                ));
-            }
-            let mut ranges = Vec::with_capacity(n);
-            for i in 0..n {
-                ranges.push(f.num(2 + i, "range")?);
-            }
-            let pose = f.pose(2 + n, "pose")?;
-            let odom = f.pose(5 + n, "odometry")?;
-            let (ipc, host, logger) = f.stamp(8 + n)?;
-            LogRecord::Laser(LaserRecord {
-                // FLASER: 180° right to left, whatever the beam count. RLASER: the rear scanner
-                // faces backwards, so its beams start on the robot's left (+90°).
-                start_angle_rad: if first.s == "RLASER" {
-                    std::f64::consts::FRAC_PI_2
-                } else {
-                    -std::f64::consts::FRAC_PI_2
-                },
-                fov_rad: std::f64::consts::PI,
-                ranges_m: ranges,
-                pose,
-                odom,
-                ipc_timestamp: ipc,
-                host,
-                logger_timestamp: logger,
-            })
-        }
-        "ROBOTLASER1" => {
-            // laser_type start_angle fov angular_res max_range accuracy remission_mode
-            // num_readings r... num_remissions rem... laser_pose robot_pose tv rv
-            // forward_safety side_safety turn_axis timestamp host logger_timestamp
-            let _laser_type = f.num(1, "laser_type")?;
-            let start = f.num(2, "start_angle")?;
-            let fov = f.num(3, "fov")?;
-            let _res = f.num(4, "angular_res")?;
-            let max_range = f.num(5, "max_range")?;
-            let _acc = f.num(6, "accuracy")?;
-            let _rem_mode = f.num(7, "remission_mode")?;
-            let n = f.count(8, "num_readings")?;
-            if toks.len() < n.saturating_add(9) {
-                return Err((
-                    end_col,
-                    format!(
-                        "ROBOTLASER1 announces {n} readings but the line has only {} values after the count; \
-                         the line is truncated or the count is wrong",
-                        toks.len() - 9
-                    ),
-                ));
-            }
-            let mut ranges = Vec::with_capacity(n);
-            for i in 0..n {
-                ranges.push(f.num(9 + i, "range")?);
-            }
-            let k = 9 + n;
-            let m = f.count(k, "num_remissions")?;
-            if toks.len() < (k + 1).saturating_add(m) {
-                return Err((
-                    end_col,
-                    format!(
-                        "ROBOTLASER1 announces {m} remissions but the line has only {} values after that count; \
-                         the line is truncated or the count is wrong",
-                        toks.len() - k - 1
-                    ),
-                ));
-            }
-            for i in 0..m {
-                f.num(k + 1 + i, "remission")?;
-            }
-            let k = k + 1 + m;
-            let laser_pose = f.pose(k, "laser pose")?;
-            let _robot = f.pose(k + 3, "robot pose")?;
-            for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
-                .iter()
-                .enumerate()
-            {
-                f.num(k + 6 + j, what)?;
-            }
-            let (ipc, host, logger) = f.stamp(k + 11)?;
-            if out.robotlaser_max_range_m.is_none() && max_range > 0.0 {
-                out.robotlaser_max_range_m = Some(max_range);
-            }
-            LogRecord::Laser(LaserRecord {
-                start_angle_rad: start,
-                fov_rad: fov,
-                ranges_m: ranges,
-                // The ranges are measured from the laser, so its pose is the scan's pose (as a
-                // FLASER line's pose is); the robot pose is only checked.
-                pose: laser_pose,
-                odom: laser_pose,
-                ipc_timestamp: ipc,
-                host,
-                logger_timestamp: logger,
-            })
-        }
-        "ODOM" => {
-            let pose = f.pose(1, "pose")?;
-            let tv = f.num(4, "tv")?;
-            let rv = f.num(5, "rv")?;
-            let accel = f.num(6, "accel")?;
-            let (ipc, host, logger) = f.stamp(7)?;
-            LogRecord::Odom(OdomRecord {
-                pose,
-                tv_m_s: tv,
-                rv_rad_s: rv,
-                accel_m_s2: accel,
-                ipc_timestamp: ipc,
-                host,
-                logger_timestamp: logger,
-            })
-        }
-        "TRUEPOS" => {
-            let truth = f.pose(1, "true pose")?;
-            let odom = f.pose(4, "odometry")?;
-            let (ipc, host, logger) = f.stamp(7)?;
-            LogRecord::TruePos(TruePosRecord {
-                truth,
-                odom,
-                ipc_timestamp: ipc,
-                host,
-                logger_timestamp: logger,
-            })
-        }
-        "PARAM" => {
-            // `PARAM name value [ipc host logger]`; some loggers drop the ipc stamp
-            // (`PARAM name value host logger`), so only name and value are required.
-            let name = f.get(1, "parameter name")?.s.to_string();
-            let rest: Vec<&str> = toks[2..].iter().map(|t| t.s).collect();
-            let value = if rest.len() >= 4
-                && rest[rest.len() - 3].parse::<f64>().is_ok()
-                && rest[rest.len() - 1].parse::<f64>().is_ok()
-            {
-                rest[..rest.len() - 3].join(" ")
-            } else if let Some(v) = rest.first() {
-                v.to_string()
-            } else {
-                return Err((
-                    end_col,
-                    "PARAM line has a name but no value; add the value or remove the line".into(),
-                ));
-            };
-            LogRecord::Param { name, value }
-        }
+    let record = match first.s {
+        "FLASER" | "RLASER" => parse_flaser(&f)?,
+        "ROBOTLASER1" => parse_robotlaser1(&f, out)?,
+        "ODOM" => parse_odom(&f)?,
+        "TRUEPOS" => parse_truepos(&f)?,
+        "PARAM" => parse_param(&f)?,
         _ => {
             out.unknown_lines += 1;
             return Ok(None);
         }
     };
     Ok(Some(StreamedRecord {
-        record: rec,
+        record,
         rear_laser: first.s == "RLASER",
     }))
+}
+
+impl Fields<'_, '_> {
+    /// The `n` values from field `at` on, each `what`, once the line is checked to hold them
+    /// all (`counted` names them in the message, `after` the count that announced them).
+    fn announced(
+        &self,
+        at: usize,
+        n: usize,
+        (counted, after, what): (&str, &str, &str),
+    ) -> Result<Vec<f64>, LineErr> {
+        if self.toks.len() < at.saturating_add(n) {
+            return Err((
+                self.end_col,
+                format!(
+                    "{} announces {n} {counted} but the line has only {} values after {after}; \
+                     the line is truncated or the count is wrong",
+                    self.kind,
+                    self.toks.len() - at
+                ),
+            ));
+        }
+        (0..n).map(|i| self.num(at + i, what)).collect()
+    }
+}
+
+/// `FLASER n r… pose odometry stamp` (and `RLASER`, the rear scanner).
+fn parse_flaser(f: &Fields) -> Result<LogRecord, LineErr> {
+    let n = f.count(1, "number of readings")?;
+    let ranges = f.announced(2, n, ("readings", "the count", "range"))?;
+    let pose = f.pose(2 + n, "pose")?;
+    let odom = f.pose(5 + n, "odometry")?;
+    let (ipc, host, logger) = f.stamp(8 + n)?;
+    Ok(LogRecord::Laser(LaserRecord {
+        // FLASER: 180° right to left, whatever the beam count. RLASER: the rear scanner
+        // faces backwards, so its beams start on the robot's left (+90°).
+        start_angle_rad: if f.kind == "RLASER" {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            -std::f64::consts::FRAC_PI_2
+        },
+        fov_rad: std::f64::consts::PI,
+        ranges_m: ranges,
+        pose,
+        odom,
+        ipc_timestamp: ipc,
+        host,
+        logger_timestamp: logger,
+    }))
+}
+
+/// `ROBOTLASER1 laser_type start_angle fov angular_res max_range accuracy remission_mode
+/// num_readings r… num_remissions rem… laser_pose robot_pose tv rv forward_safety side_safety
+/// turn_axis stamp`; the first positive max_range goes to `out`.
+fn parse_robotlaser1(f: &Fields, out: &mut LogReadout) -> Result<LogRecord, LineErr> {
+    let _laser_type = f.num(1, "laser_type")?;
+    let start = f.num(2, "start_angle")?;
+    let fov = f.num(3, "fov")?;
+    let _res = f.num(4, "angular_res")?;
+    let max_range = f.num(5, "max_range")?;
+    let _acc = f.num(6, "accuracy")?;
+    let _rem_mode = f.num(7, "remission_mode")?;
+    let n = f.count(8, "num_readings")?;
+    let ranges = f.announced(9, n, ("readings", "the count", "range"))?;
+    let k = 9 + n;
+    let m = f.count(k, "num_remissions")?;
+    f.announced(k + 1, m, ("remissions", "that count", "remission"))?;
+    let k = k + 1 + m;
+    let laser_pose = f.pose(k, "laser pose")?;
+    let _robot = f.pose(k + 3, "robot pose")?;
+    for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
+        .iter()
+        .enumerate()
+    {
+        f.num(k + 6 + j, what)?;
+    }
+    let (ipc, host, logger) = f.stamp(k + 11)?;
+    if out.robotlaser_max_range_m.is_none() && max_range > 0.0 {
+        out.robotlaser_max_range_m = Some(max_range);
+    }
+    Ok(LogRecord::Laser(LaserRecord {
+        start_angle_rad: start,
+        fov_rad: fov,
+        ranges_m: ranges,
+        // The ranges are measured from the laser, so its pose is the scan's pose (as a
+        // FLASER line's pose is); the robot pose is only checked.
+        pose: laser_pose,
+        odom: laser_pose,
+        ipc_timestamp: ipc,
+        host,
+        logger_timestamp: logger,
+    }))
+}
+
+/// `ODOM x y theta tv rv accel stamp`.
+fn parse_odom(f: &Fields) -> Result<LogRecord, LineErr> {
+    let pose = f.pose(1, "pose")?;
+    let tv = f.num(4, "tv")?;
+    let rv = f.num(5, "rv")?;
+    let accel = f.num(6, "accel")?;
+    let (ipc, host, logger) = f.stamp(7)?;
+    Ok(LogRecord::Odom(OdomRecord {
+        pose,
+        tv_m_s: tv,
+        rv_rad_s: rv,
+        accel_m_s2: accel,
+        ipc_timestamp: ipc,
+        host,
+        logger_timestamp: logger,
+    }))
+}
+
+/// `TRUEPOS true_pose odometry stamp`.
+fn parse_truepos(f: &Fields) -> Result<LogRecord, LineErr> {
+    let truth = f.pose(1, "true pose")?;
+    let odom = f.pose(4, "odometry")?;
+    let (ipc, host, logger) = f.stamp(7)?;
+    Ok(LogRecord::TruePos(TruePosRecord {
+        truth,
+        odom,
+        ipc_timestamp: ipc,
+        host,
+        logger_timestamp: logger,
+    }))
+}
+
+/// `PARAM name value [ipc host logger]`; some loggers drop the ipc stamp (`PARAM name value
+/// host logger`), so only name and value are required.
+fn parse_param(f: &Fields) -> Result<LogRecord, LineErr> {
+    let name = f.get(1, "parameter name")?.s.to_string();
+    let rest: Vec<&str> = f.toks[2..].iter().map(|t| t.s).collect();
+    let value = if rest.len() >= 4
+        && rest[rest.len() - 3].parse::<f64>().is_ok()
+        && rest[rest.len() - 1].parse::<f64>().is_ok()
+    {
+        rest[..rest.len() - 3].join(" ")
+    } else if let Some(v) = rest.first() {
+        v.to_string()
+    } else {
+        return Err((
+            f.end_col,
+            "PARAM line has a name but no value; add the value or remove the line".into(),
+        ));
+    };
+    Ok(LogRecord::Param { name, value })
 }
 
 #[cfg(test)]

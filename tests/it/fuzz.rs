@@ -166,7 +166,7 @@ proptest! {
         let c = corpus(&["tests/fixtures/fuzz-corpus/box.map"]);
         let text = mutate(&c[0], &muts);
         fuzz_timed("mobilesim", &|| text.clone(), || {
-            placewords::io::mobilesim::import_mobilesim(&text, "fuzz.map").is_ok()
+            placewords::authoring::mobilesim::import_mobilesim(&text, "fuzz.map").is_ok()
         });
     }
 

@@ -1,12 +1,12 @@
 //! Real logs and imported worlds: the CARMEN reader, log → run conversion, MobileSim import.
 
+use placewords::authoring::mobilesim::{import_mobilesim, world_to_toml};
 use placewords::geom::{Pose2, Segment, Vec2};
 use placewords::io::carmen::{
     CarmenError, LaserRecord, LogRecord, OdomRecord, ReadOptions, TruePosRecord, parse_log_str,
     read_log, read_log_from, write_record,
 };
 use placewords::io::matches_csv::{MatchRow, parse_matches, write_matches};
-use placewords::io::mobilesim::{import_mobilesim, world_to_toml};
 use placewords::io::real_log::{TruthSource, log_to_run, noise_free};
 use placewords::place::Direction;
 use placewords::spec::diag::Diagnostic;
@@ -497,7 +497,7 @@ fn a_world_without_a_route_is_still_written_and_a_route_can_be_added() {
     let e = import_mobilesim(src, "tiny.map").unwrap_err();
     let msg = e.to_string();
     assert!(msg.contains("[[routes]]"), "{msg}");
-    let placewords::io::mobilesim::MapError::NoRoute {
+    let placewords::authoring::mobilesim::MapError::NoRoute {
         partial: Some(spec),
         ..
     } = e

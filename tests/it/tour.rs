@@ -182,3 +182,106 @@ fn long_readme_lines_say_how_long_and_how_to_shorten() {
     }
     assert!(notes >= 4, "check, table, sweep and long-term are long");
 }
+
+/// The README's example report: the first ```json block after "## The report", and where it
+/// sits in the README (byte range of its body).
+fn readme_report_block(readme: &str) -> (std::ops::Range<usize>, &str) {
+    let at = readme
+        .find("## The report")
+        .expect("README has `## The report`");
+    let open = at + readme[at..].find("```json\n").expect("a ```json block") + "```json\n".len();
+    let close = open + readme[open..].find("```").expect("the block closes");
+    (open..close, &readme[open..close])
+}
+
+/// A report's JSON as the README shows it: the subject with the most levels (the last), the
+/// first entry of each list longer than 5 or holding objects, numbers to 4 decimals.
+fn trim_for_readme(v: &serde_json::Value, key: &str) -> serde_json::Value {
+    use serde_json::Value;
+    match v {
+        Value::Object(m) => Value::Object(
+            m.iter()
+                .map(|(k, v)| (k.clone(), trim_for_readme(v, k)))
+                .collect(),
+        ),
+        Value::Array(a) => {
+            let short = a.len() <= 5 && a.iter().all(|x| !x.is_object() && !x.is_array());
+            let kept: Vec<&Value> = if short {
+                a.iter().collect()
+            } else if key == "subjects" {
+                a.last().into_iter().collect()
+            } else {
+                a.first().into_iter().collect()
+            };
+            Value::Array(kept.into_iter().map(|x| trim_for_readme(x, "")).collect())
+        }
+        Value::Number(n) if n.is_f64() => {
+            let x = (n.as_f64().unwrap() * 1e4).round() / 1e4;
+            serde_json::json!(x)
+        }
+        other => other.clone(),
+    }
+}
+
+/// The example report in the README is what the report writer writes: read back as a report
+/// (and its provenance) and written again, it gives the same JSON, so a field added, renamed or
+/// dropped in the report fails here until the example is regenerated
+/// (`regenerate_readme_report`). Its figures agree with each other, as a real run's do.
+#[test]
+fn the_readme_example_report_is_a_report() {
+    use serde_json::Value;
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let (_, block) = readme_report_block(&readme);
+    let shown: Value = serde_json::from_str(block)
+        .unwrap_or_else(|e| panic!("the README's example report is JSON: {e}"));
+    let report = placewords::report::json::report_from_json(block)
+        .unwrap_or_else(|e| panic!("the README's example reads as a report: {e}"));
+    let provenance = placewords::report::json::provenance_from_json(block)
+        .unwrap_or_else(|e| panic!("the README's example has a provenance: {e}"));
+    let again: Value = serde_json::from_str(&placewords::report::json::to_json_with(
+        &report,
+        &provenance,
+    ))
+    .unwrap();
+    assert_eq!(
+        again, shown,
+        "the README's example report differs from what the report writer writes: \
+         regenerate it (cargo test --release --test it regenerate_readme_report -- --ignored)"
+    );
+    assert_eq!(report.scenario, "B", "the example is the main job's");
+    let s = &report.subjects[0];
+    assert_eq!(s.name, "words-3");
+    let ratio = |a: usize, b: usize| (a as f64 / b as f64 * 1e4).round() / 1e4;
+    assert_eq!(
+        s.scores.precision,
+        ratio(s.scores.correct_pairs, s.scores.pairs)
+    );
+    assert_eq!(s.scores.revisits, report.revisits);
+}
+
+/// Rewrites the README's example report from a new run of the main job (about 15 s of CPU):
+/// `cargo test --release --test it regenerate_readme_report -- --ignored`.
+#[test]
+#[ignore = "rewrites README.md; run by hand after the report changes"]
+fn regenerate_readme_report() {
+    let (_t, dir) = scratch();
+    let out = Command::new(env!("CARGO_BIN_EXE_placewords"))
+        .args(["run", "scenarios/B.toml", "--report", "b.json"])
+        .current_dir(&dir)
+        .output()
+        .expect("the placewords binary runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let full: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("b.json")).unwrap()).unwrap();
+    let shown = serde_json::to_string_pretty(&trim_for_readme(&full, "")).unwrap();
+    let path = root().join("README.md");
+    let readme = std::fs::read_to_string(&path).unwrap();
+    let (range, _) = readme_report_block(&readme);
+    let mut new = readme.clone();
+    new.replace_range(range, &format!("{shown}\n"));
+    std::fs::write(&path, new).unwrap();
+}

@@ -1,0 +1,150 @@
+//! The map as a grid of cells: which cells the robot fits in, where to start, and the free
+//! space reachable from there.
+
+use super::leg_clear;
+use crate::geom::{Segment, Vec2};
+use std::collections::VecDeque;
+
+/// A grid over the walls' bounding box (and the home), grown by 1 m on every side.
+pub(super) struct Raster {
+    /// Corner of cell (0, 0).
+    lo: Vec2,
+    /// Cell size, metres.
+    res: f64,
+    pub nx: usize,
+    pub ny: usize,
+}
+
+impl Raster {
+    /// Cells of `resolution_m`, coarsened (up to 10 cm) for large maps so the raster stays
+    /// under 16 M cells; larger maps are refused with their size (width, height in metres).
+    pub fn around(walls: &[Segment], home: Vec2, resolution_m: f64) -> Result<Raster, (f64, f64)> {
+        let (mut lo, mut hi) = (home, home);
+        for w in walls {
+            for p in [w.a, w.b] {
+                lo = lo.inf(&p);
+                hi = hi.sup(&p);
+            }
+        }
+        lo -= Vec2::new(1.0, 1.0);
+        hi += Vec2::new(1.0, 1.0);
+        let area = (hi.x - lo.x) * (hi.y - lo.y);
+        let res = resolution_m.max((area / 16.0e6).sqrt());
+        if res.is_nan() || res > 0.1 + 1e-12 {
+            return Err((hi.x - lo.x, hi.y - lo.y));
+        }
+        Ok(Raster {
+            lo,
+            res,
+            nx: ((hi.x - lo.x) / res).ceil() as usize,
+            ny: ((hi.y - lo.y) / res).ceil() as usize,
+        })
+    }
+
+    /// The centre of cell (i, j).
+    pub fn center(&self, i: usize, j: usize) -> Vec2 {
+        Vec2::new(
+            self.lo.x + (i as f64 + 0.5) * self.res,
+            self.lo.y + (j as f64 + 0.5) * self.res,
+        )
+    }
+
+    fn idx(&self, i: usize, j: usize) -> usize {
+        j * self.nx + i
+    }
+
+    /// Free: cell centres at least `need` from every wall surface. Each segment only visits the
+    /// cells of its own bounding box grown by that distance (exact distances, no full scan per
+    /// cell).
+    pub fn free_cells(&self, walls: &[Segment], thickness_m: f64, need: f64) -> Vec<bool> {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut free = vec![true; nx * ny];
+        let reach = need + thickness_m / 2.0;
+        let cell_of = |v: f64, o: f64, n: usize| {
+            (((v - o) / self.res - 0.5).floor().max(0.0) as usize).min(n - 1)
+        };
+        for w in walls {
+            let (a, b) = (w.a.inf(&w.b), w.a.sup(&w.b));
+            let (i0, i1) = (
+                cell_of(a.x - reach, self.lo.x, nx),
+                cell_of(b.x + reach, self.lo.x, nx) + 1,
+            );
+            let (j0, j1) = (
+                cell_of(a.y - reach, self.lo.y, ny),
+                cell_of(b.y + reach, self.lo.y, ny) + 1,
+            );
+            for j in j0..=j1.min(ny - 1) {
+                for i in i0..=i1.min(nx - 1) {
+                    let k = self.idx(i, j);
+                    if free[k] && w.distance_to_point(self.center(i, j)) - thickness_m / 2.0 < need
+                    {
+                        free[k] = false;
+                    }
+                }
+            }
+        }
+        free
+    }
+
+    /// The free cell nearest the home (within 2 m) that the home can see (no wall between
+    /// them), so a home in a tight spot never lands the route outside the building.
+    pub fn start_cell(
+        &self,
+        free: &[bool],
+        walls: &[Segment],
+        home: Vec2,
+    ) -> Option<(usize, usize)> {
+        let res = self.res;
+        let hc = (
+            (home.x - self.lo.x) / res - 0.5,
+            (home.y - self.lo.y) / res - 0.5,
+        );
+        let reach = (2.0 / res).ceil() as i64;
+        let mut cand: Vec<(f64, (usize, usize))> = Vec::new();
+        for j in (hc.1 as i64 - reach).max(0)..=(hc.1 as i64 + reach).min(self.ny as i64 - 1) {
+            for i in (hc.0 as i64 - reach).max(0)..=(hc.0 as i64 + reach).min(self.nx as i64 - 1) {
+                let (i, j) = (i as usize, j as usize);
+                let d = ((i as f64 - hc.0).powi(2) + (j as f64 - hc.1).powi(2)).sqrt() * res;
+                if free[self.idx(i, j)] && d <= 2.0 {
+                    cand.push((d, (i, j)));
+                }
+            }
+        }
+        cand.sort_by(|a, b| a.0.total_cmp(&b.0));
+        cand.iter()
+            .find(|(_, (i, j))| {
+                leg_clear(walls, 0.0, &Segment::new(home, self.center(*i, *j)), 1e-9)
+            })
+            .map(|c| c.1)
+    }
+
+    /// The 4-connected free component holding `start`.
+    pub fn component(&self, free: &[bool], start: (usize, usize)) -> Vec<bool> {
+        let (nx, ny) = (self.nx, self.ny);
+        let mut comp = vec![false; nx * ny];
+        let mut queue = VecDeque::from([start]);
+        comp[self.idx(start.0, start.1)] = true;
+        while let Some((i, j)) = queue.pop_front() {
+            let mut push = |a: usize, b: usize| {
+                let k = self.idx(a, b);
+                if free[k] && !comp[k] {
+                    comp[k] = true;
+                    queue.push_back((a, b));
+                }
+            };
+            if i > 0 {
+                push(i - 1, j);
+            }
+            if i + 1 < nx {
+                push(i + 1, j);
+            }
+            if j > 0 {
+                push(i, j - 1);
+            }
+            if j + 1 < ny {
+                push(i, j + 1);
+            }
+        }
+        comp
+    }
+}
