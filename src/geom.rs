@@ -147,6 +147,18 @@ pub fn segments_intersect(s: Segment, t: Segment) -> bool {
         || s.distance_to_point(t.b) <= EPS
 }
 
+/// Where `s` and `t` cross each other properly (each passes from one side of the other to the
+/// other side), `None` when they do not, touch only, or are parallel.
+pub fn crossing_point(s: Segment, t: Segment) -> Option<Vec2> {
+    let (ds, dt) = (s.b - s.a, t.b - t.a);
+    let d1 = cross(dt, s.a - t.a);
+    let d2 = cross(dt, s.b - t.a);
+    let d3 = cross(ds, t.a - s.a);
+    let d4 = cross(ds, t.b - s.a);
+    let opposite = |p: f64, q: f64| (p > 0.0 && q < 0.0) || (p < 0.0 && q > 0.0);
+    (opposite(d1, d2) && opposite(d3, d4)).then(|| s.a + ds * (d1 / (d1 - d2)))
+}
+
 /// Exact shortest distance between two closed segments (0 when they cross).
 pub fn segment_distance(s: Segment, t: Segment) -> f64 {
     if segments_intersect(s, t) {

@@ -38,10 +38,10 @@ pub enum AmbiguityError {
 /// One ambiguous stretch of the route.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct AmbiguousStretch {
-    /// 1-based, in route order from the first waypoint.
+    /// From 0, in route order from the first waypoint (waypoint 0).
     pub number: usize,
-    /// 1-based pair of stretches that look alike to the recognizer (numbered by the first
-    /// stretch's start).
+    /// The pair of stretches that look alike to the recognizer, counted from 0 (numbered by the
+    /// first stretch's start), as the picture's markers and the summary number them.
     pub pair: usize,
     /// Start, metres along the route from its first waypoint.
     pub from_m: f64,
@@ -305,7 +305,8 @@ fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
     out
 }
 
-/// The numbered stretches: pair k gives stretches 2k − 1 and 2k, each the other's partner.
+/// The numbered stretches, from 0: pair k gives stretches 2k and 2k + 1, each the other's
+/// partner.
 fn stretches(conf: &[Confusion], loop_m: f64) -> Vec<AmbiguousStretch> {
     let stretch = |arc: &Arc, number: usize, pair: usize, partner: usize| AmbiguousStretch {
         number,
@@ -319,8 +320,8 @@ fn stretches(conf: &[Confusion], loop_m: f64) -> Vec<AmbiguousStretch> {
         .iter()
         .enumerate()
         .flat_map(|(k, (a, b))| {
-            let (na, nb) = (2 * k + 1, 2 * k + 2);
-            [stretch(a, na, k + 1, nb), stretch(b, nb, k + 1, na)]
+            let (na, nb) = (2 * k, 2 * k + 1);
+            [stretch(a, na, k, nb), stretch(b, nb, k, na)]
         })
         .collect()
 }
@@ -376,7 +377,7 @@ pub fn ambiguity(
         tp_radius_m,
         confused_word_pairs: conf.len(),
         ambiguous_share: share,
-        pairs: list.iter().map(|s| s.pair).max().unwrap_or(0),
+        pairs: list.iter().map(|s| s.pair + 1).max().unwrap_or(0),
         stretches: list,
     };
     Ok((report, drive))
@@ -429,7 +430,7 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
     let Some(route) = world.route(&report.route) else {
         return render_world_svg(world, &opts);
     };
-    let color = |k: usize| PAIR_COLORS[(k - 1) % PAIR_COLORS.len()].to_string();
+    let color = |k: usize| PAIR_COLORS[k % PAIR_COLORS.len()].to_string();
     let mut middles = std::collections::BTreeMap::<usize, Vec<Vec2>>::new();
     for s in &report.stretches {
         let pts = route_points(route, s.from_m, s.length_m);
@@ -496,7 +497,7 @@ fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
             let at = |s: &AmbiguousStretch| format!("{:.1}-{:.1} m", s.from_m, s.to_m);
             let other = c.get(1).map(at).unwrap_or_default();
             format!(
-                "{}: {} ({:.1} m) looks like {} (metres along the route from waypoint 1)",
+                "{}: {} ({:.1} m) looks like {} (metres along the route from waypoint 0)",
                 c[0].pair,
                 at(&c[0]),
                 c[0].length_m,

@@ -13,7 +13,7 @@ pub enum WorldCommand {
     /// Validate world files and test-drive their routes (with all doors closed and all open); every problem is printed as file:line:col on stderr (exit 2).
     #[command(after_help = "Example:\n  placewords world check worlds/*.toml")]
     Check(CheckArgs),
-    /// Draw a world as SVG: walls, doors, routes, home pose, scale bar, legend.
+    /// Draw a world as SVG: walls, doors, routes, home pose, scale bar, legend (an invalid world as far as it read, its problems marked from 0).
     #[command(
         after_help = "Example:\n  placewords world render worlds/institute-floor.toml -o floor.svg --open s-04,n-01 --waypoints"
     )]
@@ -236,7 +236,7 @@ fn door_states(world: &World, open: &[String], all_open: bool) -> anyhow::Result
 }
 
 /// Renders a world; an invalid one is drawn as far as it could be read with its problems
-/// marked (numbered in the order they are printed), and exits 2.
+/// marked (numbered from 0 in the order they are printed), and exits 2.
 fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
     super::common::check_extension(&args.output, "svg")?;
     let src = std::fs::read_to_string(&args.file)
@@ -256,7 +256,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
             if let Some(svg) = svg {
                 super::common::write_file(&args.output, svg.as_bytes())?;
                 errln!(
-                    "wrote {} with the problems above marked 1..",
+                    "wrote {} with the problems above marked 0.. in their order",
                     args.output.display()
                 );
             }

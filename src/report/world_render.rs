@@ -7,7 +7,7 @@
 
 use crate::geom::{Segment, Vec2};
 use crate::report::svg::{Svg, escape, num};
-use crate::world::{DoorStates, World};
+use crate::world::{Door, DoorStates, World};
 
 /// A polyline drawn over the world, e.g. a trajectory.
 #[derive(Clone, Debug, PartialEq)]
@@ -183,9 +183,71 @@ fn nice_length(target_m: f64) -> f64 {
     best
 }
 
+/// Where everything goes: the world frame and the picture's size.
+struct Layout {
+    f: Frame,
+    width: f64,
+    map_h: f64,
+    /// The world's extent without the margin, metres.
+    size_m: (f64, f64),
+    /// The notes, wrapped to the picture's width.
+    notes: Vec<String>,
+}
+
+const PAD_PX: f64 = 20.0;
+const TITLE_H_PX: f64 = 56.0;
+const MARGIN_M: f64 = 1.0;
+/// Width of a character of the 13-pixel notes, pixels (for wrapping).
+const NOTE_CHAR_PX: f64 = 7.0;
+
 /// Renders `world` as an SVG document.
 pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
-    // Extent of everything drawn.
+    let l = layout(world, opts);
+    let f = &l.f;
+    let mut svg = Svg::new(
+        l.width,
+        f.top + l.map_h + legend_height(world, opts, &l) + PAD_PX,
+    );
+    header(&mut svg, world, opts, &l);
+    if opts.show_grid {
+        grid(&mut svg, f, l.f.s * (f.max.x - f.min.x), l.map_h);
+    }
+    if let Some(t) = &opts.tiles {
+        tiles(&mut svg, f, t);
+    }
+    if opts.show_areas {
+        areas(&mut svg, f, world);
+    }
+    walls(&mut svg, f, world);
+    doors(&mut svg, f, world, &opts.doors);
+    if opts.show_door_labels {
+        door_labels(&mut svg, f, world);
+    }
+    if opts.show_routes {
+        // Over a raster the routes get a white casing, so no colour of it hides them.
+        routes(&mut svg, f, world, opts.tiles.is_some());
+    }
+    bands(&mut svg, f, &opts.bands);
+    paths(&mut svg, f, &opts.paths);
+    segments(&mut svg, f, &opts.segments);
+    home(&mut svg, f, world);
+    // Waypoint numbers and the other marks together, so marks on one spot fan out.
+    let mut all = if opts.show_waypoints {
+        waypoint_marks(world)
+    } else {
+        Vec::new()
+    };
+    all.extend(opts.marks.iter().cloned());
+    marks(&mut svg, f, &all);
+    let y0 = f.top + l.map_h + 22.0;
+    let bar_end = scale_bar(&mut svg, f.s, PAD_PX, y0);
+    let legend_end = legend(&mut svg, world, opts, bar_end + 40.0, y0, l.width - PAD_PX);
+    notes(&mut svg, &l.notes, PAD_PX, legend_end.max(y0 + 24.0) + 22.0);
+    svg.finish()
+}
+
+/// The extent of everything drawn, metres.
+fn extent(world: &World, opts: &RenderOptions) -> (Vec2, Vec2) {
     let (mut lo, mut hi) = world.bounds();
     let mut add = |p: Vec2| {
         if p.x.is_finite() && p.y.is_finite() {
@@ -193,61 +255,73 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
             hi = hi.sup(&p);
         }
     };
-    if world.walls.is_empty() && world.doors.is_empty() {
-        add(world.home.position());
-    }
-    for r in &world.routes {
-        r.waypoints.iter().for_each(|p| add(*p));
-    }
-    for a in &world.areas {
-        add(a.min);
-        add(a.max);
-    }
-    add(world.home.position());
-    for p in &opts.paths {
-        p.points.iter().for_each(|q| add(*q));
-    }
-    for s in &opts.segments {
-        add(s.a);
-        add(s.b);
-    }
-    opts.bands
+    let routes = world
+        .routes
         .iter()
-        .flat_map(|b| &b.points)
-        .for_each(|p| add(*p));
-    opts.marks.iter().for_each(|m| add(m.at));
-    let margin_m = 1.0;
-    lo -= Vec2::new(margin_m, margin_m);
-    hi += Vec2::new(margin_m, margin_m);
+        .flat_map(|r| r.waypoints.iter().copied());
+    let areas = world.areas.iter().flat_map(|a| [a.min, a.max]);
+    let paths = opts.paths.iter().flat_map(|p| p.points.iter().copied());
+    let segments = opts.segments.iter().flat_map(|s| [s.a, s.b]);
+    let bands = opts.bands.iter().flat_map(|b| b.points.iter().copied());
+    let marks = opts.marks.iter().map(|m| m.at);
+    routes
+        .chain(areas)
+        .chain(paths)
+        .chain(segments)
+        .chain(bands)
+        .chain(marks)
+        .chain([world.home.position()])
+        .for_each(&mut add);
+    (lo, hi)
+}
+
+/// The frame and picture size for `world` with `opts`.
+fn layout(world: &World, opts: &RenderOptions) -> Layout {
+    let (lo, hi) = extent(world, opts);
+    let (lo, hi) = (lo - Vec2::repeat(MARGIN_M), hi + Vec2::repeat(MARGIN_M));
     let (w_m, h_m) = ((hi.x - lo.x).max(1.0), (hi.y - lo.y).max(1.0));
     let s = opts
         .px_per_m
         .filter(|s| s.is_finite() && *s > 0.0)
         .unwrap_or_else(|| (1500.0 / w_m.max(h_m * 1.2)).clamp(2.0, 120.0));
-    let pad = 20.0;
-    let title_h = 56.0;
-    let legend_h = 70.0 + 18.0 * opts.notes.len() as f64;
-    let map_w = w_m * s;
-    let map_h = h_m * s;
-    let width = (map_w + 2.0 * pad).max(760.0);
-    let legend_x = pad + nice_length(180.0 / s) * s + 40.0;
-    let height =
-        title_h + map_h + legend_h + legend_extra_h(world, opts, legend_x, width - pad) + pad;
-    let f = Frame {
-        min: lo,
-        max: hi,
-        s,
-        left: pad + (width - 2.0 * pad - map_w) / 2.0,
-        top: title_h,
-    };
+    let (map_w, map_h) = (w_m * s, h_m * s);
+    let width = (map_w + 2.0 * PAD_PX).max(760.0);
+    let chars = ((width - 2.0 * PAD_PX) / NOTE_CHAR_PX).max(40.0) as usize;
+    Layout {
+        f: Frame {
+            min: lo,
+            max: hi,
+            s,
+            left: PAD_PX + (width - 2.0 * PAD_PX - map_w) / 2.0,
+            top: TITLE_H_PX,
+        },
+        width,
+        map_h,
+        size_m: (w_m - 2.0 * MARGIN_M, h_m - 2.0 * MARGIN_M),
+        notes: wrap_notes(&opts.notes, chars),
+    }
+}
 
-    let mut svg = Svg::new(width, height);
-    let font = (0.55 * s).clamp(9.0, 16.0);
+/// Each note wrapped to `chars` characters, its continuation lines indented, so no text is cut.
+fn wrap_notes(notes: &[String], chars: usize) -> Vec<String> {
+    let wrap = textwrap::Options::new(chars).subsequent_indent("      ");
+    notes
+        .iter()
+        .flat_map(|n| textwrap::wrap(n, &wrap).into_iter().map(|l| l.into_owned()))
+        .collect()
+}
 
-    // Title and subtitle.
+/// Height below the map: scale bar, legend rows and notes, pixels.
+fn legend_height(world: &World, opts: &RenderOptions, l: &Layout) -> f64 {
+    let legend_x = PAD_PX + nice_length(180.0 / l.f.s) * l.f.s + 40.0;
+    70.0 + 18.0 * l.notes.len() as f64 + legend_extra_h(world, opts, legend_x, l.width - PAD_PX)
+}
+
+/// Title and subtitle (name, size, doors, routes).
+fn header(svg: &mut Svg, world: &World, opts: &RenderOptions, l: &Layout) {
     let title = opts.title.clone().unwrap_or_else(|| world.name.clone());
     svg.text(
-        (pad, 28.0),
+        (PAD_PX, 28.0),
         &title,
         r##"font-size="22" font-weight="bold" fill="#111""##,
     );
@@ -261,44 +335,42 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
     let sub = format!(
         "{} - {:.0} m x {:.0} m, {doors}, {} route(s)",
         world.name,
-        w_m - 2.0 * margin_m,
-        h_m - 2.0 * margin_m,
+        l.size_m.0,
+        l.size_m.1,
         world.routes.len()
     );
-    svg.text((pad, 47.0), &sub, r##"font-size="13" fill="#555""##);
+    svg.text((PAD_PX, 47.0), &sub, r##"font-size="13" fill="#555""##);
+}
 
-    if opts.show_grid {
-        grid(&mut svg, &f, map_w, map_h);
+/// Walking areas, filled.
+fn areas(svg: &mut Svg, f: &Frame, world: &World) {
+    if world.areas.is_empty() {
+        return;
     }
-    if let Some(t) = &opts.tiles {
-        tiles(&mut svg, &f, t);
+    svg.open_group(r#"id="areas""#);
+    for a in &world.areas {
+        let p0 = f.p(Vec2::new(a.min.x, a.max.y));
+        svg.rect(
+            p0.0,
+            p0.1,
+            (a.max.x - a.min.x) * f.s,
+            (a.max.y - a.min.y) * f.s,
+            &format!(
+                r#"class="area" id="area-{}" fill="{AREA_FILL}" fill-opacity="0.7""#,
+                escape(&a.id)
+            ),
+        );
     }
+    svg.close_group();
+}
 
-    // Walking areas.
-    if opts.show_areas && !world.areas.is_empty() {
-        svg.open_group(r#"id="areas""#);
-        for a in &world.areas {
-            let p0 = f.p(Vec2::new(a.min.x, a.max.y));
-            svg.rect(
-                p0.0,
-                p0.1,
-                (a.max.x - a.min.x) * s,
-                (a.max.y - a.min.y) * s,
-                &format!(
-                    r#"class="area" id="area-{}" fill="{AREA_FILL}" fill-opacity="0.7""#,
-                    escape(&a.id)
-                ),
-            );
-        }
-        svg.close_group();
-    }
-
-    // Walls: one line per segment.
+/// Walls: one line per segment.
+fn walls(svg: &mut Svg, f: &Frame, world: &World) {
     svg.open_group(&format!(
         r#"id="walls" stroke="{WALL_COLOR}" stroke-linecap="square""#
     ));
     for w in &world.walls {
-        let sw = (w.thickness_m * s).max(2.0);
+        let sw = (w.thickness_m * f.s).max(2.0);
         for (k, seg) in w.segments().iter().enumerate() {
             svg.line(
                 f.p(seg.a),
@@ -313,33 +385,17 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         }
     }
     svg.close_group();
+}
 
-    // Doors: one element each.
+/// Doors: one element each, closed as a line, open as the swung panel with its arc.
+fn doors(svg: &mut Svg, f: &Frame, world: &World, states: &DoorStates) {
     svg.open_group(r#"id="doors" stroke-linecap="butt""#);
     for (i, d) in world.doors.iter().enumerate() {
-        let sw = (d.thickness_m * s * 1.5).max(3.0);
-        let closed = d.panel(false);
-        if opts.doors.is_open(i) {
-            let open = d.panel(true);
-            let sweep = crate::geom::wrap_angle(d.open_heading_rad - d.closed_heading_rad);
-            // SVG's y axis points down, so a counter-clockwise turn in the world is clockwise on
-            // screen: sweep-flag 0 for positive world angles.
-            let flag = if sweep > 0.0 { 0 } else { 1 };
-            let r = d.width_m * s;
-            let (a, b) = (f.p(closed.b), f.p(open.b));
-            svg.raw(&format!(
-                r#"<g class="door open" id="door-{id}"><path d="M {ax} {ay} A {r} {r} 0 0 {flag} {bx} {by}" fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3"/><line x1="{hx}" y1="{hy}" x2="{bx}" y2="{by}" stroke="{DOOR_OPEN_COLOR}" stroke-width="{sw}"/></g>"#,
-                id = escape(&d.id),
-                ax = num(a.0),
-                ay = num(a.1),
-                bx = num(b.0),
-                by = num(b.1),
-                r = num(r),
-                hx = num(f.p(d.hinge).0),
-                hy = num(f.p(d.hinge).1),
-                sw = num(sw),
-            ));
+        let sw = (d.thickness_m * f.s * 1.5).max(3.0);
+        if states.is_open(i) {
+            open_door(svg, f, d, sw);
         } else {
+            let closed = d.panel(false);
             svg.line(
                 f.p(closed.a),
                 f.p(closed.b),
@@ -352,193 +408,218 @@ pub fn render_world_svg(world: &World, opts: &RenderOptions) -> String {
         }
     }
     svg.close_group();
+}
 
-    // Door ids, inside the room the door opens into.
-    if opts.show_door_labels && !world.doors.is_empty() {
-        svg.open_group(&format!(
-            r#"id="door-labels" font-size="{}" fill="{LABEL_COLOR}" text-anchor="middle""#,
-            num(font)
-        ));
-        for d in &world.doors {
-            let c = d.panel(false);
-            let mid = (c.a + c.b) / 2.0;
-            let into = Vec2::new(d.open_heading_rad.cos(), d.open_heading_rad.sin());
-            // Clear of the open panel and its arc: past the panel's length, plus half the
-            // label's extent in the direction it is pushed.
-            let half_w_m = 0.3 * font * d.id.chars().count() as f64 / s;
-            let half_h_m = 0.5 * font / s;
-            let at =
-                mid + into * (d.width_m + 0.25 + into.x.abs() * half_w_m + into.y.abs() * half_h_m);
-            let p = f.p(at);
-            svg.text((p.0, p.1 + font * 0.35), &d.id, r#"class="door-label""#);
-        }
-        svg.close_group();
+/// An open door: its panel and the arc its tip swept from closed.
+fn open_door(svg: &mut Svg, f: &Frame, d: &Door, sw: f64) {
+    let (closed, open) = (d.panel(false), d.panel(true));
+    let sweep = crate::geom::wrap_angle(d.open_heading_rad - d.closed_heading_rad);
+    // SVG's y axis points down, so a counter-clockwise turn in the world is clockwise on
+    // screen: sweep-flag 0 for positive world angles.
+    let flag = if sweep > 0.0 { 0 } else { 1 };
+    let r = d.width_m * f.s;
+    let (a, b, h) = (f.p(closed.b), f.p(open.b), f.p(d.hinge));
+    svg.raw(&format!(
+        r#"<g class="door open" id="door-{id}"><path d="M {ax} {ay} A {r} {r} 0 0 {flag} {bx} {by}" fill="none" stroke="{DOOR_OPEN_COLOR}" stroke-width="1.2" stroke-dasharray="4 3"/><line x1="{hx}" y1="{hy}" x2="{bx}" y2="{by}" stroke="{DOOR_OPEN_COLOR}" stroke-width="{sw}"/></g>"#,
+        id = escape(&d.id),
+        ax = num(a.0),
+        ay = num(a.1),
+        bx = num(b.0),
+        by = num(b.1),
+        r = num(r),
+        hx = num(h.0),
+        hy = num(h.1),
+        sw = num(sw),
+    ));
+}
+
+/// Door ids, inside the room the door opens into.
+fn door_labels(svg: &mut Svg, f: &Frame, world: &World) {
+    if world.doors.is_empty() {
+        return;
     }
+    let font = (0.55 * f.s).clamp(9.0, 16.0);
+    svg.open_group(&format!(
+        r#"id="door-labels" font-size="{}" fill="{LABEL_COLOR}" text-anchor="middle""#,
+        num(font)
+    ));
+    for d in &world.doors {
+        let c = d.panel(false);
+        let mid = (c.a + c.b) / 2.0;
+        let into = Vec2::new(d.open_heading_rad.cos(), d.open_heading_rad.sin());
+        // Clear of the open panel and its arc: past the panel's length, plus half the
+        // label's extent in the direction it is pushed.
+        let half_w_m = 0.3 * font * d.id.chars().count() as f64 / f.s;
+        let half_h_m = 0.5 * font / f.s;
+        let at =
+            mid + into * (d.width_m + 0.25 + into.x.abs() * half_w_m + into.y.abs() * half_h_m);
+        let p = f.p(at);
+        svg.text((p.0, p.1 + font * 0.35), &d.id, r#"class="door-label""#);
+    }
+    svg.close_group();
+}
 
-    // Routes with direction arrows.
-    if opts.show_routes {
-        svg.open_group(r#"id="routes""#);
-        for (ri, r) in world.routes.iter().enumerate() {
-            if r.waypoints.len() < 2 {
-                continue;
-            }
-            let color = ROUTE_COLORS[ri % ROUTE_COLORS.len()];
-            // Later routes are shifted a few pixels to the left of travel so that routes
-            // sharing a corridor stay visible side by side.
-            let shifted = offset_loop(&r.waypoints, ri as f64 * 6.0 / s);
-            let pts: Vec<(f64, f64)> = shifted.iter().map(|p| f.p(*p)).collect();
-            let dash = if ri == 0 {
-                ""
-            } else {
-                r#" stroke-dasharray="10 5""#
-            };
+/// Routes with direction arrows; `cased`: each on a white casing (over a raster).
+fn routes(svg: &mut Svg, f: &Frame, world: &World, cased: bool) {
+    svg.open_group(r#"id="routes""#);
+    for (ri, r) in world.routes.iter().enumerate() {
+        if r.waypoints.len() < 2 {
+            continue;
+        }
+        let color = ROUTE_COLORS[ri % ROUTE_COLORS.len()];
+        // Later routes are shifted a few pixels to the left of travel so that routes
+        // sharing a corridor stay visible side by side.
+        let shifted = offset_loop(&r.waypoints, ri as f64 * 6.0 / f.s);
+        let pts: Vec<(f64, f64)> = shifted.iter().map(|p| f.p(*p)).collect();
+        if cased {
             svg.polyline(
                 &pts,
                 true,
-                &format!(
-                    r#"class="route" id="route-{}" fill="none" stroke="{color}" stroke-width="2" stroke-opacity="0.8"{dash}"#,
-                    escape(&r.id)
-                ),
-            );
-            let n = shifted.len();
-            for k in 0..n {
-                arrows(
-                    &mut svg,
-                    &f,
-                    Segment::new(shifted[k], shifted[(k + 1) % n]),
-                    color,
-                );
-            }
-        }
-        svg.close_group();
-    }
-
-    if !opts.bands.is_empty() {
-        svg.open_group(r#"id="bands" fill="none" stroke-linecap="round" stroke-linejoin="round""#);
-        for b in &opts.bands {
-            let pts: Vec<(f64, f64)> = b.points.iter().map(|q| f.p(*q)).collect();
-            svg.polyline(
-                &pts,
-                false,
-                &format!(
-                    r#"class="band" stroke="{}" stroke-width="{}" stroke-opacity="0.75""#,
-                    escape(&b.color),
-                    num(b.width_px)
-                ),
+                r#"class="route-casing" fill="none" stroke="white" stroke-width="6" stroke-linejoin="round""#,
             );
         }
-        svg.close_group();
-    }
-
-    // Overlays.
-    if !opts.paths.is_empty() {
-        svg.open_group(r#"id="paths" fill="none""#);
-        for p in &opts.paths {
-            let pts: Vec<(f64, f64)> = p.points.iter().map(|q| f.p(*q)).collect();
-            let dash = if p.dashed {
-                r#" stroke-dasharray="6 4""#
-            } else {
-                ""
-            };
-            svg.polyline(
-                &pts,
-                false,
-                &format!(
-                    r#"class="path" stroke="{}" stroke-width="{}"{dash}"#,
-                    escape(&p.color),
-                    num(p.width_px)
-                ),
-            );
-        }
-        svg.close_group();
-    }
-    if !opts.segments.is_empty() {
-        svg.open_group(r#"id="segments" stroke-width="1" stroke-opacity="0.7""#);
-        for sg in &opts.segments {
-            let dash = if sg.dashed {
-                r#" stroke-dasharray="5 3""#
-            } else {
-                ""
-            };
-            svg.line(
-                f.p(sg.a),
-                f.p(sg.b),
-                &format!(r#"class="pair" stroke="{}"{dash}"#, escape(&sg.color)),
-            );
-        }
-        svg.close_group();
-    }
-
-    // Home pose.
-    {
-        let h = world.home;
-        let c = f.p(h.position());
-        let r = (0.25 * s).max(5.0);
-        let tip = f.p(h.position() + Vec2::new(h.theta.cos(), h.theta.sin()) * (0.25 + 0.6));
-        svg.open_group(r#"id="home" class="home""#);
-        svg.circle(
-            c,
-            r,
+        let dash = if ri == 0 {
+            ""
+        } else {
+            r#" stroke-dasharray="10 5""#
+        };
+        let (width, opacity) = if cased { ("2.5", "1") } else { ("2", "0.8") };
+        svg.polyline(
+            &pts,
+            true,
             &format!(
-                r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#
+                r#"class="route" id="route-{}" fill="none" stroke="{color}" stroke-width="{width}" stroke-opacity="{opacity}"{dash}"#,
+                escape(&r.id)
             ),
         );
-        svg.line(
-            c,
-            tip,
-            &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
+        let n = shifted.len();
+        for k in 0..n {
+            arrows(
+                svg,
+                f,
+                Segment::new(shifted[k], shifted[(k + 1) % n]),
+                color,
+            );
+        }
+    }
+    svg.close_group();
+}
+
+/// Thick translucent bands along polylines.
+fn bands(svg: &mut Svg, f: &Frame, list: &[BandOverlay]) {
+    if list.is_empty() {
+        return;
+    }
+    svg.open_group(r#"id="bands" fill="none" stroke-linecap="round" stroke-linejoin="round""#);
+    for b in list {
+        let pts: Vec<(f64, f64)> = b.points.iter().map(|q| f.p(*q)).collect();
+        svg.polyline(
+            &pts,
+            false,
+            &format!(
+                r#"class="band" stroke="{}" stroke-width="{}" stroke-opacity="0.75""#,
+                escape(&b.color),
+                num(b.width_px)
+            ),
         );
-        svg.close_group();
     }
+    svg.close_group();
+}
 
-    if opts.show_waypoints {
-        waypoint_marks(&mut svg, &f, world);
+/// Trajectories and other polylines.
+fn paths(svg: &mut Svg, f: &Frame, list: &[PathOverlay]) {
+    if list.is_empty() {
+        return;
     }
-    marks(&mut svg, &f, &opts.marks);
+    svg.open_group(r#"id="paths" fill="none""#);
+    for p in list {
+        let pts: Vec<(f64, f64)> = p.points.iter().map(|q| f.p(*q)).collect();
+        let dash = if p.dashed {
+            r#" stroke-dasharray="6 4""#
+        } else {
+            ""
+        };
+        svg.polyline(
+            &pts,
+            false,
+            &format!(
+                r#"class="path" stroke="{}" stroke-width="{}"{dash}"#,
+                escape(&p.color),
+                num(p.width_px)
+            ),
+        );
+    }
+    svg.close_group();
+}
 
-    // Scale bar, bottom left.
-    let y0 = title_h + map_h + 22.0;
+/// Single segments (matched pairs).
+fn segments(svg: &mut Svg, f: &Frame, list: &[SegmentOverlay]) {
+    if list.is_empty() {
+        return;
+    }
+    svg.open_group(r#"id="segments" stroke-width="1" stroke-opacity="0.7""#);
+    for sg in list {
+        let dash = if sg.dashed {
+            r#" stroke-dasharray="5 3""#
+        } else {
+            ""
+        };
+        svg.line(
+            f.p(sg.a),
+            f.p(sg.b),
+            &format!(r#"class="pair" stroke="{}"{dash}"#, escape(&sg.color)),
+        );
+    }
+    svg.close_group();
+}
+
+/// The home pose: the robot's disc and its heading.
+fn home(svg: &mut Svg, f: &Frame, world: &World) {
+    let h = world.home;
+    let c = f.p(h.position());
+    let r = (0.25 * f.s).max(5.0);
+    let tip = f.p(h.position() + Vec2::new(h.theta.cos(), h.theta.sin()) * (0.25 + 0.6));
+    svg.open_group(r#"id="home" class="home""#);
+    svg.circle(
+        c,
+        r,
+        &format!(
+            r#"fill="{HOME_COLOR}" fill-opacity="0.25" stroke="{HOME_COLOR}" stroke-width="2""#
+        ),
+    );
+    svg.line(
+        c,
+        tip,
+        &format!(r#"stroke="{HOME_COLOR}" stroke-width="2.5""#),
+    );
+    svg.close_group();
+}
+
+/// A scale bar at (x0, y0) for `s` pixels per metre; returns its right end.
+fn scale_bar(svg: &mut Svg, s: f64, x0: f64, y0: f64) -> f64 {
     let bar_m = nice_length(180.0 / s);
-    let x0 = pad;
+    let x1 = x0 + bar_m * s;
     svg.open_group(r#"id="scale-bar""#);
-    svg.line(
-        (x0, y0),
-        (x0 + bar_m * s, y0),
-        r##"stroke="#111" stroke-width="3""##,
-    );
-    svg.line(
-        (x0, y0 - 5.0),
-        (x0, y0 + 5.0),
-        r##"stroke="#111" stroke-width="2""##,
-    );
-    svg.line(
-        (x0 + bar_m * s, y0 - 5.0),
-        (x0 + bar_m * s, y0 + 5.0),
-        r##"stroke="#111" stroke-width="2""##,
-    );
+    svg.line((x0, y0), (x1, y0), r##"stroke="#111" stroke-width="3""##);
+    for x in [x0, x1] {
+        svg.line(
+            (x, y0 - 5.0),
+            (x, y0 + 5.0),
+            r##"stroke="#111" stroke-width="2""##,
+        );
+    }
     let label = if bar_m >= 1.0 {
         format!("{bar_m:.0} m")
     } else {
         format!("{bar_m} m")
     };
     svg.text(
-        (x0 + bar_m * s / 2.0, y0 + 20.0),
+        ((x0 + x1) / 2.0, y0 + 20.0),
         &label,
         r##"font-size="13" text-anchor="middle" fill="#111""##,
     );
     svg.close_group();
-
-    // Legend, after the scale bar.
-    let legend_end = legend(
-        &mut svg,
-        world,
-        opts,
-        x0 + bar_m * s + 40.0,
-        y0,
-        width - pad,
-    );
-    notes(&mut svg, &opts.notes, pad, legend_end.max(y0 + 24.0) + 22.0);
-    svg.finish()
+    x1
 }
 
 /// A closed loop moved `d` metres to the left of travel (mitred at the corners).
@@ -819,9 +900,9 @@ fn tiles(svg: &mut Svg, f: &Frame, t: &TileLayer) {
     svg.close_group();
 }
 
-/// A numbered marker per waypoint of every route, offset a little off the route.
-fn waypoint_marks(svg: &mut Svg, f: &Frame, world: &World) {
-    let list: Vec<MarkOverlay> = world
+/// A numbered marker per waypoint of every route.
+fn waypoint_marks(world: &World) -> Vec<MarkOverlay> {
+    world
         .routes
         .iter()
         .enumerate()
@@ -837,8 +918,32 @@ fn waypoint_marks(svg: &mut Svg, f: &Frame, world: &World) {
                     class: "waypoint".into(),
                 })
         })
-        .collect();
-    marks(svg, f, &list);
+        .collect()
+}
+
+/// Marks closer than this on screen share a spot, pixels: their labels fan out around it.
+const SAME_SPOT_PX: f64 = 10.0;
+
+/// For each mark, where its label goes relative to its spot (pixels) and whether it was fanned
+/// out (then a leader line joins it to the spot). A lone mark's label sits up and right of its
+/// ring; marks that share a spot spread theirs evenly around it, in list order.
+fn label_offsets(spots: &[(f64, f64)]) -> Vec<((f64, f64), bool)> {
+    let near = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).hypot(a.1 - b.1) < SAME_SPOT_PX;
+    (0..spots.len())
+        .map(|i| {
+            let group: Vec<usize> = (0..spots.len())
+                .filter(|&j| near(spots[i], spots[j]))
+                .collect();
+            if group.len() == 1 {
+                return ((10.0, -9.0), false);
+            }
+            let k = group.iter().position(|&j| j == i).unwrap_or(0) as f64;
+            let n = group.len() as f64;
+            let angle = std::f64::consts::FRAC_PI_4 + k * std::f64::consts::TAU / n;
+            let r = 16.0 + 2.0 * n;
+            ((r * angle.cos(), -r * angle.sin()), true)
+        })
+        .collect()
 }
 
 fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
@@ -847,17 +952,31 @@ fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
     }
     // A ring with a faint fill keeps the path under the spot visible; the text sits beside the
     // ring on a white halo, so it reads over walls and paths alike.
+    let spots: Vec<(f64, f64)> = list.iter().map(|m| f.p(m.at)).collect();
     svg.open_group(r#"id="marks" font-size="12" font-weight="bold""#);
-    for m in list {
-        let c = f.p(m.at);
+    for ((m, c), ((dx, dy), fanned)) in list.iter().zip(&spots).zip(label_offsets(&spots)) {
         let r = 7.0;
+        let leader = if fanned {
+            let len = dx.hypot(dy);
+            format!(
+                r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{color}" stroke-width="1"/>"#,
+                num(c.0 + dx * r / len),
+                num(c.1 + dy * r / len),
+                num(c.0 + dx * 0.8),
+                num(c.1 + dy * 0.8),
+                color = escape(&m.color),
+            )
+        } else {
+            String::new()
+        };
+        let anchor = if dx < 0.0 { "end" } else { "start" };
         svg.raw(&format!(
-            r##"<g class="{class}"><circle cx="{x}" cy="{y}" r="{r}" fill="{color}" fill-opacity="0.18" stroke="{color}" stroke-width="2"/><text x="{tx}" y="{ty}" fill="{color}" stroke="white" stroke-width="3" paint-order="stroke">{text}</text></g>"##,
+            r##"<g class="{class}"><circle cx="{x}" cy="{y}" r="{r}" fill="{color}" fill-opacity="0.18" stroke="{color}" stroke-width="2"/>{leader}<text x="{tx}" y="{ty}" text-anchor="{anchor}" fill="{color}" stroke="white" stroke-width="3" paint-order="stroke">{text}</text></g>"##,
             class = escape(&m.class),
             x = num(c.0),
             y = num(c.1),
-            tx = num(c.0 + r + 3.0),
-            ty = num(c.1 - r + 2.0),
+            tx = num(c.0 + dx),
+            ty = num(c.1 + dy + 4.0),
             r = num(r),
             color = escape(&m.color),
             text = escape(&m.text),
@@ -866,6 +985,7 @@ fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
     svg.close_group();
 }
 
+/// Lines of text under the legend (already wrapped to the picture's width).
 fn notes(svg: &mut Svg, lines: &[String], x: f64, y: f64) {
     if lines.is_empty() {
         return;

@@ -33,6 +33,13 @@ pub(crate) fn parse_document<'i>(src: &'i str, d: &mut Diags) -> Option<Spanned<
             .join(" ");
         let msg = lowercase_first(msg.trim_end_matches('.'));
         let at = e.span().map(|s| s.start).unwrap_or(0);
+        if msg == "duplicate key"
+            && let Some(span) = e.span()
+            && let Some(text) = duplicate_key(src, span)
+        {
+            d.at(at, text);
+            return None;
+        }
         match unclosed_before(src, at) {
             Some(end) => d.at(
                 end,
@@ -45,6 +52,63 @@ pub(crate) fn parse_document<'i>(src: &'i str, d: &mut Diags) -> Option<Spanned<
         }
     }
     None
+}
+
+/// The message for a key set twice, the second time at `span`: the key, the table it is in
+/// (named by its header and id) and the line it was first set on. `None` when the first time is
+/// not found (e.g. a dotted key), to fall back to the parser's words.
+fn duplicate_key(src: &str, span: std::ops::Range<usize>) -> Option<String> {
+    let key = src.get(span.clone())?.trim().trim_matches('"');
+    let lines: Vec<&str> = src.lines().collect();
+    let here = src[..span.start].matches('\n').count();
+    let header = |l: &str| l.trim_start().starts_with('[');
+    let is_key = |l: &str| {
+        l.trim_start()
+            .strip_prefix(key)
+            .is_some_and(|rest| rest.trim_start().starts_with('='))
+    };
+    if header(lines.get(here)?) {
+        // A table header given twice: the first header of the same text.
+        let first = lines[..here]
+            .iter()
+            .position(|l| l.trim() == lines[here].trim())?;
+        return Some(format!(
+            "duplicate table `{}` (first on line {}); merge the two into one",
+            lines[here].trim(),
+            first + 1
+        ));
+    }
+    let start = lines[..here]
+        .iter()
+        .rposition(|l| header(l))
+        .map_or(0, |k| k + 1);
+    let first = start + lines[start..here].iter().position(|l| is_key(l))?;
+    let table = match start.checked_sub(1).map(|k| lines[k].trim()) {
+        None => "the file".to_string(),
+        Some(h) => {
+            let kind = h.trim_matches(|c| c == '[' || c == ']');
+            let id = lines[start..]
+                .iter()
+                .take_while(|l| !header(l))
+                .find_map(|l| {
+                    let rest = l
+                        .trim_start()
+                        .strip_prefix("id")?
+                        .trim_start()
+                        .strip_prefix('=')?;
+                    Some(rest.trim().trim_matches('"').to_string())
+                });
+            match (h.starts_with("[["), id) {
+                (true, Some(id)) => format!("{} '{id}'", kind.strip_suffix('s').unwrap_or(kind)),
+                _ => format!("[{kind}]"),
+            }
+        }
+    };
+    Some(format!(
+        "duplicate key `{}` in {table} (first set on line {}); keep one of the two",
+        echo(key),
+        first + 1
+    ))
 }
 
 /// When an error sits at the start of a line while an array or inline table opened on an

@@ -1,4 +1,7 @@
-//! "Did you mean" hints: the closest known name to a misspelt one.
+//! "Did you mean" hints: the closest known name to a misspelt one, and the unit a number seems
+//! to be written in (radians for a heading in degrees, millimetres or centimetres for metres).
+
+use crate::spec::diag::fmt_number;
 
 /// The candidate closest to `word`, if it is close enough to be a plausible typo.
 pub fn closest<'a, I>(word: &str, candidates: I) -> Option<&'a str>
@@ -68,6 +71,56 @@ where
     }
 }
 
+/// Units a length in metres is often written in by mistake: (name, how many make a metre).
+const LENGTH_UNITS: [(&str, f64); 2] = [("millimetres", 1000.0), ("centimetres", 100.0)];
+
+/// `VALUE looks like millimetres (M m); write KEY = M` when a length `x` that should be metres
+/// lies outside `typical_m` while `x` read as millimetres (or else centimetres) lies inside it.
+pub fn length_unit_hint(key: &str, x: f64, typical_m: (f64, f64)) -> Option<String> {
+    let fits = |m: f64| m >= typical_m.0 && m <= typical_m.1;
+    if fits(x) {
+        return None;
+    }
+    LENGTH_UNITS.iter().find_map(|&(unit, per_m)| {
+        let m = x / per_m;
+        fits(m).then(|| {
+            format!(
+                "{} looks like {unit} ({} m); lengths are metres: write {key} = {}",
+                fmt_number(x),
+                fmt_number(m),
+                fmt_number(m)
+            )
+        })
+    })
+}
+
+/// The heading in whole degrees that `deg` means if it was written in radians: a value within
+/// one turn of radians (|x| <= 2 pi), not a whole number, that in degrees lies within half a
+/// degree of a multiple of 15 (1.57 is 89.95 degrees: 90). Headings people mean in degrees are
+/// whole numbers almost always; quarter and eighth turns in radians almost never are.
+pub fn radians_as_degrees(deg: f64) -> Option<f64> {
+    let as_deg = deg.to_degrees();
+    let nearest = (as_deg / 15.0).round() * 15.0;
+    (deg.is_finite()
+        && deg.fract() != 0.0
+        && deg.abs() <= std::f64::consts::TAU + 0.01
+        && (as_deg - nearest).abs() <= 0.5
+        && nearest != 0.0)
+        .then_some(nearest)
+}
+
+/// `KEY = VALUE looks like radians (D degrees); headings are degrees: write KEY = D`.
+pub fn radians_hint(key: &str, deg: f64) -> Option<String> {
+    radians_as_degrees(deg).map(|d| {
+        format!(
+            "{key} = {} looks like radians ({} degrees); headings are degrees: write {key} = {}",
+            fmt_number(deg),
+            fmt_number(d),
+            fmt_number(d)
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -88,5 +141,29 @@ mod tests {
         let door = ["id", "hinge_m", "width_m", "thickness_m"];
         assert_eq!(closest("length_m", door), Some("width_m"));
         assert_eq!(closest("widht_m", door), Some("width_m"));
+    }
+
+    #[test]
+    fn radians_and_small_units_are_recognised() {
+        assert_eq!(radians_as_degrees(1.57), Some(90.0));
+        assert_eq!(radians_as_degrees(3.1416), Some(180.0));
+        assert_eq!(radians_as_degrees(-0.785), Some(-45.0));
+        // Whole degrees, odd fractions and values past one turn are degrees.
+        assert_eq!(radians_as_degrees(90.0), None);
+        assert_eq!(radians_as_degrees(1.3), None);
+        assert_eq!(radians_as_degrees(12.5), None);
+        let door = (0.6, 1.5);
+        assert!(
+            length_unit_hint("width_m", 900.0, door)
+                .unwrap()
+                .contains("millimetres (0.9 m)")
+        );
+        assert!(
+            length_unit_hint("width_m", 90.0, door)
+                .unwrap()
+                .contains("centimetres (0.9 m)")
+        );
+        assert_eq!(length_unit_hint("width_m", 0.9, door), None);
+        assert_eq!(length_unit_hint("width_m", 30.0, door), None);
     }
 }

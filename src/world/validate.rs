@@ -10,7 +10,8 @@
 
 use crate::geom::{Segment, Vec2, wrap_angle};
 use crate::spec::diag::{Diags, fmt_number};
-use crate::spec::world::{Unread, WorldLoc, WorldSpec};
+use crate::spec::suggest::{length_unit_hint, radians_as_degrees, radians_hint};
+use crate::spec::world::{DoorSpec, Unread, WorldLoc, WorldSpec};
 use crate::world::geometry::{SegmentIndex, ThickSegment};
 use std::collections::HashMap;
 
@@ -51,6 +52,17 @@ pub const DOOR_WIDTH_RANGE_M: (f64, f64) = (0.5, 3.0);
 pub const MAX_DOOR_THICKNESS_M: f64 = 0.2;
 /// Smallest swing between closed and open headings, degrees.
 pub const MIN_DOOR_SWING_DEG: f64 = 10.0;
+/// Ordinary values, metres: a number outside its range that fits it once read as millimetres or
+/// centimetres gets a hint naming that unit (a door 900 wide is 900 mm).
+const TYPICAL_DOOR_WIDTH_M: (f64, f64) = (0.6, 1.5);
+const TYPICAL_DOOR_THICKNESS_M: (f64, f64) = (0.02, 0.1);
+const TYPICAL_WALL_THICKNESS_M: (f64, f64) = (0.05, 0.5);
+/// Largest angle, degrees, between a closed heading and the heading that spans the gap at
+/// which the two count as the same (a 0.9 m panel's tip moves 5 cm in 3 degrees).
+const SAME_HEADING_DEG: f64 = 3.0;
+/// Shortest stretch two closed door panels may share before they count as two doors in one gap
+/// (leaves of a double door meet tip to tip and share none), metres.
+const DOORS_OVERLAP_M: f64 = 0.1;
 fn v(p: &[f64; 2]) -> Vec2 {
     Vec2::new(p[0], p[1])
 }
@@ -268,8 +280,11 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
             d.at(
                 l.thickness,
                 format!(
-                    "wall '{}' has thickness_m = {}, outside (0, {MAX_WALL_THICKNESS_M}) m; use the wall's real thickness, e.g. 0.1",
-                    w.id, w.thickness_m
+                    "wall '{}' has thickness_m = {}, outside (0, {MAX_WALL_THICKNESS_M}) m; {}",
+                    w.id,
+                    fmt_number(w.thickness_m),
+                    length_unit_hint("thickness_m", w.thickness_m, TYPICAL_WALL_THICKNESS_M)
+                        .unwrap_or_else(|| "use the wall's real thickness, e.g. 0.1".into())
                 ),
             );
             ok = false;
@@ -320,8 +335,11 @@ fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
             d.at(
                 l.width,
                 format!(
-                    "door '{}' has width_m = {}, outside {lo}-{hi} m; doors are usually 0.8-1.0 m wide",
-                    door.id, door.width_m
+                    "door '{}' has width_m = {}, outside {lo}-{hi} m; {}",
+                    door.id,
+                    fmt_number(door.width_m),
+                    length_unit_hint("width_m", door.width_m, TYPICAL_DOOR_WIDTH_M)
+                        .unwrap_or_else(|| "doors are usually 0.8-1.0 m wide".into())
                 ),
             );
             ok = false;
@@ -330,8 +348,11 @@ fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
             d.at(
                 l.thickness,
                 format!(
-                    "door '{}' has thickness_m = {}, outside (0, {MAX_DOOR_THICKNESS_M}] m; leave it out for the default 0.04",
-                    door.id, door.thickness_m
+                    "door '{}' has thickness_m = {}, outside (0, {MAX_DOOR_THICKNESS_M}] m; {}",
+                    door.id,
+                    fmt_number(door.thickness_m),
+                    length_unit_hint("thickness_m", door.thickness_m, TYPICAL_DOOR_THICKNESS_M)
+                        .unwrap_or_else(|| "leave it out for the default 0.04".into())
                 ),
             );
             ok = false;
@@ -360,10 +381,23 @@ fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
             .to_degrees()
             .abs();
         if swing < MIN_DOOR_SWING_DEG {
+            // Headings written in radians swing a few degrees: say so rather than "differ".
+            let radians: Vec<String> = [
+                ("closed_heading_deg", door.closed_heading_deg),
+                ("open_heading_deg", door.open_heading_deg),
+            ]
+            .into_iter()
+            .filter_map(|(key, h)| radians_hint(key, h))
+            .collect();
+            let fix = if radians.is_empty() {
+                "make open_heading_deg differ from closed_heading_deg, usually by 90".to_string()
+            } else {
+                radians.join("; ")
+            };
             d.at(
                 l.open_heading,
                 format!(
-                    "door '{}' swings only {swing:.1} degrees between closed and open; make open_heading_deg differ from closed_heading_deg, usually by 90",
+                    "door '{}' swings only {swing:.1} degrees between closed and open; {fix}",
                     door.id
                 ),
             );
@@ -424,6 +458,11 @@ fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             loc.home.heading,
             "robot home heading_deg is outside -360..360; give the heading in degrees".into(),
         );
+    } else if loc.home.valid
+        && let Some(hint) = radians_hint("heading_deg", spec.robot_home.heading_deg)
+    {
+        // A heading of 1.57 degrees is legal but almost surely meant as 90.
+        d.warn(loc.home.heading, format!("robot home {hint}"));
     }
 }
 
@@ -468,6 +507,11 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
         );
         return false;
     }
+    let span = |axis: usize| {
+        let vals = pts.iter().map(|(p, _)| p[axis]);
+        vals.clone().fold(f64::NEG_INFINITY, f64::max) - vals.fold(f64::INFINITY, f64::min)
+    };
+    let millimetres = millimetre_hint(&pts, [span(0), span(1)]);
     for axis in 0..2 {
         let mut vals: Vec<f64> = pts.iter().map(|(p, _)| p[axis]).collect();
         let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
@@ -488,17 +532,36 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             d.at(
                 at,
                 format!(
-                    "the world is {:.0} m across in {} (limit {MAX_EXTENT_M:.0} m), because of the point [{}, {}]; coordinates are metres: check this value",
+                    "the world is {:.0} m across in {} (limit {MAX_EXTENT_M:.0} m), because of the point [{}, {}]; {}",
                     hi - lo,
                     if axis == 0 { "x" } else { "y" },
                     fmt_number(p[0]),
-                    fmt_number(p[1])
+                    fmt_number(p[1]),
+                    millimetres.clone().unwrap_or_else(|| "coordinates are metres: check this value".into())
                 ),
             );
             return false;
         }
     }
     true
+}
+
+/// `the coordinates look like millimetres…` when a world too large in metres is an ordinary
+/// building in millimetres: most of its points lie more than 100 (m) from the origin, not just
+/// one stray value, and it spans 1 to 2000 m once divided by 1000.
+fn millimetre_hint(pts: &[([f64; 2], usize)], span_m: [f64; 2]) -> Option<String> {
+    let far = pts
+        .iter()
+        .filter(|(p, _)| p[0].abs().max(p[1].abs()) > 100.0)
+        .count();
+    let (x, y) = (span_m[0] / 1000.0, span_m[1] / 1000.0);
+    (2 * far > pts.len() && x.max(y) >= 1.0 && x.max(y) <= 2000.0).then(|| {
+        format!(
+            "the coordinates look like millimetres (in metres the world would be {} m x {} m); coordinates are metres: divide them by 1000",
+            fmt_number((x * 10.0).round() / 10.0),
+            fmt_number((y * 10.0).round() / 10.0)
+        )
+    })
 }
 
 /// What an obstacle in a clearance query is.
@@ -515,7 +578,7 @@ fn owner_name(spec: &WorldSpec, o: Owner, state: &str) -> String {
     }
 }
 
-fn door_panel(door: &crate::spec::world::DoorSpec, open: bool) -> Segment {
+fn door_panel(door: &DoorSpec, open: bool) -> Segment {
     let h = if open {
         door.open_heading_deg
     } else {
@@ -553,11 +616,13 @@ fn geometry(
     let closed = door_obstacles(spec, false);
     let open = door_obstacles(spec, true);
     let all = [(&walls, ""), (&closed, "closed"), (&open, "open")];
-    doors_span_their_gaps(spec, loc, &walls, unread, d);
+    let spans = doors_span_their_gaps(spec, loc, &walls, unread, d);
     home_in_free_space(spec, loc, &all, robot_radius_m, d);
-    doors_fit_their_gaps(spec, loc, &walls, d);
+    doors_fit_their_gaps(spec, loc, &walls, &spans, d);
+    doors_do_not_share_a_gap(spec, loc, d);
+    walls_do_not_cross(spec, loc, d);
     walls_do_not_overlap(spec, loc, d);
-    home_inside_the_building(spec, loc, unread, d);
+    inside_the_building(spec, loc, unread, d);
     routes_are_drivable(spec, loc, &all, robot_radius_m, d);
     routes_near_unread(spec, loc, unread, robot_radius_m, d);
     areas_are_walkable(spec, loc, &walls, d);
@@ -686,89 +751,211 @@ fn nearest_of<'a>(
         .min_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// Doors: closed they fill a wall gap; open they do not cut through a wall.
+/// Doors: closed they fill a wall gap; open they do not cut through a wall. Per door, whether
+/// its closed panel spans a gap (the fit checks look only at those).
 fn doors_span_their_gaps(
     spec: &WorldSpec,
     loc: &WorldLoc,
     walls: &Obstacles,
     unread: &[Unread],
     d: &mut Diags,
-) {
+) -> Vec<bool> {
+    let mut spans = Vec::with_capacity(spec.doors.len());
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
-        let panel = door_panel(door, false);
-        let point = |p: Vec2| Segment::new(p, p);
-        let probe = 1.0;
-        let mut noted = false;
-        for (end, at, which, fix) in [
-            (
-                panel.a,
-                l.hinge,
-                "hinge",
-                "move hinge_m onto the end of a wall",
-            ),
-            (
-                panel.b,
+        spans.push(closed_door_spans(spec, door, l, walls, unread, d));
+        open_door_clears_walls(spec, door, l, walls, d);
+    }
+    spans
+}
+
+/// Clearance of a point from the nearest wall within `probe` metres.
+fn wall_clearance(walls: &Obstacles, p: Vec2, probe: f64) -> Option<f64> {
+    walls.nearest(Segment::new(p, p), probe).map(|(_, c)| c)
+}
+
+/// Whether the closed panel of `door` spans a wall gap; reports it (or notes that its wall did
+/// not read) when not. When the hinge is on a wall and another heading spans a gap from it,
+/// the message names that heading and why the stated one misses (radians, off by 180 degrees).
+fn closed_door_spans(
+    spec: &WorldSpec,
+    door: &DoorSpec,
+    l: &crate::spec::world::DoorLoc,
+    walls: &Obstacles,
+    unread: &[Unread],
+    d: &mut Diags,
+) -> bool {
+    let panel = door_panel(door, false);
+    let point = |p: Vec2| Segment::new(p, p);
+    let probe = 1.0;
+    let off = |p: Vec2| wall_clearance(walls, p, probe).is_none_or(|c| c > DOOR_GAP_TOLERANCE_M);
+    let mid = (panel.a + panel.b) / 2.0;
+    let along = match walls.nearest(point(mid), 0.0) {
+        Some((Owner::Wall(wi), c)) if c < -0.001 => Some(wi),
+        _ => None,
+    };
+    if !off(panel.a) && (off(panel.b) || along.is_some()) {
+        if let Some(gap) = gap_heading(door, walls) {
+            let what = match along {
+                Some(wi) => format!("its panel lies along wall '{}'", spec.walls[wi].id),
+                None => format!(
+                    "its tip at [{:.2}, {:.2}] is {} from the nearest wall",
+                    panel.b.x,
+                    panel.b.y,
+                    wall_clearance(walls, panel.b, probe)
+                        .map(|c| format!("{c:.2} m"))
+                        .unwrap_or_else(|| format!("more than {probe} m"))
+                ),
+            };
+            d.at(
                 l.closed_heading,
-                "tip",
-                "check width_m and closed_heading_deg so the panel reaches the wall across the gap",
-            ),
-        ] {
-            let c = walls.nearest(point(end), probe).map(|(_, c)| c);
-            if c.is_none_or(|c| c > DOOR_GAP_TOLERANCE_M)
-                && let Some(u) = unread_near(unread, "wall", point(end), probe)
-            {
-                // Its wall may be the one that did not read: not checked, said once.
-                if !noted {
-                    d.note(
-                        l.hinge,
-                        format!(
-                            "closed door '{}' not checked for spanning a wall gap: its wall may be {}, which has errors (line {}); fix them and check again",
-                            door.id,
-                            u.name,
-                            d.line_of(u.at)
-                        ),
-                    );
-                }
-                noted = true;
-            } else if c.is_none_or(|c| c > DOOR_GAP_TOLERANCE_M) {
-                let dist = c
-                    .map(|c| format!("{c:.2} m"))
-                    .unwrap_or_else(|| format!("more than {probe} m"));
-                d.at(
-                    at,
+                format!(
+                    "closed door '{}' does not span the gap at its hinge: {what}; {}",
+                    door.id,
+                    heading_cause(door.closed_heading_deg, gap)
+                ),
+            );
+            return false;
+        }
+    }
+    let mut ok = true;
+    let mut noted = false;
+    for (end, at, which, fix) in [
+        (
+            panel.a,
+            l.hinge,
+            "hinge",
+            "move hinge_m onto the end of a wall",
+        ),
+        (
+            panel.b,
+            l.closed_heading,
+            "tip",
+            "check width_m and closed_heading_deg so the panel reaches the wall across the gap",
+        ),
+    ] {
+        if !off(end) {
+            continue;
+        }
+        ok = false;
+        if let Some(u) = unread_near(unread, "wall", point(end), probe) {
+            // Its wall may be the one that did not read: not checked, said once.
+            if !noted {
+                d.note(
+                    l.hinge,
                     format!(
-                        "closed door '{}' does not span a wall gap: its {which} at [{:.2}, {:.2}] is {dist} from the nearest wall (at most {DOOR_GAP_TOLERANCE_M} m); {fix}",
-                        door.id, end.x, end.y
+                        "closed door '{}' not checked for spanning a wall gap: its wall may be {}, which has errors (line {}); fix them and check again",
+                        door.id,
+                        u.name,
+                        d.line_of(u.at)
                     ),
                 );
             }
-        }
-        let mid = (panel.a + panel.b) / 2.0;
-        if let Some((Owner::Wall(wi), c)) = walls.nearest(point(mid), 0.0)
-            && c < -0.001
-        {
+            noted = true;
+        } else {
+            let dist = wall_clearance(walls, end, probe)
+                .map(|c| format!("{c:.2} m"))
+                .unwrap_or_else(|| format!("more than {probe} m"));
             d.at(
-                l.hinge,
+                at,
                 format!(
-                    "closed door '{}' lies along wall '{}' instead of filling a gap in it; leave a gap in the wall where the door is",
-                    door.id, spec.walls[wi].id
+                    "closed door '{}' does not span a wall gap: its {which} at [{:.2}, {:.2}] is {dist} from the nearest wall (at most {DOOR_GAP_TOLERANCE_M} m); {fix}",
+                    door.id, end.x, end.y
                 ),
             );
         }
-        let op = door_panel(door, true);
-        let dir = (op.b - op.a) / door.width_m;
-        let part = Segment::new(op.a + dir * (0.1f64).min(door.width_m / 2.0), op.b);
-        let half = door.thickness_m / 2.0;
-        if let Some((Owner::Wall(wi), c)) = walls.nearest(part, half - 0.005) {
-            let _ = c;
-            d.at(
-                l.open_heading,
-                format!(
-                    "open door '{}' cuts through wall '{}'; turn open_heading_deg so the door swings into free space in its room",
-                    door.id, spec.walls[wi].id
-                ),
-            );
-        }
+    }
+    if let Some(wi) = along {
+        ok = false;
+        d.at(
+            l.hinge,
+            format!(
+                "closed door '{}' lies along wall '{}' instead of filling a gap in it; leave a gap in the wall where the door is",
+                door.id, spec.walls[wi].id
+            ),
+        );
+    }
+    ok
+}
+
+/// Why a closed heading misses the gap that `gap_deg` spans, and the heading to write.
+fn heading_cause(stated_deg: f64, gap_deg: f64) -> String {
+    let apart = |a: f64, b: f64| wrap_angle((a - b).to_radians()).to_degrees().abs();
+    let write = format!("write closed_heading_deg = {}", fmt_number(gap_deg));
+    if radians_as_degrees(stated_deg).is_some_and(|r| apart(r, gap_deg) <= SAME_HEADING_DEG) {
+        return radians_hint("closed_heading_deg", stated_deg).unwrap_or(write);
+    }
+    if apart(stated_deg + 180.0, gap_deg) <= SAME_HEADING_DEG {
+        return format!(
+            "closed_heading_deg = {} points away from the gap (off by 180 degrees); {write}",
+            fmt_number(stated_deg)
+        );
+    }
+    format!(
+        "the gap lies at {} degrees from the hinge; {write}",
+        fmt_number(gap_deg)
+    )
+}
+
+/// The whole-degree closed heading, in -180..180, at which the panel of `door` spans a wall gap
+/// from its hinge: its tip on a wall (within the tolerance) and its middle in free space.
+/// Among such headings, the one whose tip lies deepest in the wall (the gap's far end), then
+/// the nearest to the stated heading.
+fn gap_heading(door: &DoorSpec, walls: &Obstacles) -> Option<f64> {
+    let hinge = v(&door.hinge_m);
+    let stated = door.closed_heading_deg;
+    (-179..=180)
+        .filter_map(|deg| {
+            let h = (deg as f64).to_radians();
+            let dir = Vec2::new(h.cos(), h.sin());
+            let tip = wall_clearance(walls, hinge + dir * door.width_m, 1.0)?;
+            let mid_free = wall_clearance(walls, hinge + dir * (door.width_m / 2.0), 1.0)
+                .is_none_or(|c| c > 0.0);
+            (tip <= DOOR_GAP_TOLERANCE_M && mid_free).then_some((deg as f64, tip))
+        })
+        .min_by(|a, b| {
+            let off = |h: f64| wrap_angle((h - stated).to_radians()).abs();
+            (a.1, off(a.0))
+                .partial_cmp(&(b.1, off(b.0)))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .map(|(deg, _)| deg)
+}
+
+/// An open door must not cut through a wall (beyond the hinge's first 10 cm, which sit in the
+/// gap's end).
+fn open_door_clears_walls(
+    spec: &WorldSpec,
+    door: &DoorSpec,
+    l: &crate::spec::world::DoorLoc,
+    walls: &Obstacles,
+    d: &mut Diags,
+) {
+    if let Some(wi) = open_panel_cuts(door, door.open_heading_deg, walls) {
+        let fix = radians_hint("open_heading_deg", door.open_heading_deg).unwrap_or_else(|| {
+            "turn open_heading_deg so the door swings into free space in its room".into()
+        });
+        d.at(
+            l.open_heading,
+            format!(
+                "open door '{}' cuts through wall '{}'; {fix}",
+                door.id, spec.walls[wi].id
+            ),
+        );
+    }
+}
+
+/// The wall the panel of `door` cuts through when open at `heading_deg`, if any.
+fn open_panel_cuts(door: &DoorSpec, heading_deg: f64, walls: &Obstacles) -> Option<usize> {
+    let h = heading_deg.to_radians();
+    let a = v(&door.hinge_m);
+    let dir = Vec2::new(h.cos(), h.sin());
+    let part = Segment::new(
+        a + dir * 0.1f64.min(door.width_m / 2.0),
+        a + dir * door.width_m,
+    );
+    match walls.nearest(part, door.thickness_m / 2.0 - 0.005) {
+        Some((Owner::Wall(wi), _)) => Some(wi),
+        _ => None,
     }
 }
 
@@ -807,6 +994,7 @@ fn routes_are_drivable(
 ) {
     let [(walls, _), (closed, _), (open, _)] = *all;
     let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
+    let mut opens_into_route = std::collections::HashSet::new();
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
         let n = r.waypoints_m.len();
         if n < 3 {
@@ -855,6 +1043,24 @@ fn routes_are_drivable(
             for (hit, state, when) in checks {
                 if let Some((o, c)) = hit {
                     blocked = true;
+                    if let (Owner::Door(i), "open") = (o, state)
+                        && let Some(other) = other_way(&spec.doors[i], walls, leg, robot_radius_m)
+                    {
+                        // The door, not the route, is what is wrong: said once, at the door.
+                        if opens_into_route.insert(i) {
+                            d.at(
+                                loc.doors[i].open_heading,
+                                format!(
+                                    "open door '{}' swings into route '{}': the leg from waypoint {k} to {k2} passes {} it and the robot's disc (radius {robot_radius_m} m) cannot drive through; the door opens into the corridor: make it open into its room, open_heading_deg = {}",
+                                    spec.doors[i].id,
+                                    r.id,
+                                    fmt_m(c),
+                                    fmt_number(other)
+                                ),
+                            );
+                        }
+                        continue;
+                    }
                     d.at(
                         at,
                         format!(
@@ -894,6 +1100,21 @@ fn routes_are_drivable(
     }
 }
 
+/// The open heading, degrees, of `door` swung the other way (mirrored in its closed panel),
+/// when that way it cuts no wall and leaves `leg` the robot's radius: the door opens into the
+/// route's corridor and should open into its room.
+fn other_way(door: &DoorSpec, walls: &Obstacles, leg: Segment, robot_radius_m: f64) -> Option<f64> {
+    let mirrored = wrap_angle((2.0 * door.closed_heading_deg - door.open_heading_deg).to_radians())
+        .to_degrees();
+    let mirrored = (mirrored * 10.0).round() / 10.0 + 0.0;
+    let h = mirrored.to_radians();
+    let a = v(&door.hinge_m);
+    let panel = Segment::new(a, a + Vec2::new(h.cos(), h.sin()) * door.width_m);
+    let clear = crate::geom::segment_distance(leg, panel) - door.thickness_m / 2.0;
+    (open_panel_cuts(door, mirrored, walls).is_none() && clear >= robot_radius_m)
+        .then_some(mirrored)
+}
+
 /// Walking areas: people walk along the centre line of the longer side.
 fn areas_are_walkable(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
     for (a, l) in spec.areas.iter().zip(&loc.areas) {
@@ -924,8 +1145,20 @@ fn areas_are_walkable(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &m
 /// Closed doors whose panel runs into the wall beyond its gap (the panel is longer than the
 /// gap, or the hinge sits inside the wall): the length of panel inside a wall at each end,
 /// beyond the wall's end cap, measured every centimetre.
-fn doors_fit_their_gaps(spec: &WorldSpec, loc: &WorldLoc, walls: &Obstacles, d: &mut Diags) {
-    for (door, l) in spec.doors.iter().zip(&loc.doors) {
+fn doors_fit_their_gaps(
+    spec: &WorldSpec,
+    loc: &WorldLoc,
+    walls: &Obstacles,
+    spans: &[bool],
+    d: &mut Diags,
+) {
+    for ((door, l), _) in spec
+        .doors
+        .iter()
+        .zip(&loc.doors)
+        .zip(spans)
+        .filter(|(_, s)| **s)
+    {
         let panel = door_panel(door, false);
         // A door whose ends are off the walls is reported as not spanning a gap already.
         let off_wall = |p: Vec2| {
@@ -996,7 +1229,7 @@ fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             if reported.contains(&(wi, wk)) {
                 continue;
             }
-            let Some((len, from, to)) = overlap(&u, &t) else {
+            let Some((len, from, to)) = overlap(&u, &t, WALL_OVERLAP_M) else {
                 continue;
             };
             reported.insert((wi, wk));
@@ -1029,8 +1262,9 @@ fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     }
 }
 
-/// Length and ends of the shared stretch of two parallel thick segments lying on each other.
-fn overlap(a: &ThickSegment, b: &ThickSegment) -> Option<(f64, Vec2, Vec2)> {
+/// Length and ends of the shared stretch, longer than `min_m`, of two parallel thick segments
+/// lying on each other.
+fn overlap(a: &ThickSegment, b: &ThickSegment, min_m: f64) -> Option<(f64, Vec2, Vec2)> {
     let la = a.seg.length();
     let u = (a.seg.b - a.seg.a) / la;
     let db = b.seg.b - b.seg.a;
@@ -1046,54 +1280,176 @@ fn overlap(a: &ThickSegment, b: &ThickSegment) -> Option<(f64, Vec2, Vec2)> {
     }
     let (t0, t1) = ((b.seg.a - a.seg.a).dot(&u), (b.seg.b - a.seg.a).dot(&u));
     let (lo, hi) = (t0.min(t1).max(0.0), t0.max(t1).min(la));
-    (hi - lo > WALL_OVERLAP_M).then(|| (hi - lo, a.seg.a + u * lo, a.seg.a + u * hi))
+    (hi - lo > min_m).then(|| (hi - lo, a.seg.a + u * lo, a.seg.a + u * hi))
 }
 
-/// The robot's home must lie inside the building (free space around it does not reach past
-/// the walls) and in the part of it the routes drive through (not in a room closed off all
-/// round). Doors are taken open: a home behind a door is fine.
-fn home_inside_the_building(spec: &WorldSpec, loc: &WorldLoc, unread: &[Unread], d: &mut Diags) {
+/// Two doors in one gap: closed panels that lie on each other for more than
+/// [`DOORS_OVERLAP_M`] (a double door's leaves meet tip to tip and pass).
+fn doors_do_not_share_a_gap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+    let panels: Vec<ThickSegment> = spec
+        .doors
+        .iter()
+        .map(|door| ThickSegment {
+            seg: door_panel(door, false),
+            half_thickness_m: door.thickness_m / 2.0,
+        })
+        .collect();
+    let index = SegmentIndex::new(panels.clone());
+    for (i, t) in panels.iter().enumerate() {
+        let first = index
+            .candidates(t.seg, 0.0)
+            .into_iter()
+            .filter(|&k| k < i && panels[k].seg.length() > 0.0 && t.seg.length() > 0.0)
+            .find_map(|k| overlap(&panels[k], t, DOORS_OVERLAP_M).map(|(len, ..)| (k, len)));
+        let Some((k, len)) = first else { continue };
+        d.at(
+            loc.doors[i].hinge,
+            format!(
+                "door '{}' fills the same gap as door '{}' (line {}): their closed panels overlap for {len:.2} m; remove one, or for a double door give each leaf its share of the gap, hinged at the gap's two ends",
+                spec.doors[i].id,
+                spec.doors[k].id,
+                d.line_of(loc.doors[k].table)
+            ),
+        );
+    }
+}
+
+/// Shortest arm, metres, on every side of a crossing of two walls for it to count as walls
+/// that cross: shorter arms are a wall's end run a little past another (the shipped floors
+/// may end a wall a little past a pillar or an outline).
+pub const WALL_CROSSING_ARM_M: f64 = 0.5;
+
+/// Walls that cross like an X where that is a drawing mistake: a wall that crosses itself, or
+/// any wall through a closed wall (a room's outline), with arms longer than
+/// [`WALL_CROSSING_ARM_M`] on all four sides (a T, a corner or an end run a little past another
+/// wall is fine, and so are two open walls crossing where four rooms meet).
+fn walls_do_not_cross(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+    let segs: Vec<(usize, usize, ThickSegment)> = wall_segments(spec)
+        .filter(|(_, _, t)| t.seg.length() > 0.0)
+        .collect();
+    let index = SegmentIndex::new(segs.iter().map(|x| x.2).collect());
+    let mut reported = std::collections::HashSet::new();
+    for (i, &(wi, j, t)) in segs.iter().enumerate() {
+        for k in index.candidates(t.seg, 0.0).into_iter().filter(|&k| k < i) {
+            let (wk, jk, u) = segs[k];
+            if reported.contains(&(wi, wk)) {
+                continue;
+            }
+            let Some(x) = crate::geom::crossing_point(u.seg, t.seg) else {
+                continue;
+            };
+            let long_arms = |s: &ThickSegment| {
+                (x - s.seg.a).norm().min((x - s.seg.b).norm()) > WALL_CROSSING_ARM_M
+            };
+            // Two open walls crossing are where four rooms meet (the shipped floors draw their
+            // junctions so); a wall through its own line or through a room's closed outline is
+            // a drawing mistake.
+            let outline = wi == wk || spec.walls[wi].closed || spec.walls[wk].closed;
+            if !(outline && long_arms(&t) && long_arms(&u)) {
+                continue;
+            }
+            reported.insert((wi, wk));
+            let w = &spec.walls[wi];
+            let l = &loc.walls[wi];
+            let points = |w: &crate::spec::world::WallSpec, j: usize| {
+                format!("points {} to {}", j, (j + 1) % w.points_m.len())
+            };
+            let other = if wk == wi {
+                format!("itself ({})", points(w, jk))
+            } else {
+                format!(
+                    "wall '{}' ({})",
+                    spec.walls[wk].id,
+                    points(&spec.walls[wk], jk)
+                )
+            };
+            d.at(
+                l.points.get(j).copied().unwrap_or(l.points_key),
+                format!(
+                    "wall '{}' ({}) crosses {other} at [{:.2}, {:.2}]; walls meet at their ends or one ends on the other: check these points (if the walls are meant to cross, end each at the crossing)",
+                    w.id,
+                    points(w, j),
+                    x.x,
+                    x.y
+                ),
+            );
+            break;
+        }
+    }
+}
+
+/// The robot's home and every walking area must lie inside the building (free space around
+/// them does not reach past the walls) and in the part of it the routes drive through (not in
+/// a room closed off all round), or the robot never meets the people who walk there. Doors are
+/// taken open: a home behind a door is fine.
+fn inside_the_building(spec: &WorldSpec, loc: &WorldLoc, unread: &[Unread], d: &mut Diags) {
     let Some(first) = spec.routes.iter().find_map(|r| r.waypoints_m.first()) else {
         return;
     };
-    if !loc.home.valid {
+    let home = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
+    // (where it is reported, how messages name it, where it is, its point, the fix)
+    let mut places: Vec<(usize, String, String, Vec2, String)> = Vec::new();
+    let beside = format!(
+        "put it beside the route, e.g. near the first waypoint of route '{}' [{}, {}]",
+        spec.routes[0].id, first[0], first[1]
+    );
+    if loc.home.valid {
+        places.push((
+            loc.home.x,
+            "robot home".into(),
+            format!(" [{}, {}]", fmt_number(home.x), fmt_number(home.y)),
+            home,
+            beside,
+        ));
+    }
+    for (a, l) in spec.areas.iter().zip(&loc.areas) {
+        if a.min_m[0] < a.max_m[0] && a.min_m[1] < a.max_m[1] {
+            places.push((
+                l.min,
+                format!("area '{}'", a.id),
+                String::new(),
+                (v(&a.min_m) + v(&a.max_m)) / 2.0,
+                "people walk where the robot can meet them: move it into a corridor a route drives through".into(),
+            ));
+        }
+    }
+    if places.is_empty() {
         return;
     }
     let items: Vec<ThickSegment> = wall_segments(spec).map(|(_, _, t)| t).collect();
-    let home = Vec2::new(spec.robot_home.x_m, spec.robot_home.y_m);
-    let raster = crate::world::raster::Raster::new(&items, &[home], 0.1, 1.0, 0.05);
-    let region = raster.reachable(&[home]);
-    if !region.iter().any(|r| *r) {
-        return; // on a wall: reported above
-    }
-    let message = if raster.touches_border(&region) {
-        "is outside every wall loop (free space around it reaches past all walls)"
-    } else if !spec.routes.iter().flat_map(|r| &r.waypoints_m).any(|p| {
-        raster
-            .cell(v(p))
-            .is_some_and(|(x, y)| region[y * raster.width + x])
-    }) {
-        "is in a room closed off all round (no route passes there, even with every door open)"
-    } else {
-        return;
+    let points: Vec<Vec2> = places.iter().map(|p| p.3).collect();
+    let raster = crate::world::raster::Raster::new(&items, &points, 0.1, 1.0, 0.05);
+    let on_route = |region: &[bool]| {
+        spec.routes.iter().flat_map(|r| &r.waypoints_m).any(|p| {
+            raster
+                .cell(v(p))
+                .is_some_and(|(x, y)| region[y * raster.width + x])
+        })
     };
-    // A wall (or route) that did not read may close the loop (or pass by the home).
-    if let Some(u) = unread.iter().find(|u| matches!(u.kind, "wall" | "route")) {
-        d.note(
-            loc.home.x,
-            format!(
-                "robot home not checked for lying inside the building beside a route: {} has errors (line {}); fix them and check again",
-                u.name,
-                d.line_of(u.at)
+    // A wall (or route) that did not read may close the loop (or pass by the place).
+    let broken = unread.iter().find(|u| matches!(u.kind, "wall" | "route"));
+    for (at, name, where_, p, fix) in places {
+        let region = raster.reachable(&[p]);
+        if !region.iter().any(|r| *r) {
+            continue; // on a wall: reported with its clearance
+        }
+        let message = if raster.touches_border(&region) {
+            "is outside every wall loop (free space around it reaches past all walls)"
+        } else if !on_route(&region) {
+            "is in a room closed off all round (no route passes there, even with every door open)"
+        } else {
+            continue;
+        };
+        match broken {
+            Some(u) => d.note(
+                at,
+                format!(
+                    "{name} not checked for lying inside the building beside a route: {} has errors (line {}); fix them and check again",
+                    u.name,
+                    d.line_of(u.at)
+                ),
             ),
-        );
-        return;
+            None => d.at(at, format!("{name}{where_} {message}; {fix}")),
+        }
     }
-    d.at(
-        loc.home.x,
-        format!(
-            "robot home [{}, {}] {message}; put it beside the route, e.g. near the first waypoint of route '{}' [{}, {}]",
-            spec.robot_home.x_m, spec.robot_home.y_m, spec.routes[0].id, first[0], first[1]
-        ),
-    );
 }

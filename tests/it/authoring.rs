@@ -60,7 +60,9 @@ fn two_identical_corridors_are_flagged_and_a_niche_removes_the_flag() {
         assert_eq!(report.pairs, 1, "levels {levels}: {}", report.summary());
         // The pair is the south corridor (0-30 m along the route) and the north one (40-70 m).
         let (a, b) = (&report.stretches[0], &report.stretches[1]);
-        assert_eq!((a.partners.clone(), b.partners.clone()), (vec![2], vec![1]));
+        // Counted from 0, as every number a person reads: stretches 0 and 1, pair 0.
+        assert_eq!((a.number, b.number, a.pair, b.pair), (0, 1, 0, 0));
+        assert_eq!((a.partners.clone(), b.partners.clone()), (vec![1], vec![0]));
         let centre = |s: &placewords::authoring::AmbiguousStretch| s.from_m + s.length_m / 2.0;
         assert!((0.0..30.0).contains(&centre(a)), "{}", report.summary());
         assert!((40.0..70.0).contains(&centre(b)), "{}", report.summary());
@@ -420,4 +422,137 @@ fn render_of_a_file_that_is_not_toml_writes_no_picture() {
     ]);
     assert_eq!(run.status.code(), Some(2));
     assert!(!out.exists());
+}
+
+/// Renders an invalid fixture; the picture's document text.
+fn problem_picture(fixture: &str, extra: &[&str]) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bad.svg");
+    let file = format!("tests/fixtures/invalid/{fixture}.toml");
+    let mut args = vec![
+        "world",
+        "render",
+        file.as_str(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let run = placewords(&args);
+    assert_eq!(run.status.code(), Some(2));
+    std::fs::read_to_string(&out).unwrap()
+}
+
+fn by_class<'a>(doc: &'a roxmltree::Document, c: &str) -> Vec<roxmltree::Node<'a, 'a>> {
+    doc.descendants()
+        .filter(|n| n.attribute("class") == Some(c))
+        .collect()
+}
+
+/// The (cx, cy) of the ring of a mark group.
+fn ring(g: roxmltree::Node) -> (String, String) {
+    let c = g.first_element_child().unwrap();
+    (
+        c.attribute("cx").unwrap().to_string(),
+        c.attribute("cy").unwrap().to_string(),
+    )
+}
+
+/// A problem in a door that did not read (a misspelt key) is marked on that door's hinge, not
+/// on the entity before it in the file, and the note under the picture says so; marks count
+/// from 0.
+#[test]
+fn a_problem_in_an_unread_door_is_marked_on_its_hinge() {
+    let svg = problem_picture("unknown-key-typo", &[]);
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let problems = by_class(&doc, "problem");
+    let first = problems[0];
+    assert_eq!(first.last_element_child().unwrap().text(), Some("0"));
+    // The door's hinge [5, 2] is where wall 'room' starts.
+    let wall = doc
+        .descendants()
+        .find(|n| n.attribute("id") == Some("wall-room-0"))
+        .unwrap();
+    let hinge = (
+        wall.attribute("x1").unwrap().to_string(),
+        wall.attribute("y1").unwrap().to_string(),
+    );
+    assert_eq!(ring(first), hinge);
+    assert!(
+        svg.contains("drawn at what read of door &apos;d-1&apos;")
+            || svg.contains("drawn at what read of door 'd-1'"),
+        "{svg}"
+    );
+}
+
+/// Marks on one spot (a problem on a waypoint) fan their numbers out, each with a leader line,
+/// while their rings stay on the spot; every message is written whole, wrapped.
+#[test]
+fn stacked_marks_fan_out_and_messages_are_written_whole() {
+    let svg = problem_picture("leg-through-wall", &["--waypoints"]);
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let problem = by_class(&doc, "problem")[0];
+    let waypoint = by_class(&doc, "waypoint")[3];
+    assert_eq!(ring(problem), ring(waypoint));
+    let text_x = |g: roxmltree::Node| {
+        g.descendants()
+            .find(|n| n.has_tag_name("text"))
+            .and_then(|t| t.attribute("x"))
+            .map(str::to_string)
+    };
+    assert_ne!(text_x(problem), text_x(waypoint));
+    assert!(problem.descendants().any(|n| n.has_tag_name("line")));
+    let notes: String = doc
+        .descendants()
+        .find(|n| n.attribute("id") == Some("notes"))
+        .unwrap()
+        .descendants()
+        .filter_map(|n| n.text())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let words = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        words(&notes).contains("so the leg keeps 0.25 m from walls and doors"),
+        "{notes}"
+    );
+}
+
+/// A door whose open heading is at fault is drawn open, so the panel that cuts the wall shows.
+#[test]
+fn the_offending_open_panel_is_drawn() {
+    let svg = problem_picture("door-open-through-wall", &[]);
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    assert!(
+        doc.descendants()
+            .any(|n| n.attribute("class") == Some("door open")
+                && n.attribute("id") == Some("door-d-1")),
+        "door d-1 is not drawn open"
+    );
+}
+
+/// The density map draws the route over its colours, on a white casing.
+#[test]
+fn the_density_map_shows_the_route() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("d.svg");
+    let run = placewords(&[
+        "world",
+        "density",
+        "worlds/loop-small.toml",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let (tiles, casing) = (
+        svg.find(r#"id="tiles""#).unwrap(),
+        svg.find("route-casing").unwrap(),
+    );
+    assert!(
+        casing > tiles,
+        "the route is drawn under the density colours"
+    );
 }

@@ -696,6 +696,21 @@ fn world_check_warns_about_a_tight_leg_and_still_passes() {
     }
 }
 
+/// A home heading that looks like radians is a warning (the world stays usable) at its value,
+/// saying what it is in degrees.
+#[test]
+fn a_home_heading_in_radians_is_a_warning_with_its_degrees() {
+    let f = root().join("tests/fixtures/warnings/home-heading-radians.toml");
+    let (_, warnings) = placewords::world::check_world(&f).unwrap_or_else(|e| panic!("{e}"));
+    let text: Vec<String> = warnings.iter().map(|w| w.to_string()).collect();
+    assert!(
+        text.iter().any(|w| w.ends_with(
+            "home-heading-radians.toml:8:15: warning: robot home heading_deg = 1.5708 looks like radians (90 degrees); headings are degrees: write heading_deg = 90"
+        )),
+        "{text:?}"
+    );
+}
+
 /// Grid labels read "0" where the axis crosses zero, never "-0" (a world whose frame starts
 /// just below zero rounds its first grid line up to minus zero).
 #[test]
