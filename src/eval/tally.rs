@@ -424,9 +424,11 @@ impl Tally {
                 && t.scorer.same_truth_side(&self.scorer)
         });
         let fresh = reuse.is_none();
+        let keep = shared.tallies > 1 && !self.by_site_tree;
+        shared.tallies = shared.tallies.saturating_sub(1);
         let side = match reuse {
             Some(side) => side,
-            None => self.truth_side(sites, slots),
+            None => self.truth_side(sites, slots, keep),
         };
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
         let mut recalls_of: Vec<(f64, [f64; 3])> = Vec::new();
@@ -468,7 +470,7 @@ impl Tally {
             m.late_pairs = self.late_pairs;
             metrics.push((m, cfgs));
         }
-        if !self.by_site_tree {
+        if keep {
             shared.kept = Some(side);
         }
         let n_sens = self.spec.sensitivity_radii_m.len();
@@ -491,21 +493,23 @@ impl Tally {
     /// What the figures need from the truth and the observations alone (see
     /// [`SharedTruth`]): the revisits of every figure, the laps that revisit each observation
     /// at each radius with visit recall, pair recall's possible pairs.
-    fn truth_side(&self, frame_sites: Vec<Site>, slots: Vec<(Facing, u64)>) -> TruthSide {
+    /// `keep`: keep the laps that revisit each observation, for the next tally.
+    fn truth_side(
+        &self,
+        frame_sites: Vec<Site>,
+        slots: Vec<(Facing, u64)>,
+        keep: bool,
+    ) -> TruthSide {
         // Every figure with visit recall is at `tp_radius_m`; its sweep of the earlier laps
         // also tells which observations have a revisit there, of every facing.
         let mut sweeps: Vec<Swept> = Vec::new();
         let mut swept: Vec<bool> = Vec::new();
         for s in &self.slots {
             if s.recalls && sweeps.iter().all(|w| w.0 != s.radius_m) {
-                let v = self.visit_recalls(s.radius_m, !self.by_site_tree);
+                let v = self.visit_recalls(s.radius_m, keep);
                 sweeps.push((s.radius_m, v.revisits, v.lists, v.recall));
             }
-            swept.push(
-                sweeps
-                    .iter()
-                    .any(|w| w.0 == s.radius_m && w.1.is_some()),
-            );
+            swept.push(sweeps.iter().any(|w| w.0 == s.radius_m && w.1.is_some()));
         }
         // The revisits no sweep gave: per facing, every radius in one sweep of one k-d tree.
         let mut own: Vec<Option<Vec<bool>>> = vec![None; self.slots.len()];
@@ -531,7 +535,13 @@ impl Tally {
         let mut possible_of = Vec::new();
         let mut tree = None;
         for s in self.slots.iter().filter(|s| s.recalls) {
-            self.possible(&frame_sites, &mut tree, s.radius_m, s.facing, &mut possible_of);
+            self.possible(
+                &frame_sites,
+                &mut tree,
+                s.radius_m,
+                s.facing,
+                &mut possible_of,
+            );
         }
         drop(tree);
         TruthSide {
@@ -850,7 +860,12 @@ impl LapLists {
         let mut from = 0usize;
         for &(i, mid, end) in &self.obs {
             let (mid, end) = (mid as usize, end as usize);
-            count.add(tally, i as usize, &self.laps[from..mid], &self.laps[mid..end]);
+            count.add(
+                tally,
+                i as usize,
+                &self.laps[from..mid],
+                &self.laps[mid..end],
+            );
             from = end;
         }
         count.recall()
@@ -865,6 +880,19 @@ impl LapLists {
 #[derive(Default)]
 pub struct SharedTruth {
     kept: Option<TruthSide>,
+    /// Tallies still to finish with it, this one included: the last keeps nothing (the
+    /// default, 0, keeps nothing either).
+    tallies: usize,
+}
+
+impl SharedTruth {
+    /// For `tallies` tallies to finish one after the other.
+    pub fn new(tallies: usize) -> Self {
+        SharedTruth {
+            kept: None,
+            tallies,
+        }
+    }
 }
 
 /// One sweep of the lap grid: its radius, the revisits by facing (none from the reference
@@ -1026,7 +1054,21 @@ mod tests {
                 matches.iter().for_each(|m| t.add(m, &gt));
                 t.finish(&gt)
             };
-            prop_assert_eq!(score(false), score(true));
+            let want = score(true);
+            prop_assert_eq!(&score(false), &want);
+            // The truth side left by a tally over other observations is not taken; that of a
+            // tally over the same ones (without matches) is, with the same figures.
+            let mut shared = SharedTruth::new(3);
+            let fewer = obs.len().saturating_sub(5);
+            for (upto, ms) in [(fewer, &matches[..0]), (obs.len(), &matches[..0]), (obs.len(), &matches[..])] {
+                let mut t = Tally::new(&spec, Scope::Full);
+                t.sync(&obs[..upto], &gt);
+                ms.iter().for_each(|m| t.add(m, &gt));
+                let e = t.finish_sharing(&gt, &mut shared);
+                if upto == obs.len() && !ms.is_empty() {
+                    prop_assert_eq!(&e, &want);
+                }
+            }
         }
     }
 

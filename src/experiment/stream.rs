@@ -311,7 +311,7 @@ pub(super) fn finish_jobs(
     let truth = Arc::new(truth);
     // The level configurations see the same observations: what their scores take from the
     // truth alone is counted once.
-    let mut shared = crate::eval::SharedTruth::default();
+    let mut shared = crate::eval::SharedTruth::new(ended.len());
     Ok(ended
         .into_iter()
         .map(|(levels, e)| (levels, e.finish_sharing(truth.clone(), &mut shared)))
