@@ -225,7 +225,7 @@ pub struct BaselineArg {
 #[derive(Debug, Args)]
 pub struct ToleranceArg {
     /// How much precision or a recall may drop before it is a regression (overrides
-    /// `[expect.regression] max_drop`, default 0.01).
+    /// `[expect.regression] max_drop`, default 0.003).
     #[arg(long, value_name = "X", value_parser = parse_max_drop)]
     pub max_drop: Option<f64>,
     /// How many times slower the CPU time per lap may get (overrides `[expect.regression]

@@ -23,7 +23,7 @@
 //! - *no change*: neither (within the tolerance, or not sure).
 //!
 //! The tolerance is `[expect.regression]` of the new run's scenario (`max_drop`,
-//! `max_slowdown`), defaults 0.01 and 1.5, which the command line may override. Times are
+//! `max_slowdown`), defaults 0.003 and 1.5, which the command line may override. Times are
 //! compared as log ratios, so `max_slowdown = 1.5` reads "50 % more CPU time per lap".
 
 use crate::eval::distribution::Metric;

@@ -291,7 +291,7 @@ pub(super) struct Joined {
 /// A map of positions kept as the identity (no storage) until an entry differs: observation →
 /// site and site → observation are the identity while every observation has truth, the usual
 /// case, so a log of a million observations keeps no tables.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 struct Dense {
     len: usize,
     /// The entries, once one is not its own position.
@@ -521,6 +521,16 @@ impl Scorer {
         self.joined.site_of.len()
     }
 
+    /// Whether `other` joined the same observations to the same truth sites, with the same
+    /// gap and heading tolerance: then every revisit and every lap that revisits is the same.
+    pub(super) fn same_truth_side(&self, other: &Scorer) -> bool {
+        let (a, b) = (&*self.joined, &*other.joined);
+        self.min_gap_m == other.min_gap_m
+            && self.heading_tol_rad == other.heading_tol_rad
+            && (Arc::ptr_eq(&self.joined, &other.joined)
+                || (a.site_of == b.site_of && a.site_obs == b.site_obs && a.sites == b.sites))
+    }
+
     /// The same scorer counting only revisits facing as `facing` says.
     pub fn with_facing(&self, facing: Facing) -> Self {
         Scorer {
@@ -538,6 +548,30 @@ impl Scorer {
         let j = &self.joined;
         sweep(&j.sites, self.min_gap_m, |k, tree| {
             has[j.obs_of_site(k)] = tree.count(&self.query(k, r), true) > 0;
+        });
+        has
+    }
+
+    /// Which observations have a revisit at each radius of `radii`: [`Self::revisits`] of
+    /// each, in one sweep of one k-d tree (a revisit within a radius is one within every larger
+    /// radius, so a site's radii are asked from the smallest until one is met).
+    pub fn revisits_at(&self, radii: &[f64]) -> Vec<Vec<bool>> {
+        let mut has = vec![vec![false; self.len()]; radii.len()];
+        let mut order: Vec<usize> = (0..radii.len())
+            .filter(|&i| radii[i] > 0.0 && radii[i].is_finite())
+            .collect();
+        if order.is_empty() {
+            return has;
+        }
+        order.sort_by(|&a, &b| radii[a].total_cmp(&radii[b]));
+        let j = &self.joined;
+        sweep(&j.sites, self.min_gap_m, |k, tree| {
+            let i = j.obs_of_site(k);
+            let mut found = false;
+            for &ri in &order {
+                found = found || tree.count(&self.query(k, radii[ri]), true) > 0;
+                has[ri][i] = found;
+            }
         });
         has
     }

@@ -34,6 +34,7 @@ use crate::log::{Frame, LapLog, RunLog};
 use crate::place::{Diagnostics, Direction, Match, ObsId, Observation, RejectedCandidate};
 use crate::spec::evaluation::EvaluationSpec;
 use std::sync::Arc;
+pub use tally::SharedTruth;
 use tally::{Scope, Tally};
 
 pub use metrics::{Evaluation, Metrics, evaluate, evaluate_by_site_tree};
@@ -544,10 +545,16 @@ pub struct Ended {
 impl Ended {
     /// The recognition, scored when the recording was streaming.
     pub fn finish(self, truth: Arc<GroundTruth>) -> Recognition {
+        self.finish_sharing(truth, &mut SharedTruth::default())
+    }
+
+    /// [`Self::finish`], the truth side of the scores shared with the other recognitions of
+    /// the same observations ([`SharedTruth`]: level configurations of one experiment).
+    pub fn finish_sharing(self, truth: Arc<GroundTruth>, shared: &mut SharedTruth) -> Recognition {
         let r = self.recording;
         let w = Stopwatch::start();
         let evaluation = r.tally.map(|(spec, tally)| {
-            let e = tally.finish(&truth);
+            let e = tally.finish_sharing(&truth, shared);
             (spec, e)
         });
         let score_seconds = r.score_seconds + w.cpu_s();

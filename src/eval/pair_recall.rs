@@ -19,7 +19,7 @@
 //!   `eval::tally` (found, as matches arrive) and `count_possible` (the denominator).
 
 use super::GroundTruth;
-use super::site_tree::{Query, Site, sweep};
+use super::site_tree::{Query, Site, SiteTree, sweep, sweep_tree};
 use crate::geom::wrap_angle;
 use crate::recognizer::Direction;
 
@@ -94,7 +94,7 @@ impl PairRecall {
 
 /// Every (observation, earlier observation) pair at least `min_gap_m` of travel apart, within
 /// `r` and facing as `facing` says, counted in a k-d tree of the earlier sites
-/// ([`super::site_tree`]).
+/// ([`super::site_tree`]): the reference [`count_possible_facings`] is tested against.
 pub(super) fn count_possible(
     sites: &[Site],
     min_gap_m: f64,
@@ -111,6 +111,23 @@ pub(super) fn count_possible(
             tol_rad,
         };
         n += tree.count(&q, false);
+    });
+    n
+}
+
+/// [`count_possible`] of each facing of `facings`, in one sweep of `tree` (built over the
+/// sites, reused: [`sweep_tree`]) that walks the tree once per site for all of them.
+pub(super) fn count_possible_facings<const N: usize>(
+    tree: &mut SiteTree,
+    min_gap_m: f64,
+    r: f64,
+    facings: [Facing; N],
+    tol_rad: f64,
+) -> [u64; N] {
+    let mut n = [0u64; N];
+    sweep_tree(tree, min_gap_m, |k, tree| {
+        let c = tree.count_facings(&tree.site(k), r * r, facings, tol_rad);
+        n.iter_mut().zip(c).for_each(|(n, c)| *n += c);
     });
     n
 }

@@ -235,6 +235,72 @@ impl<'s> SiteTree<'s> {
         }
     }
 
+    /// Active sites within `r2` of `site` facing each way of `facings` (tolerance `tol_rad`):
+    /// [`Self::count`] of each facing's query, the tree walked once for all (a node's position
+    /// bounds are tested once, its headings per facing still undecided there).
+    pub fn count_facings<const N: usize>(
+        &self,
+        site: &Site,
+        r2: f64,
+        facings: [Facing; N],
+        tol_rad: f64,
+    ) -> [u64; N] {
+        assert!(N <= 8, "at most 8 facings at once");
+        let mut total = [0u64; N];
+        let all: u8 = ((1u16 << N) - 1) as u8;
+        // (node, the facings whose heading test the node's ancestors left undecided)
+        let mut stack = vec![(0u32, all)];
+        while let Some((id, mut open)) = stack.pop() {
+            let Some(node) = self.live(id) else { continue };
+            let Some(inside) = position_cover(node.x, node.y, site, r2) else {
+                continue;
+            };
+            for (f, &facing) in facings.iter().enumerate() {
+                if open & (1 << f) == 0 {
+                    continue;
+                }
+                // The decision of `cover` for this facing's query, operand for operand.
+                match heading_cover(site.theta, node.theta, facing, tol_rad) {
+                    Cover::None => open &= !(1 << f),
+                    Cover::All if inside => {
+                        total[f] += u64::from(self.active[id as usize]);
+                        open &= !(1 << f);
+                    }
+                    _ => {}
+                }
+            }
+            if open == 0 {
+                continue;
+            }
+            if node.children[0] == NO_CHILD {
+                for p in self.leaf_sites(node) {
+                    if (site.x - p.x).powi(2) + (site.y - p.y).powi(2) > r2 {
+                        continue;
+                    }
+                    for (f, &facing) in facings.iter().enumerate() {
+                        if open & (1 << f) != 0 && facing.agrees(site.theta, p.theta, tol_rad) {
+                            total[f] += 1;
+                        }
+                    }
+                }
+            } else {
+                stack.extend(node.children.map(|c| (c, open)));
+            }
+        }
+        total
+    }
+
+    /// Site `k` (creation order).
+    pub fn site(&self, k: usize) -> Site {
+        self.sites[k]
+    }
+
+    /// Deactivates every site: the tree is ready for another sweep ([`sweep_tree`]).
+    pub fn reset(&mut self) {
+        self.active.fill(0);
+        self.frontier = 0;
+    }
+
     /// Node `id` when it holds an active site.
     fn live(&self, id: u32) -> Option<&Node> {
         (self.active.get(id as usize).copied().unwrap_or(0) > 0).then(|| &self.nodes[id as usize])
@@ -256,7 +322,20 @@ impl<'s> SiteTree<'s> {
 /// query `q` takes.
 pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cover {
     let s = q.site;
-    // Distance bounds with the site test's own operations (see the module doc).
+    let Some(inside) = position_cover(x, y, s, q.r2) else {
+        return Cover::None;
+    };
+    match (inside, heading_cover(s.theta, theta, q.facing, q.tol_rad)) {
+        (_, Cover::None) => Cover::None,
+        (true, Cover::All) => Cover::All,
+        _ => Cover::Part,
+    }
+}
+
+/// Whether a box of sites (position bounds `x`, `y`) lies within `r2` (squared) of `s`:
+/// `None` when wholly outside, `Some(true)` wholly inside, `Some(false)` in part. The distance
+/// bounds use the site test's own operations (see the module doc).
+fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
     let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
     let near = |v: f64, b: [f64; 2]| {
         let (lo, hi) = (v - b[1], v - b[0]);
@@ -266,15 +345,10 @@ pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cov
             lo.powi(2).min(hi.powi(2))
         }
     };
-    if near(s.x, x) + near(s.y, y) > q.r2 {
-        return Cover::None;
+    if near(s.x, x) + near(s.y, y) > r2 {
+        return None;
     }
-    let inside = far(s.x, x) + far(s.y, y) <= q.r2;
-    match (inside, heading_cover(s.theta, theta, q.facing, q.tol_rad)) {
-        (_, Cover::None) => Cover::None,
-        (true, Cover::All) => Cover::All,
-        _ => Cover::Part,
-    }
+    Some(far(s.x, x) + far(s.y, y) <= r2)
 }
 
 /// How many headings in the wrapped range `range` agree with `theta` as `facing` says.
@@ -337,15 +411,22 @@ impl LapSet {
 
 /// Calls `visit(k, tree)` for every site `k` in order, with exactly the sites before it that
 /// are at least `min_gap_m` of true travel earlier active in `tree` (see the module doc).
-pub fn sweep(sites: &[Site], min_gap_m: f64, mut visit: impl FnMut(usize, &SiteTree)) {
-    let mut tree = SiteTree::new(sites);
+pub fn sweep(sites: &[Site], min_gap_m: f64, visit: impl FnMut(usize, &SiteTree)) {
+    sweep_tree(&mut SiteTree::new(sites), min_gap_m, visit);
+}
+
+/// [`sweep`] in a tree already built over the sites (reset first): one build serves every
+/// sweep over the same sites.
+pub fn sweep_tree(tree: &mut SiteTree, min_gap_m: f64, mut visit: impl FnMut(usize, &SiteTree)) {
+    tree.reset();
+    let sites = tree.sites;
     let mut ready = 0;
     for (k, s) in sites.iter().enumerate() {
         while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
             ready += 1;
         }
         tree.activate_to(ready);
-        visit(k, &tree);
+        visit(k, &*tree);
     }
 }
 
@@ -419,6 +500,25 @@ pub(super) mod tests {
                     assert_eq!(found, laps, "{k} {r} {facing:?}");
                 });
             }
+        }
+    }
+
+    /// Counted for every facing at once, in one tree swept again for each radius, the counts
+    /// equal the brute force's.
+    #[test]
+    fn facings_at_once_in_a_reused_tree_equal_testing_every_earlier_site() {
+        let sites = passes(4);
+        let facings = [Facing::Same, Facing::Opposite, Facing::Either];
+        let mut tree = SiteTree::new(&sites);
+        for r in [3.0, 0.05, 1.0] {
+            let mut sum = [0u64; 3];
+            sweep_tree(&mut tree, 2.0, |k, tree| {
+                let got = tree.count_facings(&sites[k], r * r, facings, 0.7);
+                let want = facings.map(|f| brute(&sites, k, 2.0, r, f).len() as u64);
+                assert_eq!(got, want, "{k} {r}");
+                sum.iter_mut().zip(got).for_each(|(s, g)| *s += g);
+            });
+            assert!(sum.iter().all(|&n| n > 0) || r < 0.1, "{r} {sum:?}");
         }
     }
 

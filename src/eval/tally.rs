@@ -33,9 +33,9 @@
 
 use super::GroundTruth;
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
-use super::pair_recall::{Facing, PairRecall, count_possible};
+use super::pair_recall::{Facing, PairRecall, count_possible, count_possible_facings};
 use super::pair_set::pack;
-use super::site_tree::Site;
+use super::site_tree::{Site, SiteTree};
 use crate::place::{Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 // foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
@@ -392,7 +392,14 @@ impl Tally {
 
     /// Every figure (a [`Scope::Full`] tally) of the observations synced ([`Self::sync`] the
     /// last ones first).
-    pub fn finish(mut self, truth: &GroundTruth) -> Evaluation {
+    pub fn finish(self, truth: &GroundTruth) -> Evaluation {
+        self.finish_sharing(truth, &mut SharedTruth::default())
+    }
+
+    /// [`Self::finish`], taking what depends on the truth and the observations alone from
+    /// `shared` when an earlier tally over the same observations, truth and rules left it
+    /// there, and leaving this tally's there for the next.
+    pub fn finish_sharing(mut self, truth: &GroundTruth, shared: &mut SharedTruth) -> Evaluation {
         self.evict_below(usize::MAX);
         // Late pairs (none from a recognizer that keeps its horizon) may repeat an entry.
         self.visits.sort_unstable();
@@ -403,35 +410,57 @@ impl Tally {
             }
             same
         });
+        let slots: Vec<(Facing, u64)> = self
+            .slots
+            .iter()
+            .map(|s| (s.facing, s.radius_m.to_bits()))
+            .collect();
         let sites = self.frame_sites(truth);
-        let mut possible_of = Vec::new();
+        let reuse = shared.kept.take().filter(|t| {
+            !self.by_site_tree
+                && t.slots == slots
+                && t.spec == self.spec
+                && t.frame_sites == sites
+                && t.scorer.same_truth_side(&self.scorer)
+        });
+        let fresh = reuse.is_none();
+        let keep = shared.tallies > 1 && !self.by_site_tree;
+        shared.tallies = shared.tallies.saturating_sub(1);
+        let side = match reuse {
+            Some(side) => side,
+            None => self.truth_side(sites, slots, keep),
+        };
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
-        // Every figure with visit recall is at `tp_radius_m`; its sweep of the earlier laps
-        // also tells which observations have a revisit there, of every facing.
-        let mut visit_recalls: Option<(f64, VisitSweep)> = None;
-        for s in &self.slots {
+        let mut recalls_of: Vec<(f64, [f64; 3])> = Vec::new();
+        for (k, s) in self.slots.iter().enumerate() {
             let scorer = self.scorer.with_facing(s.facing);
-            if s.recalls && visit_recalls.as_ref().is_none_or(|(r, _)| *r != s.radius_m) {
-                visit_recalls = Some((s.radius_m, self.visit_recalls(s.radius_m)));
-            }
             let bit = usize::from(facing_bit(s.facing));
-            let swept = visit_recalls
-                .as_ref()
-                .filter(|(r, _)| *r == s.radius_m)
-                .and_then(|(_, v)| v.revisits.as_ref());
-            let computed;
-            let revisits = match swept {
-                Some(by_facing) => &by_facing[bit],
-                None => {
-                    computed = scorer.revisits(s.radius_m);
-                    &computed
-                }
+            let swept = side.sweeps.iter().rfind(|w| w.0 == s.radius_m);
+            let revisits = match (&side.own[k], swept.and_then(|w| w.1.as_ref())) {
+                (Some(v), _) => v,
+                (None, Some(by_facing)) => &by_facing[bit],
+                (None, None) => unreachable!("every figure's revisits are counted"),
             };
             let (mut m, cfgs) = s.metrics(revisits, &scorer);
             if s.recalls {
-                let recalls = visit_recalls.as_ref().map_or([0.0; 3], |(_, v)| v.recall);
+                let recalls = match recalls_of.iter().find(|w| w.0 == s.radius_m) {
+                    Some(w) => w.1,
+                    None => {
+                        let recall = match swept {
+                            Some(w) if fresh => w.3,
+                            Some((_, _, Some(lists), _)) => lists.recall(&self),
+                            _ => self.visit_recalls(s.radius_m, false).recall,
+                        };
+                        recalls_of.push((s.radius_m, recall));
+                        recall
+                    }
+                };
                 m.visit_recall = recalls[bit];
-                let possible = self.possible(&sites, s.radius_m, s.facing, &mut possible_of);
+                let possible = side
+                    .possible_of
+                    .iter()
+                    .find(|(f, r_bits, _)| *f == s.facing && *r_bits == s.radius_m.to_bits())
+                    .map_or(0, |p| p.2);
                 m.pair_recall = PairRecall {
                     possible,
                     found: s.found,
@@ -440,6 +469,9 @@ impl Tally {
             }
             m.late_pairs = self.late_pairs;
             metrics.push((m, cfgs));
+        }
+        if keep {
+            shared.kept = Some(side);
         }
         let n_sens = self.spec.sensitivity_radii_m.len();
         let mut it = metrics.into_iter();
@@ -458,13 +490,81 @@ impl Tally {
         }
     }
 
-    /// Pair recall's possible pairs at radius `r` facing as `facing` says (`known`: the counts
-    /// made so far). With a heading tolerance below 90° no pair faces both the same and the
-    /// opposite way, so the pairs of either facing are those of the two counted apart (one
-    /// sweep of the k-d tree fewer; the reference, [`Self::by_site_tree`], counts them too).
-    fn possible(
+    /// What the figures need from the truth and the observations alone (see
+    /// [`SharedTruth`]): the revisits of every figure, the laps that revisit each observation
+    /// at each radius with visit recall, pair recall's possible pairs.
+    /// `keep`: keep the laps that revisit each observation, for the next tally.
+    fn truth_side(
         &self,
-        sites: &[Site],
+        frame_sites: Vec<Site>,
+        slots: Vec<(Facing, u64)>,
+        keep: bool,
+    ) -> TruthSide {
+        // Every figure with visit recall is at `tp_radius_m`; its sweep of the earlier laps
+        // also tells which observations have a revisit there, of every facing.
+        let mut sweeps: Vec<Swept> = Vec::new();
+        let mut swept: Vec<bool> = Vec::new();
+        for s in &self.slots {
+            if s.recalls && sweeps.iter().all(|w| w.0 != s.radius_m) {
+                let v = self.visit_recalls(s.radius_m, keep);
+                sweeps.push((s.radius_m, v.revisits, v.lists, v.recall));
+            }
+            swept.push(sweeps.iter().any(|w| w.0 == s.radius_m && w.1.is_some()));
+        }
+        // The revisits no sweep gave: per facing, every radius in one sweep of one k-d tree.
+        let mut own: Vec<Option<Vec<bool>>> = vec![None; self.slots.len()];
+        for facing in [Facing::Either, Facing::Same, Facing::Opposite] {
+            let at: Vec<usize> = (0..self.slots.len())
+                .filter(|&k| !swept[k] && self.slots[k].facing == facing)
+                .collect();
+            if at.is_empty() {
+                continue;
+            }
+            let radii: Vec<f64> = at.iter().map(|&k| self.slots[k].radius_m).collect();
+            let scorer = self.scorer.with_facing(facing);
+            let found = if self.by_site_tree {
+                // The reference: a sweep of its own per radius.
+                radii.iter().map(|&r| scorer.revisits(r)).collect()
+            } else {
+                scorer.revisits_at(&radii)
+            };
+            for (k, v) in at.into_iter().zip(found) {
+                own[k] = Some(v);
+            }
+        }
+        let mut possible_of = Vec::new();
+        let mut tree = None;
+        for s in self.slots.iter().filter(|s| s.recalls) {
+            self.possible(
+                &frame_sites,
+                &mut tree,
+                s.radius_m,
+                s.facing,
+                &mut possible_of,
+            );
+        }
+        drop(tree);
+        TruthSide {
+            scorer: self.scorer.clone(),
+            spec: self.spec.clone(),
+            slots,
+            frame_sites,
+            sweeps,
+            own,
+            possible_of,
+        }
+    }
+
+    /// Pair recall's possible pairs at radius `r` facing as `facing` says (`known`: the counts
+    /// made so far, `tree`: the k-d tree of `sites`, built when first needed). Every facing at
+    /// `r` is counted in one sweep that walks the tree once per site for all of them; with a
+    /// heading tolerance below 90° no pair faces both the same and the opposite way, so the
+    /// pairs of either facing are those of the two counted apart (the reference,
+    /// [`Self::by_site_tree`], counts each facing in a sweep of its own, either too).
+    fn possible<'s>(
+        &self,
+        sites: &'s [Site],
+        tree: &mut Option<SiteTree<'s>>,
         r: f64,
         facing: Facing,
         known: &mut Vec<(Facing, u64, u64)>,
@@ -472,22 +572,35 @@ impl Tally {
         if r <= 0.0 || !r.is_finite() {
             return 0;
         }
-        if let Some(&(.., n)) = known
-            .iter()
-            .find(|(f, r_bits, _)| *f == facing && *r_bits == r.to_bits())
-        {
+        let find = |known: &[(Facing, u64, u64)]| {
+            known
+                .iter()
+                .find(|(f, r_bits, _)| *f == facing && *r_bits == r.to_bits())
+                .map(|&(.., n)| n)
+        };
+        if let Some(n) = find(known) {
             return n;
         }
-        let tol = self.scorer.heading_tol_rad();
-        let disjoint = tol < std::f64::consts::FRAC_PI_2 - 1e-6;
-        let n = if facing == Facing::Either && disjoint && !self.by_site_tree {
-            self.possible(sites, r, Facing::Same, known)
-                + self.possible(sites, r, Facing::Opposite, known)
+        let (gap, tol) = (self.spec.min_gap_m, self.scorer.heading_tol_rad());
+        if self.by_site_tree {
+            let n = count_possible(sites, gap, r, facing, tol);
+            known.push((facing, r.to_bits(), n));
+            return n;
+        }
+        let tree = tree.get_or_insert_with(|| SiteTree::new(sites));
+        let (same, opposite) = (Facing::Same, Facing::Opposite);
+        let either = if tol < std::f64::consts::FRAC_PI_2 - 1e-6 {
+            let [s, o] = count_possible_facings(tree, gap, r, [same, opposite], tol);
+            known.extend([(same, r.to_bits(), s), (opposite, r.to_bits(), o)]);
+            s + o
         } else {
-            count_possible(sites, self.spec.min_gap_m, r, facing, tol)
+            let [e, s, o] =
+                count_possible_facings(tree, gap, r, [Facing::Either, same, opposite], tol);
+            known.extend([(same, r.to_bits(), s), (opposite, r.to_bits(), o)]);
+            e
         };
-        known.push((facing, r.to_bits(), n));
-        n
+        known.push((Facing::Either, r.to_bits(), either));
+        find(known).unwrap_or(0)
     }
 
     /// Visit recall at radius `r` of each facing, indexed as [`facing_bit`]: the earlier laps
@@ -496,11 +609,12 @@ impl Tally {
     /// one sweep of the lap grid ([`Scorer::sweep_laps`]), which also tells which observations
     /// have a revisit of each facing (an earlier lap revisits them so): the revisits at `r`
     /// need no search of their own.
-    fn visit_recalls(&self, r: f64) -> VisitSweep {
+    fn visit_recalls(&self, r: f64, record: bool) -> VisitSweep {
         if r <= 0.0 || !r.is_finite() {
             return VisitSweep {
                 recall: [0.0; 3],
                 revisits: None,
+                lists: None,
             };
         }
         if self.by_site_tree {
@@ -509,45 +623,31 @@ impl Tally {
                 recall: [Facing::Either, Facing::Same, Facing::Opposite]
                     .map(|f| self.visit_recall_by_site_tree(r, f)),
                 revisits: None,
+                lists: None,
             };
         }
-        // Per lap: bit 0 revisits the query the same way, bit 1 the opposite way.
-        let mut mark: Vec<u8> = Vec::new();
-        let mut at = 0usize;
-        let (mut visits, mut found) = ([0usize; 3], [0usize; 3]);
+        let mut count = LapCount::default();
         // An observation has a revisit of a facing when an earlier lap revisits it so (either:
         // the same or the opposite way); those without truth have none.
         let n = self.scorer.observation_count();
         let mut revisits = [vec![false; n], vec![false; n], vec![false; n]];
+        let mut lists = record.then(LapLists::default);
         self.scorer.sweep_laps(r, |i, [same, opposite]| {
             revisits[0][i] = !same.is_empty() || !opposite.is_empty();
             revisits[1][i] = !same.is_empty();
             revisits[2][i] = !opposite.is_empty();
-            for (laps, bit) in [(same, 1), (opposite, 2)] {
-                for &l in laps {
-                    if mark.len() <= l {
-                        mark.resize(l + 1, 0);
-                    }
-                    mark[l] |= bit;
+            count.add(self, i, same, opposite);
+            if let Some(l) = &mut lists {
+                l.push(i, same, opposite);
+                if l.laps.len() > LapLists::MAX_LAPS {
+                    lists = None;
                 }
-            }
-            let both = same.iter().filter(|&&l| mark[l] == 3).count();
-            visits[0] += same.len() + opposite.len() - both;
-            visits[1] += same.len();
-            visits[2] += opposite.len();
-            for &v in self.visits_of(i, &mut at) {
-                let (m, claims) = (lap_mark(&mark, v), v & 3);
-                found[0] += usize::from(m != 0 && claims != 0);
-                found[1] += usize::from(m & 1 != 0 && claims & 1 != 0);
-                found[2] += usize::from(m & 2 != 0 && claims & 2 != 0);
-            }
-            for &l in same.iter().chain(opposite) {
-                mark[l] = 0;
             }
         });
         VisitSweep {
-            recall: [0, 1, 2].map(|f| super::metrics::ratio(found[f], visits[f])),
+            recall: count.recall(),
             revisits: Some(revisits),
+            lists,
         }
     }
 
@@ -685,6 +785,133 @@ struct VisitSweep {
     /// Per observation: whether it has a revisit (`None` from the reference searches, which
     /// count them apart).
     revisits: Option<[Vec<bool>; 3]>,
+    /// The laps that revisit each observation, when kept for another tally over the same
+    /// observations ([`SharedTruth`]).
+    lists: Option<LapLists>,
+}
+
+/// Visit recall's counts, fed the laps that revisit each observation in order.
+#[derive(Default)]
+struct LapCount {
+    /// Per lap: bit 0 revisits the observation the same way, bit 1 the opposite way.
+    mark: Vec<u8>,
+    /// Where [`Tally::visits_of`] stands.
+    at: usize,
+    /// Per facing (as [`facing_bit`]): the earlier laps that revisit, those paired correctly.
+    visits: [usize; 3],
+    found: [usize; 3],
+}
+
+impl LapCount {
+    /// Counts observation `i`, revisited by the earlier laps `same` and `opposite`.
+    fn add(&mut self, tally: &Tally, i: usize, same: &[usize], opposite: &[usize]) {
+        let mark = &mut self.mark;
+        for (laps, bit) in [(same, 1), (opposite, 2)] {
+            for &l in laps {
+                if mark.len() <= l {
+                    mark.resize(l + 1, 0);
+                }
+                mark[l] |= bit;
+            }
+        }
+        let both = same.iter().filter(|&&l| mark[l] == 3).count();
+        self.visits[0] += same.len() + opposite.len() - both;
+        self.visits[1] += same.len();
+        self.visits[2] += opposite.len();
+        for &v in tally.visits_of(i, &mut self.at) {
+            let (m, claims) = (lap_mark(mark, v), v & 3);
+            self.found[0] += usize::from(m != 0 && claims != 0);
+            self.found[1] += usize::from(m & 1 != 0 && claims & 1 != 0);
+            self.found[2] += usize::from(m & 2 != 0 && claims & 2 != 0);
+        }
+        for &l in same.iter().chain(opposite) {
+            mark[l] = 0;
+        }
+    }
+
+    fn recall(&self) -> [f64; 3] {
+        [0, 1, 2].map(|f| super::metrics::ratio(self.found[f], self.visits[f]))
+    }
+}
+
+/// The laps that revisit each observation, the same and the opposite way, as one sweep of the
+/// lap grid found them (to count another tally's visit recall without sweeping again).
+#[derive(Clone, Default)]
+struct LapLists {
+    /// Per observation swept: its position, and where its same and opposite laps end.
+    obs: Vec<(u32, u32, u32)>,
+    laps: Vec<usize>,
+}
+
+impl LapLists {
+    /// Laps kept at most (8 bytes each): beyond, the next tally sweeps again.
+    const MAX_LAPS: usize = 1 << 24;
+
+    fn push(&mut self, i: usize, same: &[usize], opposite: &[usize]) {
+        self.laps.extend_from_slice(same);
+        let mid = self.laps.len() as u32;
+        self.laps.extend_from_slice(opposite);
+        self.obs.push((i as u32, mid, self.laps.len() as u32));
+    }
+
+    /// Visit recall of `tally` over these laps, per facing as [`facing_bit`].
+    fn recall(&self, tally: &Tally) -> [f64; 3] {
+        let mut count = LapCount::default();
+        let mut from = 0usize;
+        for &(i, mid, end) in &self.obs {
+            let (mid, end) = (mid as usize, end as usize);
+            count.add(
+                tally,
+                i as usize,
+                &self.laps[from..mid],
+                &self.laps[mid..end],
+            );
+            from = end;
+        }
+        count.recall()
+    }
+}
+
+/// What the last count of a tally ([`Tally::finish_sharing`]) computed from the truth and the
+/// observations alone — the revisits at every radius, the laps that revisit each observation,
+/// pair recall's possible pairs — kept for the next tally over the same observations and
+/// truth with the same rules: the level configurations of one experiment see the same
+/// observations, and count these once between them. The figures are those of counting again.
+#[derive(Default)]
+pub struct SharedTruth {
+    kept: Option<TruthSide>,
+    /// Tallies still to finish with it, this one included: the last keeps nothing (the
+    /// default, 0, keeps nothing either).
+    tallies: usize,
+}
+
+impl SharedTruth {
+    /// For `tallies` tallies to finish one after the other.
+    pub fn new(tallies: usize) -> Self {
+        SharedTruth {
+            kept: None,
+            tallies,
+        }
+    }
+}
+
+/// One sweep of the lap grid: its radius, the revisits by facing (none from the reference
+/// searches), the laps that revisit each observation (none: not kept) and the visit recall of
+/// the tally that swept.
+type Swept = (f64, Option<[Vec<bool>; 3]>, Option<LapLists>, [f64; 3]);
+
+/// One tally's truth side (see [`SharedTruth`]).
+struct TruthSide {
+    /// What it was counted over: the observations joined with their truth, the rules, the
+    /// figures (`slots`: their facing and radius).
+    scorer: Scorer,
+    spec: EvaluationSpec,
+    slots: Vec<(Facing, u64)>,
+    /// Pair recall's sites (each observation's frame truth).
+    frame_sites: Vec<Site>,
+    sweeps: Vec<Swept>,
+    own: Vec<Option<Vec<bool>>>,
+    possible_of: Vec<(Facing, u64, u64)>,
 }
 
 /// The mark of the lap of `visits` entry `v` (`query << 32 | lap << 2 | claims`), 0 when unmarked.
@@ -827,7 +1054,21 @@ mod tests {
                 matches.iter().for_each(|m| t.add(m, &gt));
                 t.finish(&gt)
             };
-            prop_assert_eq!(score(false), score(true));
+            let want = score(true);
+            prop_assert_eq!(&score(false), &want);
+            // The truth side left by a tally over other observations is not taken; that of a
+            // tally over the same ones (without matches) is, with the same figures.
+            let mut shared = SharedTruth::new(3);
+            let fewer = obs.len().saturating_sub(5);
+            for (upto, ms) in [(fewer, &matches[..0]), (obs.len(), &matches[..0]), (obs.len(), &matches[..])] {
+                let mut t = Tally::new(&spec, Scope::Full);
+                t.sync(&obs[..upto], &gt);
+                ms.iter().for_each(|m| t.add(m, &gt));
+                let e = t.finish_sharing(&gt, &mut shared);
+                if upto == obs.len() && !ms.is_empty() {
+                    prop_assert_eq!(&e, &want);
+                }
+            }
         }
     }
 

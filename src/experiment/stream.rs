@@ -346,9 +346,12 @@ pub(super) fn finish_jobs(
         .map(|(levels, mut rec, recording)| (levels, recording.end(rec.as_mut(), &truth)))
         .collect();
     let truth = Arc::new(truth);
+    // The level configurations see the same observations: what their scores take from the
+    // truth alone is counted once.
+    let mut shared = crate::eval::SharedTruth::new(ended.len());
     Ok(ended
         .into_iter()
-        .map(|(levels, e)| (levels, e.finish(truth.clone())))
+        .map(|(levels, e)| (levels, e.finish_sharing(truth.clone(), &mut shared)))
         .collect())
 }
 
