@@ -105,7 +105,6 @@ impl ExternalSpec {
         }
         Ok(out)
     }
-
 }
 
 /// The command-line flags that give `specs` again, quoted for a shell: one `--recognizer

@@ -28,10 +28,9 @@
 //!   the observation with that candidate, score `1 − distance`.
 //!
 //! Cost per observation: one k-d tree query and `candidates` comparisons, each proportional to
-//! the sectors squared plus the products of the occupied bins ring by ring; only the tree query
-//! grows with the history. The tree has exactly `rings` dimensions ([`RingTree`]): a tree padded
-//! to [`MAX_RINGS`] splits in turn on dimensions every key holds 0 on, which neither divide a
-//! bucket nor prune a search, so the query visited most of the history (BENCHMARKS.md).
+//! the sectors squared plus the products of the occupied bins ring by ring. Only the tree query
+//! grows with the history, and faster than the tree's logarithm: a k-d tree prunes poorly in
+//! the ring key's 20 dimensions (perf: 30 % of the samples of an A run, BENCHMARKS.md).
 
 use crate::geom::{OdomPose, Pose2, Vec2};
 use crate::place::{
@@ -414,59 +413,6 @@ impl Diagnostics for ScanContextDiagnostics {
     }
 }
 
-/// The ring keys' k-d tree with exactly as many dimensions as the descriptor has rings (`kiddo`
-/// fixes the dimension at compile time, so one variant per ring count): kiddo splits on each
-/// dimension in turn, and a padding dimension every key holds 0 on can neither split a bucket
-/// nor prune a search. Items are indices into the recognizer's groups of equal keys.
-macro_rules! ring_tree {
-    ($($k:literal => $v:ident),* $(,)?) => {
-        #[derive(Clone, Debug)]
-        enum RingTree {
-            $($v(KdTree<f64, $k>),)*
-        }
-
-        impl RingTree {
-            /// An empty tree for keys of `rings` rings (1 to [`MAX_RINGS`], as checked).
-            fn new(rings: usize) -> RingTree {
-                match rings {
-                    $($k => RingTree::$v(KdTree::new()),)*
-                    _ => unreachable!("rings are checked to be 1 to {MAX_RINGS}"),
-                }
-            }
-
-            /// Adds `key` (its first `rings` values) as `item`.
-            fn add(&mut self, key: &[f64; MAX_RINGS], item: u64) {
-                match self {
-                    $(RingTree::$v(t) => {
-                        t.add(key[..$k].try_into().expect("a key holds MAX_RINGS values"), item)
-                    })*
-                }
-            }
-
-            /// The items of the `n` keys nearest `key` (Euclidean), nearest first.
-            fn nearest_n(&self, key: &[f64; MAX_RINGS], n: usize) -> Vec<u64> {
-                match self {
-                    $(RingTree::$v(t) => t
-                        .nearest_n::<SquaredEuclidean>(
-                            key[..$k].try_into().expect("a key holds MAX_RINGS values"),
-                            n,
-                        )
-                        .into_iter()
-                        .map(|nn| nn.item)
-                        .collect(),)*
-                }
-            }
-        }
-    };
-}
-
-ring_tree!(
-    1 => R1, 2 => R2, 3 => R3, 4 => R4, 5 => R5, 6 => R6, 7 => R7, 8 => R8, 9 => R9,
-    10 => R10, 11 => R11, 12 => R12, 13 => R13, 14 => R14, 15 => R15, 16 => R16, 17 => R17,
-    18 => R18, 19 => R19, 20 => R20, 21 => R21, 22 => R22, 23 => R23, 24 => R24, 25 => R25,
-    26 => R26, 27 => R27, 28 => R28, 29 => R29, 30 => R30, 31 => R31, 32 => R32,
-);
-
 /// The Scan Context baseline as a [`PlaceRecognizer`].
 #[derive(Clone)]
 pub struct ScanContextRecognizer {
@@ -475,7 +421,7 @@ pub struct ScanContextRecognizer {
     descriptors: Vec<Option<Descriptor>>,
     /// Ring keys of the observations far enough back, deduplicated (kiddo refuses many equal
     /// points): the tree's item is an index into `groups`.
-    tree: RingTree,
+    tree: KdTree<f64, MAX_RINGS>,
     groups: Vec<Vec<ObsId>>,
     group_of_key: HashMap<[u64; MAX_RINGS], usize>,
     /// Observations not yet in the tree, oldest first.
@@ -498,12 +444,11 @@ impl ScanContextRecognizer {
             return Err(problems);
         }
         let schedule = TravelSchedule::new(cfg.observation_spacing_m);
-        let tree = RingTree::new(cfg.rings);
         Ok(ScanContextRecognizer {
             cfg,
             observations: Vec::new(),
             descriptors: Vec::new(),
-            tree,
+            tree: KdTree::new(),
             groups: Vec::new(),
             group_of_key: HashMap::new(),
             waiting: VecDeque::new(),
@@ -561,8 +506,8 @@ impl ScanContextRecognizer {
         }
         let k = self.cfg.candidates;
         let mut candidates: Vec<ObsId> = Vec::with_capacity(k);
-        for item in self.tree.nearest_n(&d.ring_key, k) {
-            let group = &self.groups[item as usize];
+        for nn in self.tree.nearest_n::<SquaredEuclidean>(&d.ring_key, k) {
+            let group = &self.groups[nn.item as usize];
             candidates.extend(group.iter().take(k - candidates.len()));
             if candidates.len() >= k {
                 break;

@@ -190,7 +190,10 @@ fn subjects(specs: &[SubjectSpec], path: &Path, d: &mut Diags) -> Vec<ExternalSp
         let command = match ExternalSpec::command_with_args(s.exec.get_ref(), &args) {
             Ok(c) => c,
             Err(why) => {
-                let at = s.args.first().map_or(s.exec.span().start, |a| a.span().start);
+                let at = s
+                    .args
+                    .first()
+                    .map_or(s.exec.span().start, |a| a.span().start);
                 d.at(at, format!("{why}; remove the NUL character"));
                 continue;
             }

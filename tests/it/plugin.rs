@@ -58,7 +58,8 @@ fn check_gates_an_external_recognizer_beside_the_words() {
     let line = reproduce_line(&out, "FAIL smoke ring precision");
     assert!(line.contains("--recognizer 'ring=exec:python3 "), "{line}");
     assert!(
-        xml.contains("--recognizer &apos;ring=exec:python3") || xml.contains("--recognizer 'ring=exec:python3"),
+        xml.contains("--recognizer &apos;ring=exec:python3")
+            || xml.contains("--recognizer 'ring=exec:python3"),
         "the JUnit reproduce property gives the flag: {xml}"
     );
     let reproduced = run_reproduce_line(&line);
@@ -142,7 +143,15 @@ fn a_scenario_declares_its_external_subject() {
         "[[subjects]]\nname = \"ring\"\nexec = \"python3 'my bin/ring.py'\"\n\
          args = [\"--crash-at\", \"0\"]\n",
     );
-    let o = placewords(&["run", "-q", "--laps", "1", "--levels", "1", crashing.to_str().unwrap()]);
+    let o = placewords(&[
+        "run",
+        "-q",
+        "--laps",
+        "1",
+        "--levels",
+        "1",
+        crashing.to_str().unwrap(),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
@@ -202,7 +211,10 @@ fn a_bad_subjects_entry_is_refused_at_its_place() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{name}: {err}");
         let at = format!("{}:{}:", path.display(), base + line);
-        assert!(err.contains(&at) && err.contains(want), "{name}: want {at} {want}: {err}");
+        assert!(
+            err.contains(&at) && err.contains(want),
+            "{name}: want {at} {want}: {err}"
+        );
     }
 }
 
@@ -237,7 +249,10 @@ fn table_puts_the_python_example_and_scan_context_beside_the_words() {
             .find(|l| l.starts_with(&format!("| {row} ")))
             .unwrap_or_else(|| panic!("no {row} row in {md}"));
         // precision – recall, then seconds per lap.
-        assert!(line.contains(" – ") && line.matches('|').count() >= 4, "{line}");
+        assert!(
+            line.contains(" – ") && line.matches('|').count() >= 4,
+            "{line}"
+        );
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report-smoke.json")).unwrap())
