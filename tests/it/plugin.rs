@@ -130,8 +130,8 @@ fn a_scenario_declares_its_external_subject() {
         "{out}{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    assert!(out.contains("PASS declared ring recall"), "{out}");
-    let line = reproduce_line(&out, "FAIL declared ring precision");
+    assert!(out.contains("PASS smoke ring recall"), "{out}");
+    let line = reproduce_line(&out, "FAIL smoke ring precision");
     assert!(line.ends_with("--seed 1"), "no flag is needed: {line}");
     let reproduced = run_reproduce_line(&line);
     assert!(reproduced.contains("\"name\": \"ring\""), "{reproduced}");
@@ -337,6 +337,8 @@ fn a_crash_is_named_with_its_exit_status_and_last_stderr_lines() {
         err.contains("exited") && err.contains("crashing on purpose"),
         "{err}"
     );
+    // Frames 0..=29 were answered (lines 3..=32); the crash is located after the last of them.
+    assert!(err.contains("after printing 32 line(s)"), "{err}");
 }
 
 #[test]
@@ -357,7 +359,7 @@ fn garbage_is_named_with_its_line_number_and_text() {
 fn a_match_naming_an_unknown_frame_is_refused() {
     let err = failing_run("--unknown-frame-at 30", "30");
     assert!(
-        err.contains("names frame 1000000000, which it has not observed"),
+        err.contains("line 33 names frame 1000000000, which it has not observed"),
         "{err}"
     );
 }
@@ -366,7 +368,8 @@ fn a_match_naming_an_unknown_frame_is_refused() {
 fn another_protocol_version_is_refused_at_hello() {
     let err = failing_run("--protocol 2", "30");
     assert!(
-        err.contains("protocol 2; this harness speaks protocol 1"),
+        err.contains("line 1 answers hello")
+            && err.contains("protocol 2; this harness speaks protocol 1"),
         "{err}"
     );
 }
