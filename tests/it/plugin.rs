@@ -359,7 +359,7 @@ fn garbage_is_named_with_its_line_number_and_text() {
 fn a_match_naming_an_unknown_frame_is_refused() {
     let err = failing_run("--unknown-frame-at 30", "30");
     assert!(
-        err.contains("line 33 names frame 1000000000, which it has not observed"),
+        err.contains("line 35 names frame 1000000000, which it has not observed"),
         "{err}"
     );
 }
