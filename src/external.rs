@@ -43,6 +43,12 @@ pub struct ExternalSpec {
     pub command: String,
     /// Time the program may take to answer one line, seconds. Default [`DEFAULT_TIMEOUT_S`].
     pub timeout_s: f64,
+    /// The folder the command runs in, so relative paths in it resolve there: a scenario's
+    /// folder for its `[[subjects]]`. `None` (a `--recognizer` flag): the current folder.
+    pub dir: Option<std::path::PathBuf>,
+    /// Where the subject was declared: `Some(file)` for a scenario's `[[subjects]]` entry
+    /// (the scenario reproduces it), `None` for a `--recognizer` flag.
+    pub declared_in: Option<String>,
 }
 
 impl ExternalSpec {
@@ -73,12 +79,52 @@ impl ExternalSpec {
         if command.trim().is_empty() {
             return Err(format!("`{name}=exec:` names no command"));
         }
-        Ok(ExternalSpec {
+        Ok(ExternalSpec::new(name, command))
+    }
+
+    /// A subject `name` running `command` from the current folder, with the default timeout.
+    pub fn new(name: &str, command: &str) -> Self {
+        ExternalSpec {
             name: name.to_string(),
             command: command.to_string(),
             timeout_s: DEFAULT_TIMEOUT_S,
-        })
+            dir: None,
+            declared_in: None,
+        }
     }
+
+    /// `command` followed by `args`, each quoted for `sh` so it reaches the program as one
+    /// argument (a `[[subjects]]` entry's `args`).
+    pub fn command_with_args(command: &str, args: &[String]) -> Result<String, String> {
+        let mut out = command.to_string();
+        for a in args {
+            let quoted = shlex::try_quote(a)
+                .map_err(|e| format!("argument `{}` cannot be passed: {e}", a.escape_debug()))?;
+            out.push(' ');
+            out.push_str(&quoted);
+        }
+        Ok(out)
+    }
+}
+
+/// The command-line flags that give `specs` again, quoted for a shell: one `--recognizer
+/// NAME=exec:COMMAND` per subject a flag gave (a scenario's `[[subjects]]` come with the
+/// scenario) and `--recognizer-timeout-s` when it was not the default. What a command
+/// reproducing a seed needs; empty when no flag gave a subject.
+pub fn reproduce_flags(specs: &[ExternalSpec]) -> String {
+    let flagged: Vec<&ExternalSpec> = specs.iter().filter(|s| s.declared_in.is_none()).collect();
+    let mut out: Vec<String> = flagged
+        .iter()
+        .map(|s| {
+            let value = format!("{}=exec:{}", s.name, s.command);
+            let quoted = shlex::try_quote(&value).map_or(value.clone(), |q| q.into_owned());
+            format!("--recognizer {quoted}")
+        })
+        .collect();
+    if let Some(s) = flagged.iter().find(|s| s.timeout_s != DEFAULT_TIMEOUT_S) {
+        out.push(format!("--recognizer-timeout-s {}", s.timeout_s));
+    }
+    out.join(" ")
 }
 
 /// Why an external recognizer failed.
@@ -163,7 +209,11 @@ impl ExternalRecognizer {
             command: spec.command.clone(),
             what,
         };
-        let mut child = Command::new("sh")
+        let mut command = Command::new("sh");
+        if let Some(dir) = &spec.dir {
+            command.current_dir(dir);
+        }
+        let mut child = command
             .arg("-c")
             .arg(&spec.command)
             .stdin(Stdio::piped())

@@ -12,61 +12,7 @@
 //! the words of a match and its levels) wraps these types in its own and hands the neutral part
 //! to the harness.
 //!
-//! ```
-//! use placewords::geom::{OdomPose, Pose2};
-//! use placewords::place::{FrameId, Match, Observation, PlaceRecognizer};
-//! use placewords::scan::{BeamLayout, Scan};
-//!
-//! /// Claims a revisit whenever the odometry comes back within 0.5 m of an earlier observation
-//! /// (a toy: real recognizers may not trust odometry like this).
-//! #[derive(Default)]
-//! struct NearOdometry {
-//!     observations: Vec<Observation>,
-//!     run: usize,
-//!     started: bool,
-//! }
-//!
-//! impl PlaceRecognizer for NearOdometry {
-//!     fn start_run(&mut self) -> Vec<Match> {
-//!         if self.started {
-//!             self.run += 1;
-//!         }
-//!         self.started = true;
-//!         Vec::new()
-//!     }
-//!     fn push(&mut self, frame_id: FrameId, odom: OdomPose, _scan: &Scan) -> Vec<Match> {
-//!         let id = self.observations.len();
-//!         let past = self
-//!             .observations
-//!             .iter()
-//!             .find(|o| o.run < self.run && o.odom_pose.0.distance(&odom.0) < 0.5)
-//!             .map(|o| o.id);
-//!         self.observations.push(Observation::new(id, self.run, frame_id, odom, 0.0));
-//!         past.map(|p| vec![Match::from_pairs([(id, p)], 1.0)]).unwrap_or_default()
-//!     }
-//!     fn observations(&self) -> &[Observation] {
-//!         &self.observations
-//!     }
-//!     fn name(&self) -> String {
-//!         "near-odometry".into()
-//!     }
-//! }
-//!
-//! let mut rec = NearOdometry::default();
-//! let layout = BeamLayout::centered(181, std::f64::consts::PI, 30.0, Pose2::IDENTITY);
-//! let scan = Scan { ranges_m: vec![30.0; 181], layout, time_s: 0.0 };
-//! let mut found = Vec::new();
-//! for _run in 0..2 {
-//!     found.extend(rec.start_run());
-//!     for i in 0..10 {
-//!         let odom = OdomPose(Pose2::new(i as f64, 0.0, 0.0));
-//!         found.extend(rec.push(i, odom, &scan));
-//!     }
-//! }
-//! // Every observation of the second run pairs the first run's at the same place.
-//! assert_eq!(found.len(), 10);
-//! assert!(found.iter().flat_map(|m| m.pairs()).all(|(q, p)| q == p + 10));
-//! ```
+//! [`PlaceRecognizer`] shows a tiny recognizer; `eval::recognize_runs` shows one scored.
 
 use crate::geom::OdomPose;
 use crate::scan::Scan;
@@ -118,6 +64,7 @@ impl Observation {
 /// `past_step` is +1 when both sides run the same way (−1 for a place driven in the opposite
 /// direction). A match of a long stretch costs a few words of memory.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[non_exhaustive]
 pub struct AlignedRun {
     pub query_start: ObsId,
     pub past_start: ObsId,
@@ -126,6 +73,17 @@ pub struct AlignedRun {
 }
 
 impl AlignedRun {
+    /// `len` pairs from `(query_start, past_start)`, the past side moving by `past_step` (+1
+    /// same direction, −1 opposite) per pair.
+    pub fn new(query_start: ObsId, past_start: ObsId, len: u32, past_step: i8) -> Self {
+        AlignedRun {
+            query_start,
+            past_start,
+            len,
+            past_step,
+        }
+    }
+
     /// The pairs `(query, past)` of the run, in order of query.
     pub fn pairs(&self) -> impl Iterator<Item = (ObsId, ObsId)> + '_ {
         let (q, p, step) = (
@@ -158,12 +116,7 @@ pub fn push_pair(runs: &mut Vec<AlignedRun>, query: ObsId, past: ObsId, past_ste
     {
         return;
     }
-    runs.push(AlignedRun {
-        query_start: query,
-        past_start: past,
-        len: 1,
-        past_step,
-    });
+    runs.push(AlignedRun::new(query, past, 1, past_step));
 }
 
 /// Appends the `len` pairs `(query + i, past + i·past_step)`, i < `len`, to `runs`, as `len`
@@ -252,6 +205,7 @@ impl Match {
 /// A candidate a recognizer considered and turned down, as one observation pair, so the harness
 /// can tell (by its truth) whether it turned down a true revisit or a look-alike.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub struct RejectedCandidate {
     pub query: ObsId,
     pub past: ObsId,
@@ -260,11 +214,31 @@ pub struct RejectedCandidate {
     pub check: usize,
 }
 
+impl RejectedCandidate {
+    /// Pair `(query, past)` of `direction`, turned down by check number `check`.
+    pub fn new(query: ObsId, past: ObsId, direction: Direction, check: usize) -> Self {
+        RejectedCandidate {
+            query,
+            past,
+            direction,
+            check,
+        }
+    }
+}
+
 /// Candidates by outcome, as a recognizer counts them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct CandidateCounts {
     pub accepted: usize,
     pub rejected: usize,
+}
+
+impl CandidateCounts {
+    /// `accepted` and `rejected` candidates.
+    pub fn new(accepted: usize, rejected: usize) -> Self {
+        CandidateCounts { accepted, rejected }
+    }
 }
 
 /// What a recognizer says about a run, in its own words, so a run without matches can say why
@@ -304,6 +278,65 @@ pub trait Diagnostics: std::fmt::Debug + Send + Sync {
 
 /// Anything that recognizes places from odometry and scans alone: the paper's recognizer, a
 /// baseline, a recognizer in another process, or a test double. It never sees ground truth.
+///
+/// A tiny one, fed by hand (`eval::recognize_runs` feeds one the frames of whole runs and
+/// scores it):
+///
+/// ```
+/// use placewords::geom::{OdomPose, Pose2};
+/// use placewords::place::{FrameId, Match, Observation, PlaceRecognizer};
+/// use placewords::scan::{BeamLayout, Scan};
+///
+/// /// Claims a revisit whenever the odometry comes back within 0.5 m of an earlier observation
+/// /// (a toy: real recognizers may not trust odometry like this).
+/// #[derive(Default)]
+/// struct NearOdometry {
+///     observations: Vec<Observation>,
+///     run: usize,
+///     started: bool,
+/// }
+///
+/// impl PlaceRecognizer for NearOdometry {
+///     fn start_run(&mut self) -> Vec<Match> {
+///         if self.started {
+///             self.run += 1;
+///         }
+///         self.started = true;
+///         Vec::new()
+///     }
+///     fn push(&mut self, frame_id: FrameId, odom: OdomPose, _scan: &Scan) -> Vec<Match> {
+///         let id = self.observations.len();
+///         let past = self
+///             .observations
+///             .iter()
+///             .find(|o| o.run < self.run && o.odom_pose.0.distance(&odom.0) < 0.5)
+///             .map(|o| o.id);
+///         self.observations.push(Observation::new(id, self.run, frame_id, odom, 0.0));
+///         past.map(|p| vec![Match::from_pairs([(id, p)], 1.0)]).unwrap_or_default()
+///     }
+///     fn observations(&self) -> &[Observation] {
+///         &self.observations
+///     }
+///     fn name(&self) -> String {
+///         "near-odometry".into()
+///     }
+/// }
+///
+/// let mut rec = NearOdometry::default();
+/// let layout = BeamLayout::centered(181, std::f64::consts::PI, 30.0, Pose2::IDENTITY);
+/// let scan = Scan { ranges_m: vec![30.0; 181], layout, time_s: 0.0 };
+/// let mut found = Vec::new();
+/// for _run in 0..2 {
+///     found.extend(rec.start_run());
+///     for i in 0..10 {
+///         let odom = OdomPose(Pose2::new(i as f64, 0.0, 0.0));
+///         found.extend(rec.push(i, odom, &scan));
+///     }
+/// }
+/// // Every observation of the second run pairs the first run's at the same place.
+/// assert_eq!(found.len(), 10);
+/// assert!(found.iter().flat_map(|m| m.pairs()).all(|(q, p)| q == p + 10));
+/// ```
 pub trait PlaceRecognizer {
     /// Marks the start of a new run (no matching link crosses a run boundary). Called before
     /// the first frame of every run, the first one included. Returns the matches that closing

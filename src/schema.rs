@@ -159,6 +159,7 @@ pub fn scenario_schema() -> Value {
             "odometry" => settings_schema("odometry", sc::ODOMETRY_KEYS, "model"),
             "robot" => settings_schema("robot", sc::ROBOT_KEYS, ""),
             "scan_context" => settings_schema("scan_context", sc::SCAN_CONTEXT_KEYS, ""),
+            "subjects" => json!({ "type": "array", "items": subject_schema() }),
             "recognizer" => recognizer.clone(),
             "evaluation" => evaluation.clone(),
             "expect" => expect.clone(),
@@ -174,7 +175,7 @@ pub fn scenario_schema() -> Value {
         "additionalProperties": false,
     });
     let reference = Reference::parse(SCENARIO_REFERENCE);
-    let tables: [(&[&str], &str, usize); 13] = [
+    let tables: [(&[&str], &str, usize); 14] = [
         (&[], "Top level", 0),
         (&["runs", "[]"], "`[[runs]]`", 0),
         (&["runs", "[]", "doors_random"], "`doors_random`", 0),
@@ -184,6 +185,7 @@ pub fn scenario_schema() -> Value {
         (&["robot"], "`[robot]`", 0),
         (&["recognizer"], "`[recognizer]`", 0),
         (&["scan_context"], "`[scan_context]`", 0),
+        (&["subjects", "[]"], "`[[subjects]]`", 0),
         (&["evaluation"], "`[evaluation]`", 0),
         (&["expect"], "`[expect]`", 0),
         (&["expect", "subjects", "[]"], "`[expect]`", 1),
@@ -239,6 +241,30 @@ fn run_schema() -> Value {
         "type": "object",
         "properties": props,
         "required": ["laps"],
+        "additionalProperties": false,
+    })
+}
+
+/// `[[subjects]]`: what `spec::subjects` reads of an entry.
+fn subject_schema() -> Value {
+    use crate::spec::subjects::{MAX_TIMEOUT_S, SUBJECT_KEYS};
+    let mut props = Map::new();
+    for &key in SUBJECT_KEYS {
+        let schema = match key {
+            "name" => json!({ "type": "string", "pattern": "^[A-Za-z0-9_-]+$" }),
+            "exec" => json!({ "type": "string", "minLength": 1 }),
+            "timeout_s" => {
+                json!({ "type": "number", "exclusiveMinimum": 0, "maximum": MAX_TIMEOUT_S })
+            }
+            "args" => json!({ "type": "array", "items": { "type": "string" } }),
+            _ => json!({}),
+        };
+        props.insert(key.into(), schema);
+    }
+    json!({
+        "type": "object",
+        "properties": props,
+        "required": ["name", "exec"],
         "additionalProperties": false,
     })
 }

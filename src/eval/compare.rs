@@ -147,6 +147,11 @@ pub struct ScenarioComparison {
     pub file: String,
     /// The baseline's scenario file.
     pub base_file: String,
+    /// Each side's flags for a reproducing command (`ScenarioResult::reproduce_flags`).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub reproduce_flags: String,
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub base_reproduce_flags: String,
     pub paired: bool,
     /// Why the seeds are, or are not, paired, in words.
     pub pairing: String,
@@ -161,10 +166,10 @@ impl ScenarioComparison {
     /// the baseline's build.
     pub fn reproduce(&self, seed: u64, base_commit: &str) -> (String, String) {
         (
-            reproduce_command(&self.file, seed),
+            reproduce_command(&self.file, seed, &self.reproduce_flags),
             format!(
                 "{}  # at the baseline's commit {base_commit}",
-                reproduce_command(&self.base_file, seed)
+                reproduce_command(&self.base_file, seed, &self.base_reproduce_flags)
             ),
         )
     }
@@ -437,6 +442,8 @@ fn compare_scenario(
         label: sc.label.clone(),
         file: sc.file.clone(),
         base_file: b.file.clone(),
+        reproduce_flags: sc.reproduce_flags.clone(),
+        base_reproduce_flags: b.reproduce_flags.clone(),
         paired,
         pairing,
         tolerance,

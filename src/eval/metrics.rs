@@ -694,7 +694,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::eval::LapInfo;
     use crate::geom::{OdomPose, Pose2, TruePose};
-    use crate::recognizer::Direction;
+    use crate::place::Direction;
     /// An aligned pair (query, past).
     type AlignedPair = (ObsId, ObsId);
     use rand::{RngExt, SeedableRng};

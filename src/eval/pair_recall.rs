@@ -21,7 +21,7 @@
 use super::GroundTruth;
 use super::site_tree::{Query, Site, SiteTree, sweep, sweep_tree};
 use crate::geom::wrap_angle;
-use crate::recognizer::Direction;
+use crate::place::Direction;
 
 /// Distance along the true path from the first frame to each frame, metres (kept with each
 /// frame's truth as it is pushed, [`super::FrameTruth::travel_m`]).

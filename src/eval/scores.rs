@@ -142,10 +142,10 @@ impl Scores {
 
     /// The scores of one direction's matches against that direction's revisits (no
     /// breakdowns), with the same timing.
-    pub fn of_direction(&self, d: crate::recognizer::Direction) -> Self {
+    pub fn of_direction(&self, d: crate::place::Direction) -> Self {
         let m = match d {
-            crate::recognizer::Direction::Same => &self.directions.same,
-            crate::recognizer::Direction::Opposite => &self.directions.opposite,
+            crate::place::Direction::Same => &self.directions.same,
+            crate::place::Direction::Opposite => &self.directions.opposite,
         };
         Scores::of_metrics(m, self.recognize_seconds_per_lap)
     }
@@ -692,7 +692,7 @@ pub(crate) mod tests {
     fn rejected_candidates_are_scored_against_the_truth() {
         use crate::eval::RejectedTruth;
         use crate::geom::{Pose2, TruePose};
-        use crate::recognizer::Direction;
+        use crate::place::Direction;
         let spec = EvaluationSpec::default();
         let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
         let r = |q, p, direction, reason: Rejection| RejectedTruth {

@@ -46,6 +46,12 @@ pub struct ScenarioResult {
     pub file: String,
     /// Every seed of the plan (a shard runs only some of them).
     pub seeds: SeedRange,
+    /// The flags a command reproducing one of its seeds needs besides the file and seed: the
+    /// baselines run (`--icp`, `--scan-context`) and the external subjects given by flag
+    /// (`--recognizer NAME=exec:…`); a scenario's own `[[subjects]]` come with it. Empty for
+    /// none (and in a report written before it).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub reproduce_flags: String,
     pub expect: ExpectSpec,
     /// Why the scenario could not be run at all.
     pub error: Option<String>,
@@ -73,7 +79,7 @@ impl ScenarioResult {
 
     /// The command that reproduces `seed` of this scenario.
     pub fn reproduce(&self, seed: u64) -> String {
-        reproduce_command(&self.file, seed)
+        reproduce_command(&self.file, seed, &self.reproduce_flags)
     }
 
     /// Every problem of the scenario: its own error, then each failed seed's.
@@ -87,14 +93,19 @@ impl ScenarioResult {
     }
 }
 
-/// `placewords run FILE --seed N` (the file quoted when it holds a space or a quote).
-pub fn reproduce_command(file: &str, seed: u64) -> String {
+/// `placewords run FILE --seed N FLAGS` (the file quoted when it holds a space or a quote;
+/// `flags` already quoted, as [`ScenarioResult::reproduce_flags`]).
+pub fn reproduce_command(file: &str, seed: u64, flags: &str) -> String {
     let file = if file.contains([' ', '\'', '"', '$']) {
         format!("'{}'", file.replace('\'', r"'\''"))
     } else {
         file.to_string()
     };
-    format!("placewords run {file} --seed {seed}")
+    if flags.is_empty() {
+        format!("placewords run {file} --seed {seed}")
+    } else {
+        format!("placewords run {file} --seed {seed} {flags}")
+    }
 }
 
 /// A stress run, or one part of it.
@@ -512,6 +523,7 @@ mod tests {
             name: "B".into(),
             file: "scenarios/B.toml".into(),
             seeds: SeedRange { first: 1, last: 4 },
+            reproduce_flags: String::new(),
             expect: ExpectSpec {
                 subjects: vec![SubjectExpectation {
                     subject: "words-3".into(),
@@ -651,7 +663,7 @@ mod tests {
         ]);
         assert_eq!(l, ["A (x/A.toml)", "A (y/A.toml)", "B"]);
         assert_eq!(
-            reproduce_command("my dir/B.toml", 7),
+            reproduce_command("my dir/B.toml", 7, ""),
             "placewords run 'my dir/B.toml' --seed 7"
         );
     }

@@ -215,10 +215,17 @@ fn simulate_here(scn: &Scenario, opts: &ExperimentOptions) -> Result<(Vec<RunLog
     runs
 }
 
-/// `opts` with the scenario's own baseline settings (`[scan_context]`).
+/// `opts` with the scenario's own baseline settings (`[scan_context]`) and its `[[subjects]]`
+/// before the `--recognizer` ones; a flag naming a subject of the scenario replaces it (to try
+/// another build of the same recognizer against the scenario's bounds).
 pub fn options_for_scenario(scn: &Scenario, opts: &ExperimentOptions) -> ExperimentOptions {
+    let own = scn
+        .subjects
+        .iter()
+        .filter(|s| !opts.external.iter().any(|x| x.name == s.name));
     ExperimentOptions {
         scan_context_config: scn.scan_context.clone(),
+        external: own.chain(&opts.external).cloned().collect(),
         ..opts.clone()
     }
 }

@@ -47,12 +47,14 @@
 //!                                       # sectors, max_radius_m, history_m, cell_m, candidates,
 //!                                       # max_distance, min_overlap_ratio (ScanContextConfig)
 //! [evaluation]                          # crate::spec::evaluation::EvaluationSpec
+//! [[subjects]]                          # recognizers in other processes: name, exec, timeout_s, args
 //! [expect]                              # crate::spec::evaluation::ExpectSpec
 //! ```
 //!
 //! At most one of `doors`, `doors_cycle`, `doors_random` per run; none means all closed.
 
 use crate::baseline::scan_context::ScanContextConfig;
+use crate::external::ExternalSpec;
 use crate::geom::Vec2;
 use crate::recognizer::RecognizerConfig;
 use crate::sim::laser::{LaserConfig, LaserPreset};
@@ -65,6 +67,7 @@ use crate::spec::diag::{Diagnostic, Diags, echo, fmt_number, read_text};
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario::{DoorsSpec, PedestriansSpec, RunSpec, ScenarioSpec, Settings};
 use crate::spec::seeds::SeedRange;
+use crate::spec::subjects::SubjectSpec;
 use crate::spec::suggest::hint;
 use crate::spec::{SpecError, scenario::read_scenario};
 use crate::world::{DoorStates, Route, World, WorldCheck};
@@ -86,6 +89,9 @@ pub struct Scenario {
     pub recognizer: RecognizerConfig,
     /// The Scan Context baseline's settings: the `[scan_context]` table over the defaults.
     pub scan_context: ScanContextConfig,
+    /// The `[[subjects]]`: recognizers in other processes, each run in the scenario file's
+    /// folder (so a relative path in its command resolves there).
+    pub subjects: Vec<ExternalSpec>,
     pub evaluation: EvaluationSpec,
     pub expect: ExpectSpec,
 }
@@ -132,6 +138,7 @@ pub fn parse_scenario(
     let built = read_scenario(src, &mut d).and_then(|spec| {
         let models = Models::build(&spec, &mut d);
         let scan_context = scan_context(&spec.scan_context, &mut d);
+        let subjects = subjects(&spec.subjects, path, &mut d);
         let world_path = resolve(path, spec.world.get_ref());
         let check = WorldCheck {
             robot_radius_m: models.robot.radius_m,
@@ -145,14 +152,15 @@ pub fn parse_scenario(
             &mut world_problems,
         )?;
         let sim = plan(&spec, world, models, path, world_path, &mut d)?;
-        Some((spec, sim, scan_context))
+        Some((spec, sim, scan_context, subjects))
     });
     let mut diags = d.into_sorted();
     diags.append(&mut world_problems);
     match built {
-        Some((spec, sim, scan_context)) if diags.is_empty() => Ok(Scenario {
+        Some((spec, sim, scan_context, subjects)) if diags.is_empty() => Ok(Scenario {
             recognizer: sim.1,
             scan_context,
+            subjects,
             sim: sim.0,
             description: spec.description,
             seeds: spec.seeds.map(|s| s.into_inner()),
@@ -169,6 +177,38 @@ pub fn parse_scenario(
 }
 
 /// The world path, relative to the scenario's folder unless absolute.
+/// The `[[subjects]]` entries as runnable specs: the command with its arguments quoted, run in
+/// the folder of the scenario file at `path`.
+fn subjects(specs: &[SubjectSpec], path: &Path, d: &mut Diags) -> Vec<ExternalSpec> {
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let mut out = Vec::new();
+    for s in specs {
+        let args: Vec<String> = s.args.iter().map(|a| a.get_ref().clone()).collect();
+        let command = match ExternalSpec::command_with_args(s.exec.get_ref(), &args) {
+            Ok(c) => c,
+            Err(why) => {
+                let at = s
+                    .args
+                    .first()
+                    .map_or(s.exec.span().start, |a| a.span().start);
+                d.at(at, format!("{why}; remove the NUL character"));
+                continue;
+            }
+        };
+        let mut spec = ExternalSpec::new(s.name.get_ref(), &command);
+        if let Some(t) = &s.timeout_s {
+            spec.timeout_s = *t.get_ref();
+        }
+        spec.dir = Some(dir.clone());
+        spec.declared_in = Some(path.display().to_string());
+        out.push(spec);
+    }
+    out
+}
+
 fn resolve(scenario: &Path, world: &str) -> PathBuf {
     let rel = PathBuf::from(world);
     match scenario.parent() {

@@ -13,7 +13,6 @@ use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
 use crate::experiment::scenario::{Scenario, load_scenario};
 use crate::experiment::{ExperimentOptions, ProgressSink};
 use crate::io::atomic::holds_only;
-use crate::spec::evaluation::ExpectSpec;
 use crate::spec::seeds::{SeedRange, Shard};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -47,15 +46,17 @@ struct Planned {
     options: Option<ExperimentOptions>,
 }
 
-/// A subject `expect` names that `opts` does not run (an external one not given).
-fn unrun_subject(expect: &ExpectSpec, opts: &ExperimentOptions) -> Option<String> {
-    expect
+/// A subject `scn`'s `[expect]` names that neither it (`[[subjects]]`) nor `opts` runs (an
+/// external one not given).
+fn unrun_subject(scn: &Scenario, opts: &ExperimentOptions) -> Option<String> {
+    scn.expect
         .subjects
         .iter()
         .map(|e| &e.subject)
         .find(|name| {
             !crate::spec::evaluation::KNOWN_SUBJECTS.contains(&name.as_str())
                 && !opts.external.iter().any(|x| &x.name == *name)
+                && !scn.subjects.iter().any(|x| &x.name == *name)
         })
         .cloned()
 }
@@ -81,10 +82,11 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
                     "{file}: no [expect] block, so `check` would test nothing; add \
                      [[expect.subjects]] bounds, or pass --allow-no-expect to skip it"
                 )),
-                (Ok(scn), Some(o)) => match unrun_subject(&scn.expect, o) {
+                (Ok(scn), Some(o)) => match unrun_subject(&scn, o) {
                     Some(name) => Err(format!(
                         "{file}: [expect] names subject `{name}`, which is neither built in \
-                     ({}) nor given with --recognizer {name}=exec:COMMAND",
+                     ({}) nor declared in [[subjects]] nor given with --recognizer \
+                     {name}=exec:COMMAND",
                         crate::spec::evaluation::KNOWN_SUBJECTS.join(", ")
                     )),
                     None => Ok(scn),
@@ -311,6 +313,7 @@ fn assemble(
             name,
             file,
             seeds: p.seeds,
+            reproduce_flags: p.options.as_ref().map(flags_of).unwrap_or_default(),
             expect: p
                 .scenario
                 .as_ref()
@@ -326,6 +329,19 @@ fn assemble(
         out[i].results.push(r);
     }
     out
+}
+
+/// What a command reproducing a seed run with `o` needs besides the file and seed: the
+/// baselines it ran and the external subjects a flag gave (`eval::suite::reproduce_command`).
+fn flags_of(o: &ExperimentOptions) -> String {
+    let baselines = [(o.icp, "--icp"), (o.scan_context, "--scan-context")]
+        .into_iter()
+        .filter_map(|(on, flag)| on.then(|| flag.to_string()));
+    let external = crate::external::reproduce_flags(&o.external);
+    baselines
+        .chain((!external.is_empty()).then_some(external))
+        .collect::<Vec<_>>()
+        .join(" ")
 }
 
 fn stem(file: &str) -> String {

@@ -26,6 +26,9 @@ pub struct Suite {
     pub scenario: String,
     /// The scenario file (the class name of its test cases).
     pub file: String,
+    /// The flags a reproducing command needs besides file and seed
+    /// (`ScenarioResult::reproduce_flags`).
+    pub reproduce_flags: String,
     /// The gate's outcomes (empty when the scenario failed to run).
     pub outcomes: Vec<Outcome>,
     /// Why the scenario (or some of its seeds) could not run (exit code 2), if so.
@@ -98,6 +101,7 @@ pub fn suites(report: &SuiteReport) -> Vec<Suite> {
             Suite {
                 scenario: sc.label.clone(),
                 file: sc.file.clone(),
+                reproduce_flags: sc.reproduce_flags.clone(),
                 outcomes: sc.outcomes.clone(),
                 error: (!errors.is_empty()).then(|| errors.join("\n")),
                 seconds: sc.seconds(),
@@ -161,7 +165,7 @@ fn junit_xml_with(
             x.push_str(&error_case(s, err));
         }
         for o in &s.outcomes {
-            x.push_str(&testcase(o, &s.file, s.seeds_run));
+            x.push_str(&testcase(o, s));
         }
         x.push_str("  </testsuite>\n");
     }
@@ -184,7 +188,8 @@ fn error_case(s: &Suite, err: &str) -> String {
 }
 
 /// The properties of a test case: measured value, statistic, bound, seeds run, seed, command.
-fn properties(o: &Outcome, file: &str, seeds_run: usize) -> Vec<(&'static str, String)> {
+fn properties(o: &Outcome, s: &Suite) -> Vec<(&'static str, String)> {
+    let seeds_run = s.seeds_run;
     let mut props = vec![
         ("statistic", o.statistic()),
         ("bound", fmt_value(o.bound, o.limit)),
@@ -198,13 +203,17 @@ fn properties(o: &Outcome, file: &str, seeds_run: usize) -> Vec<(&'static str, S
     }
     if let Some(seed) = o.seed {
         props.push(("seed", seed.to_string()));
-        props.push(("reproduce", reproduce_command(file, seed)));
+        props.push((
+            "reproduce",
+            reproduce_command(&s.file, seed, &s.reproduce_flags),
+        ));
     }
     props
 }
 
 /// One `<testcase>` with its properties and, if missed, its failure.
-fn testcase(o: &Outcome, file: &str, seeds_run: usize) -> String {
+fn testcase(o: &Outcome, s: &Suite) -> String {
+    let file = &s.file;
     let mut x = format!(
         "    <testcase name=\"{}\" classname=\"{}\" file=\"{}\" time=\"{}\">\n      <properties>\n",
         escape(&o.name()),
@@ -212,7 +221,7 @@ fn testcase(o: &Outcome, file: &str, seeds_run: usize) -> String {
         escape(file),
         secs(o.seconds)
     );
-    for (k, v) in properties(o, file, seeds_run) {
+    for (k, v) in properties(o, s) {
         let _ = writeln!(
             x,
             "        <property name=\"{k}\" value=\"{}\"/>",
@@ -223,7 +232,11 @@ fn testcase(o: &Outcome, file: &str, seeds_run: usize) -> String {
     if !o.passed {
         let mut text = o.line();
         if let Some(seed) = o.seed {
-            let _ = write!(text, "; reproduce: {}", reproduce_command(file, seed));
+            let _ = write!(
+                text,
+                "; reproduce: {}",
+                reproduce_command(file, seed, &s.reproduce_flags)
+            );
         }
         let line = escape(&o.line());
         let _ = writeln!(
@@ -284,6 +297,7 @@ mod tests {
             Suite {
                 scenario: rep.scenario.clone(),
                 file: "scenarios/B.toml".into(),
+                reproduce_flags: String::new(),
                 outcomes,
                 error: None,
                 seconds: 1.5,
@@ -292,6 +306,7 @@ mod tests {
             Suite {
                 scenario: "broken".into(),
                 file: "x.toml".into(),
+                reproduce_flags: String::new(),
                 outcomes: vec![],
                 error: Some("scenarios/x.toml:3:1: unknown field `lapz`\n\"hint\"".into()),
                 seconds: -0.0,

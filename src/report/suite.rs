@@ -357,6 +357,7 @@ mod tests {
             name: "B".into(),
             file: "scenarios/B.toml".into(),
             seeds: SeedRange { first: 1, last: 3 },
+            reproduce_flags: String::new(),
             expect: ExpectSpec {
                 subjects: vec![SubjectExpectation {
                     subject: "words-3".into(),

@@ -322,7 +322,9 @@ fn numbers(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option<Vec<f64>>
 
 /// `[expect]`: `[[expect.subjects]]` entries and `quantile`. The form before subjects
 /// (`[[expect.levels]]` with `levels = N`, `[expect.icp]`) is refused with how to update it.
-pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
+/// `declared`: the names of the scenario's own `[[subjects]]` (a name close to one of them,
+/// or to a built-in one, is taken for a typo).
+pub(crate) fn read_expect(top: &DeTable<'_>, declared: &[&str], d: &mut Diags) -> ExpectSpec {
     let mut ex = ExpectSpec::default();
     let Some((_, t)) = table(top, "expect", d) else {
         return ex;
@@ -346,24 +348,35 @@ pub(crate) fn read_expect(top: &DeTable<'_>, d: &mut Diags) -> ExpectSpec {
                 String::new()
             }
             Some((_, v)) => match v.get_ref() {
-                DeValue::String(name) if KNOWN_SUBJECTS.contains(&name.as_ref()) => {
+                DeValue::String(name)
+                    if KNOWN_SUBJECTS.contains(&name.as_ref())
+                        || declared.contains(&name.as_ref()) =>
+                {
                     name.to_string()
                 }
                 DeValue::String(name) => {
                     // Any other name is an external subject's (`--recognizer NAME=…`), unless
-                    // it looks like a built-in one mistyped.
-                    let near = crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().copied());
+                    // it looks like a built-in or declared one mistyped.
+                    let near = crate::spec::suggest::closest(
+                        name,
+                        KNOWN_SUBJECTS.iter().chain(declared).copied(),
+                    );
                     if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
                         let hint = match near {
                             Some(k) => format!("did you mean `{k}`? "),
                             None => String::new(),
                         };
+                        let own = if declared.is_empty() {
+                            String::new()
+                        } else {
+                            format!(", the scenario's [[subjects]] {}", declared.join(", "))
+                        };
                         d.at(
                             v.span().start,
                             format!(
                                 "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
-                                 are {} (an external recognizer's name is made of letters, \
-                                 digits, `-` and `_`)",
+                                 are {}{own} (an external recognizer's name is made of \
+                                 letters, digits, `-` and `_`)",
                                 KNOWN_SUBJECTS.join(", ")
                             ),
                         );

@@ -8,6 +8,7 @@ pub mod evaluation;
 pub(crate) mod read;
 pub mod scenario;
 pub mod seeds;
+pub mod subjects;
 pub mod suggest;
 pub mod world;
 

@@ -213,6 +213,7 @@ pub const TOP_KEYS: &[&str] = &[
     "robot",
     "recognizer",
     "scan_context",
+    "subjects",
     "evaluation",
     "expect",
 ];
@@ -325,6 +326,9 @@ pub struct ScenarioSpec {
     pub recognizer: Vec<(S<String>, toml::Value)>,
     /// `[scan_context]`: the Scan Context baseline's numbers ([`SCAN_CONTEXT_KEYS`]).
     pub scan_context: Settings,
+    /// `[[subjects]]`: recognizers in other processes the scenario runs
+    /// (`spec::subjects`).
+    pub subjects: Vec<crate::spec::subjects::SubjectSpec>,
     pub evaluation: EvaluationSpec,
     pub expect: ExpectSpec,
 }
@@ -412,8 +416,10 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
     }
     let recognizer = read_recognizer(top, d);
     let scan_context = read_settings(top, "scan_context", SCAN_CONTEXT_KEYS, "", d);
+    let subjects = crate::spec::subjects::read_subjects(top, d);
     let evaluation = crate::spec::evaluation::read_evaluation(top, d);
-    let expect = crate::spec::evaluation::read_expect(top, d);
+    let declared: Vec<&str> = subjects.iter().map(|s| s.name.get_ref().as_str()).collect();
+    let expect = crate::spec::evaluation::read_expect(top, &declared, d);
     let (name, description, world, route, seed) = head?;
     Some(ScenarioSpec {
         name,
@@ -430,6 +436,7 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
         robot,
         recognizer,
         scan_context,
+        subjects,
         evaluation,
         expect,
     })

@@ -310,6 +310,7 @@ fn icp_baseline_finds_revisits_on_a_loop_and_passes_a_gate() {
     let xml = junit_xml(&[Suite {
         scenario: "loop".into(),
         file: "loop.toml".into(),
+        reproduce_flags: String::new(),
         outcomes,
         error: None,
         seconds: r.seconds,

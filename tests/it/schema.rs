@@ -138,6 +138,7 @@ fn each_schema_table_holds_the_readers_keys() {
                 ("odometry", set(sc::ODOMETRY_KEYS)),
                 ("robot", set(sc::ROBOT_KEYS)),
                 ("scan_context", set(sc::SCAN_CONTEXT_KEYS)),
+                ("subjects[]", set(placewords::spec::subjects::SUBJECT_KEYS)),
                 ("recognizer", recognizer),
                 ("evaluation", set(ev::EVALUATION_KEYS)),
                 ("expect", set(ev::EXPECT_KEYS)),
