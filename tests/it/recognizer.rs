@@ -1491,7 +1491,7 @@ fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
     };
     // 6 steps of 4.4 m: 26.4 m of travel.
     assert_eq!(
-        count(RecognizerConfig::default().max_interpolation_m),
+        count(RecognizerConfig::default().front_end.max_interpolation_m),
         (264, 0)
     );
     assert_eq!(
@@ -1622,10 +1622,8 @@ fn a_substituted_word_is_bridged_only_with_substitutions() {
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, plain) = run_matcher(&base, &all);
     assert!(plain.is_empty(), "5-word chains must not reach τ = 6");
-    let bridged = RecognizerConfig {
-        substitutions: true,
-        ..base
-    };
+    let mut bridged = base;
+    bridged.matcher.substitutions = true;
     let (_, matches) = run_matcher(&bridged, &all);
     assert!(!matches.is_empty(), "the bridged chain reaches τ");
     let n = first.len();
@@ -1648,16 +1646,12 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
     let first = synth::observations(&lap, 0.1, 0, None);
     let second = synth::observations(&changed, 0.1, 0, first.last());
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
-    let bridged = RecognizerConfig {
-        substitutions: true,
-        ..base.clone()
-    };
-    assert_eq!(bridged.substitution_size_ratio, 0.3);
+    let mut bridged = base.clone();
+    bridged.matcher.substitutions = true;
+    assert_eq!(bridged.matcher.substitution_size_ratio, 0.3);
     assert!(run_matcher(&bridged, &all).1.is_empty());
-    let loose = RecognizerConfig {
-        substitution_size_ratio: 0.4,
-        ..bridged
-    };
+    let mut loose = bridged;
+    loose.matcher.substitution_size_ratio = 0.4;
     assert!(!run_matcher(&loose, &all).1.is_empty());
 }
 
@@ -1700,10 +1694,8 @@ fn corridor_of_long_words(
 fn long_words_match_by_travel_when_asked() {
     let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4], 60, false, 0.0);
     assert!(run_matcher(&base, &all).1.is_empty());
-    let by_travel = RecognizerConfig {
-        ngram_travel_m: 12.0,
-        ..base
-    };
+    let mut by_travel = base;
+    by_travel.matcher.ngram_travel_m = 12.0;
     let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.ngram_len >= 4));
@@ -1721,10 +1713,8 @@ fn long_words_match_by_travel_when_asked() {
 fn long_words_driven_back_match_by_travel_when_asked() {
     let psis = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1];
     let (_, straight, base) = corridor_of_long_words(&psis, 40, true, 0.0);
-    let by_travel = RecognizerConfig {
-        reverse_ngram_travel_m: 12.0,
-        ..base.clone()
-    };
+    let mut by_travel = base.clone();
+    by_travel.matcher.reverse_ngram_travel_m = 12.0;
     let (m, matches) = run_matcher(&by_travel, &straight);
     assert!(matches.is_empty(), "a straight corridor read backwards");
     assert!(
