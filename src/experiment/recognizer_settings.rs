@@ -174,9 +174,14 @@ impl Keys {
     fn misplaced(&self, section: &str, key: &str) -> String {
         match self.home_of(key) {
             Some((home, new)) if home != section || new != key => format!(
-                "`{key}` is not a key of {}: move it into {} as `{new}`",
+                "`{key}` is not a key of {}: move it into {}{}",
                 table_name(section),
-                table_name(home)
+                table_name(home),
+                if new == key {
+                    String::new()
+                } else {
+                    format!(" as `{new}`")
+                }
             ),
             _ => match closest(key, self.keys_of(section)) {
                 Some(c) => format!(

@@ -57,7 +57,13 @@ impl WordMatcher {
     /// Eq. 2: the best placement of the two words' observation windows (see the module doc).
     /// Read in direction `dir`, the past word is its Ψ backwards: offsets count from its last
     /// observation. `anchor` is the n-gram's shift for the pair (used by `alignment = "chain"`).
-    pub(super) fn placement(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
+    pub(super) fn placement(
+        &self,
+        c: WordId,
+        p: WordId,
+        dir: Direction,
+        anchor: i64,
+    ) -> Option<Placement> {
         let key = (c, p, dir, anchor);
         if let Some(w) = self.placements.borrow().get(&key) {
             return w.clone();
@@ -68,7 +74,13 @@ impl WordMatcher {
     }
 
     /// [`placement`](Self::placement), computed.
-    pub(super) fn place(&self, c: WordId, p: WordId, dir: Direction, anchor: i64) -> Option<Placement> {
+    pub(super) fn place(
+        &self,
+        c: WordId,
+        p: WordId,
+        dir: Direction,
+        anchor: i64,
+    ) -> Option<Placement> {
         let psi = self.words.psi();
         let (cw, pw) = (self.word(c), self.word(p));
         let (sc, sp) = (cw.size as i64, pw.size as i64);
@@ -244,7 +256,13 @@ impl PastSide {
     }
 
     /// Σ (Ψ(past at b + i) − cur[i − r.start])² over i in `r`.
-    pub(super) fn squared_error(&self, psi: &[f64], b: i64, r: &std::ops::Range<i64>, cur: &[f64]) -> f64 {
+    pub(super) fn squared_error(
+        &self,
+        psi: &[f64],
+        b: i64,
+        r: &std::ops::Range<i64>,
+        cur: &[f64],
+    ) -> f64 {
         if self.step > 0 {
             let from = (self.base + b + r.start) as usize;
             squared_error(&psi[from..from + cur.len()], cur)

@@ -163,7 +163,9 @@ impl WordMatcher {
             self.stamp = 1;
         }
         let stamp = self.stamp;
-        let skipped = self.matcher_opts.substitutions
+        let skipped = self
+            .matcher_opts
+            .substitutions
             .then(|| self.level0_link(c, Direction::Same));
         let bridged = skipped
             .flatten()

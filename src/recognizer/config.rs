@@ -22,19 +22,19 @@ pub struct RecognizerConfig {
     /// 4 = levels 0-3. Words are built up to level `levels − 1`. Default 3. The harness sets it
     /// per level configuration (`--levels`); a scenario or `--config` file may not.
     pub levels: usize,
-    /// `[recognizer.front_end]`: observation spacing and interpolation.
+    /// `[recognizer.front_end]`: observation spacing and interpolation; a key left out keeps its default.
     pub front_end: FrontEndOptions,
-    /// `[recognizer.grid]`: the local grid.
+    /// `[recognizer.grid]`: the local grid; a key left out keeps its default.
     pub grid: GridOptions,
-    /// `[recognizer.density]`: the density kernel.
+    /// `[recognizer.density]`: the density kernel; a key left out keeps its default.
     pub density: DensityOptions,
-    /// `[recognizer.words]`: density classes and words of every level.
+    /// `[recognizer.words]`: density classes and words of every level; a key left out keeps its default.
     pub words: WordOptions,
-    /// `[recognizer.matcher]`: word pairs and n-gram chains.
+    /// `[recognizer.matcher]`: word pairs and n-gram chains; a key left out keeps its default.
     pub matcher: MatcherOptions,
-    /// `[recognizer.alignment]`: the fine alignment.
+    /// `[recognizer.alignment]`: the fine alignment; a key left out keeps its default.
     pub alignment: AlignmentOptions,
-    /// `[recognizer.verify]`: verification of each candidate n-gram.
+    /// `[recognizer.verify]`: verification of each candidate n-gram; a key left out keeps its default.
     pub verify: VerifyOptions,
 }
 
@@ -67,8 +67,10 @@ pub const SECTIONS: &[&str] = &[
 
 /// Keys of `[recognizer]` before the subtables whose name changed when they moved: (old key,
 /// subtable, new key). Every other old key kept its name in its subtable.
-pub const RENAMED_KEYS: &[(&str, &str, &str)] =
-    &[("alignment", "alignment", "mode"), ("verify", "verify", "enabled")];
+pub const RENAMED_KEYS: &[(&str, &str, &str)] = &[
+    ("alignment", "alignment", "mode"),
+    ("verify", "verify", "enabled"),
+];
 
 /// One invalid setting: where it is (`section`, the subtable of `[recognizer]`, empty for a
 /// key of `[recognizer]` itself, and the key) and what is wrong with it.

@@ -161,7 +161,10 @@ impl DensityFrontEnd {
         );
         let kernel = DensityKernel::new(config.kernel_radius_cells(), config.density.ray_step_deg);
         Ok(DensityFrontEnd {
-            clock: ObservationClock::new(config.front_end.observation_spacing_m, config.front_end.max_interpolation_m),
+            clock: ObservationClock::new(
+                config.front_end.observation_spacing_m,
+                config.front_end.max_interpolation_m,
+            ),
             kernel_cells: config.kernel_radius_cells(),
             integrate_every_scan: config.front_end.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),

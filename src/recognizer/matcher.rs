@@ -331,7 +331,13 @@ impl WordMatcher {
     }
 
     /// Marks a candidate's new pairs reported and makes its match.
-    pub(super) fn emit(&mut self, c: WordId, k: usize, cand: &Candidate, scr: &mut Scratch) -> WordMatch {
+    pub(super) fn emit(
+        &mut self,
+        c: WordId,
+        k: usize,
+        cand: &Candidate,
+        scr: &mut Scratch,
+    ) -> WordMatch {
         let d = cand.dir as usize;
         let chain = &scr.chain[cand.pairs.clone()];
         // Counted now, not when the candidate was found: another candidate of the same word may

@@ -30,15 +30,15 @@ pub(crate) mod words;
 pub use config::{
     ConfigProblem, RENAMED_KEYS, RecognizerConfig, RecognizerError, SECTIONS, table_name,
 };
-pub use options::{
-    AlignmentMode, AlignmentOptions, DensityOptions, FrontEndOptions, GridOptions,
-    MatcherOptions, MultiLevelRule, VerifyOptions, WordOptions,
-};
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use diagnostics::{MatchDiagnostics, Rejection, VerificationCounts, long_steps_sentence};
 pub use frontend::{DensityFrontEnd, Due, ObservationClock};
 pub use grid::{Density, LocalGrid};
 pub use matcher::WordMatcher;
+pub use options::{
+    AlignmentMode, AlignmentOptions, DensityOptions, FrontEndOptions, GridOptions, MatcherOptions,
+    MultiLevelRule, VerifyOptions, WordOptions,
+};
 pub use types::{
     AlignedRun, DensityObservation, Direction, FrameId, ObsId, Observation, WordMatch, WordRef,
     push_pair,
@@ -200,7 +200,12 @@ impl Recognizer {
 
 /// The thresholds a level configuration uses (τ0 .. τ(levels-1)).
 pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
-    cfg.matcher.min_ngram.iter().copied().take(cfg.levels).collect()
+    cfg.matcher
+        .min_ngram
+        .iter()
+        .copied()
+        .take(cfg.levels)
+        .collect()
 }
 
 fn to_place(matches: Vec<WordMatch>) -> Vec<place::Match> {

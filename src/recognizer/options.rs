@@ -37,7 +37,8 @@ impl Problems {
     }
 
     fn bad(&mut self, field: &'static str, problem: String) {
-        self.out.push(ConfigProblem::new(self.section, field, problem));
+        self.out
+            .push(ConfigProblem::new(self.section, field, problem));
     }
 
     /// `field` must be a finite number of at least 0.

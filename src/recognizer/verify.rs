@@ -71,7 +71,8 @@ impl WordMatcher {
             }
             turned = turned.max(cum_c.1.abs());
         }
-        if dir == Direction::Opposite && turned < self.verify_opts.reverse_min_turn_deg.to_radians() {
+        if dir == Direction::Opposite && turned < self.verify_opts.reverse_min_turn_deg.to_radians()
+        {
             return Some(Rejection::Straight);
         }
         let (mut sum, mut lateral, mut count) = (0.0, 0.0, 0usize);
@@ -103,7 +104,13 @@ impl WordMatcher {
 
     /// Σ over the pairs of placement `w` of the squared difference of the observations'
     /// `lateral_moment`, the past side's negated when read backwards (its left is then our right).
-    pub(super) fn lateral_squared_error(&self, c: WordId, p: WordId, dir: Direction, w: &Placement) -> f64 {
+    pub(super) fn lateral_squared_error(
+        &self,
+        c: WordId,
+        p: WordId,
+        dir: Direction,
+        w: &Placement,
+    ) -> f64 {
         let lateral = self.words.lateral_moments();
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);

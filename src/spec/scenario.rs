@@ -932,10 +932,15 @@ fn recognizer_entry(
     d: &mut Diags,
 ) -> Option<RecognizerEntry> {
     let Some(value) = plain(v.get_ref()) else {
-        let table = section.as_ref().map_or(String::new(), |s| format!(".{}", s.get_ref()));
+        let table = section
+            .as_ref()
+            .map_or(String::new(), |s| format!(".{}", s.get_ref()));
         d.at(
             v.span().start,
-            format!("`{}` in [recognizer{table}] is out of range", echo(k.get_ref())),
+            format!(
+                "`{}` in [recognizer{table}] is out of range",
+                echo(k.get_ref())
+            ),
         );
         return None;
     };

@@ -116,8 +116,7 @@ fn config_defaults_parse_and_validate() {
     assert_eq!(c, RecognizerConfig::default());
     assert_eq!(c.matcher.min_ngram, vec![6, 9, 12, 15]);
     assert!(c.validate().is_ok());
-    let c: RecognizerConfig =
-        toml::from_str("levels = 2\n[matcher]\nmin_ngram = [4, 8]").unwrap();
+    let c: RecognizerConfig = toml::from_str("levels = 2\n[matcher]\nmin_ngram = [4, 8]").unwrap();
     assert!(c.validate().is_ok());
     assert!(
         toml::from_str::<RecognizerConfig>("level = 2").is_err(),

@@ -119,7 +119,12 @@ fn each_schema_table_holds_the_readers_keys() {
     // Each subtable of `[recognizer]` (`recognizer.grid`) with its keys.
     let subtables: Vec<(String, BTreeSet<String>)> = defaults
         .iter()
-        .filter_map(|(k, v)| Some((format!("recognizer.{k}"), v.as_table()?.keys().cloned().collect())))
+        .filter_map(|(k, v)| {
+            Some((
+                format!("recognizer.{k}"),
+                v.as_table()?.keys().cloned().collect(),
+            ))
+        })
         .collect();
     let expected: [(FileKind, Vec<Table>); 2] = [
         (

@@ -75,7 +75,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ),
     ("verify.verify_turn_deg", "2", "", Input::Dense),
     ("verify.verify_max_psi_rms", "0.005", "", Input::Dense),
-    ("verify.verify_max_lateral_rms", "0.001", LOOSE, Input::Dense),
+    (
+        "verify.verify_max_lateral_rms",
+        "0.001",
+        LOOSE,
+        Input::Dense,
+    ),
     (
         "verify.reverse_verify_max_lateral_rms",
         "0.001",
@@ -109,7 +114,9 @@ fn documented_keys() -> Vec<String> {
             table = h.split_once(']').map(|(t, _)| t.to_string());
         } else if let Some(row) = l.strip_prefix("| `") {
             let key = row.split_once('`').map(|(k, _)| k).unwrap();
-            let table = table.as_deref().expect("a key row under a [recognizer.…] heading");
+            let table = table
+                .as_deref()
+                .expect("a key row under a [recognizer.…] heading");
             keys.push(format!("{table}.{key}"));
         }
     }
@@ -298,7 +305,10 @@ fn settings_from_a_toml_file() {
         path,
     )
     .unwrap();
-    assert_eq!(c.alignment.mode, placewords::recognizer::AlignmentMode::Paper);
+    assert_eq!(
+        c.alignment.mode,
+        placewords::recognizer::AlignmentMode::Paper
+    );
     assert!(!c.verify.enabled);
     let e = parse_recognizer_config("[recognizer.verify]\n\nverfy_turn_deg = 3\n", path)
         .unwrap_err()
@@ -333,11 +343,7 @@ fn settings_from_a_toml_file() {
 #[test]
 fn flat_keys_say_where_they_moved() {
     let path = Path::new("old.toml");
-    let err = |src: &str| {
-        parse_recognizer_config(src, path)
-            .unwrap_err()
-            .to_string()
-    };
+    let err = |src: &str| parse_recognizer_config(src, path).unwrap_err().to_string();
     for key in setting_keys() {
         let Some((table, new)) = key.split_once('.') else {
             continue;
@@ -348,7 +354,9 @@ fn flat_keys_say_where_they_moved() {
             toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
         let value = defaults[table][new].to_string();
         let e = err(&format!("[recognizer]\n# before\n{old} = {value}\n"));
-        let want = format!("old.toml:3:1: `{old}` is no longer a key of [recognizer] itself: move {old} into [recognizer.{table}]");
+        let want = format!(
+            "old.toml:3:1: `{old}` is no longer a key of [recognizer] itself: move {old} into [recognizer.{table}]"
+        );
         assert!(e.starts_with(&want), "{key}: {e}");
         assert_eq!(e.lines().count(), 1, "{e}");
         if old != new {
