@@ -54,7 +54,7 @@ fn front_end(c: &mut Criterion) {
     let mut g = c.benchmark_group("front_end");
     g.measurement_time(Duration::from_secs(3));
 
-    let mut grid = LocalGrid::new(cfg.grid_cell_m, cfg.grid_radius_m);
+    let mut grid = LocalGrid::new(cfg.grid.grid_cell_m, cfg.grid.grid_radius_m);
     let mut i = 0usize;
     g.bench_function("grid_update_per_scan_181_beams", |b| {
         b.iter(|| {
@@ -65,8 +65,8 @@ fn front_end(c: &mut Criterion) {
     });
 
     // A grid as the robot has it in the middle of the lap.
-    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.ray_step_deg);
-    let mut grid = LocalGrid::new(cfg.grid_cell_m, cfg.grid_radius_m);
+    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.density.ray_step_deg);
+    let mut grid = LocalGrid::new(cfg.grid.grid_cell_m, cfg.grid.grid_radius_m);
     let deltas = kernel.deltas(grid.side());
     let mid = inputs.len() / 3;
     for (o, s) in &inputs[mid - 100..mid] {
@@ -119,10 +119,7 @@ fn matching(c: &mut Criterion) {
     let histories: &[usize] = if full_run() { &[1, 10, 40] } else { &[1, 2] };
     let laps = observation_laps(histories[histories.len() - 1] + 1, 1, None);
     for levels in 1..=3 {
-        let cfg = RecognizerConfig {
-            levels,
-            ..Default::default()
-        };
+        let cfg = RecognizerConfig::default().with_levels(levels);
         for &history in histories {
             let mut m = WordMatcher::new(&cfg).unwrap();
             for lap in &laps[..history] {

@@ -89,7 +89,8 @@ fn main() -> ExitCode {
 fn run(args: &Args) -> Result<()> {
     let (runs, cfg) = load(args)?;
     let obs = observe(&runs, cfg)?;
-    let window = (args.window_m / RecognizerConfig::default().observation_spacing_m).round();
+    let window =
+        (args.window_m / RecognizerConfig::default().front_end.observation_spacing_m).round();
     let window = (window as usize).max(1);
     let max_mse = args.max_rms.iter().fold(0.0f64, |a, &b| a.max(b)).powi(2);
     let picks = nearest_windows(&obs, window, args, max_mse);

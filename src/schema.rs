@@ -19,7 +19,7 @@
 //! between keys) stay the readers' own: a file may pass the schema and still be refused by
 //! `world check` or `scenario check`.
 
-use crate::recognizer::RecognizerConfig;
+use crate::recognizer::{RecognizerConfig, SECTIONS as RECOGNIZER_SECTIONS};
 use crate::sim::laser::LaserPreset;
 use crate::spec::evaluation::{EvaluationSpec, ExpectSpec};
 use crate::spec::scenario as sc;
@@ -175,7 +175,7 @@ pub fn scenario_schema() -> Value {
         "additionalProperties": false,
     });
     let reference = Reference::parse(SCENARIO_REFERENCE);
-    let tables: [(&[&str], &str, usize); 14] = [
+    let mut tables: Vec<(&[&str], &str, usize)> = vec![
         (&[], "Top level", 0),
         (&["runs", "[]"], "`[[runs]]`", 0),
         (&["runs", "[]", "doors_random"], "`doors_random`", 0),
@@ -191,6 +191,14 @@ pub fn scenario_schema() -> Value {
         (&["expect", "subjects", "[]"], "`[expect]`", 1),
         (&["expect", "regression"], "`[expect.regression]`", 0),
     ];
+    // One reference table per subtable of `[recognizer]`, under its own heading.
+    let subtables: Vec<(Vec<&str>, String)> = RECOGNIZER_SECTIONS
+        .iter()
+        .map(|&s| (vec!["recognizer", s], format!("`[recognizer.{s}]`")))
+        .collect();
+    for (path, heading) in &subtables {
+        tables.push((path.as_slice(), heading.as_str(), 0));
+    }
     for (path, section, nth) in tables {
         if let Some(t) = object_at(&mut root, path) {
             reference.describe(t, section, nth);

@@ -355,10 +355,9 @@ pub fn ambiguity(
     let drive = drive(world, route, doors)?;
     // The route is driven one way: a stretch that looks like another only when read backwards
     // would confuse a robot driving it in reverse, which this map is not about.
-    let mut rec = Recognizer::new(RecognizerConfig {
-        reverse: false,
-        ..cfg.clone()
-    })?;
+    let mut one_way = cfg.clone();
+    one_way.matcher.reverse = false;
+    let mut rec = Recognizer::new(one_way)?;
     let mut matches = Vec::new();
     for f in &drive.frames {
         matches.extend(rec.push(f.odom, &f.scan));
@@ -373,7 +372,7 @@ pub fn ambiguity(
         route: route.id.clone(),
         route_length_m: length_m,
         levels: cfg.levels,
-        min_ngram: cfg.min_ngram.iter().copied().take(cfg.levels).collect(),
+        min_ngram: crate::recognizer::thresholds(cfg),
         tp_radius_m,
         confused_word_pairs: conf.len(),
         ambiguous_share: share,

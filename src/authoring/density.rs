@@ -113,8 +113,8 @@ pub fn density_map(
     cfg: &RecognizerConfig,
     sample_m: f64,
 ) -> DensityMap {
-    let cell_m = cfg.grid_cell_m;
-    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.ray_step_deg);
+    let cell_m = cfg.grid.grid_cell_m;
+    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.density.ray_step_deg);
     // Half a cell of dilation keeps thin diagonal walls closed for the kernel's rays.
     let raster = Raster::new(&obstacles(world, doors), &[], cell_m, 1.0, cell_m * 0.5);
     let pad = kernel.radius_cells() + 1;
@@ -123,7 +123,7 @@ pub fn density_map(
     let deltas = kernel.deltas(stride);
     let step = ((sample_m / raster.cell_m).round() as usize).max(1);
     let (width, height) = (raster.width / step, raster.height / step);
-    let quantizer = WordLevels::new(cfg.classes, 1, 1);
+    let quantizer = WordLevels::new(cfg.words.classes, 1, 1);
     let psi: Vec<Option<f64>> = (0..height)
         .into_par_iter()
         .flat_map_iter(|sy| {
@@ -153,7 +153,7 @@ pub fn density_map(
         height,
         psi,
         class,
-        classes: cfg.classes,
+        classes: cfg.words.classes,
     }
 }
 
@@ -216,7 +216,7 @@ pub fn density_picture(world: &World, doors: &DoorStates) -> String {
     let map = density_map(world, doors, &cfg, DEFAULT_SAMPLE_M);
     let title = format!(
         "{}: density classes of the free space (kernel {} m, {} classes)",
-        world.name, cfg.kernel_radius_m, cfg.classes
+        world.name, cfg.density.kernel_radius_m, cfg.words.classes
     );
     density_svg(world, doors, &map, &title)
 }

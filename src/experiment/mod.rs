@@ -8,6 +8,7 @@ pub mod output;
 pub mod picture;
 pub(crate) mod progress;
 pub mod real;
+mod recognizer_settings;
 pub(crate) mod scenario;
 pub mod score;
 pub(crate) mod stream;
@@ -26,10 +27,8 @@ use crate::spec::SpecError;
 use crate::spec::evaluation::EvaluationSpec;
 pub use progress::{Progress, ProgressSink};
 use rayon::prelude::*;
-pub use scenario::{
-    Scenario, check_scenario, load_recognizer_config, load_scenario, parse_recognizer_config,
-    parse_scenario,
-};
+pub use recognizer_settings::{load_recognizer_config, parse_recognizer_config};
+pub use scenario::{Scenario, check_scenario, load_scenario, parse_scenario};
 pub use stream::run_scenario_streamed;
 
 /// Why an experiment could not be carried out.
@@ -179,10 +178,7 @@ pub fn recognizer_config(scn: &Scenario) -> Result<RecognizerConfig, SpecError> 
 
 /// `base` with `levels` level configurations (thresholds unchanged).
 pub fn config_for_levels(base: &RecognizerConfig, levels: usize) -> RecognizerConfig {
-    RecognizerConfig {
-        levels,
-        ..base.clone()
-    }
+    base.clone().with_levels(levels)
 }
 
 pub use crate::recognizer::thresholds;
@@ -403,7 +399,7 @@ pub fn back_end_matches(
     base: &RecognizerConfig,
     point: &GridPoint,
 ) -> Result<Vec<Match>, ExperimentError> {
-    let mut min_ngram = base.min_ngram.clone();
+    let mut min_ngram = base.matcher.min_ngram.clone();
     for (k, t) in point.thresholds.iter().enumerate() {
         if k < min_ngram.len() {
             min_ngram[k] = *t;
@@ -411,11 +407,8 @@ pub fn back_end_matches(
             min_ngram.push(*t);
         }
     }
-    let cfg = RecognizerConfig {
-        levels: point.levels,
-        min_ngram,
-        ..base.clone()
-    };
+    let mut cfg = config_for_levels(base, point.levels);
+    cfg.matcher.min_ngram = min_ngram;
     let mut back =
         WordMatcher::new(&cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
     let mut out: Vec<WordMatch> = Vec::new();

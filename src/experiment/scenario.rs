@@ -269,7 +269,7 @@ impl Models {
             laser: laser(&spec.laser, d),
             odometry: odometry(&spec.odometry, d),
             robot: robot(&spec.robot, d),
-            recognizer: recognizer(&spec.recognizer, d),
+            recognizer: super::recognizer_settings::recognizer(&spec.recognizer, d),
         }
     }
 }
@@ -515,85 +515,6 @@ fn scan_context(s: &Settings, d: &mut Diags) -> ScanContextConfig {
     c
 }
 
-/// `RecognizerConfig` fields the harness sets itself, never a file.
-const HARNESS_KEYS: &[&str] = crate::spec::scenario::RECOGNIZER_HARNESS_KEYS;
-
-/// Recognizer settings from a file holding a `[recognizer]` table alone (`recognize --config`),
-/// read and checked as a scenario's `[recognizer]`: every problem at its `file:line:col`, unknown
-/// keys with "did you mean".
-pub fn load_recognizer_config(path: &Path) -> Result<RecognizerConfig, SpecError> {
-    let src = read_text(path)?;
-    parse_recognizer_config(&src, path)
-}
-
-/// [`load_recognizer_config`] on text; `path` names the file in messages.
-pub fn parse_recognizer_config(src: &str, path: &Path) -> Result<RecognizerConfig, SpecError> {
-    let file = path.display().to_string();
-    let mut d = Diags::new(src, &file);
-    let cfg = crate::spec::scenario::read_recognizer_file(src, &mut d)
-        .map(|entries| recognizer(&entries, &mut d));
-    match cfg {
-        Some(cfg) if !d.has_errors() => Ok(cfg),
-        _ => Err(SpecError::Invalid(d.into_sorted())),
-    }
-}
-
-/// The `[recognizer]` keys over [`RecognizerConfig::default`]; each problem at its key.
-fn recognizer(entries: &[(S<String>, toml::Value)], d: &mut Diags) -> RecognizerConfig {
-    let defaults = toml::Table::try_from(RecognizerConfig::default()).unwrap_or_default();
-    let known: Vec<&str> = defaults
-        .keys()
-        .map(String::as_str)
-        .filter(|k| !HARNESS_KEYS.contains(k))
-        .collect();
-    let mut table = defaults.clone();
-    let mut ok = true;
-    for (key, v) in entries {
-        let k = key.get_ref();
-        if k == "levels" {
-            d.at(
-                key.span().start,
-                "`levels` in [recognizer] is not read: `run` and `recognize` search 1, 2 and 3 \
-                 levels each time (the table's rows); run one with `--levels N` (1-4), and gate \
-                 one in `check` with [[expect.subjects]] `subject = \"words-N\"`"
-                    .to_string(),
-            );
-            ok = false;
-            continue;
-        }
-        if !known.contains(&k.as_str()) {
-            let h = hint(k, known.iter().copied(), "keys here");
-            d.at(
-                key.span().start,
-                format!("unknown key `{}` in [recognizer]; {h}", echo(k)),
-            );
-            ok = false;
-            continue;
-        }
-        let mut one = defaults.clone();
-        one.insert(k.clone(), v.clone());
-        if let Err(e) = one.try_into::<RecognizerConfig>() {
-            let msg = e.message().trim().replace('\n', " ");
-            d.at(key.span().start, format!("[recognizer] {k}: {msg}"));
-            ok = false;
-        }
-        table.insert(k.clone(), v.clone());
-    }
-    let cfg = match table.try_into::<RecognizerConfig>() {
-        Ok(cfg) if ok => cfg,
-        _ => return RecognizerConfig::default(),
-    };
-    for p in cfg.problems() {
-        let at = entries.iter().find(|(k, _)| k.get_ref() == p.field);
-        let at = at
-            .or(entries.first())
-            .map(|(k, _)| k.span().start)
-            .unwrap_or(0);
-        d.at(at, format!("[recognizer] {}: {}", p.field, p.problem));
-    }
-    cfg
-}
-
 /// The simulation plan and recognizer settings: everything checked against the world.
 fn plan(
     spec: &ScenarioSpec,
@@ -682,13 +603,13 @@ fn work_budget(spec: &ScenarioSpec, sim: &SimPlan, rec: &RecognizerConfig, d: &m
             ),
         );
     }
-    let observations = travel_m / rec.observation_spacing_m;
+    let observations = travel_m / rec.front_end.observation_spacing_m;
     if observations > MAX_OBSERVATIONS {
         let key = spec
             .recognizer
             .iter()
-            .find(|(k, _)| k.get_ref() == "observation_spacing_m");
-        let at = key.map_or(laps_at, |(k, _)| k.span().start);
+            .find(|e| e.is("front_end", "observation_spacing_m"));
+        let at = key.map_or(laps_at, |e| e.key.span().start);
         let fits = travel_m / MAX_OBSERVATIONS;
         d.at(
             at,
@@ -698,7 +619,7 @@ fn work_budget(spec: &ScenarioSpec, sim: &SimPlan, rec: &RecognizerConfig, d: &m
                  observation_spacing_m = {} or more, or fewer laps",
                 if laps == 1 { "" } else { "s" },
                 sim.route.length_m(),
-                fmt_number(rec.observation_spacing_m),
+                fmt_number(rec.front_end.observation_spacing_m),
                 fmt_number(MAX_OBSERVATIONS),
                 fmt_number((fits * 1000.0).ceil() / 1000.0)
             ),

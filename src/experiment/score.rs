@@ -217,8 +217,10 @@ fn read_run(path: &Path) -> Result<(Vec<Pose2>, Vec<Pose2>), ScoreError> {
 /// (before a run's first observation, that one); `None` in a run without observations.
 fn thin(odom: &[Pose2], runs: &[(usize, usize, usize)]) -> (Vec<Observation>, Vec<Option<usize>>) {
     let defaults = crate::recognizer::RecognizerConfig::default();
-    let mut clock =
-        ObservationClock::new(defaults.observation_spacing_m, defaults.max_interpolation_m);
+    let mut clock = ObservationClock::new(
+        defaults.front_end.observation_spacing_m,
+        defaults.front_end.max_interpolation_m,
+    );
     let mut obs: Vec<Observation> = Vec::new();
     let mut of_scan = vec![None; odom.len()];
     for (run_pos, &(_, start, n)) in runs.iter().enumerate() {

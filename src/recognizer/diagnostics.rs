@@ -1,8 +1,12 @@
 //! What the word matcher saw of a run ([`MatchDiagnostics`]), and how it says so: the
 //! recognizer's side of [`crate::place::Diagnostics`]. A run without pairs is explained from
 //! these counters (the longest chain of matching words against τ, the verification checks that
-//! turned candidates down, the travel τ words need against the revisits' length).
+//! turned candidates down, the travel τ words need against the revisits' length). The matcher's
+//! side of it is here too: the counters it hands over, and the rejected candidates it samples.
 
+use super::matcher::WordMatcher;
+use super::types::Direction;
+use super::words::WordId;
 use crate::place::{CandidateCounts, Diagnostics, RejectedCandidate};
 
 /// Rejected candidates sampled at most (the first ones; 32 bytes each).
@@ -271,4 +275,48 @@ pub fn long_steps_sentence(n: usize) -> String {
 
 fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
+}
+
+/// What the matcher hands over of what it saw.
+impl WordMatcher {
+    /// What the matcher saw so far, to say why nothing matched.
+    pub fn diagnostics(&self) -> MatchDiagnostics {
+        let levels = self.levels;
+        MatchDiagnostics {
+            longest_chain: self.longest[..levels].iter().map(|&l| l as usize).collect(),
+            min_ngram: self.tau[..levels].to_vec(),
+            within_gap: self.within_gap,
+            verification: self.rejections,
+            rejected: self.rejected.clone(),
+            long_steps: 0,
+            reverse_extra_ngram: self.matcher_opts.opposite_extra_ngram(),
+            mean_word_m: if self.level0_words == 0 {
+                0.0
+            } else {
+                self.level0_travel_m / self.level0_words as f64
+            },
+        }
+    }
+
+    /// A rejected candidate's sample: the middle observation of its newest current word `c`,
+    /// and the past observation the n-gram's shift `anchor` aligns with it (clamped into the
+    /// past word `p`).
+    pub(super) fn sample(
+        &self,
+        (c, p): (WordId, WordId),
+        anchor: i64,
+        dir: Direction,
+        reason: Rejection,
+    ) -> RejectedCandidate {
+        let (cw, pw) = (self.word(c), self.word(p));
+        let i = cw.size as i64 / 2;
+        let j = (i + anchor).clamp(0, (pw.size as i64 - 1).max(0));
+        let obs = self.words.observations();
+        RejectedCandidate {
+            query: obs[cw.first_obs + i as usize].id,
+            past: obs[super::align::PastSide::of(pw, dir).index(j)].id,
+            direction: dir,
+            check: reason.index(),
+        }
+    }
 }

@@ -154,16 +154,19 @@ impl DensityFrontEnd {
     pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
         config.validate()?;
         let grid = LocalGrid::with_memory(
-            config.grid_cell_m,
-            config.grid_radius_m,
-            config.grid_memory_m,
-            config.max_interpolation_m + config.kernel_radius_m,
+            config.grid.grid_cell_m,
+            config.grid.grid_radius_m,
+            config.grid.grid_memory_m,
+            config.front_end.max_interpolation_m + config.density.kernel_radius_m,
         );
-        let kernel = DensityKernel::new(config.kernel_radius_cells(), config.ray_step_deg);
+        let kernel = DensityKernel::new(config.kernel_radius_cells(), config.density.ray_step_deg);
         Ok(DensityFrontEnd {
-            clock: ObservationClock::new(config.observation_spacing_m, config.max_interpolation_m),
+            clock: ObservationClock::new(
+                config.front_end.observation_spacing_m,
+                config.front_end.max_interpolation_m,
+            ),
             kernel_cells: config.kernel_radius_cells(),
-            integrate_every_scan: config.integrate_every_scan,
+            integrate_every_scan: config.front_end.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),
             grid,
             kernel,

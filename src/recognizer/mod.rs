@@ -11,6 +11,8 @@
 //! part of its matches ([`WordMatch::to_place`]) and hears its [`MatchDiagnostics`] through
 //! [`crate::place::Diagnostics`].
 
+mod align;
+mod chains;
 pub(crate) mod config;
 pub(crate) mod density;
 pub(crate) mod diagnostics;
@@ -18,17 +20,25 @@ pub(crate) mod frontend;
 pub(crate) mod grid;
 mod index;
 pub(crate) mod matcher;
+pub(crate) mod options;
 /// Synthetic inputs for tests and benchmarks; not part of the API.
 #[doc(hidden)]
 pub(crate) mod types;
+mod verify;
 pub(crate) mod words;
 
-pub use config::{AlignmentMode, ConfigProblem, MultiLevelRule, RecognizerConfig, RecognizerError};
+pub use config::{
+    ConfigProblem, RENAMED_KEYS, RecognizerConfig, RecognizerError, SECTIONS, table_name,
+};
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use diagnostics::{MatchDiagnostics, Rejection, VerificationCounts, long_steps_sentence};
 pub use frontend::{DensityFrontEnd, Due, ObservationClock};
 pub use grid::{Density, LocalGrid};
 pub use matcher::WordMatcher;
+pub use options::{
+    AlignmentMode, AlignmentOptions, DensityOptions, FrontEndOptions, GridOptions, MatcherOptions,
+    MultiLevelRule, VerifyOptions, WordOptions,
+};
 pub use types::{
     AlignedRun, DensityObservation, Direction, FrameId, ObsId, Observation, WordMatch, WordRef,
     push_pair,
@@ -190,7 +200,12 @@ impl Recognizer {
 
 /// The thresholds a level configuration uses (τ0 .. τ(levels-1)).
 pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
-    cfg.min_ngram.iter().copied().take(cfg.levels).collect()
+    cfg.matcher
+        .min_ngram
+        .iter()
+        .copied()
+        .take(cfg.levels)
+        .collect()
 }
 
 fn to_place(matches: Vec<WordMatch>) -> Vec<place::Match> {

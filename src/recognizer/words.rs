@@ -27,7 +27,7 @@
 //! the boundaries crossed puts `A B A` at level 1, `A B C B A` at level 2 and `A B C D C B A` at
 //! level 3, so each level adds the words of deeper bumps that lower levels cannot correct.
 
-use super::config::MultiLevelRule;
+use super::options::MultiLevelRule;
 use super::types::{DensityObservation, Observation, WordRef};
 use crate::geom::wrap_angle;
 

@@ -322,8 +322,9 @@ pub struct ScenarioSpec {
     pub laser: Settings,
     pub odometry: Settings,
     pub robot: Settings,
-    /// `[recognizer]`: each key with its value; the recognizer's model knows the keys.
-    pub recognizer: Vec<(S<String>, toml::Value)>,
+    /// `[recognizer]` and its subtables: each key with its value; the recognizer's model knows
+    /// the keys.
+    pub recognizer: Vec<RecognizerEntry>,
     /// `[scan_context]`: the Scan Context baseline's numbers ([`SCAN_CONTEXT_KEYS`]).
     pub scan_context: Settings,
     /// `[[subjects]]`: recognizers in other processes the scenario runs
@@ -873,7 +874,7 @@ fn check_robot_limits(robot: &Settings, d: &mut Diags) {
 /// A recognizer settings file (`recognize --config`): a `[recognizer]` table, read as a
 /// scenario's, and nothing else (any other key would be silently unused). `None` when the
 /// text is not TOML.
-pub fn read_recognizer_file(src: &str, d: &mut Diags) -> Option<Vec<(S<String>, toml::Value)>> {
+pub fn read_recognizer_file(src: &str, d: &mut Diags) -> Option<Vec<RecognizerEntry>> {
     let doc = crate::spec::read::parse_document(src, d)?;
     let top = doc.get_ref();
     unknown_keys(
@@ -891,23 +892,70 @@ pub fn read_recognizer_file(src: &str, d: &mut Diags) -> Option<Vec<(S<String>, 
     Some(read_recognizer(top, d))
 }
 
-/// `[recognizer]` as plain keys and values; the recognizer's model checks them.
-fn read_recognizer(top: &DeTable<'_>, d: &mut Diags) -> Vec<(S<String>, toml::Value)> {
+/// One key of `[recognizer]` or of one of its subtables, as written.
+#[derive(Clone, Debug)]
+pub struct RecognizerEntry {
+    /// The subtable (`grid` for `[recognizer.grid]`); `None` for a key of `[recognizer]` itself.
+    pub section: Option<S<String>>,
+    pub key: S<String>,
+    pub value: toml::Value,
+}
+
+impl RecognizerEntry {
+    /// Whether this is `key` of subtable `section` (`""`: of `[recognizer]` itself).
+    pub fn is(&self, section: &str, key: &str) -> bool {
+        self.key.get_ref() == key
+            && self.section.as_ref().map_or("", |s| s.get_ref().as_str()) == section
+    }
+}
+
+/// `[recognizer]` and its subtables as plain keys and values, a subtable's keys one by one;
+/// the recognizer's model checks them.
+fn read_recognizer(top: &DeTable<'_>, d: &mut Diags) -> Vec<RecognizerEntry> {
     let Some((_, t)) = table(top, "recognizer", d) else {
         return Vec::new();
     };
-    t.iter()
-        .filter_map(|(k, v)| {
-            let value = plain(v.get_ref());
-            if value.is_none() {
-                d.at(
-                    v.span().start,
-                    format!("`{}` in [recognizer] is out of range", echo(k.get_ref())),
-                );
+    let mut out = Vec::new();
+    for (k, v) in t.iter() {
+        let key = Spanned::new(k.span(), k.get_ref().to_string());
+        match v.get_ref() {
+            DeValue::Table(sub) => {
+                for (k2, v2) in sub.iter() {
+                    let entry = recognizer_entry(Some(key.clone()), k2, v2, d);
+                    out.extend(entry);
+                }
             }
-            Some((Spanned::new(k.span(), k.get_ref().to_string()), value?))
-        })
-        .collect()
+            _ => out.extend(recognizer_entry(None, k, v, d)),
+        }
+    }
+    out
+}
+
+/// One key and its plain value; `None` (reported) when the value is out of range.
+fn recognizer_entry(
+    section: Option<S<String>>,
+    k: &Spanned<std::borrow::Cow<'_, str>>,
+    v: &Spanned<DeValue<'_>>,
+    d: &mut Diags,
+) -> Option<RecognizerEntry> {
+    let Some(value) = plain(v.get_ref()) else {
+        let table = section
+            .as_ref()
+            .map_or(String::new(), |s| format!(".{}", s.get_ref()));
+        d.at(
+            v.span().start,
+            format!(
+                "`{}` in [recognizer{table}] is out of range",
+                echo(k.get_ref())
+            ),
+        );
+        return None;
+    };
+    Some(RecognizerEntry {
+        section,
+        key: Spanned::new(k.span(), k.get_ref().to_string()),
+        value,
+    })
 }
 
 /// The line (1-based) of the scenario text's `[expect]` table, or of its first `[expect.…]` /

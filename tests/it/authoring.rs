@@ -45,10 +45,7 @@ waypoints_m = [[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [0.0, 10.0]]
 }
 
 fn config(levels: usize) -> RecognizerConfig {
-    RecognizerConfig {
-        levels,
-        ..RecognizerConfig::default()
-    }
+    RecognizerConfig::default().with_levels(levels)
 }
 
 #[test]

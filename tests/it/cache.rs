@@ -225,7 +225,7 @@ fn a_recognizer_change_reuses_the_laps_and_a_world_or_robot_change_does_not() {
     let recognizer = smoke_variant(
         dir.path(),
         "recognizer",
-        &format!("[recognizer]\nverify_max_lateral_rms = 0.12\n{GATE}"),
+        &format!("[recognizer.verify]\nverify_max_lateral_rms = 0.12\n{GATE}"),
     );
     assert_eq!(hits_misses(&recognizer), (2, 0), "a recognizer change");
 

@@ -125,7 +125,7 @@ fn check_exits_0_when_met_1_when_missed_and_2_on_a_broken_scenario() {
     let xml = std::fs::read_to_string(&junit).unwrap();
     assert!(xml.contains("<failure"), "{xml}");
 
-    let broken = smoke_variant(dir.path(), "broken", "[recognizer]\nclases = 6\n");
+    let broken = smoke_variant(dir.path(), "broken", "[recognizer.words]\nclases = 6\n");
     let o = placewords(&["check", "-q", broken.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);

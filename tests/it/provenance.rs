@@ -260,7 +260,7 @@ fn the_simulation_key_follows_the_laps_not_the_recognizer() {
     let base = copy_smoke(&dir.path().join("base"), |s| s);
     let other_dir = copy_smoke(&dir.path().join("same"), |s| s);
     let recognizer = copy_smoke(&dir.path().join("rec"), |s| {
-        format!("{s}\n[recognizer]\nmax_candidates = 8\n")
+        format!("{s}\n[recognizer.matcher]\nmax_candidates = 8\n")
     });
     let reseeded = copy_smoke(&dir.path().join("seed"), |s| {
         s.replace("seed = 42", "seed = 43")

@@ -114,45 +114,44 @@ fn wr(level: usize, index: usize) -> WordRef {
 fn config_defaults_parse_and_validate() {
     let c: RecognizerConfig = toml::from_str("").unwrap();
     assert_eq!(c, RecognizerConfig::default());
-    assert_eq!(c.min_ngram, vec![6, 9, 12, 15]);
+    assert_eq!(c.matcher.min_ngram, vec![6, 9, 12, 15]);
     assert!(c.validate().is_ok());
-    let c: RecognizerConfig = toml::from_str("levels = 2\nmin_ngram = [4, 8]").unwrap();
+    let c: RecognizerConfig = toml::from_str("levels = 2\n[matcher]\nmin_ngram = [4, 8]").unwrap();
     assert!(c.validate().is_ok());
     assert!(
         toml::from_str::<RecognizerConfig>("level = 2").is_err(),
         "unknown keys are refused"
     );
-    let bad = RecognizerConfig {
-        levels: 5,
-        kernel_radius_m: 4.0,
-        min_ngram: vec![6],
-        ..Default::default()
-    };
-    let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
-    assert_eq!(fields, vec!["kernel_radius_m", "levels", "min_ngram"]);
+    let mut bad = RecognizerConfig::default();
+    bad.levels = 5;
+    bad.density.kernel_radius_m = 4.0;
+    bad.matcher.min_ngram = vec![6];
+    let keys: Vec<String> = bad
+        .problems()
+        .iter()
+        .map(|p| format!("{}.{}", p.section, p.field))
+        .collect();
+    assert_eq!(
+        keys,
+        vec![".levels", "matcher.min_ngram", "density.kernel_radius_m"]
+    );
     assert!(Recognizer::new(bad).is_err());
-    let bad = RecognizerConfig {
-        ngram_travel_m: -1.0,
-        chain_alignment_tie: f64::NAN,
-        ..Default::default()
-    };
+    let mut bad = RecognizerConfig::default();
+    bad.matcher.ngram_travel_m = -1.0;
+    bad.alignment.chain_alignment_tie = f64::NAN;
     let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
     assert_eq!(fields, vec!["ngram_travel_m", "chain_alignment_tie"]);
     // Fine cells with a long interpolation limit would need a torus of gigabytes.
-    let bad = RecognizerConfig {
-        grid_cell_m: 0.001,
-        grid_radius_m: 0.9,
-        grid_memory_m: 0.95,
-        kernel_radius_m: 0.8,
-        ..Default::default()
-    };
+    let mut bad = RecognizerConfig::default();
+    bad.grid.grid_cell_m = 0.001;
+    bad.grid.grid_radius_m = 0.9;
+    bad.grid.grid_memory_m = 0.95;
+    bad.density.kernel_radius_m = 0.8;
     let fields: Vec<&str> = bad.problems().iter().map(|p| p.field).collect();
     assert_eq!(fields, vec!["max_interpolation_m"]);
     // The grid must remember at least what a scan traces.
-    let bad = RecognizerConfig {
-        grid_memory_m: 2.0,
-        ..Default::default()
-    };
+    let mut bad = RecognizerConfig::default();
+    bad.grid.grid_memory_m = 2.0;
     let problems = bad.problems();
     assert_eq!(problems.len(), 1);
     assert_eq!(problems[0].field, "grid_memory_m");
@@ -167,7 +166,7 @@ fn config_defaults_parse_and_validate() {
 /// a word with A = -90°.
 #[test]
 fn fig2_words_from_a_synthetic_path() {
-    let cfg = config(|c| c.classes = 3);
+    let cfg = config(|c| c.words.classes = 3);
     let (corridor, corner, bifurcation) = (class_psi(0, 3), class_psi(1, 3), class_psi(2, 3));
     let obs = synth::observations(
         &[
@@ -206,8 +205,8 @@ fn fig2_words_from_a_synthetic_path() {
 #[test]
 fn fig4_level1_word_holds_all_observations() {
     let cfg = config(|c| {
-        c.min_word_size = 3;
-        c.multi_level = MultiLevelRule::Paper;
+        c.words.min_word_size = 3;
+        c.words.multi_level = MultiLevelRule::Paper;
     });
     let (g, b) = (class_psi(5, 8), class_psi(2, 8));
     let obs = synth::observations(
@@ -231,9 +230,9 @@ fn fig4_level1_word_holds_all_observations() {
 #[test]
 fn fig4_full_multilevel_set_and_predecessors() {
     let cfg = config(|c| {
-        c.min_word_size = 3;
+        c.words.min_word_size = 3;
         c.levels = 4;
-        c.multi_level = MultiLevelRule::Paper;
+        c.words.multi_level = MultiLevelRule::Paper;
     });
     let (g, b) = (class_psi(5, 8), class_psi(2, 8));
     let obs = synth::observations(
@@ -306,7 +305,7 @@ fn a_bump_across_two_class_boundaries_is_a_level2_word() {
     let words_with = |rule| {
         let cfg = config(|c| {
             c.levels = 4;
-            c.multi_level = rule;
+            c.words.multi_level = rule;
         });
         let (m, _) = run_matcher(&cfg, &obs);
         (1..4).map(|l| summary(m.words(), l)).collect::<Vec<_>>()
@@ -424,7 +423,7 @@ fn repeated_sequence_matches_and_shuffled_does_not() {
         assert_eq!(seen.len(), n, "configuration {k} repeats word pairs");
     }
     for m in &matches {
-        assert!(m.ngram_len >= cfg.min_ngram[m.levels - 1]);
+        assert!(m.ngram_len >= cfg.matcher.min_ngram[m.levels - 1]);
         assert!(!m.word_pairs.is_empty());
     }
 
@@ -493,7 +492,7 @@ fn reversed_lap_matches_in_the_opposite_direction() {
             "query {query} paired with {past}, its place is {mirror}"
         );
     }
-    let off = config(|c| c.reverse = false);
+    let off = config(|c| c.matcher.reverse = false);
     let (_, matches) = run_matcher(&off, &all);
     assert!(matches.is_empty(), "reverse = false finds nothing");
 }
@@ -659,8 +658,8 @@ fn replay_splits_runs_by_observation_run() {
 fn alignment_recovers_a_shift() {
     let cfg = config(|c| {
         c.levels = 1;
-        c.min_ngram = vec![3];
-        c.candidate_gap_m = 5.0;
+        c.matcher.min_ngram = vec![3];
+        c.matcher.candidate_gap_m = 5.0;
     });
     // A corridor whose Ψ has a distinctive ramp, seen twice; the second time its words start
     // 3 observations later relative to the ramp.
@@ -1065,9 +1064,9 @@ proptest! {
         gap in 1.0f64..8.0,
     ) {
         let cfg = config(|c| {
-            c.min_word_size = 2;
-            c.min_ngram = vec![2, 3, 4];
-            c.candidate_gap_m = gap;
+            c.words.min_word_size = 2;
+            c.matcher.min_ngram = vec![2, 3, 4];
+            c.matcher.candidate_gap_m = gap;
         });
         let mut r = SplitMix::new(seed);
         let stretches: Vec<Stretch> = (0..60)
@@ -1110,9 +1109,9 @@ fn brute_chain(
     let ok = cw.level < k
         && pw.level < k
         && cw.class == pw.class
-        && (sa - sb).abs() <= cfg.size_tolerance_ratio * sa.max(sb) + 1e-9
-        && da <= cfg.angle_tolerance_deg + 1e-9
-        && pw.end_travel_m + cfg.candidate_gap_m <= cw.start_travel_m + 1e-9;
+        && (sa - sb).abs() <= cfg.matcher.size_tolerance_ratio * sa.max(sb) + 1e-9
+        && da <= cfg.matcher.angle_tolerance_deg + 1e-9
+        && pw.end_travel_m + cfg.matcher.candidate_gap_m <= cw.start_travel_m + 1e-9;
     let v = if !ok {
         0
     } else {
@@ -1163,11 +1162,11 @@ proptest! {
     #[test]
     fn matching_finds_every_long_enough_chain(seed in 0u64..100_000) {
         let cfg = config(|c| {
-            c.min_word_size = 2;
-            c.min_ngram = vec![3, 4, 5];
-            c.candidate_gap_m = 2.0;
+            c.words.min_word_size = 2;
+            c.matcher.min_ngram = vec![3, 4, 5];
+            c.matcher.candidate_gap_m = 2.0;
             // This checks the chain search; verification is tested on its own.
-            c.verify = false;
+            c.verify.enabled = false;
         });
         let mut r = SplitMix::new(seed);
         let base: Vec<Stretch> = (0..25)
@@ -1183,7 +1182,7 @@ proptest! {
             w.all_words().iter().position(|x| x.level == r.level && x.index == r.index).unwrap() as u32
         };
         for k in 1..=3 {
-            let tau = cfg.min_ngram[k - 1];
+            let tau = cfg.matcher.min_ngram[k - 1];
             let reported: std::collections::HashSet<(u32, u32)> = matches
                 .iter()
                 .filter(|mt| mt.levels == k && mt.direction == Direction::Same)
@@ -1202,7 +1201,7 @@ proptest! {
                     // that word in different places: check when the earliest of them passes.
                     if len == tau {
                         let first = earliest_first(w, &cfg, k, c, p, tau - 1, &mut memo);
-                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.candidate_gap_m {
+                        if first + 1e-9 >= w.word(p).end_travel_m + cfg.matcher.candidate_gap_m {
                             prop_assert!(
                                 reported.contains(&(c, p)),
                                 "configuration {k}: chain of {len} ending at ({c}, {p}) not reported"
@@ -1308,7 +1307,7 @@ fn sparser_real_log_matches_on_every_noise_seed() {
 /// scan with the old 3 m limit names the steps it observed once.
 #[test]
 fn too_long_steps_are_named_when_nothing_matches() {
-    let cfg = config(|c| c.max_interpolation_m = 3.0);
+    let cfg = config(|c| c.front_end.max_interpolation_m = 3.0);
     let Some(scores) = real_log_scores_with("intel", 3, 1, &cfg) else {
         return;
     };
@@ -1330,9 +1329,9 @@ fn too_long_steps_are_named_when_nothing_matches() {
 fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
     for tau in [30, 45] {
         let cfg = config(|c| {
-            c.min_ngram = vec![tau; 4];
-            c.ngram_travel_m = 0.0;
-            c.reverse_ngram_travel_m = 0.0;
+            c.matcher.min_ngram = vec![tau; 4];
+            c.matcher.ngram_travel_m = 0.0;
+            c.matcher.reverse_ngram_travel_m = 0.0;
         });
         let Some(scores) = real_log_scores_with("intel", 1, 1, &cfg) else {
             return;
@@ -1347,7 +1346,7 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
         );
         assert!(same_m > 40.0 && opposite_m > 40.0, "{same_m} {opposite_m}");
         assert!(scores.longest_revisit_m >= same_m.max(opposite_m), "{why}");
-        let backwards = tau + cfg.reverse_extra_ngram;
+        let backwards = tau + cfg.matcher.reverse_extra_ngram;
         let too_short =
             same_m < tau as f64 * d.mean_word_m && opposite_m < backwards as f64 * d.mean_word_m;
         assert_eq!(why.contains("too short for a chain"), too_short, "{why}");
@@ -1477,7 +1476,7 @@ fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
     let layout = synth::lms200();
     let inputs = corridor_inputs(&layout);
     let count = |max_interpolation_m: f64| {
-        let cfg = config(|c| c.max_interpolation_m = max_interpolation_m);
+        let cfg = config(|c| c.front_end.max_interpolation_m = max_interpolation_m);
         let mut fe = DensityFrontEnd::new(&cfg).unwrap();
         let obs: Vec<DensityObservation> = inputs
             .iter()
@@ -1491,7 +1490,7 @@ fn steps_up_to_the_interpolation_limit_are_observed_along_their_length() {
     };
     // 6 steps of 4.4 m: 26.4 m of travel.
     assert_eq!(
-        count(RecognizerConfig::default().max_interpolation_m),
+        count(RecognizerConfig::default().front_end.max_interpolation_m),
         (264, 0)
     );
     assert_eq!(
@@ -1508,7 +1507,7 @@ fn one_scan_per_step_bounds_psi_against_every_scan() {
     let layout = synth::lms200();
     let inputs = corridor_inputs(&layout);
     let psi = |every: bool| -> Vec<f64> {
-        let cfg = config(|c| c.integrate_every_scan = every);
+        let cfg = config(|c| c.front_end.integrate_every_scan = every);
         let mut fe = DensityFrontEnd::new(&cfg).unwrap();
         inputs
             .iter()
@@ -1547,7 +1546,7 @@ fn decreasing_travel_is_refused() {
 /// pass with Ψ shifted within every class), and says why; the same pass unshifted is accepted.
 #[test]
 fn verification_rejects_a_density_mismatch_and_counts_it() {
-    let cfg = config(|c| c.verify_max_psi_rms = 0.03);
+    let cfg = config(|c| c.verify.verify_max_psi_rms = 0.03);
     let lap = random_stretches(7, 40);
     let first = synth::observations(&lap, 0.1, 0, None);
     for (shift, expect_pairs) in [(0.0, true), (0.05, false)] {
@@ -1603,9 +1602,9 @@ fn substituted_laps(size: usize) -> (Vec<Stretch>, Vec<Stretch>, RecognizerConfi
     changed[5].size = size;
     let base = config(|c| {
         c.levels = 1;
-        c.candidate_gap_m = 5.0;
-        c.substitutions = false;
-        c.reverse = false;
+        c.matcher.candidate_gap_m = 5.0;
+        c.matcher.substitutions = false;
+        c.matcher.reverse = false;
     });
     (lap, changed, base)
 }
@@ -1622,10 +1621,8 @@ fn a_substituted_word_is_bridged_only_with_substitutions() {
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let (_, plain) = run_matcher(&base, &all);
     assert!(plain.is_empty(), "5-word chains must not reach τ = 6");
-    let bridged = RecognizerConfig {
-        substitutions: true,
-        ..base
-    };
+    let mut bridged = base;
+    bridged.matcher.substitutions = true;
     let (_, matches) = run_matcher(&bridged, &all);
     assert!(!matches.is_empty(), "the bridged chain reaches τ");
     let n = first.len();
@@ -1648,16 +1645,12 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
     let first = synth::observations(&lap, 0.1, 0, None);
     let second = synth::observations(&changed, 0.1, 0, first.last());
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
-    let bridged = RecognizerConfig {
-        substitutions: true,
-        ..base.clone()
-    };
-    assert_eq!(bridged.substitution_size_ratio, 0.3);
+    let mut bridged = base.clone();
+    bridged.matcher.substitutions = true;
+    assert_eq!(bridged.matcher.substitution_size_ratio, 0.3);
     assert!(run_matcher(&bridged, &all).1.is_empty());
-    let loose = RecognizerConfig {
-        substitution_size_ratio: 0.4,
-        ..bridged
-    };
+    let mut loose = bridged;
+    loose.matcher.substitution_size_ratio = 0.4;
     assert!(!run_matcher(&loose, &all).1.is_empty());
 }
 
@@ -1687,9 +1680,9 @@ fn corridor_of_long_words(
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
     let base = config(|c| {
         c.levels = 1;
-        c.candidate_gap_m = 5.0;
-        c.ngram_travel_m = 0.0;
-        c.reverse_ngram_travel_m = 0.0;
+        c.matcher.candidate_gap_m = 5.0;
+        c.matcher.ngram_travel_m = 0.0;
+        c.matcher.reverse_ngram_travel_m = 0.0;
     });
     (first.len(), all, base)
 }
@@ -1700,10 +1693,8 @@ fn corridor_of_long_words(
 fn long_words_match_by_travel_when_asked() {
     let (n, all, base) = corridor_of_long_words(&[0.3, 0.6, 0.2, 0.7, 0.4], 60, false, 0.0);
     assert!(run_matcher(&base, &all).1.is_empty());
-    let by_travel = RecognizerConfig {
-        ngram_travel_m: 12.0,
-        ..base
-    };
+    let mut by_travel = base;
+    by_travel.matcher.ngram_travel_m = 12.0;
     let (_, matches) = run_matcher(&by_travel, &all);
     assert!(!matches.is_empty());
     assert!(matches.iter().all(|m| m.ngram_len >= 4));
@@ -1721,10 +1712,8 @@ fn long_words_match_by_travel_when_asked() {
 fn long_words_driven_back_match_by_travel_when_asked() {
     let psis = [0.3, 0.6, 0.2, 0.7, 0.4, 0.5, 0.1];
     let (_, straight, base) = corridor_of_long_words(&psis, 40, true, 0.0);
-    let by_travel = RecognizerConfig {
-        reverse_ngram_travel_m: 12.0,
-        ..base.clone()
-    };
+    let mut by_travel = base.clone();
+    by_travel.matcher.reverse_ngram_travel_m = 12.0;
     let (m, matches) = run_matcher(&by_travel, &straight);
     assert!(matches.is_empty(), "a straight corridor read backwards");
     assert!(

@@ -109,12 +109,23 @@ fn set(keys: &[&str]) -> BTreeSet<String> {
 #[test]
 fn each_schema_table_holds_the_readers_keys() {
     use placewords::spec::{evaluation as ev, scenario as sc, world as wo};
-    let recognizer = toml::Table::try_from(placewords::recognizer::RecognizerConfig::default())
-        .unwrap()
+    let defaults =
+        toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
+    let recognizer = defaults
         .keys()
         .filter(|k| !sc::RECOGNIZER_HARNESS_KEYS.contains(&k.as_str()))
         .cloned()
         .collect::<BTreeSet<_>>();
+    // Each subtable of `[recognizer]` (`recognizer.grid`) with its keys.
+    let subtables: Vec<(String, BTreeSet<String>)> = defaults
+        .iter()
+        .filter_map(|(k, v)| {
+            Some((
+                format!("recognizer.{k}"),
+                v.as_table()?.keys().cloned().collect(),
+            ))
+        })
+        .collect();
     let expected: [(FileKind, Vec<Table>); 2] = [
         (
             FileKind::World,
@@ -146,7 +157,10 @@ fn each_schema_table_holds_the_readers_keys() {
                 ("expect.subjects[].same", set(ev::EXPECT_DIRECTION_KEYS)),
                 ("expect.subjects[].opposite", set(ev::EXPECT_DIRECTION_KEYS)),
                 ("expect.regression", set(ev::EXPECT_REGRESSION_KEYS)),
-            ],
+            ]
+            .into_iter()
+            .chain(subtables.iter().map(|(p, k)| (p.as_str(), k.clone())))
+            .collect(),
         ),
     ];
     let mut wrong = Vec::new();

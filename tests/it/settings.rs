@@ -20,79 +20,86 @@ enum Input {
     Sparse,
 }
 
-/// Per documented key: a value other than the default, settings it needs to matter (`context`),
-/// and the input it matters on.
+/// Per documented key (`subtable.key`): a value other than the default, settings it needs to
+/// matter (`context`, dotted keys of `[recognizer]`), and the input it matters on.
 const TRIES: &[(&str, &str, &str, Input)] = &[
-    ("observation_spacing_m", "0.15", "", Input::Dense),
-    ("integrate_every_scan", "true", "", Input::Dense),
-    ("grid_cell_m", "0.1", "", Input::Dense),
-    ("grid_radius_m", "2.5", "", Input::Dense),
-    ("kernel_radius_m", "1.5", "", Input::Dense),
-    ("ray_step_deg", "5.0", "", Input::Dense),
-    ("classes", "5", "", Input::Dense),
-    ("min_word_size", "3", "", Input::Dense),
-    ("size_tolerance_ratio", "0.6", "", Input::Dense),
-    ("angle_tolerance_deg", "90", "", Input::Dense),
-    ("min_ngram", "[2, 3, 4, 5]", "", Input::Dense),
+    ("front_end.observation_spacing_m", "0.15", "", Input::Dense),
+    ("front_end.integrate_every_scan", "true", "", Input::Dense),
+    ("grid.grid_cell_m", "0.1", "", Input::Dense),
+    ("grid.grid_radius_m", "2.5", "", Input::Dense),
+    ("density.kernel_radius_m", "1.5", "", Input::Dense),
+    ("density.ray_step_deg", "5.0", "", Input::Dense),
+    ("words.classes", "5", "", Input::Dense),
+    ("words.min_word_size", "3", "", Input::Dense),
+    ("matcher.size_tolerance_ratio", "0.6", "", Input::Dense),
+    ("matcher.angle_tolerance_deg", "90", "", Input::Dense),
+    ("matcher.min_ngram", "[2, 3, 4, 5]", "", Input::Dense),
     (
-        "max_alignment_offset",
+        "alignment.max_alignment_offset",
         "2",
-        "alignment = \"paper\"",
+        "alignment.mode = \"paper\"",
         Input::Dense,
     ),
-    ("candidate_gap_m", "80", "", Input::Dense),
-    ("max_candidates", "1", "", Input::Dense),
-    ("max_interpolation_m", "0.5", "", Input::Sparse),
-    ("grid_memory_m", "3.0", "", Input::Sparse),
+    ("matcher.candidate_gap_m", "80", "", Input::Dense),
+    ("matcher.max_candidates", "1", "", Input::Dense),
+    ("front_end.max_interpolation_m", "0.5", "", Input::Sparse),
+    ("grid.grid_memory_m", "3.0", "", Input::Sparse),
     (
-        "multi_level",
+        "words.multi_level",
         "\"paper\"",
-        "min_ngram = [2, 3, 4, 5]",
+        "matcher.min_ngram = [2, 3, 4, 5]",
         Input::Dense,
     ),
-    ("alignment", "\"paper\"", "", Input::Dense),
-    ("chain_alignment_offset", "0", "", Input::Dense),
-    ("chain_alignment_tie", "0.05", "", Input::Dense),
-    ("reverse", "false", "", Input::Dense),
-    ("reverse_extra_ngram", "0", "", Input::Dense),
-    ("substitutions", "false", "", Input::Dense),
-    ("substitution_size_ratio", "1.0", "", Input::Dense),
-    ("ngram_travel_m", "5", "", Input::Dense),
+    ("alignment.mode", "\"paper\"", "", Input::Dense),
+    ("alignment.chain_alignment_offset", "0", "", Input::Dense),
+    ("alignment.chain_alignment_tie", "0.05", "", Input::Dense),
+    ("matcher.reverse", "false", "", Input::Dense),
+    ("matcher.reverse_extra_ngram", "0", "", Input::Dense),
+    ("matcher.substitutions", "false", "", Input::Dense),
+    ("matcher.substitution_size_ratio", "1.0", "", Input::Dense),
+    ("matcher.ngram_travel_m", "5", "", Input::Dense),
     (
-        "ngram_travel_min_words",
+        "matcher.ngram_travel_min_words",
         "2",
-        "ngram_travel_m = 5",
+        "matcher.ngram_travel_m = 5",
         Input::Dense,
     ),
-    ("reverse_ngram_travel_m", "5", "", Input::Dense),
-    ("verify", "false", "", Input::Dense),
-    ("verify_travel_ratio", "0.01", "", Input::Dense),
+    ("matcher.reverse_ngram_travel_m", "5", "", Input::Dense),
+    ("verify.enabled", "false", "", Input::Dense),
+    ("verify.verify_travel_ratio", "0.01", "", Input::Dense),
     (
-        "verify_travel_slack_m",
+        "verify.verify_travel_slack_m",
         "0.01",
-        "verify_travel_ratio = 0.01",
+        "verify.verify_travel_ratio = 0.01",
         Input::Dense,
     ),
-    ("verify_turn_deg", "2", "", Input::Dense),
-    ("verify_max_psi_rms", "0.005", "", Input::Dense),
-    ("verify_max_lateral_rms", "0.001", LOOSE, Input::Dense),
+    ("verify.verify_turn_deg", "2", "", Input::Dense),
+    ("verify.verify_max_psi_rms", "0.005", "", Input::Dense),
     (
-        "reverse_verify_max_lateral_rms",
+        "verify.verify_max_lateral_rms",
         "0.001",
         LOOSE,
         Input::Dense,
     ),
-    ("reverse_min_turn_deg", "0", LOOSE, Input::Dense),
+    (
+        "verify.reverse_verify_max_lateral_rms",
+        "0.001",
+        LOOSE,
+        Input::Dense,
+    ),
+    ("verify.reverse_min_turn_deg", "0", LOOSE, Input::Dense),
 ];
 
 /// Short chains, read backwards as readily, with a loose density check: candidates reach the
 /// later checks (sides, turn) in numbers.
-const LOOSE: &str = "min_ngram = [2, 3, 4, 5]\nreverse_extra_ngram = 0\nverify_max_psi_rms = 1.0";
+const LOOSE: &str = "matcher.min_ngram = [2, 3, 4, 5]\nmatcher.reverse_extra_ngram = 0\n\
+                     verify.verify_max_psi_rms = 1.0";
 
 /// Keys a file may not set, with a word the refusal must contain.
 const REFUSED: &[(&str, &str, &str)] = &[("levels", "1", "--levels")];
 
-/// The keys `docs/scenario-format.md` documents in its `[recognizer]` table.
+/// The keys `docs/scenario-format.md` documents in the tables of its `[recognizer]` section,
+/// as `subtable.key` (each table under a heading `` ### `[recognizer.subtable]` ``).
 fn documented_keys() -> Vec<String> {
     let doc = std::fs::read_to_string(root().join("docs/scenario-format.md")).unwrap();
     let at = doc
@@ -100,11 +107,34 @@ fn documented_keys() -> Vec<String> {
         .expect("the format documents [recognizer]");
     let section = &doc[at..];
     let end = section[3..].find("\n## ").map_or(section.len(), |i| i + 3);
-    section[..end]
-        .lines()
-        .filter_map(|l| l.strip_prefix("| `"))
-        .filter_map(|l| l.split_once('`').map(|(k, _)| k.to_string()))
-        .collect()
+    let mut table = None;
+    let mut keys = Vec::new();
+    for l in section[..end].lines() {
+        if let Some(h) = l.strip_prefix("### `[recognizer.") {
+            table = h.split_once(']').map(|(t, _)| t.to_string());
+        } else if let Some(row) = l.strip_prefix("| `") {
+            let key = row.split_once('`').map(|(k, _)| k).unwrap();
+            let table = table
+                .as_deref()
+                .expect("a key row under a [recognizer.…] heading");
+            keys.push(format!("{table}.{key}"));
+        }
+    }
+    keys
+}
+
+/// Every key of the settings as `subtable.key` (or `key` at the top).
+fn setting_keys() -> Vec<String> {
+    let defaults =
+        toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
+    let mut out = Vec::new();
+    for (k, v) in &defaults {
+        match v.as_table() {
+            Some(t) => out.extend(t.keys().map(|k2| format!("{k}.{k2}"))),
+            None => out.push(k.clone()),
+        }
+    }
+    out
 }
 
 fn reverse_smoke(dir: &Path) -> placewords::experiment::Scenario {
@@ -168,23 +198,21 @@ fn found(settings: &str, runs: &[RunLog], seed: u64) -> String {
 
 #[test]
 fn every_documented_recognizer_key_changes_the_run_or_is_refused() {
-    let documented = documented_keys();
+    let mut documented = documented_keys();
     let mut tried: Vec<&str> = TRIES.iter().map(|t| t.0).collect();
-    tried.extend(REFUSED.iter().map(|t| t.0));
-    let mut a = documented.clone();
-    a.sort();
+    documented.sort();
     tried.sort();
     assert_eq!(
-        a, tried,
-        "docs/scenario-format.md's [recognizer] keys and the keys tried here"
+        documented, tried,
+        "docs/scenario-format.md's [recognizer.…] keys and the keys tried here"
     );
-    let defaults =
-        toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
-    let mut fields: Vec<&str> = defaults.keys().map(String::as_str).collect();
+    tried.extend(REFUSED.iter().map(|t| t.0));
+    tried.sort();
+    let mut fields = setting_keys();
     fields.sort();
     assert_eq!(
         tried, fields,
-        "every RecognizerConfig field is documented and tried"
+        "every RecognizerConfig field is documented and tried, or refused"
     );
 
     for (key, value, word) in REFUSED {
@@ -273,17 +301,20 @@ fn settings_from_a_toml_file() {
     use placewords::experiment::parse_recognizer_config;
     let path = std::path::Path::new("my.toml");
     let c = parse_recognizer_config(
-        "[recognizer]\nalignment = \"paper\"\nverify = false\n",
+        "[recognizer.alignment]\nmode = \"paper\"\n[recognizer.verify]\nenabled = false\n",
         path,
     )
     .unwrap();
-    assert_eq!(c.alignment, placewords::recognizer::AlignmentMode::Paper);
-    assert!(!c.verify);
-    let e = parse_recognizer_config("[recognizer]\n\nverfy = false\n", path)
+    assert_eq!(
+        c.alignment.mode,
+        placewords::recognizer::AlignmentMode::Paper
+    );
+    assert!(!c.verify.enabled);
+    let e = parse_recognizer_config("[recognizer.verify]\n\nverfy_turn_deg = 3\n", path)
         .unwrap_err()
         .to_string();
     assert!(
-        e.starts_with("my.toml:3:1: ") && e.contains("did you mean `verify`"),
+        e.starts_with("my.toml:3:1: ") && e.contains("did you mean `verify_turn_deg`"),
         "{e}"
     );
     let e = parse_recognizer_config("[recognizer]\nlevels = 1\n", path)
@@ -293,12 +324,56 @@ fn settings_from_a_toml_file() {
         e.starts_with("my.toml:2:1: ") && e.contains("--levels"),
         "{e}"
     );
-    let e = parse_recognizer_config("x = 1\n[recognizer]\nclasses = 0\n", path)
+    let e = parse_recognizer_config("x = 1\n[recognizer.words]\nclasses = 0\n", path)
         .unwrap_err()
         .to_string();
     assert!(
         e.contains("my.toml:1:1: ") && e.contains("[recognizer] table only"),
         "{e}"
     );
-    assert!(e.contains("my.toml:3:1: ") && e.contains("classes"), "{e}");
+    assert!(
+        e.contains("my.toml:3:1: [recognizer.words] classes: must be between 1 and 255"),
+        "{e}"
+    );
+}
+
+/// A file written before the subtables: each flat key of `[recognizer]` is refused at its
+/// place with the subtable it moved to (and its new name, for the two renamed); a key in the
+/// wrong subtable names the right one; a misspelt key or subtable gets a "did you mean".
+#[test]
+fn flat_keys_say_where_they_moved() {
+    let path = Path::new("old.toml");
+    let err = |src: &str| parse_recognizer_config(src, path).unwrap_err().to_string();
+    for key in setting_keys() {
+        let Some((table, new)) = key.split_once('.') else {
+            continue;
+        };
+        let renamed = [("mode", "alignment"), ("enabled", "verify")];
+        let old = renamed.iter().find(|r| r.0 == new).map_or(new, |r| r.1);
+        let defaults =
+            toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
+        let value = defaults[table][new].to_string();
+        let e = err(&format!("[recognizer]\n# before\n{old} = {value}\n"));
+        let want = format!(
+            "old.toml:3:1: `{old}` is no longer a key of [recognizer] itself: move {old} into [recognizer.{table}]"
+        );
+        assert!(e.starts_with(&want), "{key}: {e}");
+        assert_eq!(e.lines().count(), 1, "{e}");
+        if old != new {
+            assert!(e.contains(&format!("as `{new} = {value}`")), "{e}");
+        }
+    }
+    let e = err("[recognizer.grid]\nkernel_radius_m = 2.0\n");
+    assert!(
+        e.starts_with("old.toml:2:1: ") && e.contains("move it into [recognizer.density]"),
+        "{e}"
+    );
+    let e = err("[recognizer]\nkernal_radius_m = 2.0\n");
+    assert!(
+        e.starts_with("old.toml:2:1: ")
+            && e.contains("did you mean `kernel_radius_m` in [recognizer.density]"),
+        "{e}"
+    );
+    let e = err("[recognizer.grd]\ngrid_cell_m = 0.1\n");
+    assert!(e.contains("did you mean `grid`"), "{e}");
 }

@@ -733,7 +733,7 @@ wheel_radius_mismatch_ratio = 0.001
 [robot]
 cruise_speed_m_s = 0.5
 max_turn_rate_deg_s = 90
-[recognizer]
+[recognizer.words]
 min_word_size = 4
 [evaluation]
 tp_radius_m = 1.5
@@ -769,7 +769,7 @@ min_precision = 0.9
             open_probability: 0.25
         }
     );
-    assert_eq!(scn.recognizer.min_word_size, 4);
+    assert_eq!(scn.recognizer.words.min_word_size, 4);
     assert_eq!(scn.evaluation.tp_radius_m, 1.5);
     assert_eq!(scn.expect.subjects[0].min_precision, Some(0.9));
     // Door states per lap follow the plan.

@@ -298,7 +298,14 @@ fn the_format_reference_names_every_key() {
     use placewords::spec::{evaluation as ev, scenario as sc, world as wo};
     let recognizer =
         toml::Table::try_from(placewords::recognizer::RecognizerConfig::default()).unwrap();
-    let recognizer_keys: Vec<&str> = recognizer.keys().map(String::as_str).collect();
+    // The keys of every subtable (`[recognizer.grid] grid_cell_m`) and of `[recognizer]` itself.
+    let recognizer_keys: Vec<&str> = recognizer
+        .iter()
+        .flat_map(|(k, v)| match v.as_table() {
+            Some(t) => t.keys().map(String::as_str).collect(),
+            None => vec![k.as_str()],
+        })
+        .collect();
     let docs: [(&str, Vec<&[&str]>); 2] = [
         (
             "docs/world-format.md",

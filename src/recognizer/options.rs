@@ -1,0 +1,683 @@
+//! The recognizer's options, one struct per component, each with its defaults (docs/design.md,
+//! Recognizer choices), its units and its own checks. A file sets them as subtables of
+//! `[recognizer]` named after the component: `[recognizer.front_end]`, `[recognizer.grid]`,
+//! `[recognizer.density]`, `[recognizer.words]`, `[recognizer.matcher]`,
+//! `[recognizer.alignment]`, `[recognizer.verify]` (docs/scenario-format.md). What crosses two
+//! components (the kernel inside the grid, say) is checked by `RecognizerConfig::problems`.
+
+use super::config::ConfigProblem;
+use crate::spec::diag::fmt_number;
+use serde::{Deserialize, Serialize};
+
+/// Smallest `observation_spacing_m`, metres: the observations (and their memory) grow as
+/// travel / spacing, and a real log at 1e-4 m runs for minutes.
+pub const MIN_OBSERVATION_SPACING_M: f64 = 0.01;
+/// Largest `max_alignment_offset` and `chain_alignment_offset`, observations: each shift is
+/// tried for every matched pair (1e9 never finishes).
+pub const MAX_ALIGNMENT_OFFSET: usize = 1000;
+/// Largest local grid the recognizer accepts, cells from the centre to the edge.
+pub const MAX_GRID_HALF_CELLS: f64 = 1000.0;
+
+fn positive(v: f64) -> bool {
+    v.is_finite() && v > 0.0
+}
+
+/// Problems of one options table, each located by its key.
+struct Problems {
+    section: &'static str,
+    out: Vec<ConfigProblem>,
+}
+
+impl Problems {
+    fn new(section: &'static str) -> Self {
+        Problems {
+            section,
+            out: Vec::new(),
+        }
+    }
+
+    fn bad(&mut self, field: &'static str, problem: String) {
+        self.out
+            .push(ConfigProblem::new(self.section, field, problem));
+    }
+
+    /// `field` must be a finite number of at least 0.
+    fn non_negative(&mut self, field: &'static str, v: f64) {
+        if !(v.is_finite() && v >= 0.0) {
+            self.bad(
+                field,
+                format!("must be a number of at least 0, got {}", fmt_number(v)),
+            );
+        }
+    }
+
+    /// `field` must lie in `range` (`shown` as written in the message).
+    fn within(&mut self, field: &'static str, v: f64, ok: bool, shown: &str, default: &str) {
+        if !(v.is_finite() && ok) {
+            self.bad(
+                field,
+                format!(
+                    "must be in {shown}, got {}; the default is {default}",
+                    fmt_number(v)
+                ),
+            );
+        }
+    }
+}
+
+/// Front end (paper §II): when observations are made along the odometry, and how scans reach
+/// the local grid. `[recognizer.front_end]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct FrontEndOptions {
+    /// Odometric travel between two observations, metres. Default 0.10.
+    pub observation_spacing_m: f64,
+    /// Longest step between two scans along which observations are interpolated, metres: a scan
+    /// after a step of up to this length makes one observation per spacing passed, at poses along
+    /// the step; a longer jump makes one observation at the new pose. The local grid's torus
+    /// reaches far enough that those observations' kernels never read its far side (cells
+    /// farther than `grid_memory_m` from the robot read as unknown). Default 5.0: Intel thinned
+    /// to every 3rd scan has steps up to 3.1 m (3.3 m with odometry noise); at 3.0 each longer
+    /// step left a gap of one observation where 30 were due, words broke there, and no noise
+    /// seed 1–5 gave a pair (with 4.0 or 5.0 all five do, precision 0.995; every 4th scan, steps
+    /// up to 4.2 m, needs 5.0).
+    pub max_interpolation_m: f64,
+    /// Integrate every scan into the local grid, instead of one scan per observation step as the
+    /// authors' code does. Default false.
+    pub integrate_every_scan: bool,
+}
+
+impl Default for FrontEndOptions {
+    fn default() -> Self {
+        FrontEndOptions {
+            observation_spacing_m: 0.10,
+            max_interpolation_m: 5.0,
+            integrate_every_scan: false,
+        }
+    }
+}
+
+impl FrontEndOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("front_end");
+        if !(self.observation_spacing_m.is_finite()
+            && self.observation_spacing_m >= MIN_OBSERVATION_SPACING_M)
+        {
+            p.bad(
+                "observation_spacing_m",
+                format!(
+                    "must be a distance of at least {MIN_OBSERVATION_SPACING_M} m (finer spacing \
+                     multiplies the observations and the memory they take), got {}; the default \
+                     is 0.10",
+                    fmt_number(self.observation_spacing_m)
+                ),
+            );
+        }
+        let m = self.max_interpolation_m;
+        p.within(
+            "max_interpolation_m",
+            m,
+            (0.0..=20.0).contains(&m),
+            "[0, 20]",
+            "5",
+        );
+        p.out
+    }
+}
+
+/// The local occupancy grid the scans are traced into (paper §II-A). `[recognizer.grid]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct GridOptions {
+    /// Side of a local grid cell, metres. Default 0.05.
+    pub grid_cell_m: f64,
+    /// How far from the robot each scan is traced into the local grid, metres (cells are
+    /// forgotten beyond `grid_memory_m`). Default 3.0.
+    pub grid_radius_m: f64,
+    /// How far from the robot, along either axis, the local grid remembers cells, metres (at
+    /// least `grid_radius_m`); farther cells are forgotten, and read as unknown by a kernel
+    /// centred back along a long step. Default 6.4 (a window of 256 cells of 5 cm, as before
+    /// it was a setting; 12.8 m, which remembers a corridor the robot turned out of, cost fhw
+    /// every pair).
+    pub grid_memory_m: f64,
+}
+
+impl Default for GridOptions {
+    fn default() -> Self {
+        GridOptions {
+            grid_cell_m: 0.05,
+            grid_radius_m: 3.0,
+            grid_memory_m: 6.4,
+        }
+    }
+}
+
+impl GridOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("grid");
+        if !positive(self.grid_cell_m) {
+            p.bad(
+                "grid_cell_m",
+                format!(
+                    "must be a positive size, got {}; the default is 0.05",
+                    self.grid_cell_m
+                ),
+            );
+        }
+        self.radius_problems(&mut p);
+        self.memory_problems(&mut p);
+        p.out
+    }
+
+    /// Whether `m` metres is more cells of `grid_cell_m` than the grid accepts.
+    fn too_many_cells(&self, m: f64) -> bool {
+        positive(self.grid_cell_m) && m / self.grid_cell_m > MAX_GRID_HALF_CELLS
+    }
+
+    fn radius_problems(&self, p: &mut Problems) {
+        if !positive(self.grid_radius_m) {
+            p.bad(
+                "grid_radius_m",
+                format!(
+                    "must be a positive radius, got {}; the default is 3.0",
+                    self.grid_radius_m
+                ),
+            );
+        } else if self.too_many_cells(self.grid_radius_m) {
+            p.bad(
+                "grid_radius_m",
+                format!(
+                    "{} m is more than {} cells of {} m; use a smaller radius or larger cells",
+                    self.grid_radius_m, MAX_GRID_HALF_CELLS, self.grid_cell_m
+                ),
+            );
+        }
+    }
+
+    fn memory_problems(&self, p: &mut Problems) {
+        if !positive(self.grid_memory_m) {
+            p.bad(
+                "grid_memory_m",
+                format!(
+                    "must be a positive distance, got {}; the default is 6.4",
+                    self.grid_memory_m
+                ),
+            );
+        } else if positive(self.grid_radius_m) && self.grid_memory_m < self.grid_radius_m {
+            p.bad(
+                "grid_memory_m",
+                format!(
+                    "{} m is less than grid_radius_m ({} m); the grid must remember what a scan traces",
+                    self.grid_memory_m, self.grid_radius_m
+                ),
+            );
+        } else if self.too_many_cells(self.grid_memory_m) {
+            p.bad(
+                "grid_memory_m",
+                format!(
+                    "{} m is more than {} cells of {} m; use a shorter memory or larger cells",
+                    self.grid_memory_m, MAX_GRID_HALF_CELLS, self.grid_cell_m
+                ),
+            );
+        }
+    }
+}
+
+/// The density Ψ of the free space around the robot (paper §II-B, Eq. 1): its kernel.
+/// `[recognizer.density]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct DensityOptions {
+    /// Radius of the density kernel, metres (at most `grid_radius_m`). Default 2.5.
+    pub kernel_radius_m: f64,
+    /// Angle between two density rays, degrees. Default 1.0.
+    pub ray_step_deg: f64,
+}
+
+impl Default for DensityOptions {
+    fn default() -> Self {
+        DensityOptions {
+            kernel_radius_m: 2.5,
+            ray_step_deg: 1.0,
+        }
+    }
+}
+
+impl DensityOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("density");
+        if !positive(self.kernel_radius_m) {
+            p.bad(
+                "kernel_radius_m",
+                format!(
+                    "must be a positive radius, got {}; the default is 2.5",
+                    self.kernel_radius_m
+                ),
+            );
+        }
+        let r = self.ray_step_deg;
+        p.within(
+            "ray_step_deg",
+            r,
+            positive(r) && r <= 360.0,
+            "(0, 360]",
+            "1.0",
+        );
+        p.out
+    }
+}
+
+/// Density classes, words and multi-level words (paper §III, Algorithms 1 and 2).
+/// `[recognizer.words]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct WordOptions {
+    /// Number of uniform density classes over [0, 1]: class = min(floor(classes·Ψ), classes − 1).
+    /// Default 8.
+    pub classes: usize,
+    /// Minimum word size t_o, observations: a shorter run of another class is absorbed by the word
+    /// it interrupts. Default 5.
+    pub min_word_size: usize,
+    /// How upper-level ("corrected") words are built: `paper` (Algorithm 2 as written: a level-l
+    /// word fuses l + 2 level-0 words whose first and last share a class) or `boundaries` (a
+    /// level-l word fuses a bump that leaves a class and comes back to it, crossing l class
+    /// boundaries at its deepest: `A B A` is level 1, `A B C B A` level 2). Default `boundaries`
+    /// (see the `words` module doc for why).
+    pub multi_level: MultiLevelRule,
+}
+
+impl Default for WordOptions {
+    fn default() -> Self {
+        WordOptions {
+            classes: 8,
+            min_word_size: 5,
+            multi_level: MultiLevelRule::Boundaries,
+        }
+    }
+}
+
+impl WordOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("words");
+        if self.classes == 0 || self.classes > 255 {
+            p.bad(
+                "classes",
+                format!(
+                    "must be between 1 and 255, got {}; the default is 8",
+                    self.classes
+                ),
+            );
+        }
+        if self.min_word_size == 0 {
+            p.bad(
+                "min_word_size",
+                "must be at least 1 observation; the default is 5".to_string(),
+            );
+        }
+        p.out
+    }
+}
+
+/// How upper-level words are built (`multi_level` setting); see the `words` module.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum MultiLevelRule {
+    /// Algorithm 2 as written: level l fuses the l + 2 level-0 words w_{j−l−1} … w_j when
+    /// w_{j−l−1} and w_j have the same class.
+    Paper,
+    /// Level l fuses a bump of depth l: level-0 words w_i … w_j with w_i and w_j of class D, every
+    /// word between of another class, the farthest of them l classes from D, and at most 2l + 1
+    /// of them.
+    Boundaries,
+}
+
+/// Word matching and n-gram chains (paper §III-C): which word pairs match, which chains of them
+/// are reported, in which directions. `[recognizer.matcher]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct MatcherOptions {
+    /// Minimum n-gram size (words) per level configuration: index k applies to configuration
+    /// k + 1. Needs at least `levels` entries; 0 and 1 both accept every matching word pair (the
+    /// paper's Fig. 8 sweeps from 0). Default [6, 9, 12, 15].
+    pub min_ngram: Vec<usize>,
+    /// Size syllables match when |S₁ − S₂| ≤ ratio · max(S₁, S₂). Default 0.25.
+    pub size_tolerance_ratio: f64,
+    /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
+    pub angle_tolerance_deg: f64,
+    /// Candidate gap: a past word must end at least this much odometric travel before the
+    /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
+    /// though both default to 20). Default 20.0.
+    pub candidate_gap_m: f64,
+    /// Most recent candidates a closing word is matched against: the last k earlier words of its
+    /// class that match it and end beyond the candidate gap; 0 = every one (the paper). A bound
+    /// keeps the work and the output per lap flat as the history grows (a long-term run), at the
+    /// cost of pairing each place with its k most recent look-alikes only. Default 0.
+    pub max_candidates: usize,
+    /// Also recognize revisits driven the other way (paper §VI, future work). The past words are
+    /// read backwards: their order reversed, each angle syllable negated (class and size are
+    /// unchanged), and a chain grows through successors, so current word i+1 pairs with past
+    /// word j−1 when current i pairs with past j. The fine alignment reads the past word's Ψ
+    /// backwards. Verification is the same, with the past side's travel and turn measured
+    /// backwards (the turn between two matched past words is negated). Such matches carry
+    /// `direction = "opposite"`. Default true.
+    pub reverse: bool,
+    /// Extra words an opposite-direction n-gram needs beyond the configuration's minimum size:
+    /// a corridor whose words alternate between two classes reads the same both ways, so short
+    /// opposite chains are often a place matched to its own mirror image. Default 2 (tuned on
+    /// scenario A seeds 1..10, which has no opposite revisit: 2 removed every opposite match
+    /// there; confirmed on `reverse` seeds 1..10: opposite precision 0.939 → 0.977 mean).
+    pub reverse_extra_ngram: usize,
+    /// Chains may bridge one substituted word: (c, p) may extend a chain ending one level-0 word
+    /// further back on both sides, when the two skipped words have the same class and sizes
+    /// within `substitution_size_ratio` (their angle syllable, or their size by a little, did
+    /// not match). The bridged pair does not count towards the n-gram's size. Sparse real logs
+    /// and turns between scans move a word's turn angle between visits, which breaks chains
+    /// before τ. Default true: fhw gets pairs on every noise seed 1..5 (none without, precision
+    /// 1.0); scenarios A, B, C and `reverse` keep 3-level precision ≥ 0.95 on every seed 1..10
+    /// and A's recall rises 0.562 → 0.592 (RESULTS.md).
+    pub substitutions: bool,
+    /// How far the sizes of the two words a substitution bridges may differ, as a fraction of
+    /// the larger (`substitutions`). Default 0.3: the bridged words keep (nearly) the size
+    /// syllable and differ in their turn angle, which in logs with turns between scans is what
+    /// moves; bridging any same-class word lowered scenario A's worst precision to 0.937.
+    pub substitution_size_ratio: f64,
+    /// Also accept an n-gram shorter than the configuration's minimum size when it has at least
+    /// `ngram_travel_min_words` word pairs and its current side spans at least this much
+    /// odometric travel, metres; 0 = off. Long words (a corridor loop where a word is 3–8 m)
+    /// make τ words a long stretch that one path difference breaks. Default 0 (off): with 12 m
+    /// Intel's opposite-direction recall goes 0 → 0.38 (noise seeds 1..5, precision 0.977) and
+    /// seattle gets pairs on 1 of 5 seeds, but fhw's precision falls to 0.55 and scenario
+    /// A's 3-level precision to 0.693 (RESULTS.md).
+    pub ngram_travel_m: f64,
+    /// The same for n-grams read backwards (opposite direction), metres; 0 = off. Default 30.
+    /// Read backwards, a word's boundaries do not fall where they fell driving the other way (the
+    /// laser looks ahead, so Ψ rises and falls at different places), so opposite chains break
+    /// into runs of a few long words that rarely reach τ + `reverse_extra_ngram` words: without
+    /// this rule Intel's opposite-direction recall is 0.03. Shorter spans let through corridors
+    /// that read the same backwards (scenario A, which has no opposite revisit: 3-level precision
+    /// 0.839 at 12 m); with `reverse_verify_max_lateral_rms`, 30 m keeps A's precision
+    /// (RESULTS.md; tuned on A seeds 1–10 and Intel noise seeds 1–3).
+    pub reverse_ngram_travel_m: f64,
+    /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
+    /// `reverse_extra_ngram` read backwards). Default 4.
+    pub ngram_travel_min_words: usize,
+}
+
+impl Default for MatcherOptions {
+    fn default() -> Self {
+        MatcherOptions {
+            min_ngram: vec![6, 9, 12, 15],
+            size_tolerance_ratio: 0.25,
+            angle_tolerance_deg: 30.0,
+            candidate_gap_m: 20.0,
+            max_candidates: 0,
+            reverse: true,
+            reverse_extra_ngram: 2,
+            substitutions: true,
+            substitution_size_ratio: 0.3,
+            ngram_travel_m: 0.0,
+            reverse_ngram_travel_m: 30.0,
+            ngram_travel_min_words: 4,
+        }
+    }
+}
+
+impl MatcherOptions {
+    /// Every problem of these options for a run of `levels` level configurations, located by
+    /// key; empty when they are usable.
+    pub fn problems(&self, levels: usize) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("matcher");
+        let s = self.size_tolerance_ratio;
+        p.within(
+            "size_tolerance_ratio",
+            s,
+            (0.0..1.0).contains(&s),
+            "[0, 1)",
+            "0.25",
+        );
+        let a = self.angle_tolerance_deg;
+        p.within(
+            "angle_tolerance_deg",
+            a,
+            (0.0..=180.0).contains(&a),
+            "[0, 180]",
+            "30",
+        );
+        self.min_ngram_problems(levels, &mut p);
+        if !(self.candidate_gap_m.is_finite() && self.candidate_gap_m >= 0.0) {
+            p.bad(
+                "candidate_gap_m",
+                format!(
+                    "must be a distance of at least 0, got {}; the default is 20",
+                    self.candidate_gap_m
+                ),
+            );
+        }
+        let r = self.substitution_size_ratio;
+        p.within(
+            "substitution_size_ratio",
+            r,
+            (0.0..=1.0).contains(&r),
+            "[0, 1]",
+            "0.3",
+        );
+        p.non_negative("ngram_travel_m", self.ngram_travel_m);
+        p.non_negative("reverse_ngram_travel_m", self.reverse_ngram_travel_m);
+        p.out
+    }
+
+    /// The words an n-gram read backwards needs beyond τ (none when `reverse` is off).
+    pub(crate) fn opposite_extra_ngram(&self) -> usize {
+        if self.reverse {
+            self.reverse_extra_ngram
+        } else {
+            0
+        }
+    }
+
+    /// The travel rule's span in direction `dir`: `ngram_travel_m` or `reverse_ngram_travel_m`.
+    pub(crate) fn travel_rule_m(&self, dir: super::types::Direction) -> f64 {
+        match dir {
+            super::types::Direction::Same => self.ngram_travel_m,
+            super::types::Direction::Opposite => self.reverse_ngram_travel_m,
+        }
+    }
+
+    fn min_ngram_problems(&self, levels: usize, p: &mut Problems) {
+        if self.min_ngram.len() < levels.min(4) {
+            p.bad(
+                "min_ngram",
+                format!(
+                    "has {} entries but levels = {} needs one per level configuration; e.g. [6, 9, 12, 15]",
+                    self.min_ngram.len(),
+                    levels
+                ),
+            );
+        } else if self.min_ngram.iter().take(levels).any(|&n| n > 10_000) {
+            p.bad(
+                "min_ngram",
+                "every size must be between 0 and 10000 words (0 and 1 both accept any chain)"
+                    .to_string(),
+            );
+        }
+    }
+}
+
+/// Fine alignment (paper §IV, Eq. 2): where the smaller word's window is placed against the
+/// larger one's. `[recognizer.alignment]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct AlignmentOptions {
+    /// Placements the fine alignment tries: `paper` (Eq. 2 as written: the n = min(S₁, S₂)
+    /// observations from both words' starts, shifted by d ∈ (−Δmax, Δmax)) or `whole-word`
+    /// (the smaller word's n observations at every placement inside the larger word, never past
+    /// its ends) or `chain` (within ±`chain_alignment_offset` of the shift the whole matched
+    /// n-gram agrees on, even past the words' ends, or of the nearest placement inside the
+    /// larger word; ties within `chain_alignment_tie` go to the n-gram's shift). Default `chain`.
+    /// (Before subtables, `[recognizer] alignment`.)
+    pub mode: AlignmentMode,
+    /// Largest shift Δmax tried by the fine alignment (Eq. 2), observations. Default 10.
+    pub max_alignment_offset: usize,
+    /// Largest shift from the n-gram's offset tried by `mode = "chain"`, observations.
+    /// Default 5 (tuned on scenario A seeds 1..10: 10 left near-misses of about 1 m, 2 gave
+    /// the same as 5).
+    pub chain_alignment_offset: usize,
+    /// `mode = "chain"`: placements whose mean squared Ψ difference is within this of the
+    /// best count as equally good, and the one nearest the n-gram's shift wins (a long word of
+    /// flat Ψ otherwise slid to whatever placement noise favoured). Ψ², default 1e-4 (an RMS
+    /// difference of 0.01, a twelfth of a class of 8).
+    pub chain_alignment_tie: f64,
+}
+
+impl Default for AlignmentOptions {
+    fn default() -> Self {
+        AlignmentOptions {
+            mode: AlignmentMode::Chain,
+            max_alignment_offset: 10,
+            chain_alignment_offset: 5,
+            chain_alignment_tie: 1e-4,
+        }
+    }
+}
+
+impl AlignmentOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("alignment");
+        for (field, v) in [
+            ("max_alignment_offset", self.max_alignment_offset),
+            ("chain_alignment_offset", self.chain_alignment_offset),
+        ] {
+            if v > MAX_ALIGNMENT_OFFSET {
+                p.bad(
+                    field,
+                    format!(
+                        "must be at most {MAX_ALIGNMENT_OFFSET} observations (every shift is \
+                         tried for every matched pair), got {v}; the default is 10 or 5"
+                    ),
+                );
+            }
+        }
+        p.non_negative("chain_alignment_tie", self.chain_alignment_tie);
+        p.out
+    }
+}
+
+/// Where the fine alignment may place the smaller word's window (`[recognizer.alignment] mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum AlignmentMode {
+    /// Eq. 2 as written: shifts d ∈ (−Δmax, Δmax) from both words' starts.
+    Paper,
+    /// Every placement of the smaller word inside the larger one.
+    WholeWord,
+    /// Placements inside the larger word within ±Δmax of where the n-gram puts the pair: the
+    /// travel offset between the current and past sides, taken as the median over the n-gram's
+    /// word pairs of the offset between their centres. A long word of flat Ψ no longer slides
+    /// to an arbitrary place inside its partner.
+    Chain,
+}
+
+/// Verification of each candidate n-gram before it is reported (not in the paper; see the
+/// `verify` module). `[recognizer.verify]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(default, deny_unknown_fields)]
+#[non_exhaustive]
+pub struct VerifyOptions {
+    /// Verify each match before reporting it (the other keys of this table). Default true.
+    /// (Before subtables, `[recognizer] verify`.)
+    pub enabled: bool,
+    /// Travel: between two consecutive words of a matched n-gram, and from its first word to each
+    /// later one, the odometric travel of the current and past sides may differ by at most this
+    /// fraction of the longer, plus `verify_travel_slack_m`. Default 0.15 (tuned on scenario A
+    /// seed 3 and Intel; 0.25, the word size tolerance, let through false n-grams whose words
+    /// each fit but whose spacing drifts).
+    pub verify_travel_ratio: f64,
+    /// Travel: absolute slack added to the allowed difference, metres. Default 0.5.
+    pub verify_travel_slack_m: f64,
+    /// Turn: between two consecutive words of a matched n-gram, and from its first word to each
+    /// later one, the odometric heading change of the two sides may differ by at most this,
+    /// degrees. Default 30.
+    pub verify_turn_deg: f64,
+    /// Densities: the root mean square Ψ difference over the n-gram's aligned observation pairs
+    /// must be at most this (Ψ ∈ [0, 1]; a class is 1/`classes` wide). Default 0.04 (a third of
+    /// a class of 8; tuned on scenario A seed 3 and Intel).
+    pub verify_max_psi_rms: f64,
+    /// Sides: the root mean square difference of the observations' `lateral_moment` (where the
+    /// space around the robot lies across the path, in kernel radii; a side corridor 3 m wide
+    /// off a 2 m corridor gives about 0.12) over the n-gram's aligned pairs must be at most
+    /// this. Ψ is the same on both sides of a mirror; this is not. Default 0.08 (tuned on
+    /// scenario A and Intel; 0.05 cost Intel a third of its same-direction recall).
+    pub verify_max_lateral_rms: f64,
+    /// The same bound for n-grams read backwards, where the past side's moment is negated (driven
+    /// the other way, left is right). Default 0.06: chains read backwards are runs of a few long
+    /// words accepted by travel, and a corridor that reads the same backwards needs a tighter
+    /// bound (scenario A at 30 m without the turn rule: 3-level precision 0.951, worst seed
+    /// 0.901, with 0.08; 0.977 / 0.956 with 0.05). With the turn rule 0.06 keeps A's precision and
+    /// gives every Intel noise seed 1–5 opposite pairs (0.05 left seed 4 with none).
+    pub reverse_verify_max_lateral_rms: f64,
+    /// Read backwards: the current side of an n-gram matched in the opposite direction must
+    /// turn, its odometric heading changing by at least this from its first word, degrees;
+    /// 0 = off. Default 45. A straight corridor read backwards matches itself mirrored about its
+    /// middle wherever its two halves look alike (scenarios B and C: ~100,000 false opposite
+    /// pairs per seed, 3-level precision 0.940 and 0.918 without it); Intel's opposite-direction
+    /// recall hardly changes (noise seeds 1–3: 0.331–0.465 with 45 or 80).
+    pub reverse_min_turn_deg: f64,
+}
+
+impl Default for VerifyOptions {
+    fn default() -> Self {
+        VerifyOptions {
+            enabled: true,
+            verify_travel_ratio: 0.15,
+            verify_travel_slack_m: 0.5,
+            verify_turn_deg: 30.0,
+            verify_max_psi_rms: 0.04,
+            verify_max_lateral_rms: 0.08,
+            reverse_verify_max_lateral_rms: 0.06,
+            reverse_min_turn_deg: 45.0,
+        }
+    }
+}
+
+impl VerifyOptions {
+    /// Every problem of these options, located by key; empty when they are usable.
+    pub fn problems(&self) -> Vec<ConfigProblem> {
+        let mut p = Problems::new("verify");
+        for (field, v) in [
+            ("verify_travel_ratio", self.verify_travel_ratio),
+            ("verify_travel_slack_m", self.verify_travel_slack_m),
+            ("verify_turn_deg", self.verify_turn_deg),
+            ("verify_max_psi_rms", self.verify_max_psi_rms),
+            ("verify_max_lateral_rms", self.verify_max_lateral_rms),
+            (
+                "reverse_verify_max_lateral_rms",
+                self.reverse_verify_max_lateral_rms,
+            ),
+            ("reverse_min_turn_deg", self.reverse_min_turn_deg),
+        ] {
+            p.non_negative(field, v);
+        }
+        p.out
+    }
+
+    /// The largest RMS lateral-moment difference in direction `dir`.
+    pub(crate) fn max_lateral_rms(&self, dir: super::types::Direction) -> f64 {
+        match dir {
+            super::types::Direction::Same => self.verify_max_lateral_rms,
+            super::types::Direction::Opposite => self.reverse_verify_max_lateral_rms,
+        }
+    }
+}

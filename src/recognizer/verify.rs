@@ -1,0 +1,146 @@
+//! Verification of a candidate n-gram before it is reported (`[recognizer.verify]`).
+//!
+//! **Verification** (`enabled`). A candidate n-gram is accepted only if it is consistent: the
+//! odometric travel and turn between its words agree on both sides (`verify_travel_*`,
+//! `verify_turn_deg`), the RMS Ψ difference of its aligned pairs is at most
+//! `verify_max_psi_rms`, and the free space lies on the same side of the path at both visits:
+//! the RMS difference of the observations' `lateral_moment` is at most `verify_max_lateral_rms`
+//! (`reverse_verify_max_lateral_rms` read backwards, where the past side's moment is negated,
+//! since driven the other way left is right). Ψ and the words are blind to a reflection: it
+//! negates the turns and reading backwards negates them again, so a corridor read backwards
+//! matched its mirror image (scenario A, which has no opposite revisit, got thousands of false
+//! opposite pairs); the side of the free space is what a reflection changes. Where a place is
+//! symmetric across the path the moment is near zero and decides nothing; the travel rule for
+//! chains read backwards (`reverse_ngram_travel_m`, 30 m) adds the context those need. A
+//! straight corridor is the worst case: read backwards it matches itself mirrored about any
+//! line across it where its doors and recesses happen to be symmetric (the institute floor's
+//! 40 m north corridor, about its middle alcove, in scenarios A, B and C), and its turns cannot
+//! help (there are none). So an n-gram read backwards must turn: the current side's heading must
+//! change by at least `reverse_min_turn_deg` from its first word. Within a stretch whose ends
+//! both turn, reading backwards negates the turns and breaks such false chains at the corners.
+//! The first 10,000 candidates verification turns down are kept as one observation pair each
+//! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
+//! the checks turned down look-alikes or true revisits.
+//!
+
+use super::align::{PastSide, Placement};
+use super::diagnostics::Rejection;
+use super::matcher::WordMatcher;
+use super::types::Direction;
+use super::words::WordId;
+use crate::geom::wrap_angle;
+
+impl WordMatcher {
+    /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
+    /// and turn between its words, from consecutive words and from its first word, must agree on
+    /// both sides; the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
+    /// the n-gram extends a verified one) must be small. The placements it makes (of the pairs
+    /// whose residual it measured, oldest first) are appended to `placed`.
+    /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
+    /// runs the other way, so the past side's travel and turn between two words are negated.
+    pub(super) fn verify(
+        &self,
+        word_pairs: &[(WordId, WordId)],
+        dir: Direction,
+        anchors: &[i64],
+        newest_only: bool,
+        placed: &mut Vec<Option<Placement>>,
+    ) -> Option<Rejection> {
+        let start = |w: WordId| self.reading_start(w, Direction::Same);
+        let past_start = |w: WordId| self.reading_start(w, dir);
+        let ok_travel = |a: f64, b: f64| {
+            (a - b).abs()
+                <= self.verify_opts.verify_travel_ratio * a.abs().max(b.abs())
+                    + self.verify_opts.verify_travel_slack_m
+        };
+        let turn_tol = self.verify_opts.verify_turn_deg.to_radians();
+        let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
+        let mut turned: f64 = 0.0;
+        for w in word_pairs.windows(2) {
+            let (c0, c1) = (start(w[0].0), start(w[1].0));
+            let (p0, p1) = (past_start(w[0].1), past_start(w[1].1));
+            let dc = (c1.0 - c0.0, wrap_angle(c1.1 - c0.1));
+            let dp = (p1.0 - p0.0, wrap_angle(p1.1 - p0.1));
+            cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
+            cum_p = (cum_p.0 + dp.0, cum_p.1 + dp.1);
+            if !ok_travel(dc.0, dp.0) || !ok_travel(cum_c.0, cum_p.0) {
+                return Some(Rejection::Travel);
+            }
+            if wrap_angle(dc.1 - dp.1).abs() > turn_tol || (cum_c.1 - cum_p.1).abs() > turn_tol {
+                return Some(Rejection::Turn);
+            }
+            turned = turned.max(cum_c.1.abs());
+        }
+        if dir == Direction::Opposite && turned < self.verify_opts.reverse_min_turn_deg.to_radians()
+        {
+            return Some(Rejection::Straight);
+        }
+        let (mut sum, mut lateral, mut count) = (0.0, 0.0, 0usize);
+        let from = if newest_only { word_pairs.len() - 1 } else { 0 };
+        for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
+            let placement = self.placement(c, p, dir, anchor);
+            if let Some(w) = &placement {
+                sum += w.cost * w.count() as f64;
+                lateral += self.lateral_squared_error(c, p, dir, w);
+                count += w.count();
+            }
+            placed.push(placement);
+        }
+        let mean = |s: f64| {
+            if count == 0 {
+                f64::INFINITY
+            } else {
+                (s / count as f64).sqrt()
+            }
+        };
+        if mean(sum) > self.verify_opts.verify_max_psi_rms {
+            Some(Rejection::Density)
+        } else if mean(lateral) > self.verify_opts.max_lateral_rms(dir) {
+            Some(Rejection::Sides)
+        } else {
+            None
+        }
+    }
+
+    /// Σ over the pairs of placement `w` of the squared difference of the observations'
+    /// `lateral_moment`, the past side's negated when read backwards (its left is then our right).
+    pub(super) fn lateral_squared_error(
+        &self,
+        c: WordId,
+        p: WordId,
+        dir: Direction,
+        w: &Placement,
+    ) -> f64 {
+        let lateral = self.words.lateral_moments();
+        let s2 = self.word(c).first_obs as i64;
+        let past = PastSide::of(self.word(p), dir);
+        let sign = past.step as f64;
+        w.r.clone()
+            .map(|i| {
+                let q = lateral[(s2 + w.a + i) as usize];
+                let d = q - sign * lateral[past.index(w.b + i)];
+                d * d
+            })
+            .sum()
+    }
+
+    /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
+    /// first observation, or read backwards, of its last one with travel negated (so that
+    /// differences between words read backwards come out as travelled that way).
+    pub(super) fn reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        self.reading_starts[w as usize][dir as usize]
+    }
+
+    /// [`reading_start`](Self::reading_start), from the word's observations.
+    pub(super) fn measure_reading_start(&self, w: WordId, dir: Direction) -> (f64, f64) {
+        let obs = self.words.observations();
+        let w = self.word(w);
+        match dir {
+            Direction::Same => (w.start_travel_m, obs[w.first_obs].odom_pose.0.theta),
+            Direction::Opposite => (
+                -w.end_travel_m,
+                obs[w.first_obs + w.size - 1].odom_pose.0.theta,
+            ),
+        }
+    }
+}
