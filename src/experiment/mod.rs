@@ -15,6 +15,8 @@ pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::baseline::scan_context::{ScanContextConfig, ScanContextRecognizer};
+use crate::eval::metrics::Scorer;
+use crate::eval::ranking::{self, SubjectRanking};
 use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{GroundTruth, Recognition, recognize_runs_with_progress};
@@ -444,14 +446,15 @@ pub fn back_end_matches(
 }
 
 /// The paper's Fig. 8 sweep: observations computed once, then every grid point's back end in
-/// parallel; results in grid order whatever the thread count.
+/// parallel; results in grid order whatever the thread count. With them, each words subject's
+/// curve over its match score at `base`'s thresholds (`words-1` … `words-<base.levels>`).
 pub fn sweep(
     runs: &[RunLog],
     base: &RecognizerConfig,
     evaluation: &EvaluationSpec,
     grid: &[GridPoint],
     progress: &ProgressSink,
-) -> Result<Vec<SweepResult>, ExperimentError> {
+) -> Result<(Vec<SweepResult>, Vec<SubjectRanking>), ExperimentError> {
     let (densities, _) = observe(runs, base)?;
     let observations: Vec<_> = densities.iter().map(|d| d.observation).collect();
     let truth = GroundTruth::from_runs(runs);
@@ -469,5 +472,26 @@ pub fn sweep(
         &|| progress.step(),
     );
     progress.done();
-    Ok(results)
+    let positives = Scorer::new(&observations, &truth, evaluation)
+        .revisits(evaluation.tp_radius_m)
+        .iter()
+        .filter(|&&r| r)
+        .count();
+    let score_curves = (1..=base.levels.max(1))
+        .map(|levels| {
+            let point = GridPoint::new(levels, &base.min_ngram[..levels.min(base.min_ngram.len())]);
+            let matches = back_end_matches(&densities, base, &point)?;
+            Ok(SubjectRanking {
+                name: crate::eval::scores::words_subject_name(levels),
+                ranking: ranking::of_matches(
+                    &observations,
+                    &truth,
+                    evaluation,
+                    &matches,
+                    positives,
+                ),
+            })
+        })
+        .collect::<Result<Vec<_>, ExperimentError>>()?;
+    Ok((results, score_curves))
 }

@@ -313,6 +313,7 @@ impl LoggedRuns {
             evaluation: None,
             level_gain: None,
             rejected: Vec::new(),
+            ranking: None,
         })
     }
 }

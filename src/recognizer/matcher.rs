@@ -819,6 +819,7 @@ impl WordMatcher {
         // Verification placed the last `placed.len()` word pairs already: the same placements.
         let placed_from = chain.len() - cand.placed.len();
         scr.runs.clear();
+        let mut residual = PsiResidual::default();
         for (j, &(wc, widx)) in chain.iter().enumerate().skip(fresh_from) {
             let at = cand.pairs.start + j;
             let (past, anchor) = (scr.word_pairs[at].1, scr.anchors[at]);
@@ -828,6 +829,7 @@ impl WordMatcher {
                 Some(i) => scr.placed[cand.placed.start + i].take(),
                 None => self.placement(wc, past, cand.dir, anchor),
             };
+            residual.add(placement.as_ref());
             self.aligned_pairs(wc, past, cand.dir, placement, &mut scr.runs);
         }
         self.rejections.accepted += 1;
@@ -838,6 +840,7 @@ impl WordMatcher {
             // Usually one run: exactly as many as there are, no spare capacity per match.
             runs: scr.runs.to_vec(),
             direction: cand.dir,
+            psi_rms: residual.rms(),
         }
     }
 
@@ -1173,6 +1176,33 @@ struct Placement {
 impl Placement {
     fn count(&self) -> usize {
         (self.r.end - self.r.start).max(0) as usize
+    }
+}
+
+/// The root mean square Ψ difference over the placements of a match's word pairs (its score's
+/// alignment residual, `WordMatch::psi_rms`): kept apart from the matching so that the score is
+/// one small function of what the alignment already computed.
+#[derive(Default)]
+struct PsiResidual {
+    sum: f64,
+    count: usize,
+}
+
+impl PsiResidual {
+    fn add(&mut self, placement: Option<&Placement>) {
+        if let Some(w) = placement {
+            self.sum += w.cost * w.count() as f64;
+            self.count += w.count();
+        }
+    }
+
+    /// The RMS, infinite without an aligned pair.
+    fn rms(&self) -> f64 {
+        if self.count == 0 {
+            f64::INFINITY
+        } else {
+            (self.sum / self.count as f64).sqrt()
+        }
     }
 }
 
