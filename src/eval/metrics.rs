@@ -903,25 +903,14 @@ pub(crate) mod tests {
         }
         let pairs: Vec<AlignedPair> = (0..400).map(|k| pair(&obs, 400 + k, k)).collect();
         let evaluate_as = |direction: Direction| {
-            let rec = Recognition {
-                name: "t".into(),
-                observations: obs.clone(),
-                matches: vec![Match {
+            let rec = recognition(
+                &obs,
+                &gt,
+                vec![Match {
                     direction,
                     ..one_match(pairs.clone())
                 }],
-                seconds: 0.0,
-                wall_seconds: 0.0,
-                score_seconds: 0.0,
-                laps: 2,
-                truth: std::sync::Arc::new(gt.clone()),
-                diagnostics: None,
-                lap_seconds: Vec::new(),
-                evaluation: None,
-                level_gain: None,
-                rejected: Vec::new(),
-                ranking: None,
-            };
+            );
             evaluate(&rec, &EvaluationSpec::default())
         };
         let e = evaluate_as(Direction::Opposite);
@@ -1047,20 +1036,10 @@ pub(crate) mod tests {
             (415..obs.len()).map(|q| pair(&obs, q, q - 415)).collect(),
         )];
         let rec = Recognition {
-            name: "t".into(),
-            observations: obs,
-            matches,
             seconds: 1.0,
             wall_seconds: 1.0,
-            score_seconds: 0.0,
             laps: 3,
-            truth: std::sync::Arc::new(gt),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-            ranking: None,
+            ..recognition(&obs, &gt, matches)
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -1098,22 +1077,7 @@ pub(crate) mod tests {
             one_match(vec![pair(&obs, 400, 0), pair(&obs, 401, 200)]),
             one_match(vec![pair(&obs, 400, 0)]),
         ];
-        let rec = Recognition {
-            name: "t".into(),
-            observations: obs,
-            matches,
-            seconds: 0.0,
-            wall_seconds: 0.0,
-            score_seconds: 0.0,
-            laps: 2,
-            truth: std::sync::Arc::new(gt),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-            ranking: None,
-        };
+        let rec = recognition(&obs, &gt, matches);
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);
         assert!(p[0].correct && !p[1].correct);

@@ -191,7 +191,7 @@ fn grid(s: &mut String, f: &Frame) {
             r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
             TOP + ph,
             TOP + ph + 16.0,
-            trim(fx)
+            trim(fx, f.x.2)
         );
     }
     for fy in ticks(f.y) {
@@ -202,7 +202,7 @@ fn grid(s: &mut String, f: &Frame) {
             LEFT + pw,
             LEFT - 6.0,
             y + 4.0,
-            trim(fy)
+            trim(fy, f.y.2)
         );
     }
 }
@@ -316,9 +316,11 @@ fn legend(s: &mut String, i: usize, c: &Series, colour: &str) {
     );
 }
 
-/// A tick label without trailing zeros.
-fn trim(v: f64) -> String {
-    let s = format!("{v:.2}");
+/// A tick label at the precision of the tick step `step`, without trailing zeros (so ticks
+/// 0.002 apart near P = 1 read 0.996, 0.998, 1).
+fn trim(v: f64, step: f64) -> String {
+    let decimals = (-step.log10() - 1e-9).ceil().max(2.0) as usize;
+    let s = format!("{v:.decimals$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s.is_empty() { "0".into() } else { s.into() }
 }
@@ -339,6 +341,10 @@ mod tests {
         let (a, b, _) = fitted_axis(0.5, 0.5);
         assert!(a <= 0.5 && b > a);
         assert_eq!(fitted_axis(f64::INFINITY, f64::NEG_INFINITY).0, 0.0);
+        // Ticks 0.002 apart keep their third decimal.
+        assert_eq!(trim(0.998, 0.002), "0.998");
+        assert_eq!(trim(1.0, 0.002), "1");
+        assert_eq!(trim(0.5, 0.1), "0.5");
     }
 
     #[test]
