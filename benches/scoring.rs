@@ -73,6 +73,7 @@ fn recognition(laps: usize) -> Recognition {
         evaluation: None,
         level_gain: None,
         rejected: Vec::new(),
+        ranking: None,
     }
 }
 

@@ -1,6 +1,6 @@
 //! `placewords sweep SCENARIO -o DIR`: the paper's Fig. 8. Simulates once, computes the
 //! observations once, then runs the back end at every threshold configuration in parallel;
-//! writes PR curves as SVG and JSON.
+//! writes PR curves as SVG and JSON, and each words subject's PR curve over its match score.
 
 use super::common::write_file;
 use anyhow::Context;
@@ -8,8 +8,8 @@ use clap::Args;
 use placewords::eval::scores::SweepReport;
 use placewords::eval::sweep::fig8_grid;
 use placewords::experiment::{self, ExperimentOptions};
-use placewords::report::plot::pr_curves_svg;
-use placewords::report::table::curves_table;
+use placewords::report::plot::{pr_curves_svg, score_curves_svg};
+use placewords::report::table::{curves_table, score_curves_table};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -17,7 +17,8 @@ use std::process::ExitCode;
 pub struct SweepArgs {
     /// Scenario file (TOML).
     pub scenario: PathBuf,
-    /// Output folder for sweep.json and pr-curves.svg.
+    /// Output folder for sweep.json, pr-curves.svg (the τ sweep) and score-pr.svg (each words
+    /// subject's curve over its match score).
     #[arg(short, long, value_name = "DIR")]
     pub out: PathBuf,
     /// Replace every run's lap count (for a quick look; 1 to 1000).
@@ -33,7 +34,9 @@ pub struct SweepArgs {
 pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     // Staged whole and put in place at the end: the folder holds the old sweep or the new one.
     let stage = placewords::io::atomic::StagedDir::begin(&args.out, &|d| {
-        placewords::io::atomic::holds_only(d, &|n| matches!(n, "sweep.json" | "pr-curves.svg"))
+        placewords::io::atomic::holds_only(d, &|n| {
+            matches!(n, "sweep.json" | "pr-curves.svg" | "score-pr.svg")
+        })
     })?;
     let scn = placewords::experiment::load_scenario(&args.scenario)?;
     let opts = ExperimentOptions {
@@ -42,7 +45,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
         cache: args.cache.open()?,
         ..ExperimentOptions::default()
     };
-    let (results, laps) = experiment::sweep(&scn, &opts, &fig8_grid())?;
+    let (results, laps, score_curves) = experiment::sweep(&scn, &opts, &fig8_grid())?;
     super::common::report_cache(opts.cache.as_deref());
     let report = SweepReport::new(
         &scn.sim.name,
@@ -50,8 +53,10 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
         laps,
         scn.evaluation.clone(),
         results,
+        score_curves,
     );
     out!("{}", curves_table(&report.curves))?;
+    out!("{}", score_curves_table(&report.score_curves))?;
     write_file(
         &stage.path().join("sweep.json"),
         placewords::report::json::to_json_with(&report, &{
@@ -66,6 +71,14 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     write_file(
         &stage.path().join("pr-curves.svg"),
         pr_curves_svg(&report.curves, &title).as_bytes(),
+    )?;
+    let subjects: Vec<_> = (report.score_curves.iter())
+        .map(|s| (s.name.clone(), &s.ranking))
+        .collect();
+    let title = format!("{}: precision / recall over the match score", scn.sim.name);
+    write_file(
+        &stage.path().join("score-pr.svg"),
+        score_curves_svg(&subjects, &title).as_bytes(),
     )?;
     stage
         .commit()

@@ -7,7 +7,9 @@ use anyhow::Context;
 use clap::Args;
 use placewords::eval::scores::TableReport;
 use placewords::experiment::{self, ExperimentOptions};
-use placewords::report::table::{markdown_table_i, markdown_visit_recall, thresholds_note};
+use placewords::report::table::{
+    markdown_ranking, markdown_table_i, markdown_visit_recall, thresholds_note,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -84,11 +86,16 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         )?;
         reports.push(exp.report);
     }
+    let rule = reports
+        .first()
+        .map(|r| placewords::eval::ranking::TruthRule::of(&r.evaluation).short())
+        .unwrap_or_default();
     let md = format!(
-        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized) and pair recall (share of every pair that could be found):\n\n{}",
+        "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized) and pair recall (share of every pair that could be found):\n\n{}\nOver the match score, per query observation (a query's answer is its best-scoring pair, right when it is a true revisit {rule}): recall at 99 % precision and max F1:\n\n{}",
         markdown_table_i(&reports),
         thresholds_note(&reports),
-        markdown_visit_recall(&reports)
+        markdown_visit_recall(&reports),
+        markdown_ranking(&reports)
     );
     out!("{md}")?;
     write_file(&stage.path().join("table.md"), md.as_bytes())?;

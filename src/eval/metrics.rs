@@ -87,12 +87,13 @@ pub struct Metrics {
     #[serde(default)]
     pub pair_recall: f64,
     /// The longest stretch of true travel, metres, along which consecutive observations of one
-    /// run all have a revisit (of this figure's facing): the most evidence a place gives to
+    /// run all have a revisit (of this figure's facing; the top-level figure: the longer of the
+    /// two directions', as a chain follows one direction): the most evidence a place gives to
     /// chain. A recognizer that needs τ words of a few metres each finds nothing where this is
-    /// shorter. Computed where revisits are counted (0 per door configuration; written only
-    /// when not 0).
-    #[serde(default, skip_serializing_if = "is_zero_m")]
-    pub longest_revisit_m: f64,
+    /// shorter. Written whenever the figure has revisits (0 m when none of them is followed by
+    /// another); not counted per door configuration.
+    #[serde(default, skip_serializing_if = "RevisitStretch::uncounted")]
+    pub longest_revisit_m: RevisitStretch,
     /// Pairs naming an observation id the recognizer never reported (not scored).
     pub unresolved_pairs: usize,
     /// Pairs that arrived behind the recognizer's query horizon, after the scoring had
@@ -102,13 +103,43 @@ pub struct Metrics {
     pub late_pairs: usize,
 }
 
-fn is_zero(n: &usize) -> bool {
-    *n == 0
+/// A figure's longest revisit stretch, metres ([`Metrics::longest_revisit_m`]), and whether
+/// the figure has revisits to measure it on: written as a plain number whenever it has, so a
+/// figure with a few scattered revisits says 0 m rather than nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[serde(from = "f64", into = "f64")]
+pub struct RevisitStretch {
+    pub m: f64,
+    /// The figure has revisits (read back: the number was written).
+    pub counted: bool,
 }
 
-/// Whether a length is 0 (serde: such fields are written only when not).
-pub(super) fn is_zero_m(m: &f64) -> bool {
-    *m == 0.0
+impl RevisitStretch {
+    /// A stretch of `m` metres, measured.
+    pub fn of(m: f64) -> Self {
+        RevisitStretch { m, counted: true }
+    }
+
+    /// Not measured (serde: such a stretch is not written).
+    pub fn uncounted(&self) -> bool {
+        !self.counted
+    }
+}
+
+impl From<f64> for RevisitStretch {
+    fn from(m: f64) -> Self {
+        RevisitStretch::of(m)
+    }
+}
+
+impl From<RevisitStretch> for f64 {
+    fn from(s: RevisitStretch) -> f64 {
+        s.m
+    }
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// Scores of the observations and pairs attributed to one door configuration.
@@ -479,7 +510,7 @@ impl Scorer {
     /// run all have a revisit (`revisits`, per observation): see
     /// [`Metrics::longest_revisit_m`]. Travel is the observations' frames' (observations made
     /// along one step between scans share it).
-    pub(super) fn longest_revisit_m(&self, revisits: &[bool]) -> f64 {
+    pub(super) fn longest_revisit_m(&self, revisits: &[bool]) -> RevisitStretch {
         let j = &self.joined;
         let mut longest = 0.0f64;
         // (observation position, site) of the previous observation with truth, and where the
@@ -503,7 +534,10 @@ impl Scorer {
             }
             prev = Some((i, s));
         }
-        longest
+        RevisitStretch {
+            m: longest,
+            counted: revisits.iter().any(|&r| r),
+        }
     }
 
     /// The door configuration of observation `i`, which has truth.
@@ -673,9 +707,27 @@ impl Counts {
             recall_either_side: ratio(self.recalled_any, self.revisits),
             visit_recall: 0.0,
             pair_recall: 0.0,
-            longest_revisit_m: 0.0,
+            longest_revisit_m: RevisitStretch::default(),
             unresolved_pairs: self.unresolved,
             late_pairs: 0,
+        }
+    }
+}
+
+/// The level-wide longest revisit stretch ([`Metrics::longest_revisit_m`]): the longer of the
+/// two directions' (`main`'s own, counted over revisits of either direction, when the
+/// directions were not counted: a sweep's figures).
+pub(super) fn longest_of_directions(
+    main: &Metrics,
+    same: &Metrics,
+    opposite: &Metrics,
+) -> RevisitStretch {
+    if same.revisits + opposite.revisits == 0 {
+        main.longest_revisit_m
+    } else {
+        RevisitStretch {
+            m: same.longest_revisit_m.m.max(opposite.longest_revisit_m.m),
+            counted: main.longest_revisit_m.counted,
         }
     }
 }
@@ -856,22 +908,22 @@ pub(crate) mod tests {
         // whole second lap follows on.
         let m = score(&obs, &[], &gt, &spec, 1.0);
         assert!(
-            (m.longest_revisit_m - 40.9).abs() < 0.01,
+            (m.longest_revisit_m.m - 40.9).abs() < 0.01,
             "{}",
-            m.longest_revisit_m
+            m.longest_revisit_m.m
         );
         for f in &mut gt.frames[500..520] {
             f.pose.0.x += 20.0;
         }
         let m = score(&obs, &[], &gt, &spec, 1.0);
         assert!(
-            (m.longest_revisit_m - 27.9).abs() < 0.01,
+            (m.longest_revisit_m.m - 27.9).abs() < 0.01,
             "{}",
-            m.longest_revisit_m
+            m.longest_revisit_m.m
         );
         // Three quarters of a lap revisit nothing.
         let m = score(&obs[..300], &[], &gt, &spec, 1.0);
-        assert_eq!(m.longest_revisit_m, 0.0);
+        assert_eq!(m.longest_revisit_m.m, 0.0);
     }
 
     /// A second lap facing the other way is an opposite-direction revisit, not a same-direction
@@ -885,24 +937,14 @@ pub(crate) mod tests {
         }
         let pairs: Vec<AlignedPair> = (0..400).map(|k| pair(&obs, 400 + k, k)).collect();
         let evaluate_as = |direction: Direction| {
-            let rec = Recognition {
-                name: "t".into(),
-                observations: obs.clone(),
-                matches: vec![Match {
+            let rec = recognition(
+                &obs,
+                &gt,
+                vec![Match {
                     direction,
                     ..one_match(pairs.clone())
                 }],
-                seconds: 0.0,
-                wall_seconds: 0.0,
-                score_seconds: 0.0,
-                laps: 2,
-                truth: std::sync::Arc::new(gt.clone()),
-                diagnostics: None,
-                lap_seconds: Vec::new(),
-                evaluation: None,
-                level_gain: None,
-                rejected: Vec::new(),
-            };
+            );
             evaluate(&rec, &EvaluationSpec::default())
         };
         let e = evaluate_as(Direction::Opposite);
@@ -923,6 +965,83 @@ pub(crate) mod tests {
         assert_eq!((e.main.pairs, e.main.correct_pairs), (400, 0));
         assert_eq!(e.directions.same.precision, 0.0);
         assert_eq!(e.directions.opposite.pairs, 0);
+    }
+
+    /// A recognition of `matches` over `obs` with truth `gt`, untimed.
+    pub(crate) fn recognition(
+        obs: &[Observation],
+        gt: &GroundTruth,
+        matches: Vec<Match>,
+    ) -> Recognition {
+        Recognition {
+            name: "t".into(),
+            observations: obs.to_vec(),
+            matches,
+            seconds: 0.0,
+            wall_seconds: 0.0,
+            score_seconds: 0.0,
+            laps: 2,
+            truth: std::sync::Arc::new(gt.clone()),
+            diagnostics: None,
+            lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
+            rejected: Vec::new(),
+            ranking: None,
+        }
+    }
+
+    /// A log whose second pass is driven the other way at only 8 scattered observations has 8
+    /// opposite revisits, none followed by another: the opposite figures are reported (the
+    /// terminal's row per direction, and `longest_revisit_m`, 0 m, in the JSON) as they are for
+    /// any figure with revisits; a direction without revisits writes no stretch.
+    #[test]
+    fn scattered_opposite_revisits_still_give_their_figures() {
+        let (obs, mut gt) = circle(2, 40.0);
+        for k in 0..8 {
+            gt.frames[420 + 45 * k].pose.0.theta += std::f64::consts::PI;
+        }
+        let rec = recognition(&obs, &gt, Vec::new());
+        let spec = EvaluationSpec::default();
+        let e = evaluate(&rec, &spec);
+        assert_eq!(e.directions.opposite.revisits, 8);
+        assert_eq!(
+            e.directions.opposite.longest_revisit_m,
+            RevisitStretch::of(0.0)
+        );
+        let scores = crate::eval::scores::Scores::of(&rec, &spec);
+        let json = serde_json::to_value(&scores).unwrap();
+        assert_eq!(json["directions"]["opposite"]["longest_revisit_m"], 0.0);
+        assert!(scores.has_opposite());
+        let (plain, _) = circle(1, 40.0);
+        let e = evaluate(&recognition(&plain, &circle(1, 40.0).1, Vec::new()), &spec);
+        let json = serde_json::to_value(&e.directions.opposite).unwrap();
+        assert!(json.get("longest_revisit_m").is_none(), "{json}");
+    }
+
+    /// The level-wide longest revisit is the longer of the two directions', not a stretch that
+    /// runs from same-direction revisits into opposite ones (fhw once gave 111.4 m against
+    /// 37.7 m and 65.0 m).
+    #[test]
+    fn level_wide_longest_revisit_is_the_longer_direction() {
+        let (obs, mut gt) = circle(2, 40.0);
+        // Lap 2: 30 m driven as lap 1, then 10 m turned around (headings flipped).
+        for f in &mut gt.frames[700..] {
+            f.pose.0.theta += std::f64::consts::PI;
+        }
+        let e = evaluate(
+            &recognition(&obs, &gt, Vec::new()),
+            &EvaluationSpec::default(),
+        );
+        let (same, opposite) = (
+            e.directions.same.longest_revisit_m.m,
+            e.directions.opposite.longest_revisit_m.m,
+        );
+        // Lap 1's last metre (near its start) leads into lap 2's 30 m driven the same way.
+        assert!((same - 30.9).abs() < 0.15, "{same}");
+        assert!((opposite - 9.9).abs() < 0.15, "{opposite}");
+        // Counted over revisits of either direction the stretch would run on to 40.9 m.
+        assert_eq!(e.main.longest_revisit_m.m, same);
     }
 
     #[test]
@@ -951,19 +1070,10 @@ pub(crate) mod tests {
             (415..obs.len()).map(|q| pair(&obs, q, q - 415)).collect(),
         )];
         let rec = Recognition {
-            name: "t".into(),
-            observations: obs,
-            matches,
             seconds: 1.0,
             wall_seconds: 1.0,
-            score_seconds: 0.0,
             laps: 3,
-            truth: std::sync::Arc::new(gt),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
+            ..recognition(&obs, &gt, matches)
         };
         let e = evaluate(&rec, &EvaluationSpec::default());
         assert_eq!(e.main.precision, 0.0);
@@ -1001,21 +1111,7 @@ pub(crate) mod tests {
             one_match(vec![pair(&obs, 400, 0), pair(&obs, 401, 200)]),
             one_match(vec![pair(&obs, 400, 0)]),
         ];
-        let rec = Recognition {
-            name: "t".into(),
-            observations: obs,
-            matches,
-            seconds: 0.0,
-            wall_seconds: 0.0,
-            score_seconds: 0.0,
-            laps: 2,
-            truth: std::sync::Arc::new(gt),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-        };
+        let rec = recognition(&obs, &gt, matches);
         let p = scored_pairs(&rec, 1.0);
         assert_eq!(p.len(), 2);
         assert!(p[0].correct && !p[1].correct);

@@ -22,6 +22,7 @@ pub mod pair_recall;
 pub mod pair_set;
 pub mod provenance;
 pub mod rank_test;
+pub mod ranking;
 pub mod scores;
 pub mod site_tree;
 pub mod suite;
@@ -223,6 +224,10 @@ pub struct Recognition {
     /// diagnostics sample them), with the truth of each one's observation pair: whether
     /// verification turned down true revisits or look-alikes.
     pub rejected: Vec<RejectedTruth>,
+    /// Each query observation's best-scoring answer, when the matches were scored as they
+    /// arrived ([`Recording::streaming`]; otherwise [`scores::Scores::of`] ranks `matches`),
+    /// and the observations made.
+    pub ranking: Option<(ranking::Ranking, usize)>,
 }
 
 /// A candidate the recognizer's verification turned down, with the true poses of the
@@ -416,6 +421,8 @@ pub struct Recording {
     lap_so_far: f64,
     /// Scores the matches as they arrive, when streaming.
     tally: Option<(EvaluationSpec, Tally)>,
+    /// Ranks each query's answers as they arrive, when streaming.
+    ranking: ranking::Ranking,
     level_gain: Option<(usize, usize)>,
     closed: bool,
 }
@@ -433,12 +440,13 @@ impl Recording {
     /// Keeps (or scores) matches `found`, after the frames and observations they name.
     fn take(&mut self, rec: &dyn PlaceRecognizer, truth: &GroundTruth, found: Vec<Match>) {
         match &mut self.tally {
-            Some((_, tally)) => {
+            Some((spec, tally)) => {
                 if !found.is_empty() {
                     let w = Stopwatch::start();
                     tally.sync(rec.observations(), truth);
                     for m in &found {
                         tally.add(m, truth);
+                        self.ranking.add(m, tally.scorer(), spec);
                     }
                     self.score_seconds += w.cpu_s();
                 }
@@ -628,10 +636,12 @@ impl Ended {
     pub fn finish_sharing(self, truth: Arc<GroundTruth>, shared: &mut SharedTruth) -> Recognition {
         let r = self.recording;
         let w = Stopwatch::start();
+        let observations_made = r.tally.as_ref().map_or(0, |(_, t)| t.observations());
         let evaluation = r.tally.map(|(spec, tally)| {
             let e = tally.finish_sharing(&truth, shared);
             (spec, e)
         });
+        let ranking = evaluation.is_some().then(|| (r.ranking, observations_made));
         let score_seconds = r.score_seconds + w.cpu_s();
         Recognition {
             name: self.name,
@@ -647,6 +657,7 @@ impl Ended {
             evaluation,
             level_gain: r.level_gain,
             rejected: self.rejected,
+            ranking,
         }
     }
 }

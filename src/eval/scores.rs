@@ -30,11 +30,14 @@
 //! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN); then
 //! `"no_pairs_reason"` says why when it can tell, and `"diagnostics"` (the recognizer's longest
 //! chains, verification counts and mean word length, when it tells) gives the figures behind
-//! it. `"longest_revisit_m"` (written when not 0, here and in each direction's figures) is the
-//! longest stretch of true travel along which every observation has a revisit.
+//! it. `"longest_revisit_m"` (written whenever the figure has revisits, here and in each
+//! direction's figures; the top-level one is the longer of the two directions') is the longest
+//! stretch of true travel along which every observation has a revisit.
 
 use super::Recognition;
-use super::metrics::{DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, pairs_not_in};
+use super::metrics::{
+    DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, RevisitStretch, pairs_not_in,
+};
 use super::sweep::{PrCurve, SweepResult};
 use crate::place::Diagnostics;
 use crate::spec::evaluation::EvaluationSpec;
@@ -54,9 +57,10 @@ pub struct Scores {
     pub revisits: usize,
     pub recall_either_side: f64,
     /// The longest stretch of true travel along which every observation has a revisit, metres
-    /// (see `eval::metrics::Metrics::longest_revisit_m`; written only when not 0).
-    #[serde(default, skip_serializing_if = "super::metrics::is_zero_m")]
-    pub longest_revisit_m: f64,
+    /// (see `eval::metrics::Metrics::longest_revisit_m`: the longer of the two directions';
+    /// written whenever there are revisits).
+    #[serde(default, skip_serializing_if = "RevisitStretch::uncounted")]
+    pub longest_revisit_m: RevisitStretch,
     /// Share of (observation, earlier lap through the same spot) pairs recognized: rewards
     /// matching across door changes (see `eval::metrics::Metrics::visit_recall`).
     #[serde(default)]
@@ -98,6 +102,11 @@ pub struct Scores {
     /// full); empty when it has none.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
+    /// The field's figures over the match score, per query observation: the PR curve, max
+    /// F1, recall at 100 % and 99 % precision, average precision, the query rate
+    /// (`eval::ranking`); `None` where not computed (per direction, per door configuration).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranking: Option<super::ranking::RankingScores>,
 }
 
 impl Scores {
@@ -137,6 +146,7 @@ impl Scores {
             rejected_candidates: None,
             diagnostics: None,
             notes: Vec::new(),
+            ranking: None,
         }
     }
 
@@ -162,6 +172,7 @@ impl Scores {
         let e = super::evaluate(rec, spec);
         let d = rec.diagnostics.as_deref();
         let rejected = d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec));
+        let ranking = super::ranking::of_recognition(rec, e.main.revisits, spec);
         Scores {
             recognize_wall_seconds_per_lap: rec.wall_seconds_per_lap(),
             score_seconds: rec.score_seconds + w.cpu_s(),
@@ -169,6 +180,7 @@ impl Scores {
             rejected_candidates: rejected,
             diagnostics: d.map(Diagnostics::to_json),
             notes: d.map(Diagnostics::notes).unwrap_or_default(),
+            ranking: Some(ranking),
             ..Scores::new(&e, rec.seconds_per_lap())
         }
     }
@@ -199,8 +211,8 @@ pub fn no_pairs_reason(
             let c = d.candidates();
             if m.revisits > 0 && c.accepted + c.rejected == 0 {
                 why.extend(d.revisit_length_reason(
-                    e.directions.same.longest_revisit_m,
-                    e.directions.opposite.longest_revisit_m,
+                    e.directions.same.longest_revisit_m.m,
+                    e.directions.opposite.longest_revisit_m.m,
                 ));
             }
             if c.accepted == 0 {
@@ -546,16 +558,22 @@ pub struct SweepReport {
     pub results: Vec<SweepResult>,
     /// The PR curves built from `results`.
     pub curves: Vec<PrCurve>,
+    /// Each words subject's curve over its match score, at the scenario's thresholds
+    /// (`eval::ranking`; untimed: query rate 0).
+    #[serde(default)]
+    pub score_curves: Vec<super::ranking::SubjectRanking>,
 }
 
 impl SweepReport {
-    /// A sweep report of `results` (in grid order) with its PR curves.
+    /// A sweep report of `results` (in grid order) with its PR curves, and the subjects'
+    /// `score_curves`.
     pub fn new(
         scenario: &str,
         seed: u64,
         laps: usize,
         evaluation: EvaluationSpec,
         results: Vec<SweepResult>,
+        score_curves: Vec<super::ranking::SubjectRanking>,
     ) -> Self {
         let curves = super::sweep::pr_curves(&results);
         SweepReport {
@@ -565,6 +583,7 @@ impl SweepReport {
             evaluation,
             results,
             curves,
+            score_curves,
         }
     }
 }
@@ -644,9 +663,9 @@ pub(crate) mod tests {
         let spec = EvaluationSpec::default();
         let mut e = Evaluation::default();
         e.main.revisits = 300;
-        e.main.longest_revisit_m = 20.2;
-        e.directions.same.longest_revisit_m = 11.2;
-        e.directions.opposite.longest_revisit_m = 9.0;
+        e.main.longest_revisit_m = 20.2.into();
+        e.directions.same.longest_revisit_m = 11.2.into();
+        e.directions.opposite.longest_revisit_m = 9.0.into();
         let d = MatchDiagnostics {
             longest_chain: vec![4],
             min_ngram: vec![6],
@@ -668,14 +687,14 @@ pub(crate) mod tests {
             reverse_extra_ngram: 2,
             ..d
         };
-        e.directions.opposite.longest_revisit_m = 16.0;
+        e.directions.opposite.longest_revisit_m = 16.0.into();
         let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(
             why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
             "{why}"
         );
         assert!(why.contains("too short for a chain"), "{why}");
-        e.directions.same.longest_revisit_m = 16.0;
+        e.directions.same.longest_revisit_m = 16.0.into();
         let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
         assert!(why.contains("the words differ between visits"), "{why}");
         // Verification's counts are the reason when candidates were made.

@@ -370,6 +370,11 @@ impl Tally {
         self.late_pairs
     }
 
+    /// The observations joined with their truth (what `eval::ranking` judges pairs by).
+    pub(super) fn scorer(&self) -> &Scorer {
+        &self.scorer
+    }
+
     /// Observations synced so far.
     pub fn observations(&self) -> usize {
         self.scorer.observation_count()
@@ -476,12 +481,15 @@ impl Tally {
         let n_sens = self.spec.sensitivity_radii_m.len();
         let mut it = metrics.into_iter();
         // A `Scope::Main` tally has the first figure only; the others stay empty.
-        let (main, door_configs) = it.next().unwrap_or_default();
+        let (mut main, door_configs) = it.next().unwrap_or_default();
         let sensitivity = it.by_ref().take(n_sens).map(|(m, _)| m).collect();
         let (same, opposite) = (
             it.next().unwrap_or_default().0,
             it.next().unwrap_or_default().0,
         );
+        // A chain follows one direction: the stretch the figure promises is the longer of the
+        // two directions', not one that turns from same-direction revisits to opposite ones.
+        main.longest_revisit_m = super::metrics::longest_of_directions(&main, &same, &opposite);
         Evaluation {
             main,
             sensitivity,

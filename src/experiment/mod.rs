@@ -16,6 +16,8 @@ pub mod stress;
 
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::baseline::scan_context::{ScanContextConfig, ScanContextRecognizer};
+use crate::eval::metrics::Scorer;
+use crate::eval::ranking::{self, SubjectRanking};
 use crate::eval::scores::{Report, SubjectKind};
 use crate::eval::sweep::{GridPoint, SweepResult, sweep_matches};
 use crate::eval::{Recognition, recognize_runs_with_progress};
@@ -423,12 +425,13 @@ pub fn back_end_matches(
 /// simulated (or read from `opts.cache`) and turned into observations as they come, each lap's
 /// scans dropped once observed ([`stream::observe_scenario`]), so memory holds the observations
 /// and the truth, not the scans; then every grid point's back end runs in parallel. Results in
-/// grid order whatever the thread count, with the laps driven.
+/// grid order whatever the thread count, with the laps driven and each words subject's curve
+/// over its match score at the scenario's thresholds (`words-1` … `words-<levels>`).
 pub fn sweep(
     scn: &Scenario,
     opts: &ExperimentOptions,
     grid: &[GridPoint],
-) -> Result<(Vec<SweepResult>, usize), ExperimentError> {
+) -> Result<(Vec<SweepResult>, usize, Vec<SubjectRanking>), ExperimentError> {
     let base = recognizer_config(scn)?;
     // Check every grid point's settings before any work, so errors are reported once.
     for p in grid {
@@ -447,5 +450,28 @@ pub fn sweep(
         &|| progress.step(),
     );
     progress.done();
-    Ok((results, truth.laps.len()))
+    let evaluation = &scn.evaluation;
+    let positives = Scorer::new(&observations, &truth, evaluation)
+        .revisits(evaluation.tp_radius_m)
+        .iter()
+        .filter(|&&r| r)
+        .count();
+    let thresholds = &base.matcher.min_ngram;
+    let score_curves = (1..=base.levels.max(1))
+        .map(|levels| {
+            let point = GridPoint::new(levels, &thresholds[..levels.min(thresholds.len())]);
+            let matches = back_end_matches(&densities, &base, &point)?;
+            Ok(SubjectRanking {
+                name: crate::eval::scores::words_subject_name(levels),
+                ranking: ranking::of_matches(
+                    &observations,
+                    &truth,
+                    evaluation,
+                    &matches,
+                    positives,
+                ),
+            })
+        })
+        .collect::<Result<Vec<_>, ExperimentError>>()?;
+    Ok((results, truth.laps.len(), score_curves))
 }

@@ -709,6 +709,7 @@ mod tests {
             evaluation: None,
             level_gain: None,
             rejected: Vec::new(),
+            ranking: None,
         };
         let texts = doc_texts(&matches_svg(&world, &runs, &rec, 0.5, "t"));
         for absent in [

@@ -315,6 +315,7 @@ impl LoggedRuns {
             evaluation: None,
             level_gain: None,
             rejected: Vec::new(),
+            ranking: None,
         })
     }
 }

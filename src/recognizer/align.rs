@@ -292,3 +292,30 @@ fn squared_error(a: &[f64], b: &[f64]) -> f64 {
     let tail: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
     acc[0] + acc[1] + acc[2] + acc[3] + tail
 }
+
+/// The root mean square Ψ difference over the placements of a match's word pairs (its score's
+/// alignment residual, `WordMatch::psi_rms`): kept apart from the matching so that the score is
+/// one small function of what the alignment already computed.
+#[derive(Default)]
+pub(super) struct PsiResidual {
+    sum: f64,
+    count: usize,
+}
+
+impl PsiResidual {
+    pub(super) fn add(&mut self, placement: Option<&Placement>) {
+        if let Some(w) = placement {
+            self.sum += w.cost * w.count() as f64;
+            self.count += w.count();
+        }
+    }
+
+    /// The RMS, infinite without an aligned pair.
+    pub(super) fn rms(&self) -> f64 {
+        if self.count == 0 {
+            f64::INFINITY
+        } else {
+            (self.sum / self.count as f64).sqrt()
+        }
+    }
+}

@@ -22,7 +22,7 @@
 //! nothing sweeps the trajectory.
 //!
 
-use super::align::{Placement, PlacementKey};
+use super::align::{Placement, PlacementKey, PsiResidual};
 use super::chains::Entry;
 use super::config::{RecognizerConfig, RecognizerError};
 use super::diagnostics::{MAX_REJECTED_SAMPLES, VerificationCounts};
@@ -352,6 +352,7 @@ impl WordMatcher {
         // Verification placed the last `placed.len()` word pairs already: the same placements.
         let placed_from = chain.len() - cand.placed.len();
         scr.runs.clear();
+        let mut residual = PsiResidual::default();
         for (j, &(wc, widx)) in chain.iter().enumerate().skip(fresh_from) {
             let at = cand.pairs.start + j;
             let (past, anchor) = (scr.word_pairs[at].1, scr.anchors[at]);
@@ -361,6 +362,7 @@ impl WordMatcher {
                 Some(i) => scr.placed[cand.placed.start + i].take(),
                 None => self.placement(wc, past, cand.dir, anchor),
             };
+            residual.add(placement.as_ref());
             self.aligned_pairs(wc, past, cand.dir, placement, &mut scr.runs);
         }
         self.rejections.accepted += 1;
@@ -371,6 +373,7 @@ impl WordMatcher {
             // Usually one run: exactly as many as there are, no spare capacity per match.
             runs: scr.runs.to_vec(),
             direction: cand.dir,
+            psi_rms: residual.rms(),
         }
     }
 }

@@ -40,6 +40,11 @@ impl std::ops::DerefMut for DensityObservation {
     }
 }
 
+/// The Ψ residual at which a match's score is half-way between its chain length and the
+/// chain length plus ½ ([`WordMatch::score`]): the verification's default bound on the RMS Ψ
+/// difference (`verify_max_psi_rms`), so a match at that bound adds ¼.
+pub const PSI_RMS_SCALE: f64 = 0.04;
+
 /// A word at a level of the multi-level word lists.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 pub struct WordRef {
@@ -67,6 +72,9 @@ pub struct WordMatch {
     pub runs: Vec<AlignedRun>,
     /// The way the past side was read: `Same`, or `Opposite` for a revisit driven the other way.
     pub direction: Direction,
+    /// Root mean square Ψ difference of the aligned observation pairs of its word pairs (the
+    /// fine alignment's residual; infinite when none aligned).
+    pub psi_rms: f64,
 }
 
 impl WordMatch {
@@ -80,9 +88,50 @@ impl WordMatch {
         self.runs.iter().map(|r| r.len as usize).sum()
     }
 
-    /// What the harness scores of it: the pairs and the direction, with the n-gram's length in
-    /// word pairs as its score (a longer chain of matching words is surer evidence).
+    /// What the harness scores of it: the pairs and the direction, with [`Self::score`].
     pub fn to_place(&self) -> crate::place::Match {
-        crate::place::Match::new(self.runs.clone(), self.direction, self.ngram_len as f64)
+        crate::place::Match::new(self.runs.clone(), self.direction, self.score())
+    }
+
+    /// How sure the match is: the n-gram's length in word pairs (a longer chain of matching
+    /// words is surer evidence), plus `½ · s / (s + psi_rms)` with `s` =
+    /// [`PSI_RMS_SCALE`] (in (0, ½], larger as the densities agree better) so that within
+    /// one chain length the better aligned match ranks higher and no residual lifts a match
+    /// above a longer chain. Monotone: longer chains and smaller residuals score higher.
+    pub fn score(&self) -> f64 {
+        let agreement = if self.psi_rms.is_finite() {
+            PSI_RMS_SCALE / (PSI_RMS_SCALE + self.psi_rms.max(0.0))
+        } else {
+            0.0
+        };
+        self.ngram_len as f64 + 0.5 * agreement
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn word_match(ngram_len: usize, psi_rms: f64) -> WordMatch {
+        WordMatch {
+            levels: 1,
+            ngram_len,
+            word_pairs: Vec::new(),
+            runs: Vec::new(),
+            direction: Direction::Same,
+            psi_rms,
+        }
+    }
+
+    /// The score grows with the chain and falls with the residual, and no residual lifts a
+    /// match above a longer chain.
+    #[test]
+    fn score_is_monotone_in_chain_length_and_residual() {
+        let s = |n, r| word_match(n, r).score();
+        assert!(s(7, 0.0) > s(7, 0.01) && s(7, 0.01) > s(7, 0.04));
+        assert!(s(7, 0.04) > s(7, f64::INFINITY));
+        assert!(s(8, f64::INFINITY) > s(7, 0.0));
+        assert!((s(6, PSI_RMS_SCALE) - 6.25).abs() < 1e-12);
+        assert_eq!(s(6, f64::INFINITY), 6.0);
     }
 }

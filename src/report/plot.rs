@@ -1,7 +1,10 @@
-//! Precision-recall curves as a standalone SVG (paper Fig. 8), hand-written: no system library,
-//! no plotting crate. Recall on x, precision on y; multi-level curves solid, the single-level
-//! curve dotted; a legend with each curve's max-F1 and best recall at precision ≥ 0.9.
+//! Precision-recall curves as a standalone SVG, hand-written: no system library, no plotting
+//! crate. Recall on x, precision on y. Two pictures: the τ sweep (paper Fig. 8; multi-level
+//! curves solid, the single-level curve dotted; a legend with each curve's max-F1 and best
+//! recall at precision ≥ 0.9) and each subject's curve over its match score (`eval::ranking`;
+//! the legend gives AP, max F1 and recall at 99 % and 100 % precision).
 
+use crate::eval::ranking::RankingScores;
 use crate::eval::sweep::{PRECISION_FLOOR, PrCurve};
 use crate::report::junit::escape;
 use std::fmt::Write;
@@ -46,24 +49,109 @@ pub fn fitted_axis(lo: f64, hi: f64) -> (f64, f64, f64) {
     (a.max(0.0), b.min(1.0), step)
 }
 
-/// The SVG document of `curves` titled `title`.
+/// One curve to draw: its points `(recall, precision, threshold as written)` in order, its
+/// label, whether it is dotted, and two lines of figures for the legend.
+struct Series {
+    label: String,
+    dotted: bool,
+    points: Vec<(f64, f64, String)>,
+    notes: [String; 2],
+}
+
+/// The SVG document of the τ sweep's `curves` titled `title` (paper Fig. 8): one curve per
+/// level configuration, its max F1 and best recall at precision ≥ [`PRECISION_FLOOR`].
 pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
-    // Axes fitted to the points drawn (and the precision floor), so curves near P = 1 spread.
-    let drawn = || {
-        curves
-            .iter()
-            .flat_map(|c| c.points.iter().filter(|p| p.pairs > 0))
-    };
-    let (r_lo, r_hi) = drawn().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-        (a.min(p.recall), b.max(p.recall))
-    });
-    let p_lo = drawn().map(|p| p.precision).fold(PRECISION_FLOOR, f64::min);
-    let (x_min, x_max, x_step) = fitted_axis(r_lo, r_hi);
-    let (y_min, y_max, y_step) = fitted_axis(p_lo, 1.0);
-    let pw = W - LEFT - RIGHT;
-    let ph = H - TOP - BOTTOM;
-    let sx = |x: f64| LEFT + (x - x_min) / (x_max - x_min) * pw;
-    let sy = |y: f64| TOP + (y_max - y) / (y_max - y_min) * ph;
+    let series: Vec<Series> = curves
+        .iter()
+        .map(|c| {
+            let f1 = c
+                .max_f1
+                .as_ref()
+                .map(|p| format!("max F1 {:.3} at t = {}", p.f1, p.threshold))
+                .unwrap_or_else(|| "max F1 –".into());
+            let best = c
+                .best_recall_at_precision
+                .as_ref()
+                .map(|p| {
+                    let (r, t) = (p.recall, p.threshold);
+                    format!("recall {r:.3} at P ≥ {PRECISION_FLOOR}, t = {t}")
+                })
+                .unwrap_or_else(|| format!("no point at P ≥ {PRECISION_FLOOR}"));
+            Series {
+                label: c.label.clone(),
+                dotted: c.levels == 1,
+                points: (c.points.iter().filter(|p| p.pairs > 0))
+                    .map(|p| (p.recall, p.precision, p.threshold.to_string()))
+                    .collect(),
+                notes: [f1, best],
+            }
+        })
+        .collect();
+    svg(&series, title, PRECISION_FLOOR)
+}
+
+/// The SVG document of each subject's precision–recall curve over its match score
+/// (`eval::ranking`), titled `title`, with the 0.99 precision line; each curve's AP, max F1
+/// and recall at 99 % and 100 % precision in the legend.
+pub fn score_curves_svg(subjects: &[(String, &RankingScores)], title: &str) -> String {
+    let series: Vec<Series> = subjects
+        .iter()
+        .map(|(name, r)| Series {
+            label: name.clone(),
+            dotted: false,
+            points: (r.curve.iter())
+                .map(|p| (p.recall, p.precision, format!("{:.2}", p.threshold)))
+                .collect(),
+            notes: [
+                format!(
+                    "AP {:.3}, max F1 {:.3}{}",
+                    r.average_precision,
+                    r.max_f1,
+                    r.max_f1_threshold
+                        .map_or(String::new(), |t| format!(" at t = {t:.2}"))
+                ),
+                format!(
+                    "R {:.3} at P ≥ 0.99, {:.3} at P = 1",
+                    r.recall_at_99_precision, r.recall_at_100_precision
+                ),
+            ],
+        })
+        .collect();
+    svg(&series, title, 0.99)
+}
+
+/// Axes fitted to the points drawn (and the precision `floor`), so curves near P = 1 spread.
+struct Frame {
+    x: (f64, f64, f64),
+    y: (f64, f64, f64),
+}
+
+impl Frame {
+    fn of(series: &[Series], floor: f64) -> Self {
+        let drawn = || series.iter().flat_map(|c| c.points.iter());
+        let (r_lo, r_hi) = drawn().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.0), b.max(p.0))
+        });
+        let p_lo = drawn().map(|p| p.1).fold(floor, f64::min);
+        Frame {
+            x: fitted_axis(r_lo, r_hi),
+            y: fitted_axis(p_lo, 1.0),
+        }
+    }
+
+    fn sx(&self, x: f64) -> f64 {
+        LEFT + (x - self.x.0) / (self.x.1 - self.x.0) * (W - LEFT - RIGHT)
+    }
+
+    fn sy(&self, y: f64) -> f64 {
+        TOP + (self.y.1 - y) / (self.y.1 - self.y.0) * (H - TOP - BOTTOM)
+    }
+}
+
+/// The whole document: frame, grid, the precision `floor` as a dashed line, the curves and the
+/// legend.
+fn svg(series: &[Series], title: &str, floor: f64) -> String {
+    let f = Frame::of(series, floor);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -73,37 +161,56 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
     let _ = writeln!(
         s,
         r#"<text x="{}" y="22" text-anchor="middle" font-size="15">{}</text>"#,
-        LEFT + pw / 2.0,
+        LEFT + (W - LEFT - RIGHT) / 2.0,
         escape(title)
     );
-    // Grid, ticks and labels.
-    let ticks = |a: f64, b: f64, st: f64| {
+    grid(&mut s, &f);
+    axes(&mut s, &f, floor);
+    let mut labels: Vec<(f64, f64)> = Vec::new();
+    for (i, c) in series.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        curve(&mut s, &f, c, colour);
+        end_labels(&mut s, &f, c, colour, &mut labels);
+        legend(&mut s, i, c, colour);
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// Grid lines and tick labels on both axes.
+fn grid(s: &mut String, f: &Frame) {
+    let (pw, ph) = (W - LEFT - RIGHT, H - TOP - BOTTOM);
+    let ticks = |(a, b, st): (f64, f64, f64)| {
         let n = ((b - a) / st).round() as usize;
         (0..=n).map(move |i| a + st * i as f64)
     };
-    for fx in ticks(x_min, x_max, x_step) {
-        let x = sx(fx);
+    for fx in ticks(f.x) {
+        let x = f.sx(fx);
         let _ = writeln!(
             s,
             r##"<line x1="{x:.1}" y1="{TOP}" x2="{x:.1}" y2="{:.1}" stroke="#e5e5e5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
             TOP + ph,
             TOP + ph + 16.0,
-            trim(fx)
+            trim(fx, f.x.2)
         );
     }
-    for fy in ticks(y_min, y_max, y_step) {
-        let y = sy(fy);
+    for fy in ticks(f.y) {
+        let y = f.sy(fy);
         let _ = writeln!(
             s,
             r##"<line x1="{LEFT}" y1="{y:.1}" x2="{:.1}" y2="{y:.1}" stroke="#e5e5e5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
             LEFT + pw,
             LEFT - 6.0,
             y + 4.0,
-            trim(fy)
+            trim(fy, f.y.2)
         );
     }
-    // The precision floor.
-    let yf = sy(PRECISION_FLOOR);
+}
+
+/// The precision floor, the plot's border and the axis names.
+fn axes(s: &mut String, f: &Frame, floor: f64) {
+    let (pw, ph) = (W - LEFT - RIGHT, H - TOP - BOTTOM);
+    let yf = f.sy(floor);
     let _ = writeln!(
         s,
         r##"<line x1="{LEFT}" y1="{yf:.1}" x2="{:.1}" y2="{yf:.1}" stroke="#999" stroke-dasharray="6 3"/>"##,
@@ -125,108 +232,95 @@ pub fn pr_curves_svg(curves: &[PrCurve], title: &str) -> String {
         TOP + ph / 2.0,
         TOP + ph / 2.0
     );
-    // Curves.
-    let mut labels: Vec<(f64, f64)> = Vec::new();
-    for (i, c) in curves.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
-        let dash = if c.levels == 1 {
-            r#" stroke-dasharray="2 3""#
-        } else {
-            ""
-        };
-        let pts: Vec<String> = c
-            .points
-            .iter()
-            .filter(|p| p.pairs > 0)
-            .map(|p| format!("{:.1},{:.1}", sx(p.recall), sy(p.precision)))
-            .collect();
-        let _ = writeln!(
-            s,
-            r#"<polyline fill="none" stroke="{colour}" stroke-width="2"{dash} points="{}"><title>{}</title></polyline>"#,
-            pts.join(" "),
-            escape(&c.label)
-        );
-        for p in c.points.iter().filter(|p| p.pairs > 0) {
-            let _ = writeln!(
-                s,
-                r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{}, t = {}: P {:.3} R {:.3}</title></circle>"#,
-                sx(p.recall),
-                sy(p.precision),
-                escape(&c.label),
-                p.threshold,
-                p.precision,
-                p.recall
-            );
-        }
-        // Each end of the curve says its t, so a reader sees which way t grows.
-        let drawn: Vec<_> = c.points.iter().filter(|p| p.pairs > 0).collect();
-        let ends = match (drawn.first(), drawn.last()) {
-            (Some(a), Some(b)) if drawn.len() > 1 => vec![*a, *b],
-            (Some(a), _) => vec![*a],
-            _ => Vec::new(),
-        };
-        for p in ends {
-            // A label where another already stands would hide both: the point's tooltip says it.
-            let (x, y) = (sx(p.recall), sy(p.precision));
-            if labels
-                .iter()
-                .any(|&(lx, ly): &(f64, f64)| (lx - x).abs() < 34.0 && (ly - y).abs() < 12.0)
-            {
-                continue;
-            }
-            labels.push((x, y));
-            let _ = writeln!(
-                s,
-                r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{colour}">t={}</text>"#,
-                x + 4.0,
-                y - 4.0,
-                p.threshold
-            );
-        }
-        // Legend entry.
-        let ly = TOP + 10.0 + 46.0 * i as f64;
-        let lx = W - RIGHT + 16.0;
-        let _ = writeln!(
-            s,
-            r#"<line x1="{lx}" y1="{ly}" x2="{:.1}" y2="{ly}" stroke="{colour}" stroke-width="2"{dash}/><text x="{:.1}" y="{:.1}">{}</text>"#,
-            lx + 24.0,
-            lx + 30.0,
-            ly + 4.0,
-            escape(&c.label)
-        );
-        let f1 = c
-            .max_f1
-            .as_ref()
-            .map(|p| format!("max F1 {:.3} at t = {}", p.f1, p.threshold))
-            .unwrap_or_else(|| "max F1 –".into());
-        let br = c
-            .best_recall_at_precision
-            .as_ref()
-            .map(|p| {
-                format!(
-                    "recall {:.3} at P ≥ {PRECISION_FLOOR}, t = {}",
-                    p.recall, p.threshold
-                )
-            })
-            .unwrap_or_else(|| format!("no point at P ≥ {PRECISION_FLOOR}"));
-        let _ = writeln!(
-            s,
-            r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text><text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text>"##,
-            lx + 30.0,
-            ly + 17.0,
-            escape(&f1),
-            lx + 30.0,
-            ly + 30.0,
-            escape(&br)
-        );
-    }
-    s.push_str("</svg>\n");
-    s
 }
 
-/// A tick label without trailing zeros.
-fn trim(v: f64) -> String {
-    let s = format!("{v:.2}");
+/// The stroke-dasharray attribute of a dotted curve (empty for a solid one).
+fn dash(c: &Series) -> &'static str {
+    if c.dotted {
+        r#" stroke-dasharray="2 3""#
+    } else {
+        ""
+    }
+}
+
+/// A curve's polyline and a marker with a tooltip at each point.
+fn curve(s: &mut String, f: &Frame, c: &Series, colour: &str) {
+    let pts: Vec<String> = (c.points.iter())
+        .map(|p| format!("{:.1},{:.1}", f.sx(p.0), f.sy(p.1)))
+        .collect();
+    let _ = writeln!(
+        s,
+        r#"<polyline fill="none" stroke="{colour}" stroke-width="2"{} points="{}"><title>{}</title></polyline>"#,
+        dash(c),
+        pts.join(" "),
+        escape(&c.label)
+    );
+    for (r, p, t) in &c.points {
+        let _ = writeln!(
+            s,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="{colour}"><title>{}, t = {}: P {p:.3} R {r:.3}</title></circle>"#,
+            f.sx(*r),
+            f.sy(*p),
+            escape(&c.label),
+            escape(t),
+        );
+    }
+}
+
+/// Each end of a curve says its threshold, so a reader sees which way t grows; a label where
+/// another already stands (`labels`) is left out, as it would hide both (the tooltip says it).
+fn end_labels(s: &mut String, f: &Frame, c: &Series, colour: &str, labels: &mut Vec<(f64, f64)>) {
+    let ends = match (c.points.first(), c.points.last()) {
+        (Some(a), Some(b)) if c.points.len() > 1 => vec![a, b],
+        (Some(a), _) => vec![a],
+        _ => Vec::new(),
+    };
+    for (r, p, t) in ends {
+        let (x, y) = (f.sx(*r), f.sy(*p));
+        if (labels.iter()).any(|&(lx, ly)| (lx - x).abs() < 34.0 && (ly - y).abs() < 12.0) {
+            continue;
+        }
+        labels.push((x, y));
+        let _ = writeln!(
+            s,
+            r#"<text x="{:.1}" y="{:.1}" font-size="10" fill="{colour}">t={}</text>"#,
+            x + 4.0,
+            y - 4.0,
+            escape(t)
+        );
+    }
+}
+
+/// Legend entry `i`: the curve's stroke and label, and its two lines of figures.
+fn legend(s: &mut String, i: usize, c: &Series, colour: &str) {
+    let ly = TOP + 10.0 + 46.0 * i as f64;
+    let lx = W - RIGHT + 16.0;
+    let _ = writeln!(
+        s,
+        r#"<line x1="{lx}" y1="{ly}" x2="{:.1}" y2="{ly}" stroke="{colour}" stroke-width="2"{}/><text x="{:.1}" y="{:.1}">{}</text>"#,
+        lx + 24.0,
+        dash(c),
+        lx + 30.0,
+        ly + 4.0,
+        escape(&c.label)
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text><text x="{:.1}" y="{:.1}" font-size="10" fill="#444">{}</text>"##,
+        lx + 30.0,
+        ly + 17.0,
+        escape(&c.notes[0]),
+        lx + 30.0,
+        ly + 30.0,
+        escape(&c.notes[1])
+    );
+}
+
+/// A tick label at the precision of the tick step `step`, without trailing zeros (so ticks
+/// 0.002 apart near P = 1 read 0.996, 0.998, 1).
+fn trim(v: f64, step: f64) -> String {
+    let decimals = (-step.log10() - 1e-9).ceil().max(2.0) as usize;
+    let s = format!("{v:.decimals$}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s.is_empty() { "0".into() } else { s.into() }
 }
@@ -247,6 +341,10 @@ mod tests {
         let (a, b, _) = fitted_axis(0.5, 0.5);
         assert!(a <= 0.5 && b > a);
         assert_eq!(fitted_axis(f64::INFINITY, f64::NEG_INFINITY).0, 0.0);
+        // Ticks 0.002 apart keep their third decimal.
+        assert_eq!(trim(0.998, 0.002), "0.998");
+        assert_eq!(trim(1.0, 0.002), "1");
+        assert_eq!(trim(0.5, 0.1), "0.5");
     }
 
     #[test]
@@ -289,5 +387,22 @@ mod tests {
             std::fs::write(path, &svg).unwrap();
         }
         assert!(svg.contains("B &lt;sweep&gt;"));
+    }
+
+    /// The score curves: a polyline per subject, the 0.99 precision line, and each subject's
+    /// AP and recall at 99 % precision in the legend.
+    #[test]
+    fn score_curves_have_a_polyline_per_subject() {
+        let a = crate::eval::ranking::curve(&[(9.0, true), (8.0, true), (2.0, false)], 3);
+        let b = crate::eval::ranking::curve(&[(1.0, true), (0.5, false)], 3);
+        let svg = score_curves_svg(&[("words-3".into(), &a), ("icp".into(), &b)], "B");
+        let doc = roxmltree::Document::parse(&svg).expect("valid SVG/XML");
+        let lines = doc.descendants().filter(|n| n.has_tag_name("polyline"));
+        assert_eq!(lines.count(), 2);
+        assert!(svg.contains("AP 0.667, max F1 0.800 at t = 8.00"), "{svg}");
+        assert!(svg.contains("R 0.667 at P ≥ 0.99, 0.667 at P = 1"), "{svg}");
+        if let Ok(path) = std::env::var("PLACEWORDS_SCORE_PLOT_SAMPLE") {
+            std::fs::write(path, &svg).unwrap();
+        }
     }
 }

@@ -1,5 +1,6 @@
 //! Tables from reports: a plain-text table for the terminal, and the paper's Table I in Markdown.
 
+use crate::eval::ranking::RankingScores;
 use crate::eval::scores::{Report, Scores, SubjectReport};
 use crate::place::Direction;
 use std::fmt::Write;
@@ -72,6 +73,7 @@ pub fn text_table(report: &Report) -> String {
     headlines(report, &mut out);
     main_table(report, &mut out);
     other_recalls(report, &mut out);
+    ranking(report, &mut out);
     notes(report, &mut out);
     breakdowns(report, &mut out);
     out
@@ -179,7 +181,11 @@ fn main_table(report: &Report, out: &mut String) {
     // A real log is one run, not laps: its time is the whole log's.
     let (time, time_meaning) = match report.log {
         Some(_) => ("CPU s", "the recognizer's CPU seconds over the whole log"),
-        None => ("s/lap", "the recognizer's CPU seconds per lap"),
+        None => (
+            "CPU s/lap",
+            "the recognizer's CPU seconds per lap (its own thread's: subjects run side by side, \
+             so theirs may add up to more than the wall time)",
+        ),
     };
     let split = if report.subjects.iter().any(|s| s.scores.has_opposite()) {
         " (both directions; the same/opposite rows split them)"
@@ -277,6 +283,72 @@ fn other_recalls(report: &Report, out: &mut String) {
             (
                 "match P",
                 "matches most of whose pairs are correct ÷ matches",
+            ),
+        ],
+        out,
+    );
+}
+
+/// The field's figures over each subject's match score (`eval::ranking`), in a block of their
+/// own, with the ground-truth rule they were counted with.
+fn ranking(report: &Report, out: &mut String) {
+    let ranked: Vec<(String, &RankingScores)> = rows(report)
+        .into_iter()
+        .filter_map(|(label, s)| Some((label, s.ranking.as_ref()?)))
+        .collect();
+    let Some((_, first)) = ranked.first() else {
+        return;
+    };
+    let head = format!(
+        "over the match score, per query observation (right answer: a true revisit {})",
+        first.rule.short()
+    );
+    out.push('\n');
+    for l in textwrap::wrap(&head, TEXT_WIDTH) {
+        let _ = writeln!(out, "{l}");
+    }
+    let body: Vec<Vec<String>> = ranked
+        .iter()
+        .map(|(label, r)| {
+            vec![
+                label.clone(),
+                format!("{:.3}", r.average_precision),
+                format!("{:.3}", r.max_f1),
+                r.max_f1_threshold.map_or("–".into(), |t| format!("{t:.2}")),
+                format!("{:.3}", r.recall_at_100_precision),
+                format!("{:.3}", r.recall_at_99_precision),
+                format!("{:.0}", r.queries_per_cpu_second),
+            ]
+        })
+        .collect();
+    out.push_str(&render(
+        &[
+            "subject [τ]",
+            "AP",
+            "max F1",
+            "at t",
+            "R@P100",
+            "R@P99",
+            "queries/CPU s",
+        ],
+        &body,
+    ));
+    legend_lines(
+        &[
+            (
+                "AP",
+                "average precision, scikit-learn's step-wise sum Σ (Rn − Rn−1)·Pn over the score \
+                 thresholds; a query's answer is its best-scoring pair, recall counts the queries \
+                 with a revisit",
+            ),
+            ("max F1", "the highest F1 over the thresholds, at score t"),
+            (
+                "R@P100",
+                "the highest recall at precision 1 (R@P99: at precision ≥ 0.99)",
+            ),
+            (
+                "queries/CPU s",
+                "observations the recognizer made per second of its CPU",
             ),
         ],
         out,
@@ -432,13 +504,25 @@ fn fmt_p(s: &Scores) -> String {
 
 /// The paper's Table I for several scenarios, in Markdown: a row per subject (words-1, words-2,
 /// words-3, icp, …)
-/// (those present in any report), per scenario a "P – R" column and an "s/lap" column.
+/// (those present in any report), per scenario a "P – R" column and a "CPU s/lap" column.
 pub fn markdown_table_i(reports: &[Report]) -> String {
-    markdown_by_level(reports, &["P – R", "s/lap"], |s| {
+    markdown_by_level(reports, &["P – R", "CPU s/lap"], |s| {
         vec![
             format!("{} – {:.3}", fmt_p(s), s.recall),
             format!("{:.2}", s.recognize_seconds_per_lap),
         ]
+    })
+}
+
+/// Recall at 99 % precision and max F1 over the match score per subject and scenario
+/// (`eval::ranking`), in Markdown; – where a subject has no ranking.
+pub fn markdown_ranking(reports: &[Report]) -> String {
+    markdown_by_level(reports, &["R@P99", "max F1"], |s| match &s.ranking {
+        Some(r) => vec![
+            format!("{:.3}", r.recall_at_99_precision),
+            format!("{:.3}", r.max_f1),
+        ],
+        None => vec!["–".into(), "–".into()],
     })
 }
 
@@ -560,6 +644,34 @@ pub fn curves_table(curves: &[crate::eval::sweep::PrCurve]) -> String {
     render(&["curve", "max F1", "at", &best_header], &body)
 }
 
+/// One line per subject of a sweep: its figures over the match score (`eval::ranking`).
+pub fn score_curves_table(subjects: &[crate::eval::ranking::SubjectRanking]) -> String {
+    let body: Vec<Vec<String>> = subjects
+        .iter()
+        .map(|s| {
+            let r = &s.ranking;
+            vec![
+                s.name.clone(),
+                format!("{:.3}", r.average_precision),
+                format!("{:.3}", r.max_f1),
+                r.max_f1_threshold.map_or("–".into(), |t| format!("{t:.2}")),
+                format!("{:.3}", r.recall_at_100_precision),
+                format!("{:.3}", r.recall_at_99_precision),
+            ]
+        })
+        .collect();
+    let rule = subjects
+        .first()
+        .map_or(String::new(), |s| s.ranking.rule.short());
+    format!(
+        "over the match score, per query observation (right answer: a true revisit {rule})\n{}",
+        render(
+            &["subject", "AP", "max F1", "at t", "R@P100", "R@P99"],
+            &body
+        )
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -574,7 +686,7 @@ mod tests {
         assert_eq!(lines.len(), 6, "{md}");
         assert_eq!(
             lines[0],
-            "| subject | A P – R | A s/lap | B P – R | B s/lap |"
+            "| subject | A P – R | A CPU s/lap | B P – R | B CPU s/lap |"
         );
         assert_eq!(
             lines[2],
@@ -702,7 +814,8 @@ mod tests {
             headline.contains("recall 0.250 (50 of 200 revisits)"),
             "{t}"
         );
-        assert!(t.contains("40 laps") && t.contains("s/lap"), "{t}");
+        // Per-lap times are CPU seconds, and the header says so.
+        assert!(t.contains("40 laps") && t.contains("CPU s/lap"), "{t}");
         assert!(t.contains("doors all-closed (3 laps)"), "{t}");
         rep.log = Some(crate::eval::scores::LogSummary {
             scans: 910,
@@ -720,6 +833,32 @@ mod tests {
             );
         }
         assert!(t.contains("CPU s"), "{t}");
+    }
+
+    /// The figures over the match score get a block of their own in the terminal, with the
+    /// ground-truth rule, and a Markdown table of recall at 99 % precision and max F1.
+    #[test]
+    fn ranking_figures_are_printed_with_their_truth_rule() {
+        let mut rep = sample("B", [0.9; 3], [0.2; 3]);
+        let r = crate::eval::ranking::curve(&[(7.0, true), (6.0, true), (5.0, false)], 4);
+        rep.subjects[2].scores.ranking = Some(crate::eval::ranking::RankingScores {
+            rule: crate::eval::ranking::TruthRule::of(&rep.evaluation),
+            ..r
+        });
+        let t = text_table(&rep);
+        assert!(
+            t.contains("right answer: a true revisit within 1 m, 20 m of travel"),
+            "{t}"
+        );
+        let row = t
+            .lines()
+            .find(|l| l.starts_with("words-3") && l.contains("0.500"))
+            .unwrap();
+        // AP 0.5, max F1 (P 1, R 0.5) 0.667 at t = 6, R@P100 0.5, R@P99 0.5.
+        assert!(row.contains("0.667") && row.contains("6.00"), "{t}");
+        let md = markdown_ranking(std::slice::from_ref(&rep));
+        assert!(md.contains("| words-3 | 0.500 | 0.667 |"), "{md}");
+        assert!(md.contains("| words-1 | – | – |"), "{md}");
     }
 
     #[test]

@@ -1341,11 +1341,14 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
         let d = diagnostics(&scores);
         assert!((1.0..5.0).contains(&d.mean_word_m), "{}", d.mean_word_m);
         let (same_m, opposite_m) = (
-            scores.directions.same.longest_revisit_m,
-            scores.directions.opposite.longest_revisit_m,
+            scores.directions.same.longest_revisit_m.m,
+            scores.directions.opposite.longest_revisit_m.m,
         );
         assert!(same_m > 40.0 && opposite_m > 40.0, "{same_m} {opposite_m}");
-        assert!(scores.longest_revisit_m >= same_m.max(opposite_m), "{why}");
+        assert!(
+            scores.longest_revisit_m.m >= same_m.max(opposite_m),
+            "{why}"
+        );
         let backwards = tau + cfg.matcher.reverse_extra_ngram;
         let too_short =
             same_m < tau as f64 * d.mean_word_m && opposite_m < backwards as f64 * d.mean_word_m;
