@@ -397,7 +397,7 @@ mod tests {
     fn streamed_scoring_forgets_the_pairs_behind_the_horizon() {
         let scn = load_scenario(Path::new("scenarios/smoke.toml")).expect("smoke loads");
         let mut base = recognizer_config(&scn).unwrap();
-        base.max_candidates = 8;
+        base.matcher.max_candidates = 8;
         let configs = level_configs(&base, &[2, 3]).unwrap();
         let mut jobs = jobs(&configs, &scn.evaluation, &ExperimentOptions::default()).unwrap();
         let laps_of = |run: usize| [30, 10][run];
