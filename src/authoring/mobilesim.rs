@@ -293,9 +293,12 @@ fn mm(p: Vec2) -> (i64, i64) {
 
 /// Keeps the first of segments with the same two end points (either order), a warning for
 /// each other one.
+/// A segment's two end points in map units, the smaller first.
+type SegmentKey = ((i64, i64), (i64, i64));
+
 fn drop_repeated_segments(map: &mut MobileSimMap, name: &str) -> Vec<Diagnostic> {
     let mut repairs = Vec::new();
-    let mut first: HashMap<((i64, i64), (i64, i64)), usize> = HashMap::new();
+    let mut first: HashMap<SegmentKey, usize> = HashMap::new();
     let mut keep = Vec::with_capacity(map.segments.len());
     for (s, &line) in map.segments.iter().zip(&map.segment_lines) {
         let (a, b) = (mm(s.a), mm(s.b));

@@ -162,7 +162,7 @@ impl CheckOutputs {
         super::common::check_outputs([report, junit])?;
         let files: Vec<&Path> = [report, junit].into_iter().flatten().collect();
         let replaceable: &dyn Fn(&Path) -> bool = &stress::is_check_output;
-        let folders: Vec<(&Path, &dyn Fn(&Path) -> bool)> =
+        let folders: Vec<placewords::io::atomic::Replaced> =
             out.into_iter().map(|d| (d, replaceable)).collect();
         let set = placewords::io::atomic::OutputSet::begin(&files, &[], &folders)
             .map_err(stress::StressError::from)?;

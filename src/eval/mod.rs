@@ -641,7 +641,9 @@ impl Ended {
             let e = tally.finish_sharing(&truth, shared);
             (spec, e)
         });
-        let ranking = evaluation.is_some().then(|| (r.ranking, observations_made));
+        let ranking = evaluation
+            .is_some()
+            .then_some((r.ranking, observations_made));
         let score_seconds = r.score_seconds + w.cpu_s();
         Recognition {
             name: self.name,

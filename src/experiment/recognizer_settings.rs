@@ -33,8 +33,6 @@ pub fn parse_recognizer_config(src: &str, path: &Path) -> Result<RecognizerConfi
     }
 }
 
-/// The `[recognizer]` keys over [`RecognizerConfig::default`]; each problem at its key.
-
 /// The settings `entries` give over the defaults; the defaults, with every problem in `d`,
 /// when they are not usable.
 pub(crate) fn recognizer(entries: &[RecognizerEntry], d: &mut Diags) -> RecognizerConfig {

@@ -336,7 +336,8 @@ fn assemble(
 fn flags_of(o: &ExperimentOptions) -> String {
     let baselines = [(o.icp, "--icp"), (o.scan_context, "--scan-context")]
         .into_iter()
-        .filter_map(|(on, flag)| on.then(|| flag.to_string()));
+        .filter(|&(on, _)| on)
+        .map(|(_, flag)| flag.to_string());
     let external = crate::external::reproduce_flags(&o.external);
     baselines
         .chain((!external.is_empty()).then_some(external))

@@ -501,6 +501,9 @@ pub fn holds_only(dir: &Path, named: &dyn Fn(&str) -> bool) -> bool {
     any
 }
 
+/// A folder an output set replaces whole, with the test of what may be in the old one.
+pub type Replaced<'a> = (&'a Path, &'a dyn Fn(&Path) -> bool);
+
 /// Several outputs at paths of the user's choosing (`run --report R.json --export-matches M.csv
 /// --svg DIR`, `check --report … --junit … -o DIR`) written as one: a kill at any instant leaves
 /// the old set or the new set, as every placewords reader and writer of those paths sees them.
@@ -573,7 +576,7 @@ impl OutputSet {
     pub fn begin(
         files: &[&Path],
         dirs: &[&Path],
-        replaced: &[(&Path, &dyn Fn(&Path) -> bool)],
+        replaced: &[Replaced<'_>],
     ) -> Result<OutputSet, StageError> {
         let io = |path: &Path, source| StageError::Io {
             path: path.display().to_string(),

@@ -144,6 +144,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::approx_constant)] // 3.1416 is what a user types for 180 degrees
     fn radians_and_small_units_are_recognised() {
         assert_eq!(radians_as_degrees(1.57), Some(90.0));
         assert_eq!(radians_as_degrees(3.1416), Some(180.0));

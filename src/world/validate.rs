@@ -793,29 +793,30 @@ fn closed_door_spans(
         Some((Owner::Wall(wi), c)) if c < -0.001 => Some(wi),
         _ => None,
     };
-    if !off(panel.a) && (off(panel.b) || along.is_some()) {
-        if let Some(gap) = gap_heading(door, walls) {
-            let what = match along {
-                Some(wi) => format!("its panel lies along wall '{}'", spec.walls[wi].id),
-                None => format!(
-                    "its tip at [{:.2}, {:.2}] is {} from the nearest wall",
-                    panel.b.x,
-                    panel.b.y,
-                    wall_clearance(walls, panel.b, probe)
-                        .map(|c| format!("{c:.2} m"))
-                        .unwrap_or_else(|| format!("more than {probe} m"))
-                ),
-            };
-            d.at(
-                l.closed_heading,
-                format!(
-                    "closed door '{}' does not span the gap at its hinge: {what}; {}",
-                    door.id,
-                    heading_cause(door.closed_heading_deg, gap)
-                ),
-            );
-            return false;
-        }
+    if !off(panel.a)
+        && (off(panel.b) || along.is_some())
+        && let Some(gap) = gap_heading(door, walls)
+    {
+        let what = match along {
+            Some(wi) => format!("its panel lies along wall '{}'", spec.walls[wi].id),
+            None => format!(
+                "its tip at [{:.2}, {:.2}] is {} from the nearest wall",
+                panel.b.x,
+                panel.b.y,
+                wall_clearance(walls, panel.b, probe)
+                    .map(|c| format!("{c:.2} m"))
+                    .unwrap_or_else(|| format!("more than {probe} m"))
+            ),
+        };
+        d.at(
+            l.closed_heading,
+            format!(
+                "closed door '{}' does not span the gap at its hinge: {what}; {}",
+                door.id,
+                heading_cause(door.closed_heading_deg, gap)
+            ),
+        );
+        return false;
     }
     let mut ok = true;
     let mut noted = false;
