@@ -3,15 +3,15 @@
 //!
 //! 1. rasterise at [`RouteOptions::resolution_m`]: a cell is free when its centre is at least
 //!    robot radius + margin (0.25 + 0.10 m) from every wall surface (exact point–segment
-//!    distances; [`raster`]);
+//!    distances; `raster`);
 //! 2. keep the 4-connected free component holding the home (or the free cell nearest to it);
-//! 3. thin it to a one-cell skeleton (Zhang–Suen, [`thin`]; it keeps the component's holes,
+//! 3. thin it to a one-cell skeleton (Zhang–Suen, `thin`; it keeps the component's holes,
 //!    i.e. the obstacles one can drive around);
 //! 4. in the skeleton's 8-connected graph, rooted at the pixel nearest the home, take the
 //!    fundamental cycles of a breadth-first tree, drop those enclosing less than 2 m² (pixel
-//!    noise), and keep the one maximising `length − 2 × distance to home` ([`skeleton`]);
+//!    noise), and keep the one maximising `length − 2 × distance to home` (`skeleton`);
 //! 5. rotate it to start nearest the home and simplify it (Douglas–Peucker, 0.35 m;
-//!    [`simplify`]) without ever accepting a leg closer than [`RouteOptions::leg_clearance_m`]
+//!    `simplify`) without ever accepting a leg closer than [`RouteOptions::leg_clearance_m`]
 //!    to a wall surface.
 //!
 //! With no loop, an out-and-back route along the longest skeleton branch from the home is used;

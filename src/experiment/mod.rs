@@ -423,7 +423,7 @@ pub fn back_end_matches(
 
 /// The paper's Fig. 8 sweep of `scn` (laps per run replaced by `opts.laps`): the laps are
 /// simulated (or read from `opts.cache`) and turned into observations as they come, each lap's
-/// scans dropped once observed ([`stream::observe_scenario`]), so memory holds the observations
+/// scans dropped once observed (`stream::observe_scenario`), so memory holds the observations
 /// and the truth, not the scans; then every grid point's back end runs in parallel. Results in
 /// grid order whatever the thread count, with the laps driven and each words subject's curve
 /// over its match score at the scenario's thresholds (`words-1` … `words-<levels>`).

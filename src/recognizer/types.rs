@@ -95,7 +95,7 @@ impl WordMatch {
 
     /// How sure the match is: the n-gram's length in word pairs (a longer chain of matching
     /// words is surer evidence), plus `½ · s / (s + psi_rms)` with `s` =
-    /// [`PSI_RMS_SCALE`] (in (0, ½], larger as the densities agree better) so that within
+    /// `PSI_RMS_SCALE` (in (0, ½], larger as the densities agree better) so that within
     /// one chain length the better aligned match ranks higher and no residual lifts a match
     /// above a longer chain. Monotone: longer chains and smaller residuals score higher.
     pub fn score(&self) -> f64 {
