@@ -56,9 +56,16 @@ fn a_bag_recognizes_exactly_as_the_carmen_log_of_the_same_run() {
                 true,
             )
             .unwrap();
+            // The pairs each match claims; its score holds the Ψ residual, which the CARMEN
+            // log's printed precision moves in the last digits.
             e.recognitions
                 .into_iter()
-                .map(|(_, r)| r.matches)
+                .map(|(_, r)| {
+                    r.matches
+                        .into_iter()
+                        .map(|m| (m.runs, m.direction))
+                        .collect::<Vec<_>>()
+                })
                 .collect::<Vec<_>>()
         };
         let from_log = recognize(&carmen);

@@ -633,7 +633,7 @@ fn without_seconds(v: serde_json::Value) -> serde_json::Value {
     match v {
         serde_json::Value::Object(m) => m
             .into_iter()
-            .filter(|(k, _)| !k.contains("seconds"))
+            .filter(|(k, _)| !k.contains("second"))
             .map(|(k, x)| (k, without_seconds(x)))
             .collect(),
         serde_json::Value::Array(a) => a.into_iter().map(without_seconds).collect(),
