@@ -13,6 +13,7 @@
 use crate::geom::Vec2;
 use crate::recognizer::{Recognizer, RecognizerConfig, Word, WordMatch as Match};
 use crate::sim::Frame;
+use crate::sim::plan::{DoorChoice, SimPlan};
 use crate::sim::robot::RouteTracker;
 use crate::world::{DoorStates, Route, World};
 use serde::Serialize;
@@ -51,6 +52,30 @@ pub struct AmbiguousStretch {
     pub length_m: f64,
     /// Number of the stretch whose words match this one's.
     pub partners: Vec<usize>,
+    /// Why the recognizer confuses it.
+    pub cause: Cause,
+    /// How strongly: the confused word pairs joined into this pair of stretches.
+    pub score: f64,
+}
+
+/// Why a stretch is flagged.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Cause {
+    /// Its words occur at another place under the same doors.
+    LookAlike,
+    /// Its words under one door set are another place's under another door set.
+    DoorChange,
+}
+
+impl Cause {
+    /// The cause in words, as the picture and the summary print it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Cause::LookAlike => "look-alike",
+            Cause::DoorChange => "door change",
+        }
+    }
 }
 
 /// Every ambiguous stretch of a route.
@@ -65,6 +90,8 @@ pub struct AmbiguityReport {
     pub min_ngram: Vec<usize>,
     /// Words farther apart than this are different places, metres.
     pub tp_radius_m: f64,
+    /// The door sets driven (one noise-free run of two laps each, matched against each other).
+    pub door_sets: Vec<String>,
     /// Matched word pairs at different places.
     pub confused_word_pairs: usize,
     /// Share of the route inside an ambiguous stretch, 0..1.
@@ -72,6 +99,12 @@ pub struct AmbiguityReport {
     /// Pairs of look-alike stretches.
     pub pairs: usize,
     pub stretches: Vec<AmbiguousStretch>,
+    /// Stretches where the alignment can slide along the route by more than `tp_radius_m`.
+    pub slips: Vec<super::slip::SlipStretch>,
+    /// Share of the route inside a slip, 0..1.
+    pub slip_share: f64,
+    /// Share of the route flagged for any cause (look-alike, door change, slip), 0..1.
+    pub flagged_share: f64,
 }
 
 impl AmbiguityReport {
@@ -80,22 +113,63 @@ impl AmbiguityReport {
     }
 }
 
-/// The noise-free drive: frames of two laps and each frame's position along the route.
+/// The noise-free drive: frames of two laps per door set and each frame's position along the
+/// route.
 pub struct Drive {
     pub frames: Vec<Frame>,
     pub route_m: Vec<f64>,
+    /// Per frame: the index of the door set it was driven under (into `door_sets`).
+    pub door_set_of_frame: Vec<usize>,
+    /// Per frame: its lap within its run (0 or 1).
+    pub lap_of_frame: Vec<usize>,
+    /// The door sets driven, one run of two laps each, in order.
+    pub door_sets: Vec<DoorChoice>,
     /// Length of the route, metres.
     pub loop_m: f64,
 }
 
-/// A simulation of one run of two laps over `route` with every noise and wander off.
-fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::sim::plan::SimPlan {
-    use crate::sim::plan::{DoorChoice, SimPlan};
+/// What a noise-free drive takes besides the world and route: the door sets (one run of two
+/// laps each) and the robot (its lanes and speeds change the words; its noise does not exist
+/// here). The world-only map drives one door set with the default robot.
+#[derive(Clone, Debug)]
+pub struct DriveSettings {
+    pub door_sets: Vec<DoorChoice>,
+    pub robot: crate::sim::robot::RobotConfig,
+    /// Seed of the robot's lap variation (lanes, speeds).
+    pub seed: u64,
+}
+
+impl DriveSettings {
+    /// One door set, the default robot, seed 0.
+    pub fn doors(doors: &DoorStates) -> DriveSettings {
+        DriveSettings {
+            door_sets: vec![DoorChoice {
+                name: "given".into(),
+                states: doors.clone(),
+            }],
+            robot: crate::sim::robot::RobotConfig::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// A simulation of one run of two laps over `route` per door set, with every noise off.
+fn noise_free_plan(world: &World, route: &Route, settings: &DriveSettings) -> SimPlan {
+    use crate::sim::plan::{DoorPlan, RunPlan};
     use crate::sim::{laser, odometry};
-    let doors = DoorChoice {
-        name: "given".into(),
-        states: doors.clone(),
-    };
+    let first = settings.door_sets.first().cloned().unwrap_or(DoorChoice {
+        name: "all-closed".into(),
+        states: DoorStates::all_closed(world),
+    });
+    let base = SimPlan::one_run(format!("{}-ambiguity", world.name), world, route, 2, first);
+    let runs = settings
+        .door_sets
+        .iter()
+        .map(|d| RunPlan {
+            doors: DoorPlan::Fixed(d.clone()),
+            ..base.runs[0].clone()
+        })
+        .collect();
     SimPlan {
         laser: laser::LaserConfig {
             range_noise_m: 0.0,
@@ -109,31 +183,43 @@ fn noise_free_plan(world: &World, route: &Route, doors: &DoorStates) -> crate::s
             },
             ..odometry::OdometryConfig::default()
         },
-        ..SimPlan::one_run(format!("{}-ambiguity", world.name), world, route, 2, doors)
+        robot: settings.robot.clone(),
+        seed: settings.seed,
+        runs,
+        ..base
     }
 }
 
-/// Drives `route` twice without noise.
-pub fn drive(world: &World, route: &Route, doors: &DoorStates) -> Result<Drive, AmbiguityError> {
-    let scn = noise_free_plan(world, route, doors);
+/// Drives `route` twice without noise under each door set of `settings`.
+pub fn drive(
+    world: &World,
+    route: &Route,
+    settings: &DriveSettings,
+) -> Result<Drive, AmbiguityError> {
+    let scn = noise_free_plan(world, route, settings);
     let runs = crate::sim::simulate(&scn, None, &|| {})?;
-    let frames: Vec<Frame> = runs
-        .into_iter()
-        .flat_map(|r| r.laps)
-        .flat_map(|l| l.frames)
-        .collect();
-    let mut tracker = RouteTracker::new(route, 0);
-    let length = tracker.length_m();
-    let route_m = frames
-        .iter()
-        .map(|f| {
-            tracker.update(f.truth.0.position());
-            tracker.arc_m().rem_euclid(length)
-        })
-        .collect();
+    let length = RouteTracker::new(route, 0).length_m();
+    let (mut frames, mut route_m) = (Vec::new(), Vec::new());
+    let (mut door_set_of_frame, mut lap_of_frame) = (Vec::new(), Vec::new());
+    for (k, run) in runs.into_iter().enumerate() {
+        // A tracker per run: each run starts again at waypoint 0.
+        let mut tracker = RouteTracker::new(route, 0);
+        for lap in run.laps {
+            for f in lap.frames {
+                tracker.update(f.truth.0.position());
+                route_m.push(tracker.arc_m().rem_euclid(length));
+                door_set_of_frame.push(k);
+                lap_of_frame.push(lap.lap);
+                frames.push(f);
+            }
+        }
+    }
     Ok(Drive {
         frames,
         route_m,
+        door_set_of_frame,
+        lap_of_frame,
+        door_sets: settings.door_sets.clone(),
         loop_m: length,
     })
 }
@@ -152,8 +238,22 @@ fn word_place(rec: &Recognizer, drive: &Drive, w: &Word) -> (f64, f64, Vec2) {
 /// Pairs of route stretches the recognizer confused: ((from, to), (from, to)).
 type Confusion = ((f64, f64), (f64, f64));
 
-fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64) -> Vec<Confusion> {
+/// A confusion, and whether its two words were driven under different door sets.
+#[derive(Clone, Copy, Debug)]
+struct Confused {
+    places: Confusion,
+    door_change: bool,
+}
+
+fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64) -> Vec<Confused> {
     let words = rec.words();
+    let obs = rec.observations();
+    let door_set = |w: &Word| {
+        let f = obs[w.obs_range().start]
+            .frame_id
+            .min(drive.frames.len() - 1);
+        drive.door_set_of_frame[f]
+    };
     let mut out = Vec::new();
     for m in matches {
         for (c, p) in &m.word_pairs {
@@ -170,7 +270,10 @@ fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64)
                 continue;
             }
             if wrong_pair(rec, drive, m, cw, pw, radius_m).unwrap_or((ca - pa).norm() > radius_m) {
-                out.push(((c0, c1), (p0, p1)));
+                out.push(Confused {
+                    places: ((c0, c1), (p0, p1)),
+                    door_change: door_set(cw) != door_set(pw),
+                });
             }
         }
     }
@@ -306,22 +409,40 @@ fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
 }
 
 /// The numbered stretches, from 0: pair k gives stretches 2k and 2k + 1, each the other's
-/// partner.
-fn stretches(conf: &[Confusion], loop_m: f64) -> Vec<AmbiguousStretch> {
-    let stretch = |arc: &Arc, number: usize, pair: usize, partner: usize| AmbiguousStretch {
-        number,
-        pair,
-        from_m: round_dm(arc.start),
-        to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
-        length_m: round_dm(arc.len),
-        partners: vec![partner],
-    };
-    merged_pairs(conf, loop_m)
+/// partner; each with its cause and score (the confused word pairs merged into it).
+fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
+    let places: Vec<Confusion> = conf.iter().map(|c| c.places).collect();
+    let stretch =
+        |arc: &Arc, number: usize, pair: usize, partner: usize, cause, score| AmbiguousStretch {
+            number,
+            pair,
+            from_m: round_dm(arc.start),
+            to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
+            length_m: round_dm(arc.len),
+            partners: vec![partner],
+            cause,
+            score,
+        };
+    merged_pairs(&places, loop_m)
         .iter()
         .enumerate()
-        .flat_map(|(k, (a, b))| {
+        .flat_map(|(k, pair)| {
             let (na, nb) = (2 * k, 2 * k + 1);
-            [stretch(a, na, k, nb), stretch(b, nb, k, na)]
+            let inside: Vec<&Confused> = conf
+                .iter()
+                .filter(|c| merge(pair, &arcs(&[c.places], loop_m)[0], loop_m).is_some())
+                .collect();
+            let cause = if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
+                Cause::DoorChange
+            } else {
+                Cause::LookAlike
+            };
+            let score = inside.len() as f64;
+            let (a, b) = pair;
+            [
+                stretch(a, na, k, nb, cause, score),
+                stretch(b, nb, k, na, cause, score),
+            ]
         })
         .collect()
 }
@@ -341,6 +462,26 @@ pub fn ambiguity(
     cfg: &RecognizerConfig,
     tp_radius_m: f64,
 ) -> Result<(AmbiguityReport, Drive), AmbiguityError> {
+    ambiguity_with(
+        world,
+        route_id,
+        &DriveSettings::doors(doors),
+        cfg,
+        tp_radius_m,
+    )
+}
+
+/// [`ambiguity`] over every door set of `settings` (one noise-free run of two laps each, all
+/// matched against each other, as a scenario's laps under different doors are) with its
+/// robot, plus the stretches where the alignment can slip along the route
+/// ([`super::slip`]).
+pub fn ambiguity_with(
+    world: &World,
+    route_id: &str,
+    settings: &DriveSettings,
+    cfg: &RecognizerConfig,
+    tp_radius_m: f64,
+) -> Result<(AmbiguityReport, Drive), AmbiguityError> {
     let route = world
         .route(route_id)
         .ok_or_else(|| AmbiguityError::UnknownRoute {
@@ -352,21 +493,30 @@ pub fn ambiguity(
                 "route ids",
             ),
         })?;
-    let drive = drive(world, route, doors)?;
+    let drive = drive(world, route, settings)?;
     // The route is driven one way: a stretch that looks like another only when read backwards
     // would confuse a robot driving it in reverse, which this map is not about.
     let mut one_way = cfg.clone();
     one_way.matcher.reverse = false;
     let mut rec = Recognizer::new(one_way)?;
     let mut matches = Vec::new();
-    for f in &drive.frames {
-        matches.extend(rec.push(f.odom, &f.scan));
+    for (i, f) in drive.frames.iter().enumerate() {
+        if i == 0 || drive.door_set_of_frame[i] != drive.door_set_of_frame[i - 1] {
+            matches.extend(rec.start_run());
+        }
+        matches.extend(rec.push_frame(i, f.odom, &f.scan));
     }
     matches.extend(rec.finish());
     let conf = confusions(&rec, &drive, &matches, tp_radius_m);
     let length_m = route.length_m();
     let list = stretches(&conf, length_m);
     let share = covered_share(&list, length_m);
+    let slips = super::slip::slips(&drive, cfg, tp_radius_m)?;
+    let flagged_share = flagged(&list, &slips, length_m)
+        .iter()
+        .filter(|f| **f)
+        .count() as f64
+        / bins(length_m) as f64;
     let report = AmbiguityReport {
         world: world.name.clone(),
         route: route.id.clone(),
@@ -374,25 +524,55 @@ pub fn ambiguity(
         levels: cfg.levels,
         min_ngram: crate::recognizer::thresholds(cfg),
         tp_radius_m,
+        door_sets: settings.door_sets.iter().map(|d| d.name.clone()).collect(),
         confused_word_pairs: conf.len(),
         ambiguous_share: share,
         pairs: list.iter().map(|s| s.pair + 1).max().unwrap_or(0),
         stretches: list,
+        slip_share: super::slip::share(&slips, length_m),
+        slips,
+        flagged_share,
     };
     Ok((report, drive))
 }
 
+/// Number of 0.1 m bins of a loop.
+fn bins(loop_m: f64) -> usize {
+    ((loop_m / BIN_M).ceil() as usize).max(1)
+}
+
+/// Marks the bins of `[from_m, from_m + length_m)` (wrapping) in `marked`.
+pub(crate) fn mark(marked: &mut [bool], from_m: f64, length_m: f64) {
+    let n = marked.len();
+    let first = (from_m / BIN_M) as usize;
+    let count = (length_m / BIN_M).round() as usize;
+    (0..count.min(n)).for_each(|k| marked[(first + k) % n] = true);
+}
+
+/// Per 0.1 m bin of the loop: inside a look-alike stretch or a slip.
+pub fn flagged(
+    stretches: &[AmbiguousStretch],
+    slips: &[super::slip::SlipStretch],
+    loop_m: f64,
+) -> Vec<bool> {
+    let mut marked = vec![false; bins(loop_m)];
+    for s in stretches {
+        mark(&mut marked, s.from_m, s.length_m);
+    }
+    for s in slips {
+        mark(&mut marked, s.from_m, s.length_m);
+    }
+    marked
+}
+
 /// Share of the loop inside at least one stretch (0.1 m resolution).
 fn covered_share(list: &[AmbiguousStretch], loop_m: f64) -> f64 {
-    let n = ((loop_m / 0.1).ceil() as usize).max(1);
-    let mut marked = vec![false; n];
-    for s in list {
-        let first = (s.from_m / 0.1) as usize;
-        let count = (s.length_m / 0.1).round() as usize;
-        (0..count.min(n)).for_each(|k| marked[(first + k) % n] = true);
-    }
-    marked.iter().filter(|m| **m).count() as f64 / n as f64
+    let marked = flagged(list, &[], loop_m);
+    marked.iter().filter(|m| **m).count() as f64 / marked.len() as f64
 }
+
+/// Colour of the slip bands.
+pub const SLIP_COLOR: &str = "#8c8c8c";
 
 /// Distinct colours for pairs of look-alike stretches (Tableau 10 without grey).
 pub const PAIR_COLORS: [&str; 9] = [
@@ -457,10 +637,36 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
             });
         }
     }
+    // Slips under the look-alike bands: translucent grey, as wide as their uncertainty.
+    for s in &report.slips {
+        opts.bands.insert(
+            0,
+            BandOverlay {
+                points: route_points(route, s.from_m, s.length_m),
+                color: SLIP_COLOR.into(),
+                width_px: 6.0 + 4.0 * s.uncertainty_m,
+            },
+        );
+        let pts = route_points(route, s.from_m, s.length_m);
+        opts.marks.push(MarkOverlay {
+            at: pts[pts.len() / 2],
+            text: format!("s{} ±{:.1} m", s.number, s.uncertainty_m),
+            color: SLIP_COLOR.into(),
+            class: "slip".into(),
+        });
+    }
     if !report.stretches.is_empty() {
         opts.legend.push(crate::report::world_render::LegendEntry {
             label: "look-alike stretches (same number: same words)".into(),
             color: PAIR_COLORS[0].into(),
+            dashed: false,
+        });
+    }
+    if !report.slips.is_empty() {
+        opts.legend.push(crate::report::world_render::LegendEntry {
+            label: "slips: the alignment can slide along the route (band width: uncertainty)"
+                .into(),
+            color: SLIP_COLOR.into(),
             dashed: false,
         });
     }
@@ -469,6 +675,17 @@ pub fn ambiguity_svg(world: &World, doors: &DoorStates, report: &AmbiguityReport
 }
 
 fn title(report: &AmbiguityReport) -> String {
+    if !report.slips.is_empty() {
+        return format!(
+            "{}: route '{}': {} pair(s) of places look alike, {} slip(s); {:.0} % of the route \
+             flagged",
+            report.world,
+            report.route,
+            report.pairs,
+            report.slips.len(),
+            100.0 * report.flagged_share
+        );
+    }
     if report.stretches.is_empty() {
         return format!(
             "{}: route '{}': no two places look alike to the recognizer",
@@ -495,8 +712,12 @@ fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
         .map(|c| {
             let at = |s: &AmbiguousStretch| format!("{:.1}-{:.1} m", s.from_m, s.to_m);
             let other = c.get(1).map(at).unwrap_or_default();
+            let cause = match c[0].cause {
+                Cause::LookAlike => String::new(),
+                Cause::DoorChange => " under other doors".into(),
+            };
             format!(
-                "{}: {} ({:.1} m) looks like {} (metres along the route from waypoint 0)",
+                "{}: {} ({:.1} m) looks like {}{cause} (metres along the route from waypoint 0)",
                 c[0].pair,
                 at(&c[0]),
                 c[0].length_m,
@@ -506,12 +727,27 @@ fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
         .collect()
 }
 
+/// One line per slip: where, how far the alignment can slide.
+fn slip_lines(report: &AmbiguityReport) -> Vec<String> {
+    report
+        .slips
+        .iter()
+        .map(|s| {
+            format!(
+                "s{}: {:.1}-{:.1} m ({:.1} m): the alignment can slide by up to {:.1} m ({})",
+                s.number, s.from_m, s.to_m, s.length_m, s.uncertainty_m, s.door_set
+            )
+        })
+        .collect()
+}
+
 fn notes(report: &AmbiguityReport) -> Vec<String> {
-    let lines = pair_lines(report);
+    let mut lines = pair_lines(report);
+    lines.extend(slip_lines(report));
     let mut out: Vec<String> = lines.iter().take(MAX_NOTES).cloned().collect();
     if lines.len() > MAX_NOTES {
         out.push(format!(
-            "... and {} more pairs (see --json)",
+            "... and {} more (see --json)",
             lines.len() - MAX_NOTES
         ));
     }
@@ -538,6 +774,18 @@ impl AmbiguityReport {
             100.0 * self.ambiguous_share
         );
         for line in pair_lines(self) {
+            out.push_str(&format!("  {line}\n"));
+        }
+        if !self.slips.is_empty() || self.door_sets.len() > 1 {
+            out.push_str(&format!(
+                "{} slip(s), {:.0} % of the route; flagged in all: {:.0} % (door sets: {})\n",
+                self.slips.len(),
+                100.0 * self.slip_share,
+                100.0 * self.flagged_share,
+                self.door_sets.join(", ")
+            ));
+        }
+        for line in slip_lines(self) {
             out.push_str(&format!("  {line}\n"));
         }
         out

@@ -96,8 +96,18 @@ pub struct DensityArgs {
 
 #[derive(Debug, Args)]
 pub struct AmbiguityArgs {
-    /// World file (TOML).
-    pub file: PathBuf,
+    /// World file (TOML); not needed with --scenario, which names its world.
+    #[arg(required_unless_present = "scenario", conflicts_with = "scenario")]
+    pub file: Option<PathBuf>,
+    /// Map a scenario instead: its world and route, every door set its runs use (a random-door
+    /// run: four draws), its robot and its recognizer settings; door changes between runs are
+    /// flagged too.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["open", "levels"])]
+    pub scenario: Option<PathBuf>,
+    /// With --scenario: also run the scenario at these seeds and say how many of the
+    /// recognizer's false pairs (deepest level configuration) fall in flagged stretches.
+    #[arg(long, value_name = "A..B", requires = "scenario")]
+    pub measure: Option<placewords::spec::seeds::SeedRange>,
     /// Route to drive, by id.
     #[arg(long, default_value = "lap")]
     pub route: String,
@@ -298,14 +308,20 @@ fn density(args: DensityArgs) -> anyhow::Result<ExitCode> {
 
 fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
     super::common::check_extension(&args.output, "svg")?;
-    let Some(world) = load(&args.file) else {
+    if let Some(path) = &args.scenario {
+        return scenario_ambiguity(path, &args);
+    }
+    let Some(file) = &args.file else {
+        anyhow::bail!("give a world file or --scenario FILE");
+    };
+    let Some(world) = load(file) else {
         return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
     };
     let doors = door_states(&world, &args.open, false)?;
     let levels = args.levels.map(usize::from);
     let (report, svg) =
         placewords::authoring::ambiguity::ambiguity_picture(&world, &args.route, &doors, levels)
-            .with_context(|| format!("{}", args.file.display()))?;
+            .with_context(|| format!("{}", file.display()))?;
     super::common::write_file(&args.output, svg.as_bytes())?;
     let text = if args.json {
         format!("{}\n", report.to_json())
@@ -314,6 +330,50 @@ fn ambiguity(args: AmbiguityArgs) -> anyhow::Result<ExitCode> {
     };
     print_quietly(&text)?;
     errln!("wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `world ambiguity --scenario FILE [--measure SEEDS]`.
+fn scenario_ambiguity(path: &std::path::Path, args: &AmbiguityArgs) -> anyhow::Result<ExitCode> {
+    use placewords::authoring::{ambiguity, prediction};
+    let scn = match placewords::experiment::load_scenario(path) {
+        Ok(s) => s,
+        Err(e) => {
+            errln!("{e}");
+            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
+        }
+    };
+    let (report, _) =
+        prediction::scenario_ambiguity(&scn).with_context(|| format!("{}", path.display()))?;
+    let closed = placewords::world::DoorStates::all_closed(&scn.sim.world);
+    let svg = ambiguity::ambiguity_svg(&scn.sim.world, &closed, &report);
+    super::common::write_file(&args.output, svg.as_bytes())?;
+    errln!("wrote {}", args.output.display());
+    let measured = match &args.measure {
+        Some(range) => {
+            let seeds: Vec<u64> = range.seeds().collect();
+            let tell = |seed: u64| errln!("running {} seed {seed}", scn.sim.name);
+            Some(
+                prediction::predict(&scn, &report, &seeds, &tell)
+                    .with_context(|| format!("{}", path.display()))?,
+            )
+        }
+        None => None,
+    };
+    let text = if args.json {
+        let mut v = serde_json::to_value(&report)?;
+        if let Some(m) = &measured {
+            v["prediction"] = serde_json::to_value(m)?;
+        }
+        format!("{}\n", serde_json::to_string_pretty(&v)?)
+    } else {
+        let mut t = report.summary();
+        if let Some(m) = &measured {
+            t.push_str(&m.summary());
+        }
+        t
+    };
+    print_quietly(&text)?;
     Ok(ExitCode::SUCCESS)
 }
 

@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 /// only; modules on one layer do not import each other. Keep in step with ARCHITECTURE.md.
 const LAYERS: &[&[&str]] = &[
     &["cli"],
-    &["experiment", "authoring", "schema"],
+    &["authoring"],
+    &["experiment", "schema"],
     &["report"],
     &["eval"],
     &["baseline", "sim", "external"],

@@ -13,12 +13,18 @@ use placewords::world::{load_world, parse_world};
 /// distances along travel. The east corridor is wider than the west one, so nothing else
 /// repeats. `extra_niche` adds a fourth niche to the north corridor only.
 fn twin_corridors(extra_niche: bool) -> World {
+    parse_world(&twin_corridors_src(extra_niche), "twin-corridors")
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The file text of [`twin_corridors`].
+fn twin_corridors_src(extra_niche: bool) -> String {
     let north_extra = if extra_niche {
         "[18.6, 11.0], [18.6, 12.5], [17.4, 12.5], [17.4, 11.0], "
     } else {
         ""
     };
-    let src = format!(
+    format!(
         r#"format_version = 1
 name = "twin-corridors"
 
@@ -40,8 +46,7 @@ closed = true
 id = "lap"
 waypoints_m = [[0.0, 0.0], [30.0, 0.0], [30.0, 10.0], [0.0, 10.0]]
 "#
-    );
-    parse_world(&src, "twin-corridors").unwrap_or_else(|e| panic!("{e}"))
+    )
 }
 
 fn config(levels: usize) -> RecognizerConfig {
@@ -123,7 +128,168 @@ fn ambiguity_cli_writes_a_picture_and_json_with_the_stretches() {
         .descendants()
         .filter(|n| n.attribute("class") == Some("band"))
         .count();
-    assert_eq!(bands, stretches.len());
+    let slips = json["slips"].as_array().unwrap().len();
+    assert_eq!(bands, stretches.len() + slips);
+}
+
+/// Issue 26 point 1: a long corridor with nothing along it is a slip (the alignment can slide
+/// along it), even where no two places have the same words; a corridor with niches is not.
+#[test]
+fn a_featureless_corridor_is_flagged_as_a_slip_with_its_uncertainty() {
+    let plain = parse_world(
+        r#"format_version = 1
+name = "plain-loop"
+
+[robot_home]
+x_m = 1.0
+y_m = 0.0
+
+[[walls]]
+id = "outer"
+points_m = [[-1.0, -1.0], [41.0, -1.0], [41.0, 11.0], [-1.0, 11.0]]
+closed = true
+
+[[walls]]
+id = "inner"
+points_m = [[1.0, 1.0], [39.0, 1.0], [39.0, 9.0], [1.0, 9.0]]
+closed = true
+
+[[routes]]
+id = "lap"
+waypoints_m = [[0.0, 0.0], [40.0, 0.0], [40.0, 10.0], [0.0, 10.0]]
+"#,
+        "plain-loop",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let closed = DoorStates::all_closed(&plain);
+    let (report, _) = ambiguity(&plain, "lap", &closed, &config(3), 1.0).unwrap();
+    // The 40 m corridors slip in their middles, by more than twice the radius.
+    let long: Vec<_> = report
+        .slips
+        .iter()
+        .filter(|s| s.from_m < 30.0 && s.to_m > 10.0 && s.to_m < 40.0)
+        .collect();
+    assert!(!long.is_empty(), "{}", report.summary());
+    assert!(
+        long.iter().all(|s| s.uncertainty_m > 2.0),
+        "{}",
+        report.summary()
+    );
+    assert!(report.flagged_share >= report.slip_share && report.slip_share > 0.0);
+    assert!(report.summary().contains("slide"), "{}", report.summary());
+    // Niches every few metres pin the alignment: the south corridor of the twins does not slip
+    // around its niches (8-22 m).
+    let twins = twin_corridors(false);
+    let twins_closed = DoorStates::all_closed(&twins);
+    let (report, _) = ambiguity(&twins, "lap", &twins_closed, &config(3), 1.0).unwrap();
+    assert!(
+        !report
+            .slips
+            .iter()
+            .any(|s| s.from_m <= 12.0 && s.to_m >= 18.0 && s.from_m < s.to_m),
+        "{}",
+        report.summary()
+    );
+}
+
+/// Issue 26 point 1: a scenario's map drives every door set its runs use; a random-door run
+/// stands for its distribution by a few draws.
+#[test]
+fn a_scenario_map_drives_each_door_set_of_its_runs_once() {
+    use placewords::authoring::prediction::{RANDOM_DOOR_DRAWS, scenario_drive_settings};
+    let b = placewords::experiment::load_scenario(&root().join("scenarios/B.toml")).unwrap();
+    let names: Vec<String> = scenario_drive_settings(&b)
+        .door_sets
+        .iter()
+        .map(|d| d.name.clone())
+        .collect();
+    assert_eq!(
+        names,
+        ["all-closed", "one-per-corridor-a", "one-per-corridor-b"]
+    );
+    let smoke =
+        placewords::experiment::load_scenario(&root().join("scenarios/smoke.toml")).unwrap();
+    let sets = scenario_drive_settings(&smoke).door_sets;
+    // Three cycled sets, then up to RANDOM_DOOR_DRAWS distinct draws of the random run.
+    assert!(
+        sets.len() > 3 && sets.len() <= 3 + RANDOM_DOOR_DRAWS,
+        "{}",
+        sets.len()
+    );
+    assert!(sets[3..].iter().all(|d| d.name.starts_with("random")));
+    for (i, a) in sets.iter().enumerate() {
+        assert!(
+            sets[i + 1..].iter().all(|b| b.states != a.states),
+            "a set driven twice"
+        );
+    }
+}
+
+/// Issue 26 point 1: `world ambiguity --scenario … --measure SEEDS` runs the scenario, places
+/// each false pair on the route and says how many lie in flagged stretches. On the twin
+/// corridors the recognizer's wrong pairs join the two corridors, which the map flags.
+#[test]
+fn measuring_the_map_against_the_recognizer_places_false_pairs_in_flagged_stretches() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("twins.toml"), twin_corridors_src(false)).unwrap();
+    let scenario = dir.path().join("twins.scenario.toml");
+    std::fs::write(
+        &scenario,
+        r#"format_version = 1
+name = "twins"
+world = "twins.toml"
+route = "lap"
+seed = 1
+
+[[runs]]
+start_waypoint = 0
+laps = 6
+
+[[runs]]
+start_waypoint = 2
+laps = 6
+
+[laser]
+preset = "lms200"
+
+[odometry]
+model = "proportional"
+"#,
+    )
+    .unwrap();
+    let svg = dir.path().join("a.svg");
+    let out = placewords(&[
+        "world",
+        "ambiguity",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--measure",
+        "1..2",
+        "-o",
+        svg.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let p = &json["prediction"];
+    let (wrong, hit) = (
+        p["false_pairs"].as_u64().unwrap(),
+        p["predicted"].as_u64().unwrap(),
+    );
+    let per_seed = p["per_seed"].as_array().unwrap();
+    assert_eq!(per_seed.len(), 2);
+    let sum = |k: usize| per_seed.iter().map(|s| s[k].as_u64().unwrap()).sum::<u64>();
+    assert_eq!((sum(1), sum(2)), (wrong, hit));
+    assert_eq!(p["places_m"].as_array().unwrap().len() as u64, wrong);
+    let flagged = p["flagged_share"].as_f64().unwrap();
+    assert!(flagged > 0.0 && flagged < 1.0, "{p}");
+    assert!(wrong > 0, "the twins confuse the recognizer: {p}");
+    assert!(hit as f64 >= 0.7 * wrong as f64, "{p}");
+    assert!(svg.exists());
 }
 
 #[test]
