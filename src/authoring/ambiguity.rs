@@ -66,6 +66,9 @@ pub enum Cause {
     LookAlike,
     /// Its words under one door set are another place's under another door set.
     DoorChange,
+    /// Its words match the same stretch shifted along the route by more than the radius (the
+    /// two stretches overlap): a slip along a corridor found by the words themselves.
+    Shift,
 }
 
 impl Cause {
@@ -74,6 +77,7 @@ impl Cause {
         match self {
             Cause::LookAlike => "look-alike",
             Cause::DoorChange => "door change",
+            Cause::Shift => "shift",
         }
     }
 }
@@ -432,13 +436,15 @@ fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
                 .iter()
                 .filter(|c| merge(pair, &arcs(&[c.places], loop_m)[0], loop_m).is_some())
                 .collect();
-            let cause = if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
+            let (a, b) = pair;
+            let cause = if a.touches(b, loop_m) {
+                Cause::Shift
+            } else if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
                 Cause::DoorChange
             } else {
                 Cause::LookAlike
             };
             let score = inside.len() as f64;
-            let (a, b) = pair;
             [
                 stretch(a, na, k, nb, cause, score),
                 stretch(b, nb, k, na, cause, score),
@@ -713,8 +719,9 @@ fn pair_lines(report: &AmbiguityReport) -> Vec<String> {
             let at = |s: &AmbiguousStretch| format!("{:.1}-{:.1} m", s.from_m, s.to_m);
             let other = c.get(1).map(at).unwrap_or_default();
             let cause = match c[0].cause {
-                Cause::LookAlike => String::new(),
-                Cause::DoorChange => " under other doors".into(),
+                Cause::LookAlike => "",
+                Cause::DoorChange => " under other doors",
+                Cause::Shift => ", shifted along itself",
             };
             format!(
                 "{}: {} ({:.1} m) looks like {}{cause} (metres along the route from waypoint 0)",

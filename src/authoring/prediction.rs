@@ -86,6 +86,7 @@ pub struct Prediction {
     /// several causes where flags overlap).
     pub predicted_look_alike: usize,
     pub predicted_door_change: usize,
+    /// Under a slip or a shift (the words of a stretch matching itself shifted).
     pub predicted_slip: usize,
     /// False pairs whose two ends lie within [`SLIP_PAIR_M`] of each other along the route:
     /// slips along a corridor.
@@ -115,6 +116,7 @@ impl Flags {
             let into = match s.cause {
                 Cause::LookAlike => &mut f.look_alike,
                 Cause::DoorChange => &mut f.door_change,
+                Cause::Shift => &mut f.slip,
             };
             mark(into, s.from_m, s.length_m);
         }
