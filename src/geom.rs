@@ -113,13 +113,23 @@ impl Segment {
 
     /// Shortest distance from `p` to any point of the segment.
     pub fn distance_to_point(&self, p: Vec2) -> f64 {
+        (p - self.point_at(self.project(p))).norm()
+    }
+
+    /// The fraction along the segment (0 at `a`, 1 at `b`) of its point nearest to `p`; 0 for a
+    /// segment of no length.
+    pub fn project(&self, p: Vec2) -> f64 {
         let d = self.b - self.a;
         let len2 = d.norm_squared();
         if len2 == 0.0 {
-            return (p - self.a).norm();
+            return 0.0;
         }
-        let t = ((p - self.a).dot(&d) / len2).clamp(0.0, 1.0);
-        (p - (self.a + d * t)).norm()
+        ((p - self.a).dot(&d) / len2).clamp(0.0, 1.0)
+    }
+
+    /// The point at fraction `t` along the segment.
+    pub fn point_at(&self, t: f64) -> Vec2 {
+        self.a + (self.b - self.a) * t
     }
 }
 

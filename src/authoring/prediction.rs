@@ -141,18 +141,12 @@ pub fn place_on_route(route: &Route, p: Vec2) -> f64 {
     let mut start = 0.0;
     let mut best = (f64::INFINITY, 0.0);
     for leg in route.legs() {
-        let d = leg.b - leg.a;
-        let len2 = d.norm_squared();
-        let t = if len2 > 0.0 {
-            ((p - leg.a).dot(&d) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let dist = (p - (leg.a + d * t)).norm();
+        let t = leg.project(p);
+        let dist = (p - leg.point_at(t)).norm();
         if dist < best.0 {
-            best = (dist, start + t * len2.sqrt());
+            best = (dist, start + t * leg.length());
         }
-        start += len2.sqrt();
+        start += leg.length();
     }
     best.1
 }

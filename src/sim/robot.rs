@@ -272,14 +272,8 @@ impl RouteTracker {
             .map(|g| (self.passed_gate_m - self.arc_m(), g - self.arc_m()));
         let mut best: Option<(f64, f64)> = None; // (distance, delta)
         for (i, leg) in self.legs.iter().enumerate() {
-            let d = leg.b - leg.a;
-            let len2 = d.norm_squared();
-            let t = if len2 > 0.0 {
-                ((p - leg.a).dot(&d) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let s = self.starts[i] + t * len2.sqrt();
+            let t = leg.project(p);
+            let s = self.starts[i] + t * leg.length();
             let mut delta = s - prev;
             let half = self.length_m / 2.0;
             if delta > half {
@@ -292,7 +286,7 @@ impl RouteTracker {
             {
                 continue;
             }
-            let dist = (p - (leg.a + d * t)).norm();
+            let dist = (p - leg.point_at(t)).norm();
             if best.is_none_or(|(bd, _)| dist < bd) {
                 best = Some((dist, delta));
             }
