@@ -59,22 +59,7 @@ fn recognition(laps: usize) -> Recognition {
             }
         }
     }
-    Recognition {
-        name: "bench".into(),
-        observations,
-        matches,
-        seconds: 0.0,
-        wall_seconds: 0.0,
-        score_seconds: 0.0,
-        laps,
-        truth: Arc::new(truth),
-        diagnostics: None,
-        lap_seconds: Vec::new(),
-        evaluation: None,
-        level_gain: None,
-        rejected: Vec::new(),
-        ranking: None,
-    }
+    Recognition::new("bench", observations, matches, laps, Arc::new(truth))
 }
 
 fn scoring(c: &mut Criterion) {

@@ -340,8 +340,8 @@ fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)], side: f64, name: &str
     walls
 }
 
-/// Generates a floor (see the module docs) as file structures.
-pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError> {
+/// The floor's size `(w, h)`, metres, when `opts` ask for a floor that can be generated.
+fn check_options(opts: &GenerateOptions) -> Result<(f64, f64), GenerateError> {
     let (w, h) = opts.size_m;
     if !((4..=12).contains(&opts.corridors) && opts.corridors.is_multiple_of(2)) {
         return Err(GenerateError::Corridors(opts.corridors));
@@ -349,6 +349,31 @@ pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError>
     if !((24.0..=2000.0).contains(&w) && (24.0..=2000.0).contains(&h)) {
         return Err(GenerateError::Size(w, h));
     }
+    Ok((w, h))
+}
+
+/// The generated world's description: what it was generated from.
+fn description(opts: &GenerateOptions) -> String {
+    let (w, h) = opts.size_m;
+    format!(
+        "generated: seed {}, {} x {} m, {} doors, {} corridors{}{}",
+        opts.seed,
+        w,
+        h,
+        opts.doors,
+        opts.corridors,
+        if opts.double_loaded {
+            ", double-loaded"
+        } else {
+            ""
+        },
+        if opts.look_alike { ", look-alike" } else { "" }
+    )
+}
+
+/// Generates a floor (see the module docs) as file structures.
+pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError> {
+    let (w, h) = check_options(opts)?;
     let mut rng = stream(opts.seed, 0, 0, Purpose::WorldGenerator);
     let loop_pts = centre_loop(&mut rng, w, h, (opts.corridors - 4) / 2);
     let mut all = slots(&mut rng, &loop_pts, 1.0, opts.look_alike);
@@ -416,20 +441,7 @@ pub fn generate_spec(opts: &GenerateOptions) -> Result<WorldSpec, GenerateError>
     Ok(WorldSpec {
         format_version: 1,
         name: format!("generated-{}", opts.seed),
-        description: Some(format!(
-            "generated: seed {}, {} x {} m, {} doors, {} corridors{}{}",
-            opts.seed,
-            w,
-            h,
-            opts.doors,
-            opts.corridors,
-            if opts.double_loaded {
-                ", double-loaded"
-            } else {
-                ""
-            },
-            if opts.look_alike { ", look-alike" } else { "" }
-        )),
+        description: Some(description(opts)),
         robot_home: HomeSpec {
             x_m: round_cm(home.x),
             y_m: round_cm(home.y),

@@ -103,7 +103,7 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     let mut provenance = experiment::scenario_provenance(&all, args.laps, command_line);
     provenance.lap_cache = opts.cache.as_ref().map(|c| c.used());
     super::common::report_cache(opts.cache.as_deref());
-    let json = placewords::report::json::to_json_with(&TableReport { reports }, &provenance);
+    let json = placewords::report::json::to_json_with(&TableReport::new(reports), &provenance);
     write_file(&stage.path().join("table.json"), json.as_bytes())?;
     stage
         .commit()

@@ -86,6 +86,7 @@ impl Decision {
 
 /// One metric of one subject of one scenario, new against baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct MetricComparison {
     pub scenario: String,
     pub subject: String,
@@ -141,6 +142,7 @@ impl MetricComparison {
 
 /// One scenario of the new run against the baseline's scenario of the same name.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ScenarioComparison {
     pub label: String,
     /// The new run's scenario file.
@@ -177,6 +179,7 @@ impl ScenarioComparison {
 
 /// A new run against a baseline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Comparison {
     /// The baseline file.
     pub base: String,
@@ -366,21 +369,8 @@ fn compare_scenario(
         .collect();
     let differ: Vec<u64> = pairs.iter().filter(|p| !p.3).map(|p| p.0).collect();
     let paired = differ.is_empty();
-    let pairing = if paired {
-        format!(
-            "paired by seed: seeds {} have the same simulation keys in both reports, so each \
-             seed ran the same laps and its change is the recognizer's alone",
-            seed_list(&pairs.iter().map(|p| p.0).collect::<Vec<_>>())
-        )
-    } else {
-        format!(
-            "not paired: the simulation keys differ at seeds {}{}, so the laps are not the \
-             same and a seed means nothing to the other side; the two sets of seeds are \
-             compared as two samples (Mann–Whitney), which needs a larger change to be sure",
-            seed_list(&differ),
-            what_changed(base, new)
-        )
-    };
+    let seeds: Vec<u64> = pairs.iter().map(|p| p.0).collect();
+    let pairing = pairing(&seeds, &differ, base, new);
     let mut subjects: Vec<String> = Vec::new();
     for (_, _, nr, _) in &pairs {
         for s in &nr.subjects {
@@ -452,6 +442,26 @@ fn compare_scenario(
     })
 }
 
+/// How the seeds of a scenario are compared, in words: paired by seed when no seed's
+/// simulation keys differ (`differ` empty), as two samples otherwise.
+fn pairing(seeds: &[u64], differ: &[u64], base: &SuiteReport, new: &SuiteReport) -> String {
+    if differ.is_empty() {
+        format!(
+            "paired by seed: seeds {} have the same simulation keys in both reports, so each \
+             seed ran the same laps and its change is the recognizer's alone",
+            seed_list(seeds)
+        )
+    } else {
+        format!(
+            "not paired: the simulation keys differ at seeds {}{}, so the laps are not the \
+             same and a seed means nothing to the other side; the two sets of seeds are \
+             compared as two samples (Mann–Whitney), which needs a larger change to be sure",
+            seed_list(differ),
+            what_changed(base, new)
+        )
+    }
+}
+
 /// `: the world worlds/x.toml differs` when the reports' world or scenario file hashes differ.
 fn what_changed(base: &SuiteReport, new: &SuiteReport) -> String {
     let mut changed = Vec::new();
@@ -486,20 +496,52 @@ fn compare_metric(
     tol: RegressionSpec,
 ) -> MetricComparison {
     let time = !metric.higher_is_better();
-    let tolerance = if time { tol.max_slowdown } else { tol.max_drop };
     // Changes on a scale where larger is better and the tolerance is `slack`.
     let slack = if time {
         tol.max_slowdown.ln()
     } else {
         tol.max_drop
     };
-    let better = |b: f64, n: f64| if time { (b / n).ln() } else { n - b };
+    let mut m = undecided(scenario, subject, metric, paired, values, tol);
+    if values.iter().all(|v| v.1 == v.2) {
+        m.decision = Decision::Identical;
+        m.why = "the same figure at every seed".into();
+        return m;
+    }
+    if paired {
+        if let Some(decided) = signed_rank_test(&mut m, values, time, slack) {
+            m.decision = decided;
+            return m;
+        }
+    } else {
+        rank_sum_test(&mut m, values, time, slack);
+    }
+    m.decision = match (m.p_worse, m.p_better) {
+        (Some(p), _) if p < ALPHA => Decision::Regression,
+        (_, Some(p)) if p < ALPHA => Decision::Improvement,
+        _ => Decision::NoChange,
+    };
+    m
+}
+
+/// The comparison of one metric over `values` = (seed, baseline, new) with its means, worst
+/// seeds and changes, before any test (no change decided).
+fn undecided(
+    scenario: &str,
+    subject: &str,
+    metric: Metric,
+    paired: bool,
+    values: &[(u64, f64, f64)],
+    tol: RegressionSpec,
+) -> MetricComparison {
+    let time = !metric.higher_is_better();
+    let tolerance = if time { tol.max_slowdown } else { tol.max_drop };
     let base: Vec<(u64, f64)> = values.iter().map(|v| (v.0, v.1)).collect();
     let new: Vec<(u64, f64)> = values.iter().map(|v| (v.0, v.2)).collect();
     let (base_mean, base_worst_seed, base_worst) = mean_worst(&base, time);
     let (new_mean, new_worst_seed, new_worst) = mean_worst(&new, time);
     let change = |b: f64, n: f64| if time { n / b } else { n - b };
-    let mut m = MetricComparison {
+    MetricComparison {
         scenario: scenario.to_string(),
         subject: subject.to_string(),
         metric,
@@ -521,70 +563,73 @@ fn compare_metric(
         p_better: None,
         decision: Decision::NoChange,
         why: String::new(),
-    };
-    if values.iter().all(|v| v.1 == v.2) {
-        m.decision = Decision::Identical;
-        m.why = "the same figure at every seed".into();
-        return m;
     }
+}
+
+/// The paired test of `m` (Wilcoxon signed-rank on each seed's change beyond `slack`), with
+/// the seeds that got worse; `Some` decision when there are too few seeds for the test (then
+/// every seed must be beyond the tolerance).
+fn signed_rank_test(
+    m: &mut MetricComparison,
+    values: &[(u64, f64, f64)],
+    time: bool,
+    slack: f64,
+) -> Option<Decision> {
+    let better = |b: f64, n: f64| if time { (b / n).ln() } else { n - b };
     let n = values.len();
-    if paired {
-        let g: Vec<(u64, f64)> = values
-            .iter()
-            .map(|&(s, b, nv)| (s, better(b, nv)))
-            .filter(|(_, x)| x.is_finite())
-            .collect();
-        m.worse_seeds = g.iter().filter(|x| x.1 < 0.0).map(|x| x.0).collect();
-        m.beyond_seeds = g.iter().filter(|x| x.1 < -slack).map(|x| x.0).collect();
-        m.most_worse_seed = g
-            .iter()
-            .filter(|x| x.1 < 0.0)
-            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
-            .map(|x| x.0);
-        let worse: Vec<f64> = g.iter().map(|x| -x.1 - slack).collect();
-        let gain: Vec<f64> = g.iter().map(|x| x.1 - slack).collect();
-        m.p_worse = signed_rank_greater(&worse);
-        m.p_better = signed_rank_greater(&gain);
-        if n < MIN_PAIRED_SEEDS {
-            let all = |v: &[f64]| v.iter().all(|x| *x > 0.0);
-            m.decision = if all(&worse) {
-                Decision::Regression
-            } else if all(&gain) {
-                Decision::Improvement
-            } else {
-                Decision::NoChange
-            };
-            m.why = format!(
-                "{n} seed{} is too few for the signed-rank test to reach {ALPHA} (it needs \
-                 {MIN_PAIRED_SEEDS}): decided on every seed being beyond the tolerance",
-                if n == 1 { "" } else { "s" }
-            );
-            return m;
-        }
-        m.why = "Wilcoxon signed-rank, exact, one-sided".into();
-    } else {
-        let (b, nv): (Vec<f64>, Vec<f64>) = if time {
-            (
-                values.iter().map(|v| -v.1.ln()).collect(),
-                values.iter().map(|v| -v.2.ln()).collect(),
-            )
+    let g: Vec<(u64, f64)> = values
+        .iter()
+        .map(|&(s, b, nv)| (s, better(b, nv)))
+        .filter(|(_, x)| x.is_finite())
+        .collect();
+    m.worse_seeds = g.iter().filter(|x| x.1 < 0.0).map(|x| x.0).collect();
+    m.beyond_seeds = g.iter().filter(|x| x.1 < -slack).map(|x| x.0).collect();
+    m.most_worse_seed = g
+        .iter()
+        .filter(|x| x.1 < 0.0)
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        .map(|x| x.0);
+    let worse: Vec<f64> = g.iter().map(|x| -x.1 - slack).collect();
+    let gain: Vec<f64> = g.iter().map(|x| x.1 - slack).collect();
+    m.p_worse = signed_rank_greater(&worse);
+    m.p_better = signed_rank_greater(&gain);
+    if n < MIN_PAIRED_SEEDS {
+        let all = |v: &[f64]| v.iter().all(|x| *x > 0.0);
+        m.why = format!(
+            "{n} seed{} is too few for the signed-rank test to reach {ALPHA} (it needs \
+             {MIN_PAIRED_SEEDS}): decided on every seed being beyond the tolerance",
+            if n == 1 { "" } else { "s" }
+        );
+        return Some(if all(&worse) {
+            Decision::Regression
+        } else if all(&gain) {
+            Decision::Improvement
         } else {
-            (
-                values.iter().map(|v| v.1).collect(),
-                values.iter().map(|v| v.2).collect(),
-            )
-        };
-        let shift = |v: &[f64], by: f64| v.iter().map(|x| x + by).collect::<Vec<_>>();
-        m.p_worse = rank_sum_greater(&b, &shift(&nv, slack));
-        m.p_better = rank_sum_greater(&shift(&nv, -slack), &b);
-        m.why = "Mann–Whitney, two samples (not paired), one-sided".into();
+            Decision::NoChange
+        });
     }
-    m.decision = match (m.p_worse, m.p_better) {
-        (Some(p), _) if p < ALPHA => Decision::Regression,
-        (_, Some(p)) if p < ALPHA => Decision::Improvement,
-        _ => Decision::NoChange,
+    m.why = "Wilcoxon signed-rank, exact, one-sided".into();
+    None
+}
+
+/// The two-sample test of `m` (Mann–Whitney, the new values shifted by `slack`), for seeds
+/// that did not run the same laps; times compared on a log scale.
+fn rank_sum_test(m: &mut MetricComparison, values: &[(u64, f64, f64)], time: bool, slack: f64) {
+    let (b, nv): (Vec<f64>, Vec<f64>) = if time {
+        (
+            values.iter().map(|v| -v.1.ln()).collect(),
+            values.iter().map(|v| -v.2.ln()).collect(),
+        )
+    } else {
+        (
+            values.iter().map(|v| v.1).collect(),
+            values.iter().map(|v| v.2).collect(),
+        )
     };
-    m
+    let shift = |v: &[f64], by: f64| v.iter().map(|x| x + by).collect::<Vec<_>>();
+    m.p_worse = rank_sum_greater(&b, &shift(&nv, slack));
+    m.p_better = rank_sum_greater(&shift(&nv, -slack), &b);
+    m.why = "Mann–Whitney, two samples (not paired), one-sided".into();
 }
 
 /// Mean, and the worst seed and its value.

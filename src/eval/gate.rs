@@ -45,6 +45,7 @@ impl Bound {
 
 /// The result of checking one bound over the seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Outcome {
     /// Scenario label (its name; with its file when two scenarios share a name).
     pub scenario: String,

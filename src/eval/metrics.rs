@@ -52,6 +52,7 @@ use std::sync::Arc;
 
 /// Scores at one radius.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Metrics {
     /// Radius a pair must be within to be correct (and a revisit to count), metres.
     pub radius_m: f64,
@@ -144,6 +145,7 @@ fn is_zero(n: &usize) -> bool {
 
 /// Scores of the observations and pairs attributed to one door configuration.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct DoorConfigMetrics {
     pub door_config: String,
     /// Laps driven in this configuration.
@@ -153,6 +155,7 @@ pub struct DoorConfigMetrics {
 
 /// Everything [`evaluate`] computes for one recognition.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Evaluation {
     /// At `tp_radius_m`.
     pub main: Metrics,
@@ -166,6 +169,7 @@ pub struct Evaluation {
 
 /// Scores of the matches of one direction against the revisits of that direction.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct DirectionMetrics {
     pub same: Metrics,
     pub opposite: Metrics,
@@ -973,22 +977,13 @@ pub(crate) mod tests {
         gt: &GroundTruth,
         matches: Vec<Match>,
     ) -> Recognition {
-        Recognition {
-            name: "t".into(),
-            observations: obs.to_vec(),
+        Recognition::new(
+            "t",
+            obs.to_vec(),
             matches,
-            seconds: 0.0,
-            wall_seconds: 0.0,
-            score_seconds: 0.0,
-            laps: 2,
-            truth: std::sync::Arc::new(gt.clone()),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-            ranking: None,
-        }
+            2,
+            std::sync::Arc::new(gt.clone()),
+        )
     }
 
     /// A log whose second pass is driven the other way at only 8 scattered observations has 8
@@ -1009,7 +1004,7 @@ pub(crate) mod tests {
             e.directions.opposite.longest_revisit_m,
             RevisitStretch::of(0.0)
         );
-        let scores = crate::eval::scores::Scores::of(&rec, &spec);
+        let (scores, _) = crate::eval::scores::Scores::measure(&rec, &spec);
         let json = serde_json::to_value(&scores).unwrap();
         assert_eq!(json["directions"]["opposite"]["longest_revisit_m"], 0.0);
         assert!(scores.has_opposite());

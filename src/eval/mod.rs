@@ -187,6 +187,7 @@ impl GroundTruth {
 
 /// The outcome of feeding runs to a recognizer.
 #[derive(Clone, Debug)]
+#[non_exhaustive]
 pub struct Recognition {
     /// The recognizer's name.
     pub name: String,
@@ -202,7 +203,7 @@ pub struct Recognition {
     /// cores: seeds or level configurations run in parallel).
     pub wall_seconds: f64,
     /// CPU seconds spent scoring the matches: as they arrived, the end of the scoring, or the
-    /// whole of it when scored after the recognition ([`scores::Scores::of`] adds its own).
+    /// whole of it when scored after the recognition ([`scores::Scores::measure`] adds its own).
     pub score_seconds: f64,
     /// Number of laps fed.
     pub laps: usize,
@@ -225,7 +226,7 @@ pub struct Recognition {
     /// verification turned down true revisits or look-alikes.
     pub rejected: Vec<RejectedTruth>,
     /// Each query observation's best-scoring answer, when the matches were scored as they
-    /// arrived ([`Recording::streaming`]; otherwise [`scores::Scores::of`] ranks `matches`),
+    /// arrived ([`Recording::streaming`]; otherwise [`scores::Scores::measure`] ranks `matches`),
     /// and the observations made.
     pub ranking: Option<(ranking::Ranking, usize)>,
 }
@@ -290,6 +291,35 @@ fn rejected_truth(
 }
 
 impl Recognition {
+    /// The recognition `name` made: its `observations` and `matches` over `laps` laps of the
+    /// input whose truth is `truth`; untimed, scored after (no streamed evaluation), without
+    /// diagnostics or rejected candidates. Set the other fields after, as the recognition had
+    /// them (the one way to build one: the type is `#[non_exhaustive]`).
+    pub fn new(
+        name: impl Into<String>,
+        observations: Vec<Observation>,
+        matches: Vec<Match>,
+        laps: usize,
+        truth: Arc<GroundTruth>,
+    ) -> Self {
+        Recognition {
+            name: name.into(),
+            observations,
+            matches,
+            seconds: 0.0,
+            wall_seconds: 0.0,
+            score_seconds: 0.0,
+            laps,
+            truth,
+            diagnostics: None,
+            lap_seconds: Vec::new(),
+            evaluation: None,
+            level_gain: None,
+            rejected: Vec::new(),
+            ranking: None,
+        }
+    }
+
     /// Recognition CPU seconds per lap (0 when no lap was fed).
     pub fn seconds_per_lap(&self) -> f64 {
         self.seconds / self.laps.max(1) as f64
@@ -646,20 +676,16 @@ impl Ended {
             .then_some((r.ranking, observations_made));
         let score_seconds = r.score_seconds + w.cpu_s();
         Recognition {
-            name: self.name,
-            observations: self.observations,
-            matches: r.matches,
             seconds: r.seconds,
             wall_seconds: r.wall_seconds,
             score_seconds,
-            laps: r.laps,
-            truth,
             diagnostics: self.diagnostics,
             lap_seconds: r.lap_seconds,
             evaluation,
             level_gain: r.level_gain,
             rejected: self.rejected,
             ranking,
+            ..Recognition::new(self.name, self.observations, r.matches, r.laps, truth)
         }
     }
 }

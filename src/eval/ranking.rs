@@ -141,6 +141,7 @@ pub fn of_matches(
 
 /// A subject's name and its figures over the match score (`sweep`'s score curves).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SubjectRanking {
     pub name: String,
     pub ranking: RankingScores,
@@ -184,6 +185,7 @@ impl TruthRule {
 
 /// One point of the score curve: the queries whose answer scores at least `threshold`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ScorePoint {
     pub threshold: f64,
     pub precision: f64,
@@ -192,6 +194,7 @@ pub struct ScorePoint {
 
 /// The field's figures over a subject's match score (see the module doc).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct RankingScores {
     /// The ground-truth rule the figures were counted with.
     pub rule: TruthRule,

@@ -1,6 +1,8 @@
 //! The computed results of an experiment: the [`Scores`] every recognizer gets, the [`Report`]
-//! of one scenario, the [`SweepReport`] and the [`TableReport`]. Evaluation builds them;
-//! `report` only formats them (`report::json` writes them as JSON, `report::table` as tables).
+//! of one scenario, the [`SweepReport`] and the [`TableReport`]. Evaluation computes their
+//! figures ([`Scores::measure`]) and what made a run without pairs ([`NoPairsCauses`]);
+//! `report` words the causes (`report::explain`: `Scores::of`, `Report::add_subject`) and
+//! formats the rest (`report::json` writes them as JSON, `report::table` as tables).
 //!
 //! JSON schema of [`Report`] (all times in seconds, ratios in [0, 1], radii in metres):
 //!
@@ -45,6 +47,7 @@ use serde::{Deserialize, Serialize};
 
 /// The scores every recognizer gets (flattened into its JSON object).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Scores {
     pub precision: f64,
     pub recall: f64,
@@ -166,68 +169,94 @@ impl Scores {
         self.directions.opposite.revisits > 0 || self.directions.opposite.pairs > 0
     }
 
-    /// Evaluates `rec` with `spec` and takes its timing (the scoring's included).
-    pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
+    /// Evaluates `rec` with `spec` and takes its timing (the scoring's included): the figures,
+    /// with `no_pairs_reason` unset, and what made a run without pairs, when it has none.
+    /// `Scores::of` (`report::explain`) puts the causes into words.
+    pub fn measure(rec: &Recognition, spec: &EvaluationSpec) -> (Self, Option<NoPairsCauses>) {
         let w = crate::clock::Stopwatch::start();
         let e = super::evaluate(rec, spec);
         let d = rec.diagnostics.as_deref();
         let rejected = d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec));
         let ranking = super::ranking::of_recognition(rec, e.main.revisits, spec);
-        Scores {
+        let causes = no_pairs_causes(&e, d, rejected.as_ref());
+        let scores = Scores {
             recognize_wall_seconds_per_lap: rec.wall_seconds_per_lap(),
             score_seconds: rec.score_seconds + w.cpu_s(),
-            no_pairs_reason: no_pairs_reason(&e, d, rejected.as_ref(), spec),
             rejected_candidates: rejected,
             diagnostics: d.map(Diagnostics::to_json),
             notes: d.map(Diagnostics::notes).unwrap_or_default(),
             ranking: Some(ranking),
             ..Scores::new(&e, rec.seconds_per_lap())
-        }
+        };
+        (scores, causes)
     }
 }
 
-/// Why evaluation `e` has no pair, as far as the truth and the recognizer's `diagnostics` tell;
-/// `None` when there are pairs.
-pub fn no_pairs_reason(
+/// What made an evaluation without pairs, as far as the truth and the recognizer tell
+/// (`report::explain` puts it into words for `Scores::no_pairs_reason`).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct NoPairsCauses {
+    /// No observation has a revisit (within `tp_radius_m`, `min_gap_m` of travel before).
+    pub no_revisit: bool,
+    /// The recognizer's own account, when it keeps diagnostics.
+    pub recognizer: Option<RecognizerAccount>,
+}
+
+/// A recognizer's account of why it matched nothing, in its own words
+/// ([`Diagnostics`]), with the truth of the candidates its verification turned down.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct RecognizerAccount {
+    /// [`Diagnostics::no_match_reason`].
+    pub no_match_reason: String,
+    /// [`Diagnostics::revisit_length_reason`] against the longest revisits of each
+    /// direction, when there were revisits but no candidate at all.
+    pub revisit_length_reason: Option<String>,
+    /// The rejected candidates scored against the truth, when none was accepted.
+    pub rejected: Option<RejectedScores>,
+}
+
+/// What made evaluation `e` have no pair, from the truth, the recognizer's `diagnostics` and
+/// its `rejected` candidates scored; `None` when there are pairs.
+pub fn no_pairs_causes(
     e: &Evaluation,
     diagnostics: Option<&dyn Diagnostics>,
     rejected: Option<&RejectedScores>,
-    spec: &EvaluationSpec,
-) -> Option<String> {
+) -> Option<NoPairsCauses> {
     let m = &e.main;
     if m.pairs > 0 {
         return None;
     }
-    let mut why = Vec::new();
-    if m.revisits == 0 {
-        why.push(format!(
-            "no observation has a revisit (an earlier pass within {} m, {} m of travel before)",
-            spec.tp_radius_m, spec.min_gap_m
-        ));
-    }
-    match diagnostics {
-        Some(d) => {
-            why.push(d.no_match_reason());
-            let c = d.candidates();
-            if m.revisits > 0 && c.accepted + c.rejected == 0 {
-                why.extend(d.revisit_length_reason(
+    let recognizer = diagnostics.map(|d| {
+        let c = d.candidates();
+        RecognizerAccount {
+            no_match_reason: d.no_match_reason(),
+            revisit_length_reason: if m.revisits > 0 && c.accepted + c.rejected == 0 {
+                d.revisit_length_reason(
                     e.directions.same.longest_revisit_m.m,
                     e.directions.opposite.longest_revisit_m.m,
-                ));
-            }
-            if c.accepted == 0 {
-                why.extend(rejected.map(|r| r.sentence(spec)));
-            }
+                )
+            } else {
+                None
+            },
+            rejected: if c.accepted == 0 {
+                rejected.cloned()
+            } else {
+                None
+            },
         }
-        None if why.is_empty() => why.push("the recognizer does not say why".into()),
-        None => {}
-    }
-    Some(why.join("; "))
+    });
+    Some(NoPairsCauses {
+        no_revisit: m.revisits == 0,
+        recognizer,
+    })
 }
 
 /// The candidates a recognizer turned down, scored against the truth at their sampled
 /// observation pairs (`eval::Recognition::rejected`).
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct RejectedScores {
     /// Rejected candidates sampled (the paper's recognizer keeps the first 10,000).
     pub sampled: usize,
@@ -241,10 +270,21 @@ pub struct RejectedScores {
 
 /// A count for one of a recognizer's checks.
 #[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct CheckCount {
     /// The check's name, as the recognizer calls it ("turn").
     pub check: String,
     pub count: usize,
+}
+
+impl CheckCount {
+    /// `count` for the check named `check`.
+    pub fn new(check: &str, count: usize) -> Self {
+        CheckCount {
+            check: check.to_string(),
+            count,
+        }
+    }
 }
 
 impl RejectedScores {
@@ -261,13 +301,7 @@ impl RejectedScores {
         let mut s = RejectedScores {
             sampled: rejected.len(),
             correct: 0,
-            correct_by_check: checks
-                .iter()
-                .map(|c| CheckCount {
-                    check: c.clone(),
-                    count: 0,
-                })
-                .collect(),
+            correct_by_check: checks.iter().map(|c| CheckCount::new(c, 0)).collect(),
         };
         for r in rejected.iter().filter(|r| r.is_right(spec)) {
             s.correct += 1;
@@ -284,30 +318,6 @@ impl RejectedScores {
             .iter()
             .find(|c| c.check == check)
             .map_or(0, |c| c.count)
-    }
-
-    /// What the truth says of the rejected candidates, in words.
-    fn sentence(&self, spec: &EvaluationSpec) -> String {
-        if self.correct == 0 {
-            return format!(
-                "by the ground truth none of the {} rejected candidates sampled paired the same \
-                 place (within {} m): verification turned down look-alikes",
-                self.sampled, spec.tp_radius_m
-            );
-        }
-        let by_check: Vec<String> = self
-            .correct_by_check
-            .iter()
-            .map(|c| format!("{} {}", c.check, c.count))
-            .collect();
-        format!(
-            "by the ground truth {} of the {} rejected candidates sampled paired the same place \
-             (within {} m; {}): verification turned down true revisits",
-            self.correct,
-            self.sampled,
-            spec.tp_radius_m,
-            by_check.join(", ")
-        )
     }
 }
 
@@ -342,6 +352,7 @@ pub use crate::spec::evaluation::{words_subject_levels, words_subject_name};
 /// The result of one subject: a recognizer under test (one level configuration of the paper's
 /// recognizer, a baseline, or an external program), scored on the same runs as the others.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SubjectReport {
     /// Its name, unique in the report: what `[[expect.subjects]]`, tables and JUnit call it
     /// (`words-3`, `icp`, or the name an external subject was given).
@@ -401,6 +412,7 @@ impl SubjectReport {
 
 /// What a level configuration adds over the one with one level fewer.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct LevelGain {
     /// The configuration compared with (levels − 1).
     pub than_levels: usize,
@@ -410,8 +422,21 @@ pub struct LevelGain {
     pub correct_pairs: usize,
 }
 
+impl LevelGain {
+    /// `pairs` found (`correct_pairs` of them correct) that the configuration with
+    /// `than_levels` levels did not find.
+    pub fn new(than_levels: usize, pairs: usize, correct_pairs: usize) -> Self {
+        LevelGain {
+            than_levels,
+            pairs,
+            correct_pairs,
+        }
+    }
+}
+
 /// The report of one scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct Report {
     /// Scenario name (file stem, e.g. "B").
     pub scenario: String,
@@ -433,6 +458,7 @@ pub struct Report {
 
 /// What a real log held, for a report's header (a log has no laps or door states).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct LogSummary {
     /// Scans the recognizers were given (after `--scan-step`).
     pub scans: usize,
@@ -473,33 +499,6 @@ impl Report {
         self.revisits = self.subjects.first().map_or(0, |s| s.scores.revisits);
     }
 
-    /// Scores `rec` (the paper's recognizer run with `levels` levels and `thresholds`) and adds
-    /// it as subject `words-<levels>`.
-    pub fn add_level(
-        &mut self,
-        levels: usize,
-        thresholds: &[usize],
-        rec: &Recognition,
-    ) -> &SubjectReport {
-        let added = self.add_subject(&words_subject_name(levels), SubjectKind::Words, rec);
-        added.levels = Some(levels);
-        added.thresholds = thresholds.to_vec();
-        added
-    }
-
-    /// Scores `rec` and adds it as the subject `name` of `kind`.
-    pub fn add_subject(
-        &mut self,
-        name: &str,
-        kind: SubjectKind,
-        rec: &Recognition,
-    ) -> &mut SubjectReport {
-        let mut added = SubjectReport::new(name, kind, Scores::of(rec, &self.evaluation));
-        added.recognize_seconds_by_lap = rec.lap_seconds.clone();
-        self.subjects.push(added);
-        self.subjects.last_mut().expect("just pushed")
-    }
-
     /// Sets each level configuration's `only_here` from the recognitions of every configuration
     /// run, `(levels, recognition)`: the pairs it found that the one with one level fewer did not.
     pub fn set_level_gains(&mut self, recognitions: &[(usize, Recognition)]) {
@@ -523,11 +522,7 @@ impl Report {
                 Some(gain) => gain,
                 None => pairs_not_in(here, fewer, radius_m),
             };
-            lr.only_here = Some(LevelGain {
-                than_levels: below,
-                pairs,
-                correct_pairs,
-            });
+            lr.only_here = Some(LevelGain::new(below, pairs, correct_pairs));
         }
     }
 
@@ -549,6 +544,7 @@ impl Report {
 
 /// The JSON output of `placewords sweep`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SweepReport {
     pub scenario: String,
     pub seed: u64,
@@ -590,206 +586,21 @@ impl SweepReport {
 
 /// The JSON output of `placewords table`: one report per scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct TableReport {
     pub reports: Vec<Report>,
+}
+
+impl TableReport {
+    /// The table of `reports`, one per scenario.
+    pub fn new(reports: Vec<Report>) -> Self {
+        TableReport { reports }
+    }
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::recognizer::{MatchDiagnostics, Rejection};
-
-    /// A run without pairs says why: verification counts when every candidate was rejected,
-    /// chain lengths against τ when no chain was long enough, and missing revisits.
-    #[test]
-    fn no_pairs_reason_names_the_cause() {
-        let spec = EvaluationSpec::default();
-        let none = Evaluation {
-            main: Metrics {
-                revisits: 10,
-                ..Metrics::default()
-            },
-            ..Evaluation::default()
-        };
-        let mut d = MatchDiagnostics {
-            longest_chain: vec![7, 9],
-            min_ngram: vec![6, 9],
-            within_gap: 0,
-            verification: Default::default(),
-            long_steps: 0,
-            reverse_extra_ngram: 0,
-            rejected: Vec::new(),
-            mean_word_m: 0.0,
-        };
-        d.verification.rejected_travel = 3;
-        d.verification.rejected_density = 2;
-        d.verification.rejected_straight = 1;
-        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(
-            why.contains(
-                "rejected by verification: 6 (travel 3, turn 0, density 2, sides 0, straight 1)"
-            ),
-            "{why}"
-        );
-        d.verification = Default::default();
-        d.longest_chain = vec![4, 8];
-        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(why.contains("no word sequence long enough"), "{why}");
-        assert!(
-            why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
-            "{why}"
-        );
-        d.long_steps = 3;
-        let why = no_pairs_reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(why.contains("no word sequence long enough"), "{why}");
-        assert!(
-            why.contains("3 steps between scans were longer than max_interpolation_m"),
-            "{why}"
-        );
-        let why = no_pairs_reason(&Evaluation::default(), None, None, &spec).unwrap();
-        assert!(why.starts_with("no observation has a revisit"), "{why}");
-        let mut some = none.clone();
-        some.main.pairs = 1;
-        assert_eq!(
-            no_pairs_reason(&some, Some(&d as &dyn Diagnostics), None, &spec),
-            None
-        );
-    }
-
-    /// When no chain is long enough, the reason says whether the revisits are shorter than τ
-    /// words of the run's mean length (nothing to chain) or long enough (the words differ).
-    #[test]
-    fn no_pairs_reason_compares_revisit_length_with_tau_words() {
-        let spec = EvaluationSpec::default();
-        let mut e = Evaluation::default();
-        e.main.revisits = 300;
-        e.main.longest_revisit_m = 20.2.into();
-        e.directions.same.longest_revisit_m = 11.2.into();
-        e.directions.opposite.longest_revisit_m = 9.0.into();
-        let d = MatchDiagnostics {
-            longest_chain: vec![4],
-            min_ngram: vec![6],
-            mean_word_m: 2.5,
-            ..MatchDiagnostics::default()
-        };
-        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(why.contains("no word sequence long enough"), "{why}");
-        assert!(
-            why.contains("is 11.2 m driven the same way and 9.0 m the other way"),
-            "{why}"
-        );
-        assert!(why.contains("a word spans 2.5 m on average"), "{why}");
-        assert!(why.contains("τ = 6 words need about 15 m,"), "{why}");
-        assert!(why.contains("too short for a chain"), "{why}");
-        // Read backwards a chain needs more words: 16 m is enough driven the same way, not
-        // the other way.
-        let d = MatchDiagnostics {
-            reverse_extra_ngram: 2,
-            ..d
-        };
-        e.directions.opposite.longest_revisit_m = 16.0.into();
-        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(
-            why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
-            "{why}"
-        );
-        assert!(why.contains("too short for a chain"), "{why}");
-        e.directions.same.longest_revisit_m = 16.0.into();
-        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(why.contains("the words differ between visits"), "{why}");
-        // Verification's counts are the reason when candidates were made.
-        let mut v = d.clone();
-        v.verification.rejected_turn = 2;
-        let why = no_pairs_reason(&e, Some(&v as &dyn Diagnostics), None, &spec).unwrap();
-        assert!(!why.contains("stretch"), "{why}");
-    }
-
-    /// Rejected candidates are scored at their sampled pair: right when the two true poses are
-    /// within the radius and face as the candidate's direction claims; the reason then says
-    /// whether verification turned down true revisits or look-alikes.
-    #[test]
-    fn rejected_candidates_are_scored_against_the_truth() {
-        use crate::eval::RejectedTruth;
-        use crate::geom::{Pose2, TruePose};
-        use crate::place::Direction;
-        let spec = EvaluationSpec::default();
-        let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
-        let r = |q, p, direction, reason: Rejection| RejectedTruth {
-            query: q,
-            past: p,
-            direction,
-            check: reason.index(),
-        };
-        let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
-        let rejected = [
-            // The same place, facing alike: a true revisit turned down by the turn check.
-            r(
-                at(0.0, 0.0),
-                at(0.5, 10.0),
-                Direction::Same,
-                Rejection::Turn,
-            ),
-            // The same place driven the other way, claimed opposite: right too.
-            r(
-                at(0.0, 0.0),
-                at(0.3, 175.0),
-                Direction::Opposite,
-                Rejection::Sides,
-            ),
-            // Claimed the same direction but driven the other way: wrong.
-            r(
-                at(0.0, 0.0),
-                at(0.3, 175.0),
-                Direction::Same,
-                Rejection::Turn,
-            ),
-            // A look-alike 5 m away.
-            r(
-                at(0.0, 0.0),
-                at(5.0, 0.0),
-                Direction::Same,
-                Rejection::Travel,
-            ),
-        ];
-        let s = RejectedScores::of(&rejected, &checks, &spec).expect("four sampled");
-        assert_eq!((s.sampled, s.correct), (4, 2));
-        assert_eq!(
-            (
-                s.correct_by("turn"),
-                s.correct_by("sides"),
-                s.correct_by("travel")
-            ),
-            (1, 1, 0)
-        );
-        assert_eq!(RejectedScores::of(&[], &checks, &spec), None);
-        let mut e = Evaluation::default();
-        e.main.revisits = 10;
-        let d = MatchDiagnostics {
-            longest_chain: vec![8],
-            min_ngram: vec![6],
-            verification: crate::recognizer::VerificationCounts {
-                rejected_turn: 2,
-                rejected_sides: 1,
-                rejected_travel: 1,
-                ..Default::default()
-            },
-            ..MatchDiagnostics::default()
-        };
-        let why = no_pairs_reason(&e, Some(&d as &dyn Diagnostics), Some(&s), &spec).unwrap();
-        assert!(
-            why.contains("every candidate was rejected by verification: 4"),
-            "{why}"
-        );
-        assert!(
-            why.contains("2 of the 4 rejected candidates sampled paired the same place"),
-            "{why}"
-        );
-        assert!(why.contains("turned down true revisits"), "{why}");
-        let none_right = RejectedScores::of(&rejected[3..], &checks, &spec).unwrap();
-        let why =
-            no_pairs_reason(&e, Some(&d as &dyn Diagnostics), Some(&none_right), &spec).unwrap();
-        assert!(why.contains("turned down look-alikes"), "{why}");
-    }
 
     pub(crate) fn sample(scenario: &str, p: [f64; 3], r: [f64; 3]) -> Report {
         let mut rep = Report::new(scenario, 7, 40, EvaluationSpec::default());

@@ -252,7 +252,6 @@ pub fn matches_svg(
     for p in &mut opts.paths {
         p.color = PLAIN_COLOR.into();
     }
-    let counts = |k: ObservationKind| status.kinds.iter().filter(|x| **x == k).count();
     // Missed first, so the recognized and the wrong stretches are drawn over it.
     for kind in [
         ObservationKind::Missed,
@@ -291,12 +290,23 @@ pub fn matches_svg(
             dashed: true,
         })
         .collect();
+    opts.legend
+        .extend(status_legend(&status, clusters.len(), shown));
+    let mut notes = pair_notes(&status, rec.rejected.len(), right_rejected);
+    notes.append(&mut opts.notes);
+    opts.notes = notes;
+    render_world_svg(world, &opts)
+}
+
+/// The matches picture's legend: a row only for what it shows (each kind of observation
+/// drawn, and the `clusters` dashed lines of `shown` wrong pairs).
+fn status_legend(status: &ObservationStatus, clusters: usize, shown: usize) -> Vec<LegendEntry> {
     let legend = |label: String, color: &str, dashed: bool| LegendEntry {
         label,
         color: color.into(),
         dashed,
     };
-    // A legend row only for what the picture shows.
+    let counts = |k: ObservationKind| status.kinds.iter().filter(|x| **x == k).count();
     let rows = [
         (
             ObservationKind::Recognized,
@@ -305,29 +315,36 @@ pub fn matches_svg(
         (ObservationKind::Wrong, "recognized, most pairs wrong"),
         (ObservationKind::Missed, "revisit missed"),
     ];
+    let mut out = Vec::new();
     for (kind, what) in rows {
         let n = counts(kind);
         if n > 0 {
             let label = format!("{what} ({n} observation{})", plural(n));
-            opts.legend.push(legend(label, kind_color(kind), false));
+            out.push(legend(label, kind_color(kind), false));
         }
     }
-    if !clusters.is_empty() {
+    if clusters > 0 {
         let label = format!(
             "dashed lines: the worst {} wrong-pair cluster{} ({shown} pair{})",
-            clusters.len(),
-            plural(clusters.len()),
+            clusters,
+            plural(clusters),
             plural(shown)
         );
-        opts.legend.push(legend(label, WRONG_LINE_COLOR, true));
+        out.push(legend(label, WRONG_LINE_COLOR, true));
     }
+    out
+}
+
+/// The matches picture's notes: the pairs, and what verification turned down (`rejected`
+/// candidates sampled, `right_rejected` of them true revisits).
+fn pair_notes(status: &ObservationStatus, rejected: usize, right_rejected: usize) -> Vec<String> {
     let mut notes = vec![format!(
         "pairs: {} correct, {} wrong",
         status.correct_pairs,
         status.wrong_pairs.len()
     )];
-    if !rec.rejected.is_empty() {
-        let look_alikes = rec.rejected.len() - right_rejected;
+    if rejected > 0 {
+        let look_alikes = rejected - right_rejected;
         notes.push(format!(
             "verification turned down {right_rejected} true revisit{}, {look_alikes} \
              look-alike{} (candidates sampled)",
@@ -342,9 +359,7 @@ pub fn matches_svg(
             );
         }
     }
-    notes.append(&mut opts.notes);
-    opts.notes = notes;
-    render_world_svg(world, &opts)
+    notes
 }
 
 /// A check's short label on the picture: its name's first two letters, the first capitalised
@@ -695,22 +710,8 @@ mod tests {
         use crate::eval::{GroundTruth, Recognition};
         let world = loop_small();
         let runs = [run_in(&world, 0, &[])];
-        let rec = Recognition {
-            name: "none".into(),
-            observations: Vec::new(),
-            matches: Vec::new(),
-            seconds: 0.0,
-            wall_seconds: 0.0,
-            score_seconds: 0.0,
-            laps: 1,
-            truth: std::sync::Arc::new(GroundTruth::from_runs(&runs)),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-            ranking: None,
-        };
+        let truth = std::sync::Arc::new(GroundTruth::from_runs(&runs));
+        let rec = Recognition::new("none", Vec::new(), Vec::new(), 1, truth);
         let texts = doc_texts(&matches_svg(&world, &runs, &rec, 0.5, "t"));
         for absent in [
             "most pairs wrong",

@@ -301,22 +301,13 @@ impl LoggedRuns {
             m.direction = r.direction;
             matches.push(m);
         }
-        Ok(Recognition {
-            name: "external".into(),
-            observations: self.observations.clone(),
+        Ok(Recognition::new(
+            "external",
+            self.observations.clone(),
             matches,
-            seconds: 0.0,
-            wall_seconds: 0.0,
-            score_seconds: 0.0,
-            laps: self.laps,
-            truth: std::sync::Arc::new(self.truth.clone()),
-            diagnostics: None,
-            lap_seconds: Vec::new(),
-            evaluation: None,
-            level_gain: None,
-            rejected: Vec::new(),
-            ranking: None,
-        })
+            self.laps,
+            std::sync::Arc::new(self.truth.clone()),
+        ))
     }
 }
 

@@ -1,6 +1,7 @@
 //! Output for people and machines: JSON reports, text and Markdown tables, SVG pictures.
 
 pub mod compare;
+pub mod explain;
 pub mod json;
 pub mod junit;
 pub(crate) mod lap_strip;

@@ -335,68 +335,7 @@ pub(crate) fn read_expect(top: &DeTable<'_>, declared: &[&str], d: &mut Diags) -
     for (i, (_, lt)) in table_array(t, "subjects", d).into_iter().enumerate() {
         let ctx = format!("[[expect.subjects]] #{i}");
         unknown_keys(lt, EXPECT_SUBJECT_KEYS, &ctx, d);
-        let subject = match get(lt, "subject") {
-            None => {
-                d.at(
-                    0,
-                    format!(
-                        "missing key `subject` in {ctx}; add e.g. `subject = \"words-3\"` \
-                         (one of {})",
-                        KNOWN_SUBJECTS.join(", ")
-                    ),
-                );
-                String::new()
-            }
-            Some((_, v)) => match v.get_ref() {
-                DeValue::String(name)
-                    if KNOWN_SUBJECTS.contains(&name.as_ref())
-                        || declared.contains(&name.as_ref()) =>
-                {
-                    name.to_string()
-                }
-                DeValue::String(name) => {
-                    // Any other name is an external subject's (`--recognizer NAME=…`), unless
-                    // it looks like a built-in or declared one mistyped.
-                    let near = crate::spec::suggest::closest(
-                        name,
-                        KNOWN_SUBJECTS.iter().chain(declared).copied(),
-                    );
-                    if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
-                        let hint = match near {
-                            Some(k) => format!("did you mean `{k}`? "),
-                            None => String::new(),
-                        };
-                        let own = if declared.is_empty() {
-                            String::new()
-                        } else {
-                            format!(", the scenario's [[subjects]] {}", declared.join(", "))
-                        };
-                        d.at(
-                            v.span().start,
-                            format!(
-                                "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
-                                 are {}{own} (an external recognizer's name is made of \
-                                 letters, digits, `-` and `_`)",
-                                KNOWN_SUBJECTS.join(", ")
-                            ),
-                        );
-                        String::new()
-                    } else {
-                        name.to_string()
-                    }
-                }
-                _ => {
-                    d.at(
-                        v.span().start,
-                        format!(
-                            "`subject` in {ctx} must be a name in quotes, e.g. \
-                             `subject = \"words-3\"`"
-                        ),
-                    );
-                    String::new()
-                }
-            },
-        };
+        let subject = expect_subject_name(lt, declared, &ctx, d);
         let e = expectation(lt, &ctx, d);
         ex.subjects.push(SubjectExpectation {
             subject,
@@ -426,6 +365,73 @@ pub(crate) fn read_expect(top: &DeTable<'_>, declared: &[&str], d: &mut Diags) -
     }
     ex.regression = read_regression(t, d);
     ex
+}
+
+/// The `subject` of one `[[expect.subjects]]` entry (`ctx` names it): a built-in or declared
+/// name, or an external recognizer's; empty, with the error reported, when missing, mistyped
+/// or not a name.
+fn expect_subject_name(lt: &DeTable<'_>, declared: &[&str], ctx: &str, d: &mut Diags) -> String {
+    match get(lt, "subject") {
+        None => {
+            d.at(
+                0,
+                format!(
+                    "missing key `subject` in {ctx}; add e.g. `subject = \"words-3\"` \
+                     (one of {})",
+                    KNOWN_SUBJECTS.join(", ")
+                ),
+            );
+            String::new()
+        }
+        Some((_, v)) => match v.get_ref() {
+            DeValue::String(name)
+                if KNOWN_SUBJECTS.contains(&name.as_ref()) || declared.contains(&name.as_ref()) =>
+            {
+                name.to_string()
+            }
+            DeValue::String(name) => {
+                // Any other name is an external subject's (`--recognizer NAME=…`), unless
+                // it looks like a built-in or declared one mistyped.
+                let near = crate::spec::suggest::closest(
+                    name,
+                    KNOWN_SUBJECTS.iter().chain(declared).copied(),
+                );
+                if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
+                    let hint = match near {
+                        Some(k) => format!("did you mean `{k}`? "),
+                        None => String::new(),
+                    };
+                    let own = if declared.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", the scenario's [[subjects]] {}", declared.join(", "))
+                    };
+                    d.at(
+                        v.span().start,
+                        format!(
+                            "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
+                             are {}{own} (an external recognizer's name is made of \
+                             letters, digits, `-` and `_`)",
+                            KNOWN_SUBJECTS.join(", ")
+                        ),
+                    );
+                    String::new()
+                } else {
+                    name.to_string()
+                }
+            }
+            _ => {
+                d.at(
+                    v.span().start,
+                    format!(
+                        "`subject` in {ctx} must be a name in quotes, e.g. \
+                         `subject = \"words-3\"`"
+                    ),
+                );
+                String::new()
+            }
+        },
+    }
 }
 
 /// `[expect.regression]` over [`RegressionSpec::default`]; each bad value reported at its key.

@@ -797,17 +797,7 @@ fn closed_door_spans(
         && (off(panel.b) || along.is_some())
         && let Some(gap) = gap_heading(door, walls)
     {
-        let what = match along {
-            Some(wi) => format!("its panel lies along wall '{}'", spec.walls[wi].id),
-            None => format!(
-                "its tip at [{:.2}, {:.2}] is {} from the nearest wall",
-                panel.b.x,
-                panel.b.y,
-                wall_clearance(walls, panel.b, probe)
-                    .map(|c| format!("{c:.2} m"))
-                    .unwrap_or_else(|| format!("more than {probe} m"))
-            ),
-        };
+        let what = panel_miss(spec, along, panel.b, walls, probe);
         d.at(
             l.closed_heading,
             format!(
@@ -876,6 +866,28 @@ fn closed_door_spans(
         );
     }
     ok
+}
+
+/// What keeps a closed panel from spanning the gap at its hinge: it lies along wall `along`,
+/// or its `tip` is off the walls (`probe` metres the farthest looked).
+fn panel_miss(
+    spec: &WorldSpec,
+    along: Option<usize>,
+    tip: Vec2,
+    walls: &Obstacles,
+    probe: f64,
+) -> String {
+    match along {
+        Some(wi) => format!("its panel lies along wall '{}'", spec.walls[wi].id),
+        None => format!(
+            "its tip at [{:.2}, {:.2}] is {} from the nearest wall",
+            tip.x,
+            tip.y,
+            wall_clearance(walls, tip, probe)
+                .map(|c| format!("{c:.2} m"))
+                .unwrap_or_else(|| format!("more than {probe} m"))
+        ),
+    }
 }
 
 /// Why a closed heading misses the gap that `gap_deg` spans, and the heading to write.
@@ -994,32 +1006,13 @@ fn routes_are_drivable(
     d: &mut Diags,
 ) {
     let [(walls, _), (closed, _), (open, _)] = *all;
-    let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
     let mut opens_into_route = std::collections::HashSet::new();
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
         let n = r.waypoints_m.len();
         if n < 3 {
             continue;
         }
-        let mut bad = vec![false; n];
-        for (k, p) in r.waypoints_m.iter().enumerate() {
-            let p = v(p);
-            let s = Segment::new(p, p);
-            let worst = nearest_of(all, s, need_wp);
-            if let Some((o, c, state)) = worst {
-                bad[k] = true;
-                d.at(
-                    l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
-                    format!(
-                        "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
-                        r.id,
-                        k,
-                        fmt_m(c),
-                        owner_name(spec, o, state)
-                    ),
-                );
-            }
-        }
+        let bad = waypoints_too_close(spec, r, l, all, robot_radius_m, d);
         for k in 0..n {
             let k2 = (k + 1) % n;
             if bad[k] || bad[k2] {
@@ -1099,6 +1092,40 @@ fn routes_are_drivable(
             }
         }
     }
+}
+
+/// Whether each waypoint of route `r` is closer than radius + margin to a wall or a door (in
+/// either state); each one that is reported at its key of `l`.
+fn waypoints_too_close(
+    spec: &WorldSpec,
+    r: &crate::spec::world::RouteSpec,
+    l: &crate::spec::world::RouteLoc,
+    all: &[(&Obstacles, &str); 3],
+    robot_radius_m: f64,
+    d: &mut Diags,
+) -> Vec<bool> {
+    let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
+    let n = r.waypoints_m.len();
+    let mut bad = vec![false; n];
+    for (k, p) in r.waypoints_m.iter().enumerate() {
+        let p = v(p);
+        let s = Segment::new(p, p);
+        let worst = nearest_of(all, s, need_wp);
+        if let Some((o, c, state)) = worst {
+            bad[k] = true;
+            d.at(
+                l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
+                format!(
+                    "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
+                    r.id,
+                    k,
+                    fmt_m(c),
+                    owner_name(spec, o, state)
+                ),
+            );
+        }
+    }
+    bad
 }
 
 /// The open heading, degrees, of `door` swung the other way (mirrored in its closed panel),

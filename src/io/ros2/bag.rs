@@ -361,66 +361,82 @@ pub fn read_bag_bytes(
     let scan = pick("scan", msg::LASER_SCAN, &topics.scan, "--scan-topic")?;
     let odom = pick("odometry", msg::ODOMETRY, &topics.odom, "--odom-topic")?;
     let truth = truth_channel(&channels);
-    let decode_all = |id: u16, f: &dyn Fn(&[u8]) -> Result<(), super::cdr::CdrError>| {
-        let topic = &channels.info[&id].topic;
-        let data = channels.data.get(&id).map(Vec::as_slice).unwrap_or(&[]);
-        if data.is_empty() {
-            return Err(BagError::Empty {
-                path: name.into(),
-                topic: topic.clone(),
-            });
-        }
-        for (index, d) in data.iter().enumerate() {
-            f(d).map_err(|source| BagError::Message {
-                path: name.into(),
-                topic: topic.clone(),
-                index,
-                source,
-            })?;
-        }
-        Ok(())
-    };
-    let odoms = std::cell::RefCell::new(Vec::new());
-    decode_all(odom, &|d| {
+    let mut odoms = decode_all(&channels, name, odom, |d| {
         let o = Odometry::decode(d)?;
-        odoms
-            .borrow_mut()
-            .push((o.header.stamp_s, pose_at_log_resolution(o.pose)));
-        Ok(())
+        Ok((o.header.stamp_s, pose_at_log_resolution(o.pose)))
     })?;
-    let mut odoms = odoms.into_inner();
     odoms.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let scans = std::cell::RefCell::new(Vec::new());
-    decode_all(scan, &|d| {
-        scans.borrow_mut().push(LaserScan::decode(d)?);
-        Ok(())
-    })?;
-    let scans = scans.into_inner();
-    let truepos = std::cell::RefCell::new(Vec::new());
-    if let Some(t) = truth {
-        decode_all(t, &|d| {
+    let scans = decode_all(&channels, name, scan, LaserScan::decode)?;
+    let truepos = match truth {
+        Some(t) => decode_all(&channels, name, t, |d| {
             let p = PoseStamped::decode(d)?;
-            truepos.borrow_mut().push(TruePosRecord {
+            Ok(TruePosRecord {
                 truth: pose_at_log_resolution(p.pose),
                 odom: Pose2::IDENTITY,
                 ipc_timestamp: p.header.stamp_s,
                 host: String::new(),
                 logger_timestamp: p.header.stamp_s,
-            });
-            Ok(())
-        })?;
-    }
+            })
+        })?,
+        None => Vec::new(),
+    };
     let max_range_m = scans
         .first()
         .map(|s| f32_decimal(s.range_max))
         .filter(|r| r.is_finite() && *r > 0.0);
+    let lasers = laser_records(scans, &odoms, max_range_m, name)?;
+    Ok(BagReadout {
+        lasers,
+        truepos,
+        max_range_m,
+        topics: list,
+    })
+}
+
+/// Every message of channel `id`, decoded by `decode`, in file order; an error names the
+/// topic and the message's index, and a channel without messages is an error.
+fn decode_all<T>(
+    channels: &Channels,
+    name: &str,
+    id: u16,
+    decode: impl Fn(&[u8]) -> Result<T, super::cdr::CdrError>,
+) -> Result<Vec<T>, BagError> {
+    let topic = &channels.info[&id].topic;
+    let data = channels.data.get(&id).map(Vec::as_slice).unwrap_or(&[]);
+    if data.is_empty() {
+        return Err(BagError::Empty {
+            path: name.into(),
+            topic: topic.clone(),
+        });
+    }
+    data.iter()
+        .enumerate()
+        .map(|(index, d)| {
+            decode(d).map_err(|source| BagError::Message {
+                path: name.into(),
+                topic: topic.clone(),
+                index,
+                source,
+            })
+        })
+        .collect()
+}
+
+/// One laser record per scan, at the odometry of its stamp (`odoms` sorted by time); ranges
+/// that are not finite read as `max_range_m` (no return; infinite without one).
+fn laser_records(
+    scans: Vec<LaserScan>,
+    odoms: &[(f64, Pose2)],
+    max_range_m: Option<f64>,
+    name: &str,
+) -> Result<Vec<LaserRecord>, BagError> {
     let no_return = max_range_m.unwrap_or(f64::INFINITY);
-    let lasers = scans
+    scans
         .into_iter()
         .enumerate()
         .map(|(index, s)| {
             let t = s.header.stamp_s;
-            let pose = odometry_at(&odoms, t).map_err(|gap_s| BagError::NoOdometry {
+            let pose = odometry_at(odoms, t).map_err(|gap_s| BagError::NoOdometry {
                 path: name.into(),
                 index,
                 time_s: t,
@@ -449,13 +465,7 @@ pub fn read_bag_bytes(
                 logger_timestamp: t,
             })
         })
-        .collect::<Result<Vec<_>, BagError>>()?;
-    Ok(BagReadout {
-        lasers,
-        truepos: truepos.into_inner(),
-        max_range_m,
-        topics: list,
-    })
+        .collect()
 }
 
 /// `r` as the shortest decimal that reads back as `r` (what was meant before it became binary).

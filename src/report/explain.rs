@@ -1,0 +1,305 @@
+//! Explanations for people, from the figures `eval` computes: why a subject has no pair
+//! (`Scores::no_pairs_reason`), in sentences. `eval` finds the causes
+//! ([`crate::eval::scores::NoPairsCauses`]); this module words them, and so builds the
+//! [`Scores`] and the report's subjects a run writes: [`Scores::of`], [`Report::add_subject`],
+//! [`Report::add_level`] (inherent methods of `eval`'s types, defined here, above `eval`).
+
+use crate::eval::Recognition;
+use crate::eval::scores::{
+    NoPairsCauses, RejectedScores, Report, Scores, SubjectKind, SubjectReport, words_subject_name,
+};
+use crate::spec::evaluation::EvaluationSpec;
+
+impl Scores {
+    /// Evaluates `rec` with `spec` and takes its timing (the scoring's included), with the
+    /// reason in words when there is no pair ([`Scores::measure`], then [`no_pairs_reason`]).
+    pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
+        let (mut scores, causes) = Scores::measure(rec, spec);
+        scores.no_pairs_reason = causes.map(|c| no_pairs_reason(&c, spec));
+        scores
+    }
+}
+
+impl Report {
+    /// Scores `rec` (the paper's recognizer run with `levels` levels and `thresholds`) and adds
+    /// it as subject `words-<levels>`.
+    pub fn add_level(
+        &mut self,
+        levels: usize,
+        thresholds: &[usize],
+        rec: &Recognition,
+    ) -> &SubjectReport {
+        let added = self.add_subject(&words_subject_name(levels), SubjectKind::Words, rec);
+        added.levels = Some(levels);
+        added.thresholds = thresholds.to_vec();
+        added
+    }
+
+    /// Scores `rec` ([`Scores::of`]) and adds it as the subject `name` of `kind`.
+    pub fn add_subject(
+        &mut self,
+        name: &str,
+        kind: SubjectKind,
+        rec: &Recognition,
+    ) -> &mut SubjectReport {
+        let mut added = SubjectReport::new(name, kind, Scores::of(rec, &self.evaluation));
+        added.recognize_seconds_by_lap = rec.lap_seconds.clone();
+        self.subjects.push(added);
+        self.subjects.last_mut().expect("just pushed")
+    }
+}
+
+/// Why a run has no pair, in words: the causes `eval` found, joined by "; ".
+pub fn no_pairs_reason(causes: &NoPairsCauses, spec: &EvaluationSpec) -> String {
+    let mut why = Vec::new();
+    if causes.no_revisit {
+        why.push(format!(
+            "no observation has a revisit (an earlier pass within {} m, {} m of travel before)",
+            spec.tp_radius_m, spec.min_gap_m
+        ));
+    }
+    match &causes.recognizer {
+        Some(r) => {
+            why.push(r.no_match_reason.clone());
+            why.extend(r.revisit_length_reason.clone());
+            why.extend(r.rejected.as_ref().map(|r| rejected_sentence(r, spec)));
+        }
+        None if why.is_empty() => why.push("the recognizer does not say why".into()),
+        None => {}
+    }
+    why.join("; ")
+}
+
+/// What the truth says of the rejected candidates, in words.
+fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
+    if r.correct == 0 {
+        return format!(
+            "by the ground truth none of the {} rejected candidates sampled paired the same \
+             place (within {} m): verification turned down look-alikes",
+            r.sampled, spec.tp_radius_m
+        );
+    }
+    let by_check: Vec<String> = r
+        .correct_by_check
+        .iter()
+        .map(|c| format!("{} {}", c.check, c.count))
+        .collect();
+    format!(
+        "by the ground truth {} of the {} rejected candidates sampled paired the same place \
+         (within {} m; {}): verification turned down true revisits",
+        r.correct,
+        r.sampled,
+        spec.tp_radius_m,
+        by_check.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::metrics::{Evaluation, Metrics};
+    use crate::eval::scores::no_pairs_causes;
+    use crate::place::Diagnostics;
+    use crate::recognizer::{MatchDiagnostics, Rejection};
+
+    /// The reason `Scores::of` would write for `e`.
+    fn reason(
+        e: &Evaluation,
+        d: Option<&dyn Diagnostics>,
+        rejected: Option<&RejectedScores>,
+        spec: &EvaluationSpec,
+    ) -> Option<String> {
+        no_pairs_causes(e, d, rejected).map(|c| no_pairs_reason(&c, spec))
+    }
+
+    /// A run without pairs says why: verification counts when every candidate was rejected,
+    /// chain lengths against τ when no chain was long enough, and missing revisits.
+    #[test]
+    fn no_pairs_reason_names_the_cause() {
+        let spec = EvaluationSpec::default();
+        let none = Evaluation {
+            main: Metrics {
+                revisits: 10,
+                ..Metrics::default()
+            },
+            ..Evaluation::default()
+        };
+        let mut d = MatchDiagnostics {
+            longest_chain: vec![7, 9],
+            min_ngram: vec![6, 9],
+            within_gap: 0,
+            verification: Default::default(),
+            long_steps: 0,
+            reverse_extra_ngram: 0,
+            rejected: Vec::new(),
+            mean_word_m: 0.0,
+        };
+        d.verification.rejected_travel = 3;
+        d.verification.rejected_density = 2;
+        d.verification.rejected_straight = 1;
+        let why = reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(
+            why.contains(
+                "rejected by verification: 6 (travel 3, turn 0, density 2, sides 0, straight 1)"
+            ),
+            "{why}"
+        );
+        d.verification = Default::default();
+        d.longest_chain = vec![4, 8];
+        let why = reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("4 (τ = 6) at 1 level, 8 (τ = 9) at 2 levels"),
+            "{why}"
+        );
+        d.long_steps = 3;
+        let why = reason(&none, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("3 steps between scans were longer than max_interpolation_m"),
+            "{why}"
+        );
+        let why = reason(&Evaluation::default(), None, None, &spec).unwrap();
+        assert!(why.starts_with("no observation has a revisit"), "{why}");
+        let mut some = none.clone();
+        some.main.pairs = 1;
+        assert_eq!(
+            reason(&some, Some(&d as &dyn Diagnostics), None, &spec),
+            None
+        );
+    }
+
+    /// When no chain is long enough, the reason says whether the revisits are shorter than τ
+    /// words of the run's mean length (nothing to chain) or long enough (the words differ).
+    #[test]
+    fn no_pairs_reason_compares_revisit_length_with_tau_words() {
+        let spec = EvaluationSpec::default();
+        let mut e = Evaluation::default();
+        e.main.revisits = 300;
+        e.main.longest_revisit_m = 20.2.into();
+        e.directions.same.longest_revisit_m = 11.2.into();
+        e.directions.opposite.longest_revisit_m = 9.0.into();
+        let d = MatchDiagnostics {
+            longest_chain: vec![4],
+            min_ngram: vec![6],
+            mean_word_m: 2.5,
+            ..MatchDiagnostics::default()
+        };
+        let why = reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(why.contains("no word sequence long enough"), "{why}");
+        assert!(
+            why.contains("is 11.2 m driven the same way and 9.0 m the other way"),
+            "{why}"
+        );
+        assert!(why.contains("a word spans 2.5 m on average"), "{why}");
+        assert!(why.contains("τ = 6 words need about 15 m,"), "{why}");
+        assert!(why.contains("too short for a chain"), "{why}");
+        // Read backwards a chain needs more words: 16 m is enough driven the same way, not
+        // the other way.
+        let d = MatchDiagnostics {
+            reverse_extra_ngram: 2,
+            ..d
+        };
+        e.directions.opposite.longest_revisit_m = 16.0.into();
+        let why = reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(
+            why.contains("τ = 6 words need about 15 m (8 read backwards, about 20 m)"),
+            "{why}"
+        );
+        assert!(why.contains("too short for a chain"), "{why}");
+        e.directions.same.longest_revisit_m = 16.0.into();
+        let why = reason(&e, Some(&d as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(why.contains("the words differ between visits"), "{why}");
+        // Verification's counts are the reason when candidates were made.
+        let mut v = d.clone();
+        v.verification.rejected_turn = 2;
+        let why = reason(&e, Some(&v as &dyn Diagnostics), None, &spec).unwrap();
+        assert!(!why.contains("stretch"), "{why}");
+    }
+
+    /// Rejected candidates are scored at their sampled pair: right when the two true poses are
+    /// within the radius and face as the candidate's direction claims; the reason then says
+    /// whether verification turned down true revisits or look-alikes.
+    #[test]
+    fn rejected_candidates_are_scored_against_the_truth() {
+        use crate::eval::RejectedTruth;
+        use crate::geom::{Pose2, TruePose};
+        use crate::place::Direction;
+        let spec = EvaluationSpec::default();
+        let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
+        let r = |q, p, direction, reason: Rejection| RejectedTruth {
+            query: q,
+            past: p,
+            direction,
+            check: reason.index(),
+        };
+        let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
+        let rejected = [
+            // The same place, facing alike: a true revisit turned down by the turn check.
+            r(
+                at(0.0, 0.0),
+                at(0.5, 10.0),
+                Direction::Same,
+                Rejection::Turn,
+            ),
+            // The same place driven the other way, claimed opposite: right too.
+            r(
+                at(0.0, 0.0),
+                at(0.3, 175.0),
+                Direction::Opposite,
+                Rejection::Sides,
+            ),
+            // Claimed the same direction but driven the other way: wrong.
+            r(
+                at(0.0, 0.0),
+                at(0.3, 175.0),
+                Direction::Same,
+                Rejection::Turn,
+            ),
+            // A look-alike 5 m away.
+            r(
+                at(0.0, 0.0),
+                at(5.0, 0.0),
+                Direction::Same,
+                Rejection::Travel,
+            ),
+        ];
+        let s = RejectedScores::of(&rejected, &checks, &spec).expect("four sampled");
+        assert_eq!((s.sampled, s.correct), (4, 2));
+        assert_eq!(
+            (
+                s.correct_by("turn"),
+                s.correct_by("sides"),
+                s.correct_by("travel")
+            ),
+            (1, 1, 0)
+        );
+        assert_eq!(RejectedScores::of(&[], &checks, &spec), None);
+        let mut e = Evaluation::default();
+        e.main.revisits = 10;
+        let d = MatchDiagnostics {
+            longest_chain: vec![8],
+            min_ngram: vec![6],
+            verification: crate::recognizer::VerificationCounts {
+                rejected_turn: 2,
+                rejected_sides: 1,
+                rejected_travel: 1,
+                ..Default::default()
+            },
+            ..MatchDiagnostics::default()
+        };
+        let why = reason(&e, Some(&d as &dyn Diagnostics), Some(&s), &spec).unwrap();
+        assert!(
+            why.contains("every candidate was rejected by verification: 4"),
+            "{why}"
+        );
+        assert!(
+            why.contains("2 of the 4 rejected candidates sampled paired the same place"),
+            "{why}"
+        );
+        assert!(why.contains("turned down true revisits"), "{why}");
+        let none_right = RejectedScores::of(&rejected[3..], &checks, &spec).unwrap();
+        let why = reason(&e, Some(&d as &dyn Diagnostics), Some(&none_right), &spec).unwrap();
+        assert!(why.contains("turned down look-alikes"), "{why}");
+    }
+}
