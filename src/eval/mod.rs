@@ -546,6 +546,16 @@ impl Recording {
         t
     }
 
+    /// Adds work done for the recognizer outside its own calls to its time (and to the lap's,
+    /// inside a lap): CPU seconds `cpu_s`, wall-clock seconds `wall_s`. The harness charges
+    /// each level configuration the whole of a density front end it shares with others, as if
+    /// it ran alone (`experiment::shared_front`).
+    pub fn charge(&mut self, cpu_s: f64, wall_s: f64) {
+        self.seconds += cpu_s;
+        self.wall_seconds += wall_s;
+        self.lap_so_far += cpu_s;
+    }
+
     /// Ends the lap started.
     pub fn end_lap(&mut self) {
         self.lap_seconds.push(self.lap_so_far);

@@ -11,6 +11,7 @@ pub mod real;
 mod recognizer_settings;
 pub(crate) mod scenario;
 pub mod score;
+mod shared_front;
 pub(crate) mod stream;
 pub mod stress;
 

@@ -7,6 +7,7 @@
 //! recognizers a chunk at a time and only their truth is kept, so a log of any size fits in the
 //! memory of the recognizers' own state.
 
+use super::shared_front::FrontEnds;
 use super::stream::{Job, finish_jobs, jobs, settle};
 use super::{Experiment, ExperimentError, ExperimentOptions, assemble, level_configs};
 use crate::eval::scores::LogSummary;
@@ -24,7 +25,6 @@ use crate::sim::odometry::{
 };
 use crate::sim::rng::{Purpose, SimRng, stream};
 use crate::spec::evaluation::EvaluationSpec;
-use rayon::prelude::*;
 use std::path::Path;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 
@@ -218,7 +218,7 @@ pub fn recognize_log_streamed(
     opts: &ExperimentOptions,
 ) -> Result<(Experiment, usize), ExperimentError> {
     let configs = level_configs(base, &opts.levels)?;
-    let mut jobs = jobs(&configs, evaluation, opts)?;
+    let (mut jobs, mut fronts) = jobs(&configs, evaluation, opts)?;
     let read = ReadOptions {
         lenient: log.lenient,
     };
@@ -230,7 +230,7 @@ pub fn recognize_log_streamed(
     let mut truth = GroundTruth::default();
     let read = std::thread::scope(|s| {
         let producer = s.spawn(|| send_chunks(path, read, &survey, log, tx));
-        feed_chunks(&mut jobs, &mut truth, rx, &opts.progress);
+        feed_chunks(&mut jobs, &mut fronts, &mut truth, rx, &opts.progress);
         producer.join().expect("the log reader does not panic")
     });
     opts.progress.done();
@@ -272,11 +272,12 @@ fn send_chunks(
     Ok(())
 }
 
-/// Feeds the chunks from `rx` to every job (the jobs in parallel) as frames of one run of one
+/// Feeds the chunks from `rx` to every job (the jobs in parallel, through `fronts`) as frames of one run of one
 /// lap, doors unknown (as a real log's run is), with their truth kept once in `truth`; a
 /// progress step per chunk.
 fn feed_chunks(
     jobs: &mut [Job],
+    fronts: &mut FrontEnds,
     truth: &mut GroundTruth,
     rx: Receiver<Vec<Frame>>,
     progress: &super::ProgressSink,
@@ -287,16 +288,13 @@ fn feed_chunks(
         door_config: "unknown".into(),
         open_doors: Vec::new(),
     });
-    for (_, rec, recording) in jobs.iter_mut() {
-        recording.start_run(rec.as_mut(), truth);
+    fronts.start_run(jobs, truth);
+    for (_, _, recording) in jobs.iter_mut() {
         recording.start_lap();
     }
     for chunk in rx {
         let first = truth.push_frames(&chunk);
-        let truth = &*truth;
-        jobs.par_iter_mut().for_each(|(_, rec, recording)| {
-            recording.frames(rec.as_mut(), &chunk, first, truth);
-        });
+        fronts.frames(jobs, &chunk, first, truth);
         settle(jobs, false);
         progress.step();
     }

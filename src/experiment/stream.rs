@@ -12,6 +12,7 @@
 //!
 //! The lap producer ([`with_laps`]) also feeds `simulate`'s log writer (`super::output`).
 
+use super::shared_front::FrontEnds;
 use super::{ExperimentError, ExperimentOptions, ProgressSink, SubjectId, assemble, level_configs};
 use crate::baseline::icp::{IcpConfig, IcpRecognizer};
 use crate::eval::provenance::LapSource;
@@ -19,11 +20,10 @@ use crate::eval::{GroundTruth, LapInfo, PlaceRecognizer, Recognition, Recording}
 use crate::experiment::cache::LapCache;
 use crate::external::ExternalRecognizer;
 use crate::log::LapLog;
-use crate::recognizer::{DensityFrontEnd, DensityObservation, Recognizer, RecognizerConfig};
+use crate::recognizer::{DensityFrontEnd, DensityObservation, RecognizerConfig};
 use crate::sim::runner::RunSim;
 use crate::sim::{SimError, SimPlan};
 use crate::spec::evaluation::EvaluationSpec;
-use rayon::prelude::*;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::time::Instant;
@@ -43,14 +43,14 @@ pub fn run_scenario_streamed(
 ) -> Result<Experiment, ExperimentError> {
     let opts = &super::options_for_scenario(scn, opts);
     let configs = level_configs(&recognizer_config(scn)?, &opts.levels)?;
-    let mut jobs = jobs(&configs, &scn.evaluation, opts)?;
+    let (mut jobs, mut fronts) = jobs(&configs, &scn.evaluation, opts)?;
     let plan = &scn.sim;
     let laps_of = |run: usize| opts.laps.unwrap_or(plan.runs[run].laps);
     let total: usize = (0..plan.runs.len()).map(laps_of).sum();
     opts.progress.start("laps", total as u64);
     let mut truth = GroundTruth::default();
     let (sim, ()) = with_laps(plan, &laps_of, opts.cache.as_deref(), |rx| {
-        feed(&mut jobs, &mut truth, rx, &opts.progress)
+        feed(&mut jobs, &mut fronts, &mut truth, rx, &opts.progress)
     });
     opts.progress.done();
     let (sim_s, lap_source) = sim?;
@@ -197,18 +197,20 @@ fn simulate_laps(
 }
 
 /// One job per level configuration, in order, then ICP's and Scan Context's if asked (with the
-/// evaluation's `min_gap_m`), then one per external recognizer (started here). Each scores its matches as they arrive ([`Recording::streaming`]); a
-/// configuration with one level fewer than another keeps what it forgets, to count the other's
-/// gain ([`settle`]).
+/// evaluation's `min_gap_m`), then one per external recognizer (started here). Each scores its
+/// matches as they arrive ([`Recording::streaming`]; a configuration with one level fewer than
+/// another keeps what it forgets, to count the other's gain, [`settle`]). The level
+/// configurations with the same front-end settings share one density front end (the
+/// [`FrontEnds`] returned, which feed the jobs: `shared_front`).
 pub(super) fn jobs(
     configs: &[RecognizerConfig],
     evaluation: &EvaluationSpec,
     opts: &ExperimentOptions,
-) -> Result<Vec<Job>, ExperimentError> {
+) -> Result<(Vec<Job>, FrontEnds), ExperimentError> {
     let mut jobs: Vec<Job> = Vec::new();
+    let mut fronts = FrontEnds::default();
     for cfg in configs {
-        let rec =
-            Recognizer::new(cfg.clone()).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
+        let rec = fronts.words_job(cfg)?;
         jobs.push((
             SubjectId::Words(cfg.levels),
             Box::new(rec),
@@ -229,6 +231,7 @@ pub(super) fn jobs(
             Box::new(icp),
             Recording::streaming(evaluation),
         ));
+        fronts.own_job();
     }
     if opts.scan_context {
         jobs.push((
@@ -236,6 +239,7 @@ pub(super) fn jobs(
             Box::new(super::scan_context_recognizer(opts, evaluation)?),
             Recording::streaming(evaluation),
         ));
+        fronts.own_job();
     }
     for spec in &opts.external {
         let rec = ExternalRecognizer::start(spec)
@@ -245,8 +249,9 @@ pub(super) fn jobs(
             Box::new(rec),
             Recording::streaming(evaluation),
         ));
+        fronts.own_job();
     }
-    Ok(jobs)
+    Ok((jobs, fronts))
 }
 
 /// `(job, job with one level fewer)` for every level configuration whose gain is reported.
@@ -293,11 +298,12 @@ pub(super) fn settle(jobs: &mut [Job], last: bool) {
     }
 }
 
-/// Feeds each lap from `rx` to every job (the jobs in parallel), starting a run at each new
-/// run index, with the laps' truth kept once in `truth`; tells `progress` a step per lap and a
-/// status of laps per second and memory.
+/// Feeds each lap from `rx` to every job (the jobs in parallel, through `fronts`), starting a
+/// run at each new run index, with the laps' truth kept once in `truth`; tells `progress` a
+/// step per lap and a status of laps per second and memory.
 fn feed(
     jobs: &mut [Job],
+    fronts: &mut FrontEnds,
     truth: &mut GroundTruth,
     rx: Receiver<(usize, LapLog)>,
     progress: &ProgressSink,
@@ -308,16 +314,17 @@ fn feed(
         let new_run = current != Some(run);
         current = Some(run);
         if new_run {
-            let truth = &*truth;
-            jobs.par_iter_mut()
-                .for_each(|(_, rec, recording)| recording.start_run(rec.as_mut(), truth));
+            fronts.start_run(jobs, truth);
         }
         truth.start_lap(LapInfo::of(run, &lap));
         let first = truth.push_frames(&lap.frames);
-        let truth = &*truth;
-        jobs.par_iter_mut().for_each(|(_, rec, recording)| {
-            recording.lap(rec.as_mut(), &lap.frames, first, truth);
-        });
+        for (_, _, recording) in jobs.iter_mut() {
+            recording.start_lap();
+        }
+        fronts.frames(jobs, &lap.frames, first, truth);
+        for (_, _, recording) in jobs.iter_mut() {
+            recording.end_lap();
+        }
         settle(jobs, false);
         progress.step();
         let done = jobs.first().map_or(0, |j| j.2.laps());
@@ -399,7 +406,8 @@ mod tests {
         let mut base = recognizer_config(&scn).unwrap();
         base.matcher.max_candidates = 8;
         let configs = level_configs(&base, &[2, 3]).unwrap();
-        let mut jobs = jobs(&configs, &scn.evaluation, &ExperimentOptions::default()).unwrap();
+        let (mut jobs, mut fronts) =
+            jobs(&configs, &scn.evaluation, &ExperimentOptions::default()).unwrap();
         let laps_of = |run: usize| [30, 10][run];
         let mut held_at = Vec::new();
         let mut truth = GroundTruth::default();
@@ -407,15 +415,13 @@ mod tests {
             let mut current = None;
             for (run, lap) in rx {
                 if current != Some(run) {
-                    for (_, rec, recording) in jobs.iter_mut() {
-                        recording.start_run(rec.as_mut(), &truth);
-                    }
+                    fronts.start_run(&mut jobs, &truth);
                 }
                 truth.start_lap(LapInfo::of(run, &lap));
                 let first = truth.push_frames(&lap.frames);
-                for (_, rec, recording) in jobs.iter_mut() {
-                    recording.lap(rec.as_mut(), &lap.frames, first, &truth);
-                }
+                jobs.iter_mut().for_each(|j| j.2.start_lap());
+                fronts.frames(&mut jobs, &lap.frames, first, &truth);
+                jobs.iter_mut().for_each(|j| j.2.end_lap());
                 current = Some(run);
                 settle(&mut jobs, false);
                 held_at.push(jobs[1].2.pairs_held().expect("streaming").0);

@@ -151,6 +151,8 @@ pub struct DensityFrontEnd {
 }
 
 impl DensityFrontEnd {
+    /// A front end with the `[recognizer.front_end]`, `grid` and `density` settings of
+    /// `config` (checked whole): it reads no other (see [`Self::same_settings`]).
     pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
         config.validate()?;
         let grid = LocalGrid::with_memory(
@@ -175,6 +177,14 @@ impl DensityFrontEnd {
             next_id: 0,
             long_steps: 0,
         })
+    }
+
+    /// Whether the front ends of `a` and `b` make the same observations of the same input: their
+    /// `[recognizer.front_end]`, `grid` and `density` settings, all that [`Self::new`] reads,
+    /// are equal (level configurations differ only past the front end, so a harness may run
+    /// one front end for them all).
+    pub fn same_settings(a: &RecognizerConfig, b: &RecognizerConfig) -> bool {
+        a.front_end == b.front_end && a.grid == b.grid && a.density == b.density
     }
 
     /// Integrates one scan taken at `odom`; returns the observations it made: usually none or

@@ -208,8 +208,14 @@ pub fn thresholds(cfg: &RecognizerConfig) -> Vec<usize> {
         .collect()
 }
 
-fn to_place(matches: Vec<WordMatch>) -> Vec<place::Match> {
+/// The neutral matches the harness scores.
+pub(crate) fn to_place(matches: Vec<WordMatch>) -> Vec<place::Match> {
     matches.iter().map(WordMatch::to_place).collect()
+}
+
+/// A recognizer's name in the harness: `levels=3 [6, 9, 12]`.
+pub(crate) fn harness_name(c: &RecognizerConfig) -> String {
+    format!("levels={} {:?}", c.levels, thresholds(c))
 }
 
 /// The recognizer as the harness sees it: neutral matches scored by chain length.
@@ -230,8 +236,7 @@ impl PlaceRecognizer for Recognizer {
         Recognizer::query_horizon(self)
     }
     fn name(&self) -> String {
-        let c = self.config();
-        format!("levels={} {:?}", c.levels, thresholds(c))
+        harness_name(self.config())
     }
     fn diagnostics(&self) -> Option<Box<dyn place::Diagnostics>> {
         Some(Box::new(Recognizer::diagnostics(self)))

@@ -2,7 +2,10 @@
 //! recognize per subject, score per subject, write), summed over the reports given (the seeds
 //! and scenarios of a check). CPU seconds of the threads that did the work
 //! ([`crate::clock`]), so stages that ran side by side add up to the CPU the command used; the
-//! recognizers' wall clock is given beside theirs, and the writing is wall clock.
+//! recognizers' wall clock is given beside theirs, and the writing is wall clock. One exception:
+//! level configurations that share a density front end are each charged the whole of it
+//! (`experiment::shared_front`), so with more than one `words-*` subject their recognize lines
+//! count it once per subject and the total is more than the CPU used (a note line says so).
 
 use crate::eval::scores::{Report, Scores};
 use std::fmt::Write;
@@ -87,6 +90,15 @@ pub fn profile_text<'r>(
         "total CPU",
         share(scoring)
     );
+    let words = subjects
+        .iter()
+        .filter(|(n, ..)| crate::eval::scores::words_subject_levels(n).is_some());
+    if words.count() > 1 {
+        out.push_str(
+            "  (the words subjects share one front end and each counts the whole of it: \
+             the total overstates the CPU used)\n",
+        );
+    }
     out
 }
 
