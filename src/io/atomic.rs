@@ -812,7 +812,9 @@ pub fn settle(path: &Path) {
     let marker_temp = format!(".{commit}");
     for e in &entries {
         let n = e.file_name().to_string_lossy().into_owned();
-        let Some((_, pid)) = n.strip_prefix(&marker_temp).and_then(|t| t.rsplit_once(".tmp"))
+        let Some((_, pid)) = n
+            .strip_prefix(&marker_temp)
+            .and_then(|t| t.rsplit_once(".tmp"))
         else {
             continue;
         };

@@ -466,17 +466,24 @@ fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
 #[test]
 fn settle_removes_the_marker_temporaries_of_dead_processes() {
     let tmp = tempfile::tempdir().unwrap();
-    let dead = tmp.path().join(format!("..r.json.commit{DEAD_PID}.tmp{DEAD_PID}"));
+    let dead = tmp
+        .path()
+        .join(format!("..r.json.commit{DEAD_PID}.tmp{DEAD_PID}"));
     let me = std::process::id();
     let live = tmp.path().join(format!("..r.json.commit{me}.tmp{me}"));
-    let other = tmp.path().join(format!("..m.csv.commit{DEAD_PID}.tmp{DEAD_PID}"));
+    let other = tmp
+        .path()
+        .join(format!("..m.csv.commit{DEAD_PID}.tmp{DEAD_PID}"));
     for p in [&dead, &live, &other] {
         std::fs::write(p, "{}").unwrap();
     }
     placewords::io::atomic::settle(&tmp.path().join("r.json"));
     assert!(!dead.exists());
     assert!(live.exists(), "a running process's temporary is its own");
-    assert!(other.exists(), "another output's temporaries are its settle's");
+    assert!(
+        other.exists(),
+        "another output's temporaries are its settle's"
+    );
 }
 
 /// An output file another live process writes is refused, naming it and that process, before
