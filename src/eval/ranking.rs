@@ -123,7 +123,7 @@ pub fn of_recognition(
 }
 
 /// The figures of `matches` over `observations` (joined with `truth`), with `positives`
-/// queries that have a revisit; untimed (query rate 0): a sweep's score curves.
+/// queries that have a revisit; untimed (query rate 0).
 pub fn of_matches(
     observations: &[Observation],
     truth: &GroundTruth,

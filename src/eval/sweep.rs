@@ -91,28 +91,42 @@ where
         .collect()
 }
 
-/// Scores the matches `matches_of` produces for every grid point against one set of
-/// observations; the revisit search is done once. In parallel, results in grid order.
+/// Observations the back end's query horizon must advance by before a grid point's tally
+/// forgets the pairs behind it (each forgetting walks the pairs held).
+const FORGET_EVERY: usize = 512;
+
+/// Scores the matches `run_point` produces for every grid point against one set of
+/// observations; the revisit search is done once. `run_point` hands each batch of matches to
+/// its sink as it finds them, with the back end's query horizon after them (no later match
+/// names an older query, [`crate::place::PlaceRecognizer::query_horizon`]): each point's tally
+/// counts them at once and forgets the pairs behind the horizon, so neither a point's matches
+/// nor its pairs are held. In parallel, results in grid order.
 pub fn sweep_matches<F>(
     grid: &[GridPoint],
     observations: &[Observation],
     truth: &GroundTruth,
     spec: &EvaluationSpec,
-    matches_of: F,
+    run_point: F,
     on_done: &(dyn Fn() + Sync),
 ) -> Vec<SweepResult>
 where
-    F: Fn(&GridPoint) -> Vec<Match> + Sync,
+    F: Fn(&GridPoint, &mut dyn FnMut(&[Match], usize)) + Sync,
 {
     let scorer = Scorer::new(observations, truth, spec);
     let revisits = scorer.revisits(spec.tp_radius_m);
     grid.par_iter()
         .map(|p| {
-            let matches = matches_of(p);
             let mut tally = Tally::over(&scorer, spec, Scope::Main);
-            for m in &matches {
-                tally.add(m, truth);
-            }
+            let mut forgot_below = 0;
+            run_point(p, &mut |matches, horizon| {
+                for m in matches {
+                    tally.add(m, truth);
+                }
+                if horizon >= forgot_below + FORGET_EVERY {
+                    tally.evict_below(horizon);
+                    forgot_below = horizon;
+                }
+            });
             let metrics = tally.finish_main(Some(&revisits));
             on_done();
             SweepResult {
@@ -292,16 +306,17 @@ mod tests {
     fn sweep_matches_keeps_grid_order_whatever_the_threads() {
         let (obs, gt) = crate::eval::metrics::tests::circle(3, 40.0);
         let grid = fig8_grid();
-        let matches_of = |p: &GridPoint| -> Vec<Match> {
+        let matches_of = |p: &GridPoint, sink: &mut dyn FnMut(&[Match], usize)| {
             // A fake back-end: pairs each observation with one a lap back, shifted by the
             // last threshold, so precision falls as the threshold grows.
             let shift = *p.thresholds.last().unwrap();
-            vec![Match::from_pairs(
+            let m = Match::from_pairs(
                 (420..obs.len())
                     .step_by(p.levels)
                     .map(|q| (q, q - 400 - shift)),
                 1.0,
-            )]
+            );
+            sink(&[m], 0);
         };
         let spec = EvaluationSpec::default();
         let run = |threads| {

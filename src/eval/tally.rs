@@ -392,7 +392,9 @@ impl Tally {
                 &computed
             }
         };
-        self.slots[0].metrics(revisits, &self.scorer).0
+        let mut metrics = self.slots[0].metrics(revisits, &self.scorer).0;
+        metrics.late_pairs = self.late_pairs;
+        metrics
     }
 
     /// Every figure (a [`Scope::Full`] tally) of the observations synced ([`Self::sync`] the

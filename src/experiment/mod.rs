@@ -396,12 +396,16 @@ fn assemble(
     }
 }
 
-/// The matches the back end finds in `observations` with the levels and thresholds of `point`.
-pub fn back_end_matches(
+/// Runs the back end with the levels and thresholds of `point` over `observations`, handing
+/// `sink` the matches of each observation as they are found, with the back end's query horizon
+/// after them (no later match names an older query), so the caller scores them as they come
+/// rather than holding them.
+pub fn back_end_stream(
     observations: &[DensityObservation],
     base: &RecognizerConfig,
     point: &GridPoint,
-) -> Result<Vec<Match>, ExperimentError> {
+    sink: &mut dyn FnMut(&[Match], usize),
+) -> Result<(), ExperimentError> {
     let mut min_ngram = base.matcher.min_ngram.clone();
     for (k, t) in point.thresholds.iter().enumerate() {
         if k < min_ngram.len() {
@@ -414,12 +418,19 @@ pub fn back_end_matches(
     cfg.matcher.min_ngram = min_ngram;
     let mut back =
         WordMatcher::new(&cfg).map_err(|e| ExperimentError::Recognizer(e.to_string()))?;
-    let mut out: Vec<WordMatch> = Vec::new();
+    let mut hand = |found: Vec<WordMatch>, horizon: usize| {
+        if !found.is_empty() {
+            let matches: Vec<Match> = found.iter().map(WordMatch::to_place).collect();
+            sink(&matches, horizon);
+        }
+    };
     for o in observations {
-        out.extend(back.push_observation(o));
+        let found = back.push_observation(o);
+        hand(found, back.query_horizon());
     }
-    out.extend(back.finish_run());
-    Ok(out.iter().map(WordMatch::to_place).collect())
+    let found = back.finish_run();
+    hand(found, back.query_horizon());
+    Ok(())
 }
 
 /// The paper's Fig. 8 sweep of `scn` (laps per run replaced by `opts.laps`): the laps are
@@ -436,7 +447,7 @@ pub fn sweep(
     let base = recognizer_config(scn)?;
     // Check every grid point's settings before any work, so errors are reported once.
     for p in grid {
-        back_end_matches(&[], &base, p)?;
+        back_end_stream(&[], &base, p, &mut |_, _| {})?;
     }
     let (densities, truth) = stream::observe_scenario(scn, &base, opts)?;
     let observations: Vec<_> = densities.iter().map(|d| d.observation).collect();
@@ -447,12 +458,16 @@ pub fn sweep(
         &observations,
         &truth,
         &scn.evaluation,
-        |p| back_end_matches(&densities, &base, p).unwrap_or_default(),
+        |p, sink| {
+            // Every point's settings were checked above.
+            let _ = back_end_stream(&densities, &base, p, sink);
+        },
         &|| progress.step(),
     );
     progress.done();
     let evaluation = &scn.evaluation;
-    let positives = Scorer::new(&observations, &truth, evaluation)
+    let scorer = Scorer::new(&observations, &truth, evaluation);
+    let positives = scorer
         .revisits(evaluation.tp_radius_m)
         .iter()
         .filter(|&&r| r)
@@ -461,16 +476,15 @@ pub fn sweep(
     let score_curves = (1..=base.levels.max(1))
         .map(|levels| {
             let point = GridPoint::new(levels, &thresholds[..levels.min(thresholds.len())]);
-            let matches = back_end_matches(&densities, &base, &point)?;
+            let mut ranking = ranking::Ranking::default();
+            back_end_stream(&densities, &base, &point, &mut |matches, _| {
+                for m in matches {
+                    ranking.add(m, &scorer, evaluation);
+                }
+            })?;
             Ok(SubjectRanking {
                 name: crate::eval::scores::words_subject_name(levels),
-                ranking: ranking::of_matches(
-                    &observations,
-                    &truth,
-                    evaluation,
-                    &matches,
-                    positives,
-                ),
+                ranking: ranking.scores(positives, observations.len(), 0.0, evaluation),
             })
         })
         .collect::<Result<Vec<_>, ExperimentError>>()?;

@@ -512,14 +512,18 @@ pub type Replaced<'a> = (&'a Path, &'a dyn Fn(&Path) -> bool);
 /// ("write-ahead"): every file is first written in full beside its place (`.NAME.tmpPID`; a
 /// picture folder's files in `.DIR.tmpPID/`, a replaced folder as [`StagedDir`] stages it);
 /// then a journal naming every move is left beside each output (`.NAME.pendingPID`); then the
-/// commit marker (`.FIRST.commitPID`, the journal again) is written with one rename — the
-/// instant the new set is the result; then the moves are made and the journals removed, the
+/// commit marker (`.FIRST.commitPID`) is made by renaming the first output's journal — the
+/// instant the new set is the result, with no temporary file of its own for a kill to leave; then the moves are made and the journals removed, the
 /// marker last. A process killed before the marker leaves the old set (its temporaries are
 /// removed later as any killed writer's); killed after it, the new set is complete on disk and
 /// [`settle`], which every reader of these outputs (`score --matches`, `compare`, `merge`,
 /// `check --baseline`) and every writer of them calls first, finishes the moves. While the set
 /// is written, `.NAME.lock` beside each output holds the pid, as for a staged folder, and
 /// another writer is refused ([`StageError::Busy`]).
+///
+/// A set of one output (`check -o DIR` alone, `run --report R` alone) needs no journal: it
+/// commits by the one rename of its file, or the one exchange of its folder ([`StagedDir`]), so
+/// even a reader that does not settle finds the old output or the new one whole.
 #[derive(Debug)]
 pub struct OutputSet {
     /// Output files, each with where it is staged.
@@ -650,6 +654,9 @@ impl OutputSet {
     /// Puts every output written in its place, as one (see the type's doc). Outputs of the set
     /// never written are left as they were.
     pub fn commit(mut self) -> std::io::Result<()> {
+        if self.dirs.is_empty() && self.files.len() + self.replaced.len() == 1 {
+            return self.commit_single();
+        }
         let pid = std::process::id();
         let mut moves: Vec<(PathBuf, PathBuf)> = self
             .files
@@ -702,13 +709,33 @@ impl OutputSet {
             f.write_all(&text)?;
             f.sync_all()?;
         }
-        // The commit: from here the new set is the result, whatever happens to this process.
-        write_atomic(&journal.marker, &text)?;
+        // The commit: from here the new set is the result, whatever happens to this process. The
+        // first output's journal becomes the marker by one rename, so no temporary file of the
+        // marker exists for a kill to leave behind.
+        rename(&journal.pendings[0], &journal.marker)?;
         self.finished = true;
         for s in &mut self.replaced {
             s.committed = true; // its move is the journal's now
         }
         apply(&journal)
+    }
+}
+
+impl OutputSet {
+    /// Commits a set of one output (a file, or a folder replaced whole) by one rename or
+    /// exchange: no journal, so nothing is left for [`settle`] and a reader never sees a
+    /// committed-but-unmoved output.
+    fn commit_single(mut self) -> std::io::Result<()> {
+        if let Some(stage) = self.replaced.pop() {
+            self.finished = true;
+            return stage.commit();
+        }
+        let (target, staged) = &self.files[0];
+        if staged.exists() {
+            rename(staged, target)?;
+        }
+        self.finished = true;
+        Ok(())
     }
 }
 
@@ -779,8 +806,24 @@ pub fn settle(path: &Path) {
     let Ok(entries) = std::fs::read_dir(&dir) else {
         return;
     };
+    let entries: Vec<std::fs::DirEntry> = entries.flatten().collect();
+    // The temporary file of a marker (`..NAME.commitPID.tmpPID`, as versions that wrote the
+    // marker through one could leave) of a process that is gone: never a commit, removed.
+    let marker_temp = format!(".{commit}");
+    for e in &entries {
+        let n = e.file_name().to_string_lossy().into_owned();
+        let Some((_, pid)) = n
+            .strip_prefix(&marker_temp)
+            .and_then(|t| t.rsplit_once(".tmp"))
+        else {
+            continue;
+        };
+        if pid.parse::<u32>().is_ok_and(|pid| !may_be_running(pid)) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
     let journals: Vec<PathBuf> = entries
-        .flatten()
+        .iter()
         .filter(|e| {
             let n = e.file_name().to_string_lossy().into_owned();
             [&pending, &commit].iter().any(|p| {

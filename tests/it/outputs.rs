@@ -281,9 +281,6 @@ fn kill_at_every_rename(old_args: &[&str], new_args: &[&str]) {
 
 /// Issue 31 point 3: every multi-file writer puts its folder in place in one step.
 #[test]
-#[ignore = "issue 31, open: since output sets commit through a journal, a kill past the commit \
-            marker leaves the folder mixed until the next placewords command settles it; this \
-            test reads without settling"]
 fn a_kill_at_any_rename_leaves_the_old_output_or_the_new_one_whole() {
     let smoke = "scenarios/smoke.toml";
     kill_at_every_rename(
@@ -368,8 +365,6 @@ fn set_snapshot(files: &[&Path], dirs: &[&Path]) -> std::collections::BTreeMap<S
 /// old one or every one is new and whole — never a new report beside old matches — and the run
 /// that goes through leaves nothing hidden behind.
 #[test]
-#[ignore = "issue 31, open: a kill between writing the commit marker's temp file and its rename \
-            leaves that temp file behind, and nothing cleans it up"]
 fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
     let tmp = tempfile::tempdir().unwrap();
     let (r, m, d) = (
@@ -462,6 +457,32 @@ fn run_outputs_are_one_set_under_a_kill_at_any_rename() {
         names(&d).iter().all(|n| !n.starts_with('.')),
         "{:?}",
         names(&d)
+    );
+}
+
+/// A commit marker's temporary file left by a killed process (as versions that wrote the marker
+/// through one could leave, `..NAME.commitPID.tmpPID`) is removed by the next settle; a live
+/// process's is left to it.
+#[test]
+fn settle_removes_the_marker_temporaries_of_dead_processes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dead = tmp
+        .path()
+        .join(format!("..r.json.commit{DEAD_PID}.tmp{DEAD_PID}"));
+    let me = std::process::id();
+    let live = tmp.path().join(format!("..r.json.commit{me}.tmp{me}"));
+    let other = tmp
+        .path()
+        .join(format!("..m.csv.commit{DEAD_PID}.tmp{DEAD_PID}"));
+    for p in [&dead, &live, &other] {
+        std::fs::write(p, "{}").unwrap();
+    }
+    placewords::io::atomic::settle(&tmp.path().join("r.json"));
+    assert!(!dead.exists());
+    assert!(live.exists(), "a running process's temporary is its own");
+    assert!(
+        other.exists(),
+        "another output's temporaries are its settle's"
     );
 }
 
