@@ -1242,17 +1242,38 @@ fn doors_fit_their_gaps(
 /// (longer than a pillar set against a wall, as the institute floor has).
 pub const WALL_OVERLAP_M: f64 = 0.5;
 
-/// Walls drawn twice or over each other: two parallel wall segments less than half their
-/// thicknesses apart that share more than [`WALL_OVERLAP_M`] of length.
-fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
-    let segs: Vec<(usize, usize, ThickSegment)> = wall_segments(spec)
+/// A wall segment of non-zero length: (wall, index of its first point, segment).
+type WallSegment = (usize, usize, ThickSegment);
+
+/// The wall segments of `spec` of non-zero length and, for each, the earlier ones whose boxes
+/// touch it: the pairs the overlap and crossing checks test.
+fn near_wall_segments(spec: &WorldSpec) -> (Vec<WallSegment>, Vec<Vec<usize>>) {
+    let segs: Vec<WallSegment> = wall_segments(spec)
         .filter(|(_, _, t)| t.seg.length() > 0.0)
         .collect();
     let index = SegmentIndex::new(segs.iter().map(|x| x.2).collect());
+    let near = segs
+        .iter()
+        .enumerate()
+        .map(|(i, (_, _, t))| {
+            index
+                .candidates(t.seg, 0.0)
+                .into_iter()
+                .filter(|&k| k < i)
+                .collect()
+        })
+        .collect();
+    (segs, near)
+}
+
+/// Walls drawn twice or over each other: two parallel wall segments less than half their
+/// thicknesses apart that share more than [`WALL_OVERLAP_M`] of length.
+fn walls_do_not_overlap(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
+    let (segs, near) = near_wall_segments(spec);
     // One message per pair of walls: a duplicated wall overlaps its twin on every segment.
     let mut reported = std::collections::HashSet::new();
     for (i, &(wi, j, t)) in segs.iter().enumerate() {
-        for k in index.candidates(t.seg, 0.0).into_iter().filter(|&k| k < i) {
+        for &k in &near[i] {
             let (wk, _, u) = segs[k];
             if reported.contains(&(wi, wk)) {
                 continue;
@@ -1352,13 +1373,10 @@ pub const WALL_CROSSING_ARM_M: f64 = 0.5;
 /// [`WALL_CROSSING_ARM_M`] on all four sides (a T, a corner or an end run a little past another
 /// wall is fine, and so are two open walls crossing where four rooms meet).
 fn walls_do_not_cross(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
-    let segs: Vec<(usize, usize, ThickSegment)> = wall_segments(spec)
-        .filter(|(_, _, t)| t.seg.length() > 0.0)
-        .collect();
-    let index = SegmentIndex::new(segs.iter().map(|x| x.2).collect());
+    let (segs, near) = near_wall_segments(spec);
     let mut reported = std::collections::HashSet::new();
     for (i, &(wi, j, t)) in segs.iter().enumerate() {
-        for k in index.candidates(t.seg, 0.0).into_iter().filter(|&k| k < i) {
+        for &k in &near[i] {
             let (wk, jk, u) = segs[k];
             if reported.contains(&(wi, wk)) {
                 continue;
