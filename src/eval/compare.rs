@@ -73,15 +73,40 @@ pub enum Decision {
     Improvement,
 }
 
-impl Decision {
-    pub fn name(self) -> &'static str {
-        match self {
-            Decision::Identical => "no change (identical)",
-            Decision::NoChange => "no change",
-            Decision::Regression => "REGRESSION",
-            Decision::Improvement => "improvement",
-        }
-    }
+/// How a metric's decision was reached (`report::compare` words it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Basis {
+    /// The same figure at every seed: no test needed.
+    SameAtEverySeed,
+    /// Paired with fewer seeds than [`MIN_PAIRED_SEEDS`], too few for the signed-rank test to
+    /// reach [`ALPHA`]: decided on every seed being beyond the tolerance.
+    EverySeedBeyond,
+    /// The exact one-sided Wilcoxon signed-rank test of the per-seed changes (paired).
+    SignedRank,
+    /// The one-sided Mann–Whitney test of the two samples (not paired).
+    RankSum,
+}
+
+/// An input file whose content hash differs between the two reports.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ChangedInput {
+    /// `world` or `scenario`.
+    pub role: String,
+    /// The new report's file name.
+    pub name: String,
+}
+
+/// Something of a scenario that was not compared.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum NotCompared {
+    /// These seeds failed in the new run (the gate reports them).
+    FailedSeeds { seeds: Vec<u64> },
+    /// The subject is missing from some seed of the baseline.
+    SubjectNotInBaseline { subject: String },
+    /// No seed has the figure on both sides (no matches).
+    NoFigure { subject: String, metric: Metric },
 }
 
 /// One metric of one subject of one scenario, new against baseline.
@@ -119,8 +144,11 @@ pub struct MetricComparison {
     /// The same for "better beyond the tolerance".
     pub p_better: Option<f64>,
     pub decision: Decision,
-    /// How the decision was reached, in words.
-    pub why: String,
+    /// How the decision was reached.
+    pub basis: Basis,
+    /// Seeds left out because one side has no figure (no matches).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub left_out_seeds: Vec<u64>,
 }
 
 impl MetricComparison {
@@ -154,13 +182,20 @@ pub struct ScenarioComparison {
     pub reproduce_flags: String,
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub base_reproduce_flags: String,
+    /// Paired by seed: no compared seed's simulation keys differ.
     pub paired: bool,
-    /// Why the seeds are, or are not, paired, in words.
-    pub pairing: String,
+    /// The seeds compared.
+    pub seeds: Vec<u64>,
+    /// The seeds whose simulation keys differ (empty when paired).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub differing_seeds: Vec<u64>,
+    /// The world and scenario files whose content differs (when not paired).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub changed_inputs: Vec<ChangedInput>,
     pub tolerance: RegressionSpec,
     pub metrics: Vec<MetricComparison>,
     /// What was not compared and why (a subject only one side ran).
-    pub notes: Vec<String>,
+    pub not_compared: Vec<NotCompared>,
 }
 
 impl ScenarioComparison {
@@ -183,8 +218,8 @@ impl ScenarioComparison {
 pub struct Comparison {
     /// The baseline file.
     pub base: String,
-    /// The baseline's build: `0.1.0 at commit …`.
-    pub base_build: String,
+    /// The baseline's tool version and the commit it was built from.
+    pub base_version: String,
     pub base_commit: String,
     pub scenarios: Vec<ScenarioComparison>,
 }
@@ -201,18 +236,6 @@ impl Comparison {
     /// 1 when any metric regressed, else 0.
     pub fn exit_code(&self) -> u8 {
         u8::from(self.count(Decision::Regression) > 0)
-    }
-
-    /// `1 regression, 0 improvements, 13 no change`.
-    pub fn line(&self) -> String {
-        let r = self.count(Decision::Regression);
-        let i = self.count(Decision::Improvement);
-        let same = self.metrics().count() - r - i;
-        format!(
-            "{r} regression{}, {i} improvement{}, {same} no change",
-            if r == 1 { "" } else { "s" },
-            if i == 1 { "" } else { "s" }
-        )
     }
 }
 
@@ -293,7 +316,7 @@ pub fn compare(
     let p = &base.provenance;
     Ok(Comparison {
         base: base_file.to_string(),
-        base_build: format!("{} at commit {}", p.version, p.commit),
+        base_version: p.version.clone(),
         base_commit: p.commit.clone(),
         scenarios,
     })
@@ -370,7 +393,11 @@ fn compare_scenario(
     let differ: Vec<u64> = pairs.iter().filter(|p| !p.3).map(|p| p.0).collect();
     let paired = differ.is_empty();
     let seeds: Vec<u64> = pairs.iter().map(|p| p.0).collect();
-    let pairing = pairing(&seeds, &differ, base, new);
+    let changed_inputs = if paired {
+        Vec::new()
+    } else {
+        changed_inputs(base, new)
+    };
     let mut subjects: Vec<String> = Vec::new();
     for (_, _, nr, _) in &pairs {
         for s in &nr.subjects {
@@ -380,23 +407,18 @@ fn compare_scenario(
         }
     }
     let mut metrics = Vec::new();
-    let mut notes = Vec::new();
+    let mut not_compared = Vec::new();
     if !failed.is_empty() {
-        notes.push(format!(
-            "{}: seeds {} failed in the new run, not compared",
-            sc.label,
-            seed_list(&failed)
-        ));
+        not_compared.push(NotCompared::FailedSeeds { seeds: failed });
     }
     for subject in &subjects {
         if pairs
             .iter()
             .any(|(_, br, _, _)| br.subject(subject).is_none())
         {
-            notes.push(format!(
-                "{}/{subject}: not in every seed of the baseline, not compared",
-                sc.label
-            ));
+            not_compared.push(NotCompared::SubjectNotInBaseline {
+                subject: subject.clone(),
+            });
             continue;
         }
         for metric in Metric::ALL {
@@ -411,20 +433,14 @@ fn compare_scenario(
                 }
             }
             if values.is_empty() {
-                notes.push(format!(
-                    "{}/{subject}/{}: no seed has the figure on both sides (no matches)",
-                    sc.label,
-                    metric.name()
-                ));
+                not_compared.push(NotCompared::NoFigure {
+                    subject: subject.clone(),
+                    metric,
+                });
                 continue;
             }
             let mut m = compare_metric(&sc.label, subject, metric, paired, &values, tolerance);
-            if !skipped.is_empty() {
-                m.why.push_str(&format!(
-                    "; seeds {} left out (no matches on one side)",
-                    seed_list(&skipped)
-                ));
-            }
+            m.left_out_seeds = skipped;
             metrics.push(m);
         }
     }
@@ -435,35 +451,17 @@ fn compare_scenario(
         reproduce_flags: sc.reproduce_flags.clone(),
         base_reproduce_flags: b.reproduce_flags.clone(),
         paired,
-        pairing,
+        seeds,
+        differing_seeds: differ,
+        changed_inputs,
         tolerance,
         metrics,
-        notes,
+        not_compared,
     })
 }
 
-/// How the seeds of a scenario are compared, in words: paired by seed when no seed's
-/// simulation keys differ (`differ` empty), as two samples otherwise.
-fn pairing(seeds: &[u64], differ: &[u64], base: &SuiteReport, new: &SuiteReport) -> String {
-    if differ.is_empty() {
-        format!(
-            "paired by seed: seeds {} have the same simulation keys in both reports, so each \
-             seed ran the same laps and its change is the recognizer's alone",
-            seed_list(seeds)
-        )
-    } else {
-        format!(
-            "not paired: the simulation keys differ at seeds {}{}, so the laps are not the \
-             same and a seed means nothing to the other side; the two sets of seeds are \
-             compared as two samples (Mann–Whitney), which needs a larger change to be sure",
-            seed_list(differ),
-            what_changed(base, new)
-        )
-    }
-}
-
-/// `: the world worlds/x.toml differs` when the reports' world or scenario file hashes differ.
-fn what_changed(base: &SuiteReport, new: &SuiteReport) -> String {
+/// The world and scenario files whose content hashes differ between the reports.
+fn changed_inputs(base: &SuiteReport, new: &SuiteReport) -> Vec<ChangedInput> {
     let mut changed = Vec::new();
     for role in ["world", "scenario"] {
         for n in new.provenance.inputs_of(role) {
@@ -475,15 +473,14 @@ fn what_changed(base: &SuiteReport, new: &SuiteReport) -> String {
             if let Some(b) = same_name
                 && b.blake3 != n.blake3
             {
-                changed.push(format!("the {role} file {} differs", n.name));
+                changed.push(ChangedInput {
+                    role: role.to_string(),
+                    name: n.name.clone(),
+                });
             }
         }
     }
-    if changed.is_empty() {
-        String::new()
-    } else {
-        format!(" ({})", changed.join(", "))
-    }
+    changed
 }
 
 /// One metric over `values` = (seed, baseline, new).
@@ -505,7 +502,7 @@ fn compare_metric(
     let mut m = undecided(scenario, subject, metric, paired, values, tol);
     if values.iter().all(|v| v.1 == v.2) {
         m.decision = Decision::Identical;
-        m.why = "the same figure at every seed".into();
+        m.basis = Basis::SameAtEverySeed;
         return m;
     }
     if paired {
@@ -562,7 +559,12 @@ fn undecided(
         p_worse: None,
         p_better: None,
         decision: Decision::NoChange,
-        why: String::new(),
+        basis: if paired {
+            Basis::SignedRank
+        } else {
+            Basis::RankSum
+        },
+        left_out_seeds: Vec::new(),
     }
 }
 
@@ -595,11 +597,7 @@ fn signed_rank_test(
     m.p_better = signed_rank_greater(&gain);
     if n < MIN_PAIRED_SEEDS {
         let all = |v: &[f64]| v.iter().all(|x| *x > 0.0);
-        m.why = format!(
-            "{n} seed{} is too few for the signed-rank test to reach {ALPHA} (it needs \
-             {MIN_PAIRED_SEEDS}): decided on every seed being beyond the tolerance",
-            if n == 1 { "" } else { "s" }
-        );
+        m.basis = Basis::EverySeedBeyond;
         return Some(if all(&worse) {
             Decision::Regression
         } else if all(&gain) {
@@ -608,7 +606,7 @@ fn signed_rank_test(
             Decision::NoChange
         });
     }
-    m.why = "Wilcoxon signed-rank, exact, one-sided".into();
+    m.basis = Basis::SignedRank;
     None
 }
 
@@ -629,7 +627,7 @@ fn rank_sum_test(m: &mut MetricComparison, values: &[(u64, f64, f64)], time: boo
     let shift = |v: &[f64], by: f64| v.iter().map(|x| x + by).collect::<Vec<_>>();
     m.p_worse = rank_sum_greater(&b, &shift(&nv, slack));
     m.p_better = rank_sum_greater(&shift(&nv, -slack), &b);
-    m.why = "Mann–Whitney, two samples (not paired), one-sided".into();
+    m.basis = Basis::RankSum;
 }
 
 /// Mean, and the worst seed and its value.
@@ -783,7 +781,7 @@ mod tests {
             Default::default(),
         );
         assert_eq!(m.decision, Decision::Regression);
-        assert!(m.why.contains("too few"), "{}", m.why);
+        assert_eq!(m.basis, Basis::EverySeedBeyond);
     }
 
     #[test]

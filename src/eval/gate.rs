@@ -43,6 +43,18 @@ impl Bound {
     }
 }
 
+/// Why a bound has no figure to check.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum Missing {
+    /// No report holds the subject.
+    NotInReport,
+    /// The subject is there but matched nothing (in the bound's direction) at any seed.
+    NoMatches,
+    /// No seed ran to the end; the first seed's error, first line.
+    EverySeedFailed { error: String },
+}
+
 /// The result of checking one bound over the seeds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
@@ -67,8 +79,8 @@ pub struct Outcome {
     pub seeds: usize,
     /// Seeds checked (those that matched nothing included).
     pub runs: usize,
-    /// Why there is no figure: "not in the report" or "no matches".
-    pub missing: Option<String>,
+    /// Why there is no figure.
+    pub missing: Option<Missing>,
     pub passed: bool,
     /// Seconds the configuration spent recognizing, over all seeds.
     pub seconds: f64,
@@ -85,74 +97,12 @@ impl Outcome {
         format!("{}/{subject}/{}", self.scenario, self.bound.metric().name())
     }
 
-    /// The configuration, and the direction if the bound is on one: `words-3 opposite`.
-    fn target(&self) -> String {
-        match self.direction {
-            None => self.subject.clone(),
-            Some(d) => format!("{} {}", self.subject, d.name()),
-        }
-    }
-
-    fn what_op(&self) -> (&'static str, &'static str) {
-        match self.bound {
-            Bound::MinPrecision => ("precision", ">="),
-            Bound::MinRecall => ("recall", ">="),
-            Bound::MinVisitRecall => ("visit recall", ">="),
-            Bound::MinPairRecall => ("pair recall", ">="),
-            Bound::MaxSecondsPerLap => ("s/lap", "<="),
-        }
-    }
-
     /// "worst" or "p10" (the statistic the bound applies to).
     pub fn statistic(&self) -> String {
         match self.quantile {
             None => "worst".into(),
             Some(q) => format!("p{}", fmt_quantile(q)),
         }
-    }
-
-    /// The line printed for people: `PASS B words-3 precision worst 0.930 >= 0.900 (seed 7 of
-    /// 20)`.
-    pub fn line(&self) -> String {
-        let status = if self.passed { "PASS" } else { "FAIL" };
-        let (what, op) = self.what_op();
-        let limit = fmt_value(self.bound, self.limit);
-        let stat = self.statistic();
-        match (self.actual, self.seed) {
-            (Some(a), Some(seed)) => {
-                let op = if self.passed { op } else { negate(op) };
-                let n = self.runs;
-                let of = match n - self.seeds {
-                    0 if n == 1 => "over 1 seed".to_string(),
-                    0 => format!("over {n} seeds"),
-                    nothing => format!("over {n} seeds; {nothing} matched nothing"),
-                };
-                format!(
-                    "{status} {} {} {what} {stat} {} {op} {limit} (seed {seed}, {of})",
-                    self.scenario,
-                    self.target(),
-                    fmt_value(self.bound, a),
-                )
-            }
-            _ => format!(
-                "{status} {} {} {what} {op} {limit}: {}",
-                self.scenario,
-                self.target(),
-                self.missing.as_deref().unwrap_or("not in the report")
-            ),
-        }
-    }
-}
-
-fn negate(op: &str) -> &'static str {
-    if op == ">=" { "<" } else { ">" }
-}
-
-/// A bound or a measured value as printed: ratios with 3 decimals, times in seconds.
-pub fn fmt_value(bound: Bound, v: f64) -> String {
-    match bound {
-        Bound::MaxSecondsPerLap => format!("{v:.2}s"),
-        _ => format!("{v:.3}"),
     }
 }
 
@@ -238,11 +188,10 @@ fn check_bound(
     let present = reports
         .iter()
         .any(|r| distribution::scores_of(r, subject).is_some());
-    let which = direction.map_or(String::new(), |d| format!("{} ", d.name()));
     let missing = match (at, present) {
         (Some(_), _) => None,
-        (None, true) => Some(format!("no {which}matches at any seed")),
-        (None, false) => Some("not in the report".to_string()),
+        (None, true) => Some(Missing::NoMatches),
+        (None, false) => Some(Missing::NotInReport),
     };
     let passed = match at {
         None => false,
@@ -343,14 +292,12 @@ mod tests {
         let o = check(&rep, &spec);
         assert_eq!(o.len(), 5);
         assert_eq!(exit_code(&o), 0);
-        assert_eq!(
-            o[0].line(),
-            "PASS B words-3 precision worst 0.900 >= 0.900 (seed 7, over 1 seed)"
-        );
+        assert!(o[0].passed);
+        assert_eq!((o[0].actual, o[0].seed, o[0].runs), (Some(0.9), Some(7), 1));
         assert_eq!(o[0].name(), "B/words-3/precision");
         assert_eq!(
-            o[2].line(),
-            "PASS B words-3 s/lap worst 1.50s <= 2.00s (seed 7, over 1 seed)"
+            (o[2].bound, o[2].actual),
+            (Bound::MaxSecondsPerLap, Some(1.5))
         );
     }
 
@@ -364,9 +311,10 @@ mod tests {
         };
         let o = check(&rep, &spec);
         assert_eq!(exit_code(&o), 1);
+        assert!(!o[0].passed);
         assert_eq!(
-            o[0].line(),
-            "FAIL C words-2 precision worst 0.910 < 0.950 (seed 7, over 1 seed)"
+            (o[0].subject.as_str(), o[0].actual),
+            ("words-2", Some(0.91))
         );
         assert!(o[1].passed && o[2].passed);
         assert_eq!(o[2].subject, "icp");
@@ -383,11 +331,7 @@ mod tests {
         };
         let o = check(&rep, &spec);
         assert!(o.iter().all(|o| !o.passed));
-        assert!(
-            o[0].line().ends_with("not in the report"),
-            "{}",
-            o[0].line()
-        );
+        assert_eq!(o[0].missing, Some(Missing::NotInReport));
         assert_eq!(exit_code(&o), 1);
     }
 
@@ -418,11 +362,10 @@ mod tests {
         assert_eq!((worst[0].seed, worst[0].seeds), (Some(4), 10));
         spec.quantile = Some(0.2);
         let p20 = check_seeds("A", &reports, &spec);
-        assert!(p20[0].passed, "{}", p20[0].line());
-        assert!(
-            p20[0].line().contains("precision p20 0.900"),
-            "{}",
-            p20[0].line()
+        assert!(p20[0].passed, "{:?}", p20[0]);
+        assert_eq!(
+            (p20[0].statistic().as_str(), p20[0].actual),
+            ("p20", Some(0.9))
         );
     }
 
@@ -437,11 +380,7 @@ mod tests {
         };
         let o = check(&rep, &spec);
         assert!(!o[0].passed);
-        assert!(
-            o[0].line().ends_with("no matches at any seed"),
-            "{}",
-            o[0].line()
-        );
+        assert_eq!(o[0].missing, Some(Missing::NoMatches));
         assert!(o[1].passed, "recall 0 >= 0");
     }
 
@@ -494,10 +433,8 @@ mod tests {
         assert!(o[0].passed && o[1].passed && o[2].passed && o[4].passed);
         assert_eq!(o[2].name(), "R/words-3/same/precision");
         assert_eq!(o[3].direction, Some(Direction::Opposite));
-        assert_eq!(
-            o[3].line(),
-            "FAIL R words-3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
-        );
+        assert!(!o[3].passed);
+        assert_eq!((o[3].actual, o[3].seed, o[3].runs), (Some(0.8), Some(2), 3));
         assert_eq!(o[3].name(), "R/words-3/opposite/precision");
         assert_eq!(exit_code(&o), 1);
     }
@@ -510,12 +447,8 @@ mod tests {
         }
         let o = check_seeds("R", &reports, &direction_spec());
         assert!(!o[3].passed);
-        assert!(
-            o[3].line()
-                .ends_with("opposite precision >= 0.900: no opposite matches at any seed"),
-            "{}",
-            o[3].line()
-        );
+        assert_eq!(o[3].missing, Some(Missing::NoMatches));
+        assert_eq!(o[3].direction, Some(Direction::Opposite));
         assert!(o[2].passed, "the same direction is untouched");
     }
 }

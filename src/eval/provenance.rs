@@ -8,7 +8,7 @@
 //!
 //! ```json
 //! "provenance": {
-//!   "tool": "placewords", "version": "0.1.0", "commit": "c864de6…", "report_version": 2,
+//!   "tool": "placewords", "version": "0.1.0", "commit": "c864de6…", "report_version": 3,
 //!   "command_line": ["placewords", "check", "scenarios/B.toml"], "seeds": [1, 2, 3],
 //!   "inputs": [
 //!     { "role": "scenario", "name": "scenarios/B.toml", "blake3": "…" },
@@ -44,8 +44,9 @@ use std::path::{Path, PathBuf};
 /// The version of the report schema (the JSON every command writes). Raised when a key
 /// changes meaning or goes away; `merge` and baselines refuse another version. 2: the
 /// level-wide `longest_revisit_m` became the longer of the two directions' and is written
-/// whenever there are revisits; each subject gained `ranking` (`eval::ranking`).
-pub const REPORT_VERSION: u32 = 2;
+/// whenever there are revisits; each subject gained `ranking` (`eval::ranking`). 3: a gate
+/// outcome's `missing` is data (`{"kind": "no_matches"}`, `eval::gate::Missing`), not words.
+pub const REPORT_VERSION: u32 = 3;
 
 /// The version of what the simulator makes of a plan. Raised whenever a change of the
 /// simulator (kinematics, laser, odometry, people, lap variation, random streams) makes other

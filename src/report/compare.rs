@@ -3,7 +3,10 @@
 //! on both sides), the Markdown table of what moved both ways (for a pull-request comment and
 //! GitHub's step summary), and the JUnit test cases `B/words-3/precision/vs-baseline`.
 
-use crate::eval::compare::{Comparison, Decision, MetricComparison, ScenarioComparison};
+use crate::eval::compare::{
+    ALPHA, Basis, Comparison, Decision, MIN_PAIRED_SEEDS, MetricComparison, NotCompared,
+    ScenarioComparison,
+};
 use crate::report::xml::escape;
 use std::fmt::Write;
 
@@ -29,12 +32,109 @@ fn seeds(s: &[u64]) -> String {
     crate::eval::compare::seed_list(s)
 }
 
+/// A decision as printed: `REGRESSION`, `no change (identical)`.
+pub fn decision_name(d: Decision) -> &'static str {
+    match d {
+        Decision::Identical => "no change (identical)",
+        Decision::NoChange => "no change",
+        Decision::Regression => "REGRESSION",
+        Decision::Improvement => "improvement",
+    }
+}
+
+/// How the decision was reached, in words, with the seeds left out.
+pub fn basis_words(m: &MetricComparison) -> String {
+    let n = m.seeds.len();
+    let mut s = match m.basis {
+        Basis::SameAtEverySeed => "the same figure at every seed".to_string(),
+        Basis::EverySeedBeyond => format!(
+            "{n} seed{} is too few for the signed-rank test to reach {ALPHA} (it needs \
+             {MIN_PAIRED_SEEDS}): decided on every seed being beyond the tolerance",
+            if n == 1 { "" } else { "s" }
+        ),
+        Basis::SignedRank => "Wilcoxon signed-rank, exact, one-sided".to_string(),
+        Basis::RankSum => "Mann–Whitney, two samples (not paired), one-sided".to_string(),
+    };
+    if !m.left_out_seeds.is_empty() {
+        let _ = write!(
+            s,
+            "; seeds {} left out (no matches on one side)",
+            seeds(&m.left_out_seeds)
+        );
+    }
+    s
+}
+
+/// How the seeds of a scenario are compared, in words: paired by seed when no seed's
+/// simulation keys differ, as two samples otherwise (with the input files that changed).
+pub fn pairing_words(sc: &ScenarioComparison) -> String {
+    if sc.paired {
+        return format!(
+            "paired by seed: seeds {} have the same simulation keys in both reports, so each \
+             seed ran the same laps and its change is the recognizer's alone",
+            seeds(&sc.seeds)
+        );
+    }
+    let changed: Vec<String> = sc
+        .changed_inputs
+        .iter()
+        .map(|c| format!("the {} file {} differs", c.role, c.name))
+        .collect();
+    let changed = if changed.is_empty() {
+        String::new()
+    } else {
+        format!(" ({})", changed.join(", "))
+    };
+    format!(
+        "not paired: the simulation keys differ at seeds {}{changed}, so the laps are not the \
+         same and a seed means nothing to the other side; the two sets of seeds are \
+         compared as two samples (Mann–Whitney), which needs a larger change to be sure",
+        seeds(&sc.differing_seeds),
+    )
+}
+
+/// What of scenario `label` was not compared, and why, in words.
+pub fn not_compared_words(label: &str, n: &NotCompared) -> String {
+    match n {
+        NotCompared::FailedSeeds { seeds: s } => {
+            format!(
+                "{label}: seeds {} failed in the new run, not compared",
+                seeds(s)
+            )
+        }
+        NotCompared::SubjectNotInBaseline { subject } => {
+            format!("{label}/{subject}: not in every seed of the baseline, not compared")
+        }
+        NotCompared::NoFigure { subject, metric } => format!(
+            "{label}/{subject}/{}: no seed has the figure on both sides (no matches)",
+            metric.name()
+        ),
+    }
+}
+
+/// The closing line: `1 regression, 0 improvements, 13 no change`.
+pub fn closing_line(c: &Comparison) -> String {
+    let r = c.count(Decision::Regression);
+    let i = c.count(Decision::Improvement);
+    let same = c.metrics().count() - r - i;
+    format!(
+        "{r} regression{}, {i} improvement{}, {same} no change",
+        if r == 1 { "" } else { "s" },
+        if i == 1 { "" } else { "s" }
+    )
+}
+
+/// The baseline's build in words: `0.1.0 at commit …`.
+fn base_build(c: &Comparison) -> String {
+    format!("{} at commit {}", c.base_version, c.base_commit)
+}
+
 /// The test's p-values, `p(worse) 0.002, p(better) 0.99`, or why there is none.
 fn test_words(m: &MetricComparison) -> String {
     let p = |x: Option<f64>| x.map_or("–".to_string(), |p| format!("{p:.3}"));
     format!(
         "{}: p(worse beyond tolerance) {}, p(better beyond it) {}",
-        m.why,
+        basis_words(m),
         p(m.p_worse),
         p(m.p_better)
     )
@@ -53,7 +153,7 @@ fn tolerance(m: &MetricComparison) -> String {
 pub fn metric_line(m: &MetricComparison) -> String {
     let mut s = format!(
         "{} {}: mean {} → {} ({}), worst {} (seed {}) → {} (seed {}) ({})",
-        m.decision.name(),
+        decision_name(m.decision),
         m.name(),
         value(m, m.base_mean),
         value(m, m.new_mean),
@@ -106,9 +206,13 @@ pub fn reproduce_lines(sc: &ScenarioComparison, m: &MetricComparison, commit: &s
 /// The terminal text: the baseline, per scenario how seeds pair, every metric that moved (and
 /// how many did not), the reproducing commands of each regression, and the closing line.
 pub fn text(c: &Comparison) -> String {
-    let mut out = format!("compared with the baseline {} ({})\n", c.base, c.base_build);
+    let mut out = format!(
+        "compared with the baseline {} ({})\n",
+        c.base,
+        base_build(c)
+    );
     for sc in &c.scenarios {
-        let _ = writeln!(out, "{}: {}", sc.label, sc.pairing);
+        let _ = writeln!(out, "{}: {}", sc.label, pairing_words(sc));
         let mut quiet = 0;
         for m in &sc.metrics {
             if m.decision == Decision::Identical {
@@ -130,11 +234,11 @@ pub fn text(c: &Comparison) -> String {
                 if quiet == 1 { "" } else { "s" }
             );
         }
-        for n in &sc.notes {
-            let _ = writeln!(out, "note: {n}");
+        for n in &sc.not_compared {
+            let _ = writeln!(out, "note: {}", not_compared_words(&sc.label, n));
         }
     }
-    let _ = writeln!(out, "vs baseline: {}", c.line());
+    let _ = writeln!(out, "vs baseline: {}", closing_line(c));
     out
 }
 
@@ -144,11 +248,17 @@ pub fn markdown(c: &Comparison) -> String {
     let mut out = format!(
         "# placewords vs baseline\n\nBaseline `{}` ({}): {}\n",
         c.base,
-        c.base_build,
-        c.line()
+        base_build(c),
+        closing_line(c)
     );
     for sc in &c.scenarios {
-        let _ = writeln!(out, "\n## {} (`{}`)\n\n{}\n", sc.label, sc.file, sc.pairing);
+        let _ = writeln!(
+            out,
+            "\n## {} (`{}`)\n\n{}\n",
+            sc.label,
+            sc.file,
+            pairing_words(sc)
+        );
         let mut moved: Vec<&MetricComparison> = sc
             .metrics
             .iter()
@@ -175,7 +285,7 @@ pub fn markdown(c: &Comparison) -> String {
             let p = m.p_worse.map_or("–".into(), |p| format!("{p:.3}"));
             let decision = match m.decision {
                 Decision::Regression => "**REGRESSION**".to_string(),
-                d => d.name().to_string(),
+                d => decision_name(d).to_string(),
             };
             let _ = writeln!(
                 out,
@@ -191,8 +301,8 @@ pub fn markdown(c: &Comparison) -> String {
         if same > 0 {
             let _ = writeln!(out, "\n{same} metric(s) identical at every seed.");
         }
-        for n in &sc.notes {
-            let _ = writeln!(out, "\n- {n}");
+        for n in &sc.not_compared {
+            let _ = writeln!(out, "\n- {}", not_compared_words(&sc.label, n));
         }
     }
     out
@@ -240,7 +350,7 @@ pub fn junit_suites(c: &Comparison) -> (usize, usize, String) {
                     "p_worse",
                     m.p_worse.map_or("none".into(), |p| format!("{p:.4}")),
                 ),
-                ("decision", m.decision.name().to_string()),
+                ("decision", decision_name(m.decision).to_string()),
             ];
             for (k, v) in props {
                 let _ = writeln!(
@@ -315,7 +425,7 @@ pub fn json(c: &Comparison) -> String {
         comparison: &'a Comparison,
     }
     serde_json::to_string_pretty(&J {
-        line: c.line(),
+        line: closing_line(c),
         exit_code: c.exit_code(),
         comparison: c,
     })

@@ -14,9 +14,10 @@
 
 pub use super::xml::escape;
 use crate::eval::compare::Comparison;
-use crate::eval::gate::{Outcome, fmt_value};
+use crate::eval::gate::Outcome;
 use crate::eval::provenance::{GIT_COMMIT, TOOL_VERSION};
 use crate::eval::suite::{SuiteReport, reproduce_command};
+use crate::report::suite::{fmt_value, outcome_line};
 use std::fmt::Write;
 
 /// What `check` knows about one scenario.
@@ -230,7 +231,7 @@ fn testcase(o: &Outcome, s: &Suite) -> String {
     }
     x.push_str("      </properties>\n");
     if !o.passed {
-        let mut text = o.line();
+        let mut text = outcome_line(o);
         if let Some(seed) = o.seed {
             let _ = write!(
                 text,
@@ -238,7 +239,7 @@ fn testcase(o: &Outcome, s: &Suite) -> String {
                 reproduce_command(file, seed, &s.reproduce_flags)
             );
         }
-        let line = escape(&o.line());
+        let line = escape(&outcome_line(o));
         let _ = writeln!(
             x,
             "      <failure message=\"{line}\" type=\"expectation\">{}</failure>",

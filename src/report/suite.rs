@@ -3,11 +3,90 @@
 //! (mean, 10th percentile, worst and its seed, and the gate), and the `--json` summary.
 
 use crate::eval::distribution::{ConfigSpread, Metric, Spread};
-use crate::eval::gate::{Outcome, fmt_value};
-use crate::eval::suite::{ScenarioResult, SuiteReport};
+use crate::eval::gate::{Bound, Missing, Outcome};
+use crate::eval::suite::{ScenarioResult, SuiteReport, Tally};
 use crate::recognizer::Direction;
 use serde::Serialize;
 use std::fmt::Write;
+
+/// A bound or a measured value as printed: ratios with 3 decimals, times in seconds.
+pub fn fmt_value(bound: Bound, v: f64) -> String {
+    match bound {
+        Bound::MaxSecondsPerLap => format!("{v:.2}s"),
+        _ => format!("{v:.3}"),
+    }
+}
+
+/// The metric's words and the comparison a bound asks for: `("precision", ">=")`.
+fn what_op(bound: Bound) -> (&'static str, &'static str) {
+    match bound {
+        Bound::MinPrecision => ("precision", ">="),
+        Bound::MinRecall => ("recall", ">="),
+        Bound::MinVisitRecall => ("visit recall", ">="),
+        Bound::MinPairRecall => ("pair recall", ">="),
+        Bound::MaxSecondsPerLap => ("s/lap", "<="),
+    }
+}
+
+/// Why a bound has no figure, in words.
+pub fn missing_words(o: &Outcome) -> String {
+    match &o.missing {
+        None | Some(Missing::NotInReport) => "not in the report".into(),
+        Some(Missing::NoMatches) => match o.direction {
+            Some(d) => format!("no {} matches at any seed", d.name()),
+            None => "no matches at any seed".into(),
+        },
+        Some(Missing::EverySeedFailed { error }) => {
+            format!("every seed failed: {error}, see the error test cases")
+        }
+    }
+}
+
+/// The line printed for people: `PASS B words-3 precision worst 0.930 >= 0.900 (seed 7, over
+/// 20 seeds)`, or with the direction a bound is on, `FAIL R words-3 opposite precision …`.
+pub fn outcome_line(o: &Outcome) -> String {
+    let status = if o.passed { "PASS" } else { "FAIL" };
+    let (what, op) = what_op(o.bound);
+    let limit = fmt_value(o.bound, o.limit);
+    let target = match o.direction {
+        None => o.subject.clone(),
+        Some(d) => format!("{} {}", o.subject, d.name()),
+    };
+    let (Some(a), Some(seed)) = (o.actual, o.seed) else {
+        return format!(
+            "{status} {} {target} {what} {op} {limit}: {}",
+            o.scenario,
+            missing_words(o)
+        );
+    };
+    let op = match (o.passed, op) {
+        (true, op) => op,
+        (false, ">=") => "<",
+        (false, _) => ">",
+    };
+    let n = o.runs;
+    let of = match n - o.seeds {
+        0 if n == 1 => "over 1 seed".to_string(),
+        0 => format!("over {n} seeds"),
+        nothing => format!("over {n} seeds; {nothing} matched nothing"),
+    };
+    format!(
+        "{status} {} {target} {what} {} {} {op} {limit} (seed {seed}, {of})",
+        o.scenario,
+        o.statistic(),
+        fmt_value(o.bound, a),
+    )
+}
+
+/// `N passed, M failed` (and `, E errors` when there are any).
+pub fn tally_line(t: &Tally) -> String {
+    let mut s = format!("{} passed, {} failed", t.passed, t.failed);
+    if t.errors > 0 {
+        let plural = if t.errors == 1 { "" } else { "s" };
+        let _ = write!(s, ", {} error{plural}", t.errors);
+    }
+    s
+}
 
 /// `mean` of a spread, or "no matches" when no seed has a value.
 fn mean(s: Option<&Spread>) -> String {
@@ -142,15 +221,20 @@ pub fn check_text(suite: &SuiteReport) -> String {
         for o in &sc.outcomes {
             match (o.passed, o.seed) {
                 (false, Some(seed)) => {
-                    let _ = writeln!(out, "{}; reproduce: {}", o.line(), sc.reproduce(seed));
+                    let _ = writeln!(
+                        out,
+                        "{}; reproduce: {}",
+                        outcome_line(o),
+                        sc.reproduce(seed)
+                    );
                 }
                 _ => {
-                    let _ = writeln!(out, "{}", o.line());
+                    let _ = writeln!(out, "{}", outcome_line(o));
                 }
             }
         }
     }
-    let _ = writeln!(out, "{}", suite.tally().line());
+    let _ = writeln!(out, "{}", tally_line(&suite.tally()));
     out
 }
 
@@ -162,7 +246,7 @@ pub fn markdown(suite: &SuiteReport) -> String {
         out.push_str(&md_scenario(sc));
     }
     if suite.gated {
-        let _ = writeln!(out, "\n{}", suite.tally().line());
+        let _ = writeln!(out, "\n{}", tally_line(&suite.tally()));
     }
     out
 }
@@ -208,10 +292,9 @@ fn md_cells(s: Option<&Spread>) -> String {
 }
 
 fn md_outcome(o: &Outcome) -> String {
-    let value = o.actual.map_or_else(
-        || o.missing.clone().unwrap_or_default(),
-        |a| fmt_value(o.bound, a),
-    );
+    let value = o
+        .actual
+        .map_or_else(|| missing_words(o), |a| fmt_value(o.bound, a));
     let seed = o.seed.map_or("–".into(), |s| s.to_string());
     let result = if o.passed { "pass" } else { "**FAIL**" };
     format!(
@@ -236,7 +319,7 @@ pub fn github_annotations(
             None => format!("file={}", gh_property(&sc.file)),
         };
         for o in sc.outcomes.iter().filter(|o| !o.passed) {
-            let mut text = o.line();
+            let mut text = outcome_line(o);
             if let Some(seed) = o.seed {
                 let _ = write!(text, "; reproduce: {}", sc.reproduce(seed));
             }
@@ -306,7 +389,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
                 seed: o.seed,
                 seeds: o.seeds,
                 reproduce: o.seed.map(|s| sc.reproduce(s)),
-                line: o.line(),
+                line: outcome_line(o),
             })
         })
         .collect();
@@ -377,6 +460,97 @@ mod tests {
             outcomes: vec![],
         };
         SuiteReport::new(None, true, vec![sc])
+    }
+
+    /// An outcome of `bound` on `words-3` of scenario R: `actual` at seed 2 of `runs` seeds.
+    fn outcome(bound: Bound, limit: f64, actual: Option<f64>, runs: usize) -> Outcome {
+        let passed = actual.is_some_and(|a| match bound {
+            Bound::MaxSecondsPerLap => a <= limit,
+            _ => a >= limit,
+        });
+        Outcome {
+            scenario: "R".into(),
+            subject: "words-3".into(),
+            direction: None,
+            bound,
+            limit,
+            quantile: None,
+            actual,
+            seed: actual.map(|_| 2),
+            seeds: if actual.is_some() { runs } else { 0 },
+            runs,
+            missing: if actual.is_some() {
+                None
+            } else {
+                Some(Missing::NoMatches)
+            },
+            passed,
+            seconds: 1.0,
+        }
+    }
+
+    #[test]
+    fn outcome_lines_say_pass_or_fail_the_statistic_the_bound_and_the_seed() {
+        let pass = outcome(Bound::MinPrecision, 0.9, Some(0.9), 1);
+        assert_eq!(
+            outcome_line(&pass),
+            "PASS R words-3 precision worst 0.900 >= 0.900 (seed 2, over 1 seed)"
+        );
+        let slow = outcome(Bound::MaxSecondsPerLap, 2.0, Some(1.5), 1);
+        assert_eq!(
+            outcome_line(&slow),
+            "PASS R words-3 s/lap worst 1.50s <= 2.00s (seed 2, over 1 seed)"
+        );
+        let mut fail = outcome(Bound::MinPrecision, 0.9, Some(0.8), 3);
+        fail.direction = Some(Direction::Opposite);
+        assert_eq!(
+            outcome_line(&fail),
+            "FAIL R words-3 opposite precision worst 0.800 < 0.900 (seed 2, over 3 seeds)"
+        );
+        fail.quantile = Some(0.2);
+        fail.seeds = 2;
+        assert!(
+            outcome_line(&fail)
+                .contains("precision p20 0.800 < 0.900 (seed 2, over 3 seeds; 1 matched nothing)"),
+            "{}",
+            outcome_line(&fail)
+        );
+    }
+
+    #[test]
+    fn outcome_lines_without_a_figure_say_why() {
+        let mut o = outcome(Bound::MinPrecision, 0.9, None, 3);
+        assert!(outcome_line(&o).ends_with("precision >= 0.900: no matches at any seed"));
+        o.direction = Some(Direction::Opposite);
+        assert!(
+            outcome_line(&o)
+                .ends_with("opposite precision >= 0.900: no opposite matches at any seed"),
+            "{}",
+            outcome_line(&o)
+        );
+        o.missing = Some(Missing::NotInReport);
+        assert!(outcome_line(&o).ends_with(": not in the report"));
+        o.missing = Some(Missing::EverySeedFailed {
+            error: "robot blocked".into(),
+        });
+        assert!(
+            outcome_line(&o)
+                .ends_with(": every seed failed: robot blocked, see the error test cases"),
+            "{}",
+            outcome_line(&o)
+        );
+    }
+
+    #[test]
+    fn the_tally_line_names_errors_only_when_there_are_some() {
+        let t = Tally {
+            passed: 1,
+            failed: 0,
+            errors: 0,
+        };
+        assert_eq!(tally_line(&t), "1 passed, 0 failed");
+        let t = Tally { errors: 2, ..t };
+        assert_eq!(tally_line(&t), "1 passed, 0 failed, 2 errors");
     }
 
     #[test]

@@ -33,7 +33,11 @@ fn provenance(path: &Path, command: &str) -> (Value, Vec<String>) {
             || (commit.len() == 40 && commit.chars().all(|c| c.is_ascii_hexdigit())),
         "{what}: commit {commit}"
     );
-    assert_eq!(p["report_version"], 2, "{what}");
+    assert_eq!(
+        p["report_version"],
+        placewords::eval::provenance::REPORT_VERSION,
+        "{what}"
+    );
     assert_eq!(p["command_line"][1], command, "{what}");
     let mut roles = Vec::new();
     for i in p["inputs"].as_array().unwrap() {
