@@ -303,7 +303,10 @@ impl CacheArg {
 
 /// Prints what the lap cache did (`lap cache DIR: 9 hits, 1 miss`, and each corrupt entry).
 pub fn report_cache(cache: Option<&placewords::experiment::cache::LapCache>) {
-    for line in cache.map(|c| c.used().lines()).unwrap_or_default() {
+    for line in cache
+        .map(|c| placewords::report::explain::lap_cache_lines(&c.used()))
+        .unwrap_or_default()
+    {
         errln!("{line}");
     }
 }

@@ -88,7 +88,11 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
     }
     let rule = reports
         .first()
-        .map(|r| placewords::eval::ranking::TruthRule::of(&r.evaluation).short())
+        .map(|r| {
+            placewords::report::explain::truth_rule(&placewords::eval::ranking::TruthRule::of(
+                &r.evaluation,
+            ))
+        })
         .unwrap_or_default();
     let md = format!(
         "{}\n{}\nVisit recall (share of the earlier laps through each spot that were recognized) and pair recall (share of every pair that could be found):\n\n{}\nOver the match score, per query observation (a query's answer is its best-scoring pair, right when it is a true revisit {rule}): recall at 99 % precision and max F1:\n\n{}",

@@ -148,29 +148,6 @@ impl LapCacheUse {
         self.corrupt.extend(other.corrupt.iter().cloned());
         self.not_stored.extend(other.not_stored.iter().cloned());
     }
-
-    /// `lap cache DIR: 9 hits, 1 miss`, then a line per corrupt entry and per entry not stored.
-    pub fn lines(&self) -> Vec<String> {
-        let s =
-            |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
-        let mut out = vec![format!(
-            "lap cache {}: {}, {}",
-            self.dir,
-            s(self.hits, "hit", "hits"),
-            s(self.misses, "miss", "misses")
-        )];
-        out.extend(
-            self.corrupt
-                .iter()
-                .map(|c| format!("lap cache: corrupt entry simulated again: {c}")),
-        );
-        out.extend(
-            self.not_stored
-                .iter()
-                .map(|c| format!("lap cache: laps not stored: {c}")),
-        );
-        out
-    }
 }
 
 impl Default for Provenance {

@@ -173,14 +173,6 @@ impl TruthRule {
             heading_tolerance_deg: spec.heading_tolerance_deg,
         }
     }
-
-    /// `1 m, gap 20 m, heading 45°`: the rule in a few words.
-    pub fn short(&self) -> String {
-        format!(
-            "within {} m, {} m of travel before, heading within {}°",
-            self.tp_radius_m, self.min_gap_m, self.heading_tolerance_deg
-        )
-    }
 }
 
 /// One point of the score curve: the queries whose answer scores at least `threshold`.

@@ -3,6 +3,9 @@
 //! ([`crate::eval::scores::NoPairsCauses`]); this module words them, and so builds the
 //! [`Scores`] and the report's subjects a run writes: [`Scores::of`], [`Report::add_subject`],
 //! [`Report::add_level`] (inherent methods of `eval`'s types, defined here, above `eval`).
+//! Also the truth rule in words ([`truth_rule`]) and the lap cache's lines
+//! ([`lap_cache_lines`]); a comparison's and a gate's sentences are in `report::compare` and
+//! `report::suite`. `eval` itself writes no sentence a person reads, only data and error messages.
 
 use crate::eval::Recognition;
 use crate::eval::scores::{
@@ -92,6 +95,38 @@ fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
         spec.tp_radius_m,
         by_check.join(", ")
     )
+}
+
+/// The truth rule in a few words: `within 1 m, 20 m of travel before, heading within 45°`.
+pub fn truth_rule(rule: &crate::eval::ranking::TruthRule) -> String {
+    format!(
+        "within {} m, {} m of travel before, heading within {}°",
+        rule.tp_radius_m, rule.min_gap_m, rule.heading_tolerance_deg
+    )
+}
+
+/// `lap cache DIR: 9 hits, 1 miss`, then a line per corrupt entry and per entry not stored.
+pub fn lap_cache_lines(cache: &crate::eval::provenance::LapCacheUse) -> Vec<String> {
+    let s = |n: usize, one: &str, many: &str| format!("{n} {}", if n == 1 { one } else { many });
+    let mut out = vec![format!(
+        "lap cache {}: {}, {}",
+        cache.dir,
+        s(cache.hits, "hit", "hits"),
+        s(cache.misses, "miss", "misses")
+    )];
+    out.extend(
+        cache
+            .corrupt
+            .iter()
+            .map(|c| format!("lap cache: corrupt entry simulated again: {c}")),
+    );
+    out.extend(
+        cache
+            .not_stored
+            .iter()
+            .map(|c| format!("lap cache: laps not stored: {c}")),
+    );
+    out
 }
 
 #[cfg(test)]

@@ -301,7 +301,7 @@ fn ranking(report: &Report, out: &mut String) {
     };
     let head = format!(
         "over the match score, per query observation (right answer: a true revisit {})",
-        first.rule.short()
+        crate::report::explain::truth_rule(&first.rule)
     );
     out.push('\n');
     for l in textwrap::wrap(&head, TEXT_WIDTH) {
@@ -660,9 +660,9 @@ pub fn score_curves_table(subjects: &[crate::eval::ranking::SubjectRanking]) -> 
             ]
         })
         .collect();
-    let rule = subjects
-        .first()
-        .map_or(String::new(), |s| s.ranking.rule.short());
+    let rule = subjects.first().map_or(String::new(), |s| {
+        crate::report::explain::truth_rule(&s.ranking.rule)
+    });
     format!(
         "over the match score, per query observation (right answer: a true revisit {rule})\n{}",
         render(
