@@ -24,6 +24,7 @@ pub mod common;
 pub mod compare;
 pub mod import;
 pub mod merge;
+pub mod motion;
 pub mod out;
 pub mod progress;
 pub mod recognize;
@@ -85,6 +86,12 @@ pub enum Command {
     /// The paper's Fig. 8: precision/recall over the n-gram thresholds.
     #[command(after_help = "Example:\n  placewords sweep scenarios/B.toml -o sweep/ --laps 2")]
     Sweep(sweep::SweepArgs),
+    /// How a robot weaves along its route: speed, heading against the corridor, weave, turns on
+    /// the spot and their spectrum, on real logs and simulated laps, with KS distances.
+    #[command(
+        after_help = "Example:\n  placewords motion ../shared/data/carmen/intel-corrected.log.gz scenarios/A.toml --laps 2"
+    )]
+    Motion(motion::MotionArgs),
     /// Recognize places in a real CARMEN log and evaluate against its corrected poses.
     #[command(
         after_help = "Example:\n  placewords recognize ../shared/data/carmen/intel-corrected.log.gz --report r.json\n  placewords recognize LOG --scan-step 2 --config docs/recognizer.toml --seed 3"
@@ -113,6 +120,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Compare(a) => compare::run(a),
         Command::Table(a) => table::run(a),
         Command::Sweep(a) => sweep::run(a),
+        Command::Motion(a) => motion::run(a),
         Command::Recognize(a) => recognize::run(a),
         Command::Score(a) => score::run(a),
         Command::Schema(a) => schema::run(a),

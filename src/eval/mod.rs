@@ -17,6 +17,7 @@ pub(crate) mod distribution;
 pub mod gate;
 mod lap_grid;
 pub mod metrics;
+pub mod motion;
 pub mod observation_status;
 pub mod pair_recall;
 pub mod pair_set;

@@ -4,6 +4,7 @@
 //! `recognize` are thin layers over this module.
 
 pub mod cache;
+pub mod motion;
 pub mod output;
 pub mod picture;
 pub(crate) mod progress;

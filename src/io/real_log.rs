@@ -202,16 +202,9 @@ pub fn load_bag_run(
     corrected_to_run(&lasers, &truepos, &name, truth, max_range_m, perturb)
 }
 
-/// Turns a read log into one run; see the module documentation for every convention.
-/// `perturb` maps each corrected increment (robot frame) to the odometry increment.
-pub fn log_to_run(
-    readout: &LogReadout,
-    name: &str,
-    truth: TruthSource,
-    perturb: impl FnMut(Pose2) -> Pose2,
-) -> Result<RunLog, RealLogError> {
-    // Front lasers only, unless the log has nothing but rear ones: interleaving two scanners
-    // would make every other frame look backwards.
+/// The laser messages a run is made of: front lasers only, unless the log has nothing but rear
+/// ones (interleaving two scanners would make every other frame look backwards).
+fn lasers_used(readout: &LogReadout) -> Vec<&LaserRecord> {
     let rear: std::collections::HashSet<usize> =
         readout.rear_laser_indices.iter().copied().collect();
     let all: Vec<(usize, &LaserRecord)> = readout
@@ -224,11 +217,27 @@ pub fn log_to_run(
         })
         .collect();
     let any_front = all.iter().any(|(i, _)| !rear.contains(i));
-    let lasers: Vec<&LaserRecord> = all
-        .into_iter()
+    all.into_iter()
         .filter(|(i, _)| !any_front || !rear.contains(i))
         .map(|(_, l)| l)
-        .collect();
+        .collect()
+}
+
+/// Whether the run [`log_to_run`] makes of `readout` takes its time from the stamps
+/// ([`stamps_usable`]) rather than from the travelled distance.
+pub fn log_stamps_usable(readout: &LogReadout) -> bool {
+    stamps_usable(&lasers_used(readout))
+}
+
+/// Turns a read log into one run; see the module documentation for every convention.
+/// `perturb` maps each corrected increment (robot frame) to the odometry increment.
+pub fn log_to_run(
+    readout: &LogReadout,
+    name: &str,
+    truth: TruthSource,
+    perturb: impl FnMut(Pose2) -> Pose2,
+) -> Result<RunLog, RealLogError> {
+    let lasers = lasers_used(readout);
     let truepos: Vec<&TruePosRecord> = readout
         .records
         .iter()

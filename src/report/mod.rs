@@ -5,6 +5,7 @@ pub mod explain;
 pub mod json;
 pub mod junit;
 pub(crate) mod lap_strip;
+pub mod motion;
 pub mod plot;
 pub mod profile;
 pub mod suite;

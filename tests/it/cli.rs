@@ -630,3 +630,46 @@ fn help_and_small_behaviours_match() {
     let len = v["wall_length_m"].as_f64().unwrap();
     assert_eq!(len, (len * 1000.0).round() / 1000.0, "{len}");
 }
+
+/// `motion` measures a real log's corrected path and a scenario's simulated laps side by side:
+/// a row each, the smooth simulated laps with less heading deviation than the real robot, and
+/// the KS distance of the second to the first; a missing input is named, exit 2.
+#[test]
+fn motion_compares_a_real_log_with_simulated_laps() {
+    let log = root().join("../shared/data/carmen/intel-corrected.log.gz");
+    // csail's stamps are unusable (six significant digits): its speed is not made up.
+    let csail = root().join("../shared/data/carmen/csail-corrected.log.gz");
+    let o = placewords(&[
+        "motion",
+        log.to_str().unwrap(),
+        csail.to_str().unwrap(),
+        "scenarios/smoke.toml",
+        "--laps",
+        "1",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let row = |name: &str| {
+        out.lines()
+            .find(|l| l.contains(name) && l.contains(" | "))
+            .unwrap_or_else(|| panic!("no row for {name} in\n{out}"))
+            .to_string()
+    };
+    // The median |heading − corridor| is the middle figure of the third column.
+    let median_deviation = |line: &str| -> f64 {
+        let cols: Vec<&str> = line.split(" | ").collect();
+        cols[2].split(" / ").nth(1).unwrap().parse().unwrap()
+    };
+    let (real, sim) = (row("intel-corrected"), row("smoke.toml"));
+    assert!(
+        median_deviation(&real) > median_deviation(&sim),
+        "the real robot weaves more than the smooth laps:\n{out}"
+    );
+    assert!(out.contains("Kolmogorov–Smirnov distance to"), "{out}");
+    assert!(row("csail-corrected").contains("– (stamps unusable)"), "{out}");
+    assert!(!row("intel-corrected").contains("stamps unusable"), "{out}");
+    assert!(out.contains("smoke.toml: speed "), "{out}");
+    let o = placewords(&["motion", "no-such.log"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no-such.log"));
+}
