@@ -1,5 +1,5 @@
-//! Recognizer costs: grid update per scan, density per observation, word building per lap,
-//! matching per lap (1, 2, 3 level configurations × 1, 10, 40 laps of history), and the whole
+//! Recognizer costs past the front end (grid and density: `benches/front_end.rs`): word building
+//! per lap, matching per lap (1, 2, 3 level configurations × 1, 10, 40 laps of history), and the whole
 //! recognizer per lap. Inputs are synthetic (see `tests/support/synth.rs`); setup is outside the
 //! timed part. Figures and the machine are in BENCHMARKS.md.
 
@@ -8,8 +8,7 @@ use placewords::geom::OdomPose;
 #[path = "../tests/support/synth.rs"]
 mod synth;
 use placewords::recognizer::{
-    DensityFrontEnd, DensityKernel, DensityObservation, LocalGrid, Recognizer, RecognizerConfig,
-    WordLevels, WordMatcher,
+    DensityObservation, Recognizer, RecognizerConfig, WordLevels, WordMatcher,
 };
 use placewords::scan::Scan;
 use std::hint::black_box;
@@ -46,52 +45,6 @@ fn observation_laps(
             lap
         })
         .collect()
-}
-
-fn front_end(c: &mut Criterion) {
-    let cfg = RecognizerConfig::default();
-    let inputs = lap_inputs(1);
-    let mut g = c.benchmark_group("front_end");
-    g.measurement_time(Duration::from_secs(3));
-
-    let mut grid = LocalGrid::new(cfg.grid.grid_cell_m, cfg.grid.grid_radius_m);
-    let mut i = 0usize;
-    g.bench_function("grid_update_per_scan_181_beams", |b| {
-        b.iter(|| {
-            let (o, s) = &inputs[i % inputs.len()];
-            grid.integrate(o, s);
-            i += 1;
-        })
-    });
-
-    // A grid as the robot has it in the middle of the lap.
-    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.density.ray_step_deg);
-    let mut grid = LocalGrid::new(cfg.grid.grid_cell_m, cfg.grid.grid_radius_m);
-    let deltas = kernel.deltas(grid.side());
-    let mid = inputs.len() / 3;
-    for (o, s) in &inputs[mid - 100..mid] {
-        grid.integrate(o, s);
-    }
-    let at = inputs[mid - 1].0.0;
-    g.bench_function("density_per_observation_2.5m_1deg", |b| {
-        b.iter(|| black_box(grid.psi_at(&kernel, &deltas, at.x, at.y)))
-    });
-
-    g.sample_size(10);
-    g.bench_function("front_end_per_lap_5000_scans", |b| {
-        b.iter_batched(
-            || DensityFrontEnd::new(&cfg).unwrap(),
-            |mut fe| {
-                let mut n = 0;
-                for (o, s) in &inputs {
-                    n += fe.push(*o, s).len();
-                }
-                n
-            },
-            BatchSize::LargeInput,
-        )
-    });
-    g.finish();
 }
 
 fn word_building(c: &mut Criterion) {
@@ -211,11 +164,5 @@ fn whole_recognizer(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(
-    benches,
-    front_end,
-    word_building,
-    matching,
-    whole_recognizer
-);
+criterion_group!(benches, word_building, matching, whole_recognizer);
 criterion_main!(benches);

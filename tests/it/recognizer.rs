@@ -1739,3 +1739,159 @@ fn long_words_driven_back_match_by_travel_when_asked() {
         );
     }
 }
+
+/// Today's (2026-12-04) density count as a reference, ray by ray over the grid's cell states:
+/// the definition the front end's prefix-tree walk implements (a ray stops at an occupied
+/// cell, passes unknown ones, and each free cell counts once), with the first moment summed over
+/// the distinct ray prefixes reached. Slow on purpose: it shares no code with the walk.
+struct RayByRay {
+    /// Per ray, per step: (cell offset, id of the ray prefix ending there).
+    rays: Vec<Vec<((i16, i16), usize)>>,
+    /// Last offset of each distinct prefix.
+    prefix_end: Vec<(i16, i16)>,
+}
+
+impl RayByRay {
+    fn new(kernel: &DensityKernel) -> Self {
+        let mut ids = std::collections::HashMap::new();
+        let mut prefix_end = Vec::new();
+        let rays = (0..kernel.ray_count())
+            .map(|r| {
+                let mut parent = usize::MAX;
+                kernel
+                    .ray(r)
+                    .iter()
+                    .map(|&o| {
+                        let next = ids.len();
+                        parent = *ids.entry((parent, o)).or_insert_with(|| {
+                            prefix_end.push(o);
+                            next
+                        });
+                        (o, parent)
+                    })
+                    .collect()
+            })
+            .collect();
+        RayByRay { rays, prefix_end }
+    }
+
+    /// (free cells counted, first moment of the prefixes reached) from global cell (cx, cy).
+    fn count(
+        &self,
+        grid: &placewords::recognizer::LocalGrid,
+        cx: i32,
+        cy: i32,
+    ) -> (u32, (i32, i32)) {
+        let mut cells = std::collections::HashSet::new();
+        let mut prefixes = vec![false; self.prefix_end.len()];
+        for ray in &self.rays {
+            for &((ox, oy), id) in ray {
+                let (x, y) = (cx + ox as i32, cy + oy as i32);
+                match grid.state(x, y) {
+                    CellState::Occupied => break,
+                    CellState::Free => {
+                        cells.insert((x, y));
+                    }
+                    CellState::Unknown => {}
+                }
+                prefixes[id] = true;
+            }
+        }
+        let moment = prefixes
+            .iter()
+            .zip(&self.prefix_end)
+            .filter(|(reached, _)| **reached)
+            .fold((0, 0), |(mx, my), (_, &(ox, oy))| {
+                (mx + ox as i32, my + oy as i32)
+            });
+        (cells.len() as u32, moment)
+    }
+}
+
+/// Feeds `frames` (odometry, scan) to a front end and checks every observation's Ψ, and the
+/// free cells and first moment behind it, against [`RayByRay`]; returns the observations checked.
+fn check_density_against_reference<'a>(
+    what: &str,
+    frames: impl Iterator<Item = (OdomPose, &'a placewords::scan::Scan)>,
+) -> usize {
+    let cfg = RecognizerConfig::default();
+    let mut fe = DensityFrontEnd::new(&cfg).unwrap();
+    let kernel = fe.kernel().clone();
+    let reference = RayByRay::new(&kernel);
+    let deltas = kernel.deltas(fe.grid().side());
+    let mut checked = 0;
+    for (odom, scan) in frames {
+        let made = fe.push(odom, scan);
+        if made.is_empty() {
+            continue;
+        }
+        let mut grid = fe.grid().clone();
+        for o in made {
+            let pose = o.observation.odom_pose.0;
+            let (cx, cy) = grid.cell_of(pose.x, pose.y);
+            let (count, moment) = reference.count(&grid, cx, cy);
+            let free = grid.free_cells(&kernel, &deltas, cx, cy);
+            assert_eq!(
+                (free.count, free.reach_moment),
+                (count, moment),
+                "{what}: observation {}",
+                o.observation.id
+            );
+            assert_eq!(
+                o.psi,
+                kernel.psi_of_count(count),
+                "{what}: Ψ of observation {}",
+                o.observation.id
+            );
+            checked += 1;
+        }
+    }
+    checked
+}
+
+/// Ψ (and the lateral moment's integer sum) of the front end equals the ray-by-ray reference
+/// exactly on a lap of every shipped scenario and a stretch of every shipped real log, so the
+/// density classes and words built on it are today's too.
+#[test]
+fn density_equals_the_ray_by_ray_reference_on_shipped_scenarios_and_logs() {
+    let root = crate::common::root();
+    let mut scenarios: Vec<_> = std::fs::read_dir(root.join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenarios.sort();
+    assert!(scenarios.len() >= 6, "{scenarios:?}");
+    for path in &scenarios {
+        let scn = placewords::experiment::load_scenario(path).unwrap();
+        let mut sim = placewords::sim::runner::RunSim::new(&scn.sim, 0);
+        let lap = sim.run_lap(0).unwrap();
+        let n = check_density_against_reference(
+            &path.display().to_string(),
+            lap.frames.iter().map(|f| (f.odom, &f.scan)),
+        );
+        assert!(n > 100, "{}: only {n} observations", path.display());
+    }
+    let logs = root.join("../shared/data/carmen");
+    for name in ["csail", "fhw", "freiburg-079", "intel", "seattle"] {
+        let log = logs.join(format!("{name}-corrected.log.gz"));
+        if !log.exists() {
+            eprintln!("skipping {}: absent", log.display());
+            continue;
+        }
+        let (run, _) = placewords::experiment::real::load_real_run(
+            &log,
+            false,
+            placewords::io::real_log::TruthSource::Corrected,
+            None,
+            1,
+            &Default::default(),
+        )
+        .unwrap();
+        let n = check_density_against_reference(
+            name,
+            run.frames().take(3000).map(|f| (f.odom, &f.scan)),
+        );
+        assert!(n > 100, "{name}: only {n} observations");
+    }
+}
