@@ -15,7 +15,8 @@
 //! - **Recall.** Per observation, one flag per figure: the query (or either side) of a correct
 //!   pair.
 //! - **Visit recall.** The earlier laps each query observation was correctly paired with, one
-//!   packed `u64` per (observation, lap), not per pair.
+//!   packed `u64` per (observation, lap), not per pair (appended as pairs come, merged whenever
+//!   the list doubles).
 //! - **Pair recall.** The count of distinct correct pairs.
 //!
 //! A pair that comes again with the claim it was counted with (later matches of a chain repeat
@@ -117,11 +118,13 @@ pub struct Tally {
     /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
     /// recognizer that names unknown observations is broken, not long-running).
     unresolved: HashMap<u64, u8>,
-    /// (query index, lap) → claims (bit 0 same, bit 1 opposite) of the correct pairs joining
-    /// them, for queries at or after the horizon.
-    visits_window: PairMap<u8>,
-    /// The same behind the horizon: `query << 32 | lap << 2 | claims`.
+    /// (query index, lap, claims: bit 0 same, bit 1 opposite) of the correct pairs, packed
+    /// `query << 32 | lap << 2 | claims`: appended as pairs arrive (no lookup per pair) and
+    /// compacted (`compact_visits`) whenever it doubles, so it holds at most about twice the
+    /// distinct (query, lap) entries.
     visits: Vec<u64>,
+    /// Length of `visits` after its last compaction.
+    visits_compact: usize,
     /// Query indices below this were forgotten.
     evicted_below: usize,
     late_pairs: usize,
@@ -168,8 +171,8 @@ impl Tally {
             slots,
             window: PairMap::default(),
             unresolved: HashMap::default(),
-            visits_window: PairMap::default(),
             visits: Vec::new(),
+            visits_compact: 0,
             evicted_below: 0,
             late_pairs: 0,
             forgotten: None,
@@ -296,7 +299,12 @@ impl Tally {
             *entry = after;
             if recalls && d2 <= r_main * r_main && agrees {
                 let claims = if claim == Facing::Same { 1 } else { 2 };
-                *self.visits_window.entry(pack(qi, pa.lap)).or_insert(0) |= claims;
+                self.visits
+                    .push((qi as u64) << 32 | (pa.lap as u64) << 2 | claims);
+                if self.visits.len() >= 2 * self.visits_compact.max(1 << 16) {
+                    compact_visits(&mut self.visits);
+                    self.visits_compact = self.visits.len();
+                }
             }
         }
         for s in self.slots.iter_mut().filter(|s| counts(s) && s.n > 0) {
@@ -332,16 +340,6 @@ impl Tally {
             }
             None => self.window.retain(|&k, _| !behind(k)),
         }
-        let from = self.visits.len();
-        let visits = &mut self.visits;
-        self.visits_window.retain(|&k, &mut claims| {
-            let keep = !behind(k);
-            if !keep {
-                visits.push((k >> 32) << 32 | (k & 0xffff_ffff) << 2 | u64::from(claims));
-            }
-            keep
-        });
-        self.visits[from..].sort_unstable();
         self.evicted_below = h;
     }
 
@@ -408,15 +406,7 @@ impl Tally {
     /// there, and leaving this tally's there for the next.
     pub fn finish_sharing(mut self, truth: &GroundTruth, shared: &mut SharedTruth) -> Evaluation {
         self.evict_below(usize::MAX);
-        // Late pairs (none from a recognizer that keeps its horizon) may repeat an entry.
-        self.visits.sort_unstable();
-        self.visits.dedup_by(|b, a| {
-            let same = *a >> 2 == *b >> 2;
-            if same {
-                *a |= *b & 3;
-            }
-            same
-        });
+        compact_visits(&mut self.visits);
         let slots: Vec<(Facing, u64)> = self
             .slots
             .iter()
@@ -772,12 +762,28 @@ fn could_be_found(
     if r <= 0.0 || !r.is_finite() {
         return false;
     }
+    // A site's travel is its frame's; the gap is tested before the frames are read (the past
+    // frame's truth is a read from far back).
+    if qs.travel_m - ps.travel_m < spec.min_gap_m {
+        return false;
+    }
     let (fq, fp) = (scorer.frame_of(qi), scorer.frame_of(pi));
     let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
-    // A site's travel is its frame's.
-    qs.travel_m - ps.travel_m >= spec.min_gap_m
-        && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
+    (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
         && claim.agrees(q.theta, p.theta, scorer.heading_tol_rad())
+}
+
+/// Sorts visit entries (`query << 32 | lap << 2 | claims`) and merges those of one (query,
+/// lap), their claims joined.
+fn compact_visits(visits: &mut Vec<u64>) {
+    visits.sort_unstable();
+    visits.dedup_by(|b, a| {
+        let same = *a >> 2 == *b >> 2;
+        if same {
+            *a |= *b & 3;
+        }
+        same
+    });
 }
 
 /// Whether the query ranges of `m`'s runs are in increasing order and do not overlap (then no
