@@ -213,7 +213,7 @@ impl Tally {
     }
 
     /// Counts match `m` (its observations must be synced).
-    pub fn add(&mut self, m: &Match, truth: &GroundTruth) {
+    pub fn add(&mut self, m: &Match) {
         let claim = Facing::of(m.direction);
         let claim_bit = facing_bit(claim);
         let tol = self.scorer.heading_tol_rad();
@@ -285,9 +285,7 @@ impl Tally {
                 }
             }
             let mut after = before | 1 | (1 << claim_bit);
-            if recalls
-                && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim, truth)
-            {
+            if recalls && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim) {
                 for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
                     let bit = 1 << (3 + facing_bit(s.facing));
                     if before & bit == 0 {
@@ -302,7 +300,7 @@ impl Tally {
                 self.visits
                     .push((qi as u64) << 32 | (pa.lap as u64) << 2 | claims);
                 if self.visits.len() >= 2 * self.visits_compact.max(1 << 16) {
-                    compact_visits(&mut self.visits);
+                    compact_visits(&mut self.visits, self.visits_compact);
                     self.visits_compact = self.visits.len();
                 }
             }
@@ -406,7 +404,7 @@ impl Tally {
     /// there, and leaving this tally's there for the next.
     pub fn finish_sharing(mut self, truth: &GroundTruth, shared: &mut SharedTruth) -> Evaluation {
         self.evict_below(usize::MAX);
-        compact_visits(&mut self.visits);
+        compact_visits(&mut self.visits, self.visits_compact);
         let slots: Vec<(Facing, u64)> = self
             .slots
             .iter()
@@ -756,7 +754,6 @@ fn could_be_found(
     (qi, qs): (usize, &Site),
     (pi, ps): (usize, &Site),
     claim: Facing,
-    truth: &GroundTruth,
 ) -> bool {
     let r = spec.tp_radius_m;
     if r <= 0.0 || !r.is_finite() {
@@ -767,16 +764,19 @@ fn could_be_found(
     if qs.travel_m - ps.travel_m < spec.min_gap_m {
         return false;
     }
-    let (fq, fp) = (scorer.frame_of(qi), scorer.frame_of(pi));
-    let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
-    (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
-        && claim.agrees(q.theta, p.theta, scorer.heading_tol_rad())
+    let (Some(q), Some(p)) = (scorer.frame_pose(qi), scorer.frame_pose(pi)) else {
+        return false;
+    };
+    (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) <= r * r
+        && claim.agrees(q[2], p[2], scorer.heading_tol_rad())
 }
 
-/// Sorts visit entries (`query << 32 | lap << 2 | claims`) and merges those of one (query,
-/// lap), their claims joined.
-fn compact_visits(visits: &mut Vec<u64>) {
-    visits.sort_unstable();
+/// Sorts visit entries (`query << 32 | lap << 2 | claims`), the first `sorted` already in
+/// order, and merges those of one (query, lap), their claims joined.
+fn compact_visits(visits: &mut Vec<u64>, sorted: usize) {
+    visits[sorted..].sort_unstable();
+    // Two sorted runs: the stable sort finds them and merges them in one pass.
+    visits.sort();
     visits.dedup_by(|b, a| {
         let same = *a >> 2 == *b >> 2;
         if same {
@@ -1067,7 +1067,7 @@ mod tests {
                     t.by_site_tree();
                 }
                 t.sync(&obs, &gt);
-                matches.iter().for_each(|m| t.add(m, &gt));
+                matches.iter().for_each(|m| t.add(m));
                 t.finish(&gt)
             };
             let want = score(true);
@@ -1079,7 +1079,7 @@ mod tests {
             for (upto, ms) in [(fewer, &matches[..0]), (obs.len(), &matches[..0]), (obs.len(), &matches[..])] {
                 let mut t = Tally::new(&spec, Scope::Full);
                 t.sync(&obs[..upto], &gt);
-                ms.iter().for_each(|m| t.add(m, &gt));
+                ms.iter().for_each(|m| t.add(m));
                 let e = t.finish_sharing(&gt, &mut shared);
                 if upto == obs.len() && !ms.is_empty() {
                     prop_assert_eq!(&e, &want);
@@ -1099,7 +1099,7 @@ mod tests {
             let m = Match::from_pairs(pairs.iter().map(|&(q, p)| (q + shift, p + shift)), 1.0);
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(obs, &gt);
-            t.add(&m, &gt);
+            t.add(&m);
             t.finish(&gt)
         };
         let moved: Vec<Observation> = obs
