@@ -299,13 +299,7 @@ impl Tally {
             }
             *entry = after;
             if recalls && d2 <= r_main * r_main && agrees {
-                let claims = if claim == Facing::Same { 1 } else { 2 };
-                self.visits
-                    .push((qi as u64) << 32 | (pa.lap as u64) << 2 | claims);
-                if self.visits.len() >= 2 * self.visits_compact.max(self.visits_compact_min) {
-                    compact_visits(&mut self.visits, self.visits_compact);
-                    self.visits_compact = self.visits.len();
-                }
+                self.push_visit(qi, pa.lap, if claim == Facing::Same { 1 } else { 2 });
             }
         }
         for s in self.slots.iter_mut().filter(|s| counts(s) && s.n > 0) {
@@ -316,6 +310,17 @@ impl Tally {
                 s.per_cfg[c].matches += 1;
                 s.per_cfg[c].correct_matches += usize::from(good);
             }
+        }
+    }
+
+    /// Records that query `qi` was correctly paired with lap `lap` by a match claiming
+    /// `claims` (1 same, 2 opposite), merging the list whenever it doubles.
+    fn push_visit(&mut self, qi: usize, lap: usize, claims: u64) {
+        self.visits
+            .push((qi as u64) << 32 | (lap as u64) << 2 | claims);
+        if self.visits.len() >= 2 * self.visits_compact.max(self.visits_compact_min) {
+            compact_visits(&mut self.visits, self.visits_compact);
+            self.visits_compact = self.visits.len();
         }
     }
 
