@@ -188,7 +188,7 @@ pub fn evaluate(rec: &Recognition, spec: &EvaluationSpec) -> Evaluation {
     let mut tally = Tally::new(spec, Scope::Full);
     tally.sync(&rec.observations, &rec.truth);
     for m in &rec.matches {
-        tally.add(m, &rec.truth);
+        tally.add(m);
     }
     tally.finish(&rec.truth)
 }
@@ -202,7 +202,7 @@ pub fn evaluate_by_site_tree(rec: &Recognition, spec: &EvaluationSpec) -> Evalua
     tally.by_site_tree();
     tally.sync(&rec.observations, &rec.truth);
     for m in &rec.matches {
-        tally.add(m, &rec.truth);
+        tally.add(m);
     }
     tally.finish(&rec.truth)
 }
@@ -223,7 +223,7 @@ pub fn score(
     let mut tally = Tally::new(&spec, Scope::Main);
     tally.sync(observations, truth);
     for m in matches {
-        tally.add(m, truth);
+        tally.add(m);
     }
     tally.finish_main(None)
 }
@@ -317,6 +317,9 @@ pub(super) struct Joined {
     frame_of: Vec<u32>,
     /// The observations with truth, in creation order.
     sites: Vec<Site>,
+    /// Per site: its frame's true pose (x, y, θ), which pair recall tests (a site is the
+    /// observation's pose); kept beside the sites so that the test reads no frame truth.
+    frame_pose: Vec<[f64; 3]>,
     /// Per site: its door configuration index.
     site_config: Vec<u32>,
     /// Per site: its position in the observations.
@@ -420,6 +423,8 @@ impl Joined {
             travel_m: f.travel_m,
             lap: f.lap_slot,
         });
+        self.frame_pose
+            .push([f.pose.0.x, f.pose.0.y, f.pose.0.theta]);
         self.site_config.push(lap_config[f.lap_slot]);
         self.site_obs.push(i as u32);
     }
@@ -502,6 +507,12 @@ impl Scorer {
             (Some(a), Some(b)) => ((a.x - b.x).powi(2) + (a.y - b.y).powi(2)).sqrt() <= r,
             _ => false,
         }
+    }
+
+    /// The true pose (x, y, θ) of the frame of observation `i` (a position), if it has truth.
+    pub(super) fn frame_pose(&self, i: usize) -> Option<&[f64; 3]> {
+        let k = self.joined.site_of.get(i)?;
+        self.joined.frame_pose.get(k as usize)
     }
 
     /// The truth of observation `i` (its position in the observations), if its frame has one.
@@ -846,7 +857,7 @@ pub(crate) mod tests {
             };
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(&obs, &gt);
-            matches.iter().for_each(|m| t.add(m, &gt));
+            matches.iter().for_each(|m| t.add(m));
             t.finish(&gt).main.visit_recall
         };
         let nearest = vec![one_match(oracle(&obs, &gt, &spec))];

@@ -476,7 +476,7 @@ impl Recording {
                     let w = Stopwatch::start();
                     tally.sync(rec.observations(), truth);
                     for m in &found {
-                        tally.add(m, truth);
+                        tally.add(m);
                         self.ranking.add(m, tally.scorer(), spec);
                     }
                     self.score_seconds += w.cpu_s();

@@ -158,7 +158,7 @@ mod tests {
         };
         let mut t = Tally::new(&spec, Scope::Full);
         t.sync(obs, gt);
-        matches.iter().for_each(|m| t.add(m, gt));
+        matches.iter().for_each(|m| t.add(m));
         let e = t.finish(gt);
         match facing {
             Facing::Either => e.main.pair_recall,

@@ -120,7 +120,7 @@ where
             let mut forgot_below = 0;
             run_point(p, &mut |matches, horizon| {
                 for m in matches {
-                    tally.add(m, truth);
+                    tally.add(m);
                 }
                 if horizon >= forgot_below + FORGET_EVERY {
                     tally.evict_below(horizon);

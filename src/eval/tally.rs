@@ -15,7 +15,8 @@
 //! - **Recall.** Per observation, one flag per figure: the query (or either side) of a correct
 //!   pair.
 //! - **Visit recall.** The earlier laps each query observation was correctly paired with, one
-//!   packed `u64` per (observation, lap), not per pair.
+//!   packed `u64` per (observation, lap), not per pair (appended as pairs come, merged whenever
+//!   the list doubles).
 //! - **Pair recall.** The count of distinct correct pairs.
 //!
 //! A pair that comes again with the claim it was counted with (later matches of a chain repeat
@@ -117,11 +118,15 @@ pub struct Tally {
     /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
     /// recognizer that names unknown observations is broken, not long-running).
     unresolved: HashMap<u64, u8>,
-    /// (query index, lap) → claims (bit 0 same, bit 1 opposite) of the correct pairs joining
-    /// them, for queries at or after the horizon.
-    visits_window: PairMap<u8>,
-    /// The same behind the horizon: `query << 32 | lap << 2 | claims`.
+    /// (query index, lap, claims: bit 0 same, bit 1 opposite) of the correct pairs, packed
+    /// `query << 32 | lap << 2 | claims`: appended as pairs arrive (no lookup per pair) and
+    /// compacted (`compact_visits`) whenever it doubles, so it holds at most about twice the
+    /// distinct (query, lap) entries.
     visits: Vec<u64>,
+    /// Length of `visits` after its last compaction.
+    visits_compact: usize,
+    /// `visits` is not compacted below this length (a test lowers it).
+    visits_compact_min: usize,
     /// Query indices below this were forgotten.
     evicted_below: usize,
     late_pairs: usize,
@@ -168,8 +173,9 @@ impl Tally {
             slots,
             window: PairMap::default(),
             unresolved: HashMap::default(),
-            visits_window: PairMap::default(),
             visits: Vec::new(),
+            visits_compact: 0,
+            visits_compact_min: 1 << 16,
             evicted_below: 0,
             late_pairs: 0,
             forgotten: None,
@@ -210,7 +216,7 @@ impl Tally {
     }
 
     /// Counts match `m` (its observations must be synced).
-    pub fn add(&mut self, m: &Match, truth: &GroundTruth) {
+    pub fn add(&mut self, m: &Match) {
         let claim = Facing::of(m.direction);
         let claim_bit = facing_bit(claim);
         let tol = self.scorer.heading_tol_rad();
@@ -282,9 +288,7 @@ impl Tally {
                 }
             }
             let mut after = before | 1 | (1 << claim_bit);
-            if recalls
-                && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim, truth)
-            {
+            if recalls && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim) {
                 for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
                     let bit = 1 << (3 + facing_bit(s.facing));
                     if before & bit == 0 {
@@ -295,8 +299,7 @@ impl Tally {
             }
             *entry = after;
             if recalls && d2 <= r_main * r_main && agrees {
-                let claims = if claim == Facing::Same { 1 } else { 2 };
-                *self.visits_window.entry(pack(qi, pa.lap)).or_insert(0) |= claims;
+                self.push_visit(qi, pa.lap, if claim == Facing::Same { 1 } else { 2 });
             }
         }
         for s in self.slots.iter_mut().filter(|s| counts(s) && s.n > 0) {
@@ -307,6 +310,17 @@ impl Tally {
                 s.per_cfg[c].matches += 1;
                 s.per_cfg[c].correct_matches += usize::from(good);
             }
+        }
+    }
+
+    /// Records that query `qi` was correctly paired with lap `lap` by a match claiming
+    /// `claims` (1 same, 2 opposite), merging the list whenever it doubles.
+    fn push_visit(&mut self, qi: usize, lap: usize, claims: u64) {
+        self.visits
+            .push((qi as u64) << 32 | (lap as u64) << 2 | claims);
+        if self.visits.len() >= 2 * self.visits_compact.max(self.visits_compact_min) {
+            compact_visits(&mut self.visits, self.visits_compact);
+            self.visits_compact = self.visits.len();
         }
     }
 
@@ -332,16 +346,6 @@ impl Tally {
             }
             None => self.window.retain(|&k, _| !behind(k)),
         }
-        let from = self.visits.len();
-        let visits = &mut self.visits;
-        self.visits_window.retain(|&k, &mut claims| {
-            let keep = !behind(k);
-            if !keep {
-                visits.push((k >> 32) << 32 | (k & 0xffff_ffff) << 2 | u64::from(claims));
-            }
-            keep
-        });
-        self.visits[from..].sort_unstable();
         self.evicted_below = h;
     }
 
@@ -408,15 +412,7 @@ impl Tally {
     /// there, and leaving this tally's there for the next.
     pub fn finish_sharing(mut self, truth: &GroundTruth, shared: &mut SharedTruth) -> Evaluation {
         self.evict_below(usize::MAX);
-        // Late pairs (none from a recognizer that keeps its horizon) may repeat an entry.
-        self.visits.sort_unstable();
-        self.visits.dedup_by(|b, a| {
-            let same = *a >> 2 == *b >> 2;
-            if same {
-                *a |= *b & 3;
-            }
-            same
-        });
+        compact_visits(&mut self.visits, self.visits_compact);
         let slots: Vec<(Facing, u64)> = self
             .slots
             .iter()
@@ -766,18 +762,36 @@ fn could_be_found(
     (qi, qs): (usize, &Site),
     (pi, ps): (usize, &Site),
     claim: Facing,
-    truth: &GroundTruth,
 ) -> bool {
     let r = spec.tp_radius_m;
     if r <= 0.0 || !r.is_finite() {
         return false;
     }
-    let (fq, fp) = (scorer.frame_of(qi), scorer.frame_of(pi));
-    let (q, p) = (truth.frames[fq].pose.0, truth.frames[fp].pose.0);
-    // A site's travel is its frame's.
-    qs.travel_m - ps.travel_m >= spec.min_gap_m
-        && (q.x - p.x).powi(2) + (q.y - p.y).powi(2) <= r * r
-        && claim.agrees(q.theta, p.theta, scorer.heading_tol_rad())
+    // A site's travel is its frame's; the gap is tested before the frames are read (the past
+    // frame's truth is a read from far back).
+    if qs.travel_m - ps.travel_m < spec.min_gap_m {
+        return false;
+    }
+    let (Some(q), Some(p)) = (scorer.frame_pose(qi), scorer.frame_pose(pi)) else {
+        return false;
+    };
+    (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) <= r * r
+        && claim.agrees(q[2], p[2], scorer.heading_tol_rad())
+}
+
+/// Sorts visit entries (`query << 32 | lap << 2 | claims`), the first `sorted` already in
+/// order, and merges those of one (query, lap), their claims joined.
+fn compact_visits(visits: &mut Vec<u64>, sorted: usize) {
+    visits[sorted..].sort_unstable();
+    // Two sorted runs: the stable sort finds them and merges them in one pass.
+    visits.sort();
+    visits.dedup_by(|b, a| {
+        let same = *a >> 2 == *b >> 2;
+        if same {
+            *a |= *b & 3;
+        }
+        same
+    });
 }
 
 /// Whether the query ranges of `m`'s runs are in increasing order and do not overlap (then no
@@ -1055,17 +1069,20 @@ mod tests {
                 heading_tolerance_deg: tol_deg,
                 ..EvaluationSpec::default()
             };
-            let score = |reference: bool| {
+            let score = |reference: bool, compact_min: usize| {
                 let mut t = Tally::new(&spec, Scope::Full);
                 if reference {
                     t.by_site_tree();
                 }
+                t.visits_compact_min = compact_min;
                 t.sync(&obs, &gt);
-                matches.iter().for_each(|m| t.add(m, &gt));
+                matches.iter().for_each(|m| t.add(m));
                 t.finish(&gt)
             };
-            let want = score(true);
-            prop_assert_eq!(&score(false), &want);
+            let want = score(true, 1 << 16);
+            prop_assert_eq!(&score(false, 1 << 16), &want);
+            // The visits merged every few correct pairs as they arrive: the same figures.
+            prop_assert_eq!(&score(false, 1), &want);
             // The truth side left by a tally over other observations is not taken; that of a
             // tally over the same ones (without matches) is, with the same figures.
             let mut shared = SharedTruth::new(3);
@@ -1073,7 +1090,7 @@ mod tests {
             for (upto, ms) in [(fewer, &matches[..0]), (obs.len(), &matches[..0]), (obs.len(), &matches[..])] {
                 let mut t = Tally::new(&spec, Scope::Full);
                 t.sync(&obs[..upto], &gt);
-                ms.iter().for_each(|m| t.add(m, &gt));
+                ms.iter().for_each(|m| t.add(m));
                 let e = t.finish_sharing(&gt, &mut shared);
                 if upto == obs.len() && !ms.is_empty() {
                     prop_assert_eq!(&e, &want);
@@ -1093,7 +1110,7 @@ mod tests {
             let m = Match::from_pairs(pairs.iter().map(|&(q, p)| (q + shift, p + shift)), 1.0);
             let mut t = Tally::new(&spec, Scope::Full);
             t.sync(obs, &gt);
-            t.add(&m, &gt);
+            t.add(&m);
             t.finish(&gt)
         };
         let moved: Vec<Observation> = obs
