@@ -176,6 +176,10 @@ impl WordMatcher {
             .enumerate()
             .chain(bridged.iter().enumerate().map(|(i, w)| (MAX_LEVELS + i, w)))
         {
+            debug_assert!(
+                cp as usize >= self.memo_forgotten,
+                "memo of word {cp} read once freed"
+            );
             let table = &mut self.lookup[slot];
             if table.len() < n_words {
                 table.resize(n_words, (0, 0));
@@ -235,6 +239,10 @@ impl WordMatcher {
         // The memo entries of c_skip's predecessors, by past word: lookup slots MAX_LEVELS.. (see
         // `memoise`).
         for (slot, &c2) in self.word(c_skip).pred_ids().iter().enumerate() {
+            debug_assert!(
+                c2 as usize >= self.memo_forgotten,
+                "memo of word {c2} read once freed"
+            );
             let memo = &self.memo[d][c2 as usize];
             if memo.is_empty() {
                 continue;
@@ -309,6 +317,10 @@ impl WordMatcher {
                 chain.truncate(start);
                 return false;
             };
+            debug_assert!(
+                pc as usize >= self.memo_forgotten,
+                "memo of word {pc} read once freed"
+            );
             let pe = memo[pc as usize][pidx];
             chain.push((pc, pidx));
             (wc, we) = (pc, pe);

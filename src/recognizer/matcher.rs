@@ -55,8 +55,8 @@ pub struct WordMatcher {
     /// Per word, the words whose predecessor it is (the chain links of a past n-gram read
     /// backwards).
     pub(super) successors: Vec<Vec<WordId>>,
-    /// Words before this one belong to finished runs; their memo (both directions) has been
-    /// freed.
+    /// Words before this one belong to finished runs or lie behind the query horizon; their
+    /// memo (both directions) has been freed and is never read again.
     pub(super) memo_forgotten: usize,
     /// Per predecessor slot of the word being matched: (stamp, entry index) per past word.
     /// Slots `MAX_LEVELS..`: the same for the predecessors of its level-0 predecessor (the
@@ -184,6 +184,27 @@ impl WordMatcher {
         self.memo_forgotten = self.memo[0].len();
     }
 
+    /// Frees the memo (both directions) of the words, oldest first, that begin before the
+    /// query horizon: a memo is read only for a current word of a future n-gram (its own, its
+    /// predecessors' while memoising, the chain walk's at most τ steps back), and those all begin
+    /// at or after the horizon ([`query_horizon`](Self::query_horizon)). Without this, a long
+    /// run with `max_candidates = 0` holds a memo entry per matching word pair of all its laps,
+    /// which grows with the laps squared. Stops at the first word that begins at or after the
+    /// horizon: a higher-level word may begin before a lower one closed earlier, so a few words
+    /// are freed late, never early.
+    pub(super) fn forget_behind_horizon(&mut self) {
+        let horizon = self.query_horizon();
+        let made = self.memo[0].len();
+        while self.memo_forgotten < made
+            && self.words.word(self.memo_forgotten as WordId).first_obs < horizon
+        {
+            for memo in &mut self.memo {
+                memo[self.memo_forgotten] = Vec::new();
+            }
+            self.memo_forgotten += 1;
+        }
+    }
+
     /// Closes the current run's open word and matches it, without starting a new run (call at
     /// the end of the input).
     pub fn finish_run(&mut self) -> Vec<WordMatch> {
@@ -254,6 +275,7 @@ impl WordMatcher {
             let class = self.word(c).class as usize;
             self.occurrences[class].push(c);
         }
+        self.forget_behind_horizon();
         out
     }
 
