@@ -185,7 +185,106 @@ fn within_limits(src: &str, name: &str, map: &MobileSimMap) -> Result<(f64, f64,
             ),
         ));
     }
+    within_route_budget(src, name, map, home)?;
     Ok((hx, hy, hdeg))
+}
+
+/// Route generation's work grows with the area it rasterises (the walls' and home's bounding
+/// box, [`crate::authoring::route::MAX_AREA_M2`] at most): a map over it is refused before any
+/// planning, at the segment farthest from the home (the column of its farthest coordinate),
+/// with an end for it that would fit (the rest of the map's box) when there is one.
+fn within_route_budget(
+    src: &str,
+    name: &str,
+    map: &MobileSimMap,
+    home: Vec2,
+) -> Result<(), Diagnostic> {
+    use crate::authoring::route::{COARSEST_M, MARGIN_M, MAX_AREA_M2, MAX_CELLS};
+    let bbox = |skip: Option<usize>| {
+        let (mut lo, mut hi) = (home, home);
+        for (_, s) in map
+            .segments
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| Some(*i) != skip)
+        {
+            lo = lo.inf(&s.a).inf(&s.b);
+            hi = hi.sup(&s.a).sup(&s.b);
+        }
+        (lo, hi)
+    };
+    let area =
+        |(lo, hi): (Vec2, Vec2)| (hi.x - lo.x + 2.0 * MARGIN_M) * (hi.y - lo.y + 2.0 * MARGIN_M);
+    let (lo, hi) = bbox(None);
+    if area((lo, hi)) <= MAX_AREA_M2 {
+        return Ok(());
+    }
+    let far = |p: Vec2| (p - home).norm();
+    let Some((i, s)) = map.segments.iter().enumerate().max_by(|a, b| {
+        far(a.1.a)
+            .max(far(a.1.b))
+            .total_cmp(&far(b.1.a).max(far(b.1.b)))
+    }) else {
+        return Ok(());
+    };
+    let (end, p) = if far(s.a) >= far(s.b) {
+        (0, s.a)
+    } else {
+        (1, s.b)
+    };
+    // x or y of that end, whichever lies farther from the home: tokens x1 y1 x2 y2.
+    let token = 2 * end + usize::from((p.y - home.y).abs() > (p.x - home.x).abs());
+    let line = map.segment_lines[i];
+    let col = src
+        .lines()
+        .nth(line - 1)
+        .and_then(|l| token_column(l, token))
+        .unwrap_or(1);
+    let rest = bbox(Some(i));
+    let fits = if area(rest) <= MAX_AREA_M2 {
+        let q = p.sup(&rest.0).inf(&rest.1);
+        format!(
+            "an end within the rest of the map, e.g. `{:.0} {:.0}`, would fit",
+            q.x * 1000.0,
+            q.y * 1000.0
+        )
+    } else {
+        "the rest of the map is too large as well: split it".to_string()
+    };
+    Err(Diagnostic::error(
+        name,
+        (line, col),
+        format!(
+            "this line stretches the map (with its home) to {:.0} × {:.0} m, {:.0} m² to plan a route over, \
+             more than route generation takes ({MAX_AREA_M2:.0} m²: {:.0} million cells of {:.0} cm); \
+             its end ({:.0}, {:.0}) mm is the farthest from the home; {fits}",
+            hi.x - lo.x,
+            hi.y - lo.y,
+            area((lo, hi)),
+            MAX_CELLS / 1e6,
+            COARSEST_M * 100.0,
+            p.x * 1000.0,
+            p.y * 1000.0,
+        ),
+    ))
+}
+
+/// The 1-based column (in characters) of the `k`-th whitespace-separated token of `line`.
+fn token_column(line: &str, k: usize) -> Option<usize> {
+    let mut tokens = 0;
+    let mut in_token = false;
+    for (col, ch) in line.chars().enumerate() {
+        if ch.is_whitespace() {
+            in_token = false;
+        } else if !in_token {
+            if tokens == k {
+                return Some(col + 1);
+            }
+            tokens += 1;
+            in_token = true;
+        }
+    }
+    None
 }
 
 /// The world the map gives before its route: walls from the chains, the home, a description
@@ -510,6 +609,28 @@ mod tests {
         let src = "2D-Map\nCairn: RobotHome 300 300 0\nLINES\n0 0 600 0\n600 0 600 600\n600 600 0 600\n0 600 0 0\n";
         let e = import_mobilesim(src, "t.map").unwrap_err();
         assert!(e.to_string().contains("[[routes]]"), "{e}");
+    }
+
+    #[test]
+    fn a_line_stretched_far_is_refused_at_its_column_before_planning() {
+        let src = "2D-Map\nCairn: RobotHome 1000 1000 0\nLINES\n0 0 4000 0\n4000 0 4000 4000\n\
+                   4000 4000 300000 350000\n0 4000 0 0\n";
+        let e = import_mobilesim(src, "far.map").unwrap_err().to_string();
+        // Line 6, its fourth number (the far end's y, farther from the home than its x).
+        assert!(
+            e.starts_with("far.map:6:18: this line stretches the map"),
+            "{e}"
+        );
+        // The far end clamped into the rest of the map's box.
+        assert!(e.contains("e.g. `4000 4000`, would fit"), "{e}");
+        let fixed = src.replace("300000 350000", "0 4000");
+        let e = import_mobilesim(&fixed, "far.map")
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            e.as_ref().is_none_or(|e| !e.contains("plan a route over")),
+            "{e:?}"
+        );
     }
 
     #[test]

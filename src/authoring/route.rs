@@ -24,6 +24,7 @@ mod thin;
 
 use crate::geom::{Segment, Vec2, segment_distance};
 use raster::Raster;
+pub use raster::{COARSEST_M, MARGIN_M, MAX_AREA_M2, MAX_CELLS};
 use skeleton::Tree;
 
 /// Settings of the route generator.

@@ -15,9 +15,26 @@ pub(super) struct Raster {
     pub ny: usize,
 }
 
+/// Most cells route generation rasterises a map into: its work budget. Thinning a free space
+/// that fills the whole raster (a map whose outer wall a far-away line broke open) costs about
+/// 0.25 µs of CPU per cell, so 4 million cells keep the worst case near a second.
+pub const MAX_CELLS: f64 = 4.0e6;
+
+/// The coarsest cell a large map is rasterised at, metres.
+pub const COARSEST_M: f64 = 0.1;
+
+/// The largest raster area route generation takes (the walls' and home's bounding box grown by
+/// [`MARGIN_M`] on every side), square metres: [`MAX_CELLS`] cells of [`COARSEST_M`].
+pub const MAX_AREA_M2: f64 = MAX_CELLS * COARSEST_M * COARSEST_M;
+
+/// How far the raster reaches beyond the walls' and home's bounding box, metres.
+pub const MARGIN_M: f64 = 1.0;
+
 impl Raster {
-    /// Cells of `resolution_m`, coarsened (up to 10 cm) for large maps so the raster stays
-    /// under 16 M cells; larger maps are refused with their size (width, height in metres).
+    /// Cells of `resolution_m`, coarsened (up to [`COARSEST_M`]) for large maps so the raster
+    /// stays under [`MAX_CELLS`]; larger maps are refused with their size (width, height in
+    /// metres). `world import` refuses them earlier, at the map's line
+    /// (`authoring::mobilesim`).
     pub fn around(walls: &[Segment], home: Vec2, resolution_m: f64) -> Result<Raster, (f64, f64)> {
         let (mut lo, mut hi) = (home, home);
         for w in walls {
@@ -26,11 +43,11 @@ impl Raster {
                 hi = hi.sup(&p);
             }
         }
-        lo -= Vec2::new(1.0, 1.0);
-        hi += Vec2::new(1.0, 1.0);
+        lo -= Vec2::new(MARGIN_M, MARGIN_M);
+        hi += Vec2::new(MARGIN_M, MARGIN_M);
         let area = (hi.x - lo.x) * (hi.y - lo.y);
-        let res = resolution_m.max((area / 16.0e6).sqrt());
-        if res.is_nan() || res > 0.1 + 1e-12 {
+        let res = resolution_m.max((area / MAX_CELLS).sqrt());
+        if res.is_nan() || res > COARSEST_M + 1e-12 {
             return Err((hi.x - lo.x, hi.y - lo.y));
         }
         Ok(Raster {
