@@ -171,21 +171,25 @@ pub fn metric_line(m: &MetricComparison) -> String {
         let _ = write!(s, "; within {}", tolerance(m));
         return s;
     }
+    let _ = write!(s, "; {}; {}", seeds_against_tolerance(m), test_words(m));
+    s
+}
+
+/// Paired, how many seeds got worse and which went beyond the tolerance; unpaired, how many
+/// seeds were held against it.
+fn seeds_against_tolerance(m: &MetricComparison) -> String {
     if m.paired {
-        let _ = write!(
-            s,
-            "; worse at {} of {} seeds {}, beyond {} at {}",
+        format!(
+            "worse at {} of {} seeds {}, beyond {} at {}",
             m.worse_seeds.len(),
             m.seeds.len(),
             seeds(&m.worse_seeds),
             tolerance(m),
             seeds(&m.beyond_seeds)
-        );
+        )
     } else {
-        let _ = write!(s, "; {} against {}", m.seeds.len(), tolerance(m));
+        format!("{} against {}", m.seeds.len(), tolerance(m))
     }
-    let _ = write!(s, "; {}", test_words(m));
-    s
 }
 
 /// The commands reproducing the worst seed of both sides: paired, the seed that got most
@@ -212,34 +216,40 @@ pub fn text(c: &Comparison) -> String {
         base_build(c)
     );
     for sc in &c.scenarios {
-        let _ = writeln!(out, "{}: {}", sc.label, pairing_words(sc));
-        let mut quiet = 0;
-        for m in &sc.metrics {
-            if m.decision == Decision::Identical {
-                quiet += 1;
-                continue;
-            }
-            let _ = writeln!(out, "{}", metric_line(m));
-            if m.decision == Decision::Regression {
-                for l in reproduce_lines(sc, m, &c.base_commit) {
-                    let _ = writeln!(out, "{l}");
-                }
-            }
-        }
-        if quiet > 0 {
-            let _ = writeln!(
-                out,
-                "{}: {quiet} metric{} identical at every seed",
-                sc.label,
-                if quiet == 1 { "" } else { "s" }
-            );
-        }
-        for n in &sc.not_compared {
-            let _ = writeln!(out, "note: {}", not_compared_words(&sc.label, n));
-        }
+        scenario_text(sc, &c.base_commit, &mut out);
     }
     let _ = writeln!(out, "vs baseline: {}", closing_line(c));
     out
+}
+
+/// One scenario's part of [`text`]: pairing, moved metrics (with commands for regressions),
+/// identical ones counted, the metrics not compared.
+fn scenario_text(sc: &ScenarioComparison, base_commit: &str, out: &mut String) {
+    let _ = writeln!(out, "{}: {}", sc.label, pairing_words(sc));
+    let mut quiet = 0;
+    for m in &sc.metrics {
+        if m.decision == Decision::Identical {
+            quiet += 1;
+            continue;
+        }
+        let _ = writeln!(out, "{}", metric_line(m));
+        if m.decision == Decision::Regression {
+            for l in reproduce_lines(sc, m, base_commit) {
+                let _ = writeln!(out, "{l}");
+            }
+        }
+    }
+    if quiet > 0 {
+        let _ = writeln!(
+            out,
+            "{}: {quiet} metric{} identical at every seed",
+            sc.label,
+            if quiet == 1 { "" } else { "s" }
+        );
+    }
+    for n in &sc.not_compared {
+        let _ = writeln!(out, "note: {}", not_compared_words(&sc.label, n));
+    }
 }
 
 /// The Markdown section: per scenario its pairing and a table of every metric that moved

@@ -64,18 +64,23 @@ pub fn outcome_line(o: &Outcome) -> String {
         (false, ">=") => "<",
         (false, _) => ">",
     };
-    let n = o.runs;
-    let of = match n - o.seeds {
-        0 if n == 1 => "over 1 seed".to_string(),
-        0 => format!("over {n} seeds"),
-        nothing => format!("over {n} seeds; {nothing} matched nothing"),
-    };
+    let of = over_seeds(o);
     format!(
         "{status} {} {target} {what} {} {} {op} {limit} (seed {seed}, {of})",
         o.scenario,
         o.statistic(),
         fmt_value(o.bound, a),
     )
+}
+
+/// `over 20 seeds`, with how many of them matched nothing when some did.
+fn over_seeds(o: &Outcome) -> String {
+    let n = o.runs;
+    match n - o.seeds {
+        0 if n == 1 => "over 1 seed".to_string(),
+        0 => format!("over {n} seeds"),
+        nothing => format!("over {n} seeds; {nothing} matched nothing"),
+    }
 }
 
 /// `N passed, M failed` (and `, E errors` when there are any).
@@ -142,24 +147,29 @@ pub fn text_table(suite: &SuiteReport) -> String {
             out.push('\n');
             continue;
         }
-        let body: Vec<Vec<String>> = sc.summary.iter().map(text_row).collect();
-        out.push_str(&super::table::render(
-            &[
-                "subject [τ]",
-                "precision mean",
-                "worst",
-                "recall mean",
-                "worst",
-                "visit R mean",
-                "s/lap mean",
-                "worst",
-            ],
-            &body,
-        ));
+        out.push_str(&summary_table(sc));
         out.push_str(&worst_seeds(sc));
         out.push('\n');
     }
     out
+}
+
+/// The table of a scenario's configurations, one [`text_row`] each.
+fn summary_table(sc: &ScenarioResult) -> String {
+    let body: Vec<Vec<String>> = sc.summary.iter().map(text_row).collect();
+    super::table::render(
+        &[
+            "subject [τ]",
+            "precision mean",
+            "worst",
+            "recall mean",
+            "worst",
+            "visit R mean",
+            "s/lap mean",
+            "worst",
+        ],
+        &body,
+    )
 }
 
 fn text_row(c: &ConfigSpread) -> Vec<String> {
@@ -314,31 +324,37 @@ pub fn github_annotations(
 ) -> Vec<String> {
     let mut out = Vec::new();
     for sc in &suite.scenarios {
-        let at = match expect_line(&sc.file) {
-            Some(line) => format!("file={},line={line}", gh_property(&sc.file)),
-            None => format!("file={}", gh_property(&sc.file)),
-        };
-        for o in sc.outcomes.iter().filter(|o| !o.passed) {
-            let mut text = outcome_line(o);
-            if let Some(seed) = o.seed {
-                let _ = write!(text, "; reproduce: {}", sc.reproduce(seed));
-            }
-            out.push(format!(
-                "::error {at},title={}::{}",
-                gh_property(&o.name()),
-                gh_data(&text)
-            ));
-        }
-        for e in sc.errors() {
-            out.push(format!(
-                "::error file={},title={}::{}",
-                gh_property(&sc.file),
-                gh_property(&format!("{}/run", sc.label)),
-                gh_data(&e)
-            ));
-        }
+        scenario_annotations(sc, expect_line(&sc.file), &mut out);
     }
     out
+}
+
+/// The annotations of one scenario: its missed bounds at `line` of its file, its errors on the
+/// file.
+fn scenario_annotations(sc: &ScenarioResult, line: Option<usize>, out: &mut Vec<String>) {
+    let at = match line {
+        Some(line) => format!("file={},line={line}", gh_property(&sc.file)),
+        None => format!("file={}", gh_property(&sc.file)),
+    };
+    for o in sc.outcomes.iter().filter(|o| !o.passed) {
+        let mut text = outcome_line(o);
+        if let Some(seed) = o.seed {
+            let _ = write!(text, "; reproduce: {}", sc.reproduce(seed));
+        }
+        out.push(format!(
+            "::error {at},title={}::{}",
+            gh_property(&o.name()),
+            gh_data(&text)
+        ));
+    }
+    for e in sc.errors() {
+        out.push(format!(
+            "::error file={},title={}::{}",
+            gh_property(&sc.file),
+            gh_property(&format!("{}/run", sc.label)),
+            gh_data(&e)
+        ));
+    }
 }
 
 /// A workflow command's message, escaped as GitHub's runner reads it.
@@ -374,7 +390,24 @@ struct JsonOutcome<'a> {
 /// The `--json` summary: tally, exit code, every outcome and every error, and the provenance.
 pub fn summary_json(suite: &SuiteReport) -> String {
     let t = suite.tally();
-    let outcomes: Vec<JsonOutcome> = suite
+    let outcomes = json_outcomes(suite);
+    let errors: Vec<String> = suite.scenarios.iter().flat_map(|s| s.errors()).collect();
+    let v = serde_json::json!({
+        "passed": t.passed,
+        "failed": t.failed,
+        "errors": t.errors,
+        "exit_code": suite.exit_code(),
+        "shard": suite.shard.map(|s| s.to_string()),
+        "outcomes": outcomes,
+        "error_messages": errors,
+        "provenance": suite.provenance,
+    });
+    serde_json::to_string_pretty(&v).expect("a summary always serializes")
+}
+
+/// Every outcome of the run, in scenario order, as the summary lists it.
+fn json_outcomes(suite: &SuiteReport) -> Vec<JsonOutcome<'_>> {
+    suite
         .scenarios
         .iter()
         .flat_map(|sc| {
@@ -392,19 +425,7 @@ pub fn summary_json(suite: &SuiteReport) -> String {
                 line: outcome_line(o),
             })
         })
-        .collect();
-    let errors: Vec<String> = suite.scenarios.iter().flat_map(|s| s.errors()).collect();
-    let v = serde_json::json!({
-        "passed": t.passed,
-        "failed": t.failed,
-        "errors": t.errors,
-        "exit_code": suite.exit_code(),
-        "shard": suite.shard.map(|s| s.to_string()),
-        "outcomes": outcomes,
-        "error_messages": errors,
-        "provenance": suite.provenance,
-    });
-    serde_json::to_string_pretty(&v).expect("a summary always serializes")
+        .collect()
 }
 
 #[cfg(test)]

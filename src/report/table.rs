@@ -32,12 +32,7 @@ fn rows_with_directions(report: &Report) -> Vec<(String, Scores)> {
 
 /// Left-aligned first column, right-aligned others, two spaces apart.
 pub(crate) fn render(header: &[&str], body: &[Vec<String>]) -> String {
-    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
-    for r in body {
-        for (i, c) in r.iter().enumerate() {
-            width[i] = width[i].max(c.chars().count());
-        }
-    }
+    let width = column_widths(header, body);
     let mut out = String::new();
     let line = |cells: Vec<&str>, out: &mut String| {
         let mut s = String::new();
@@ -64,6 +59,17 @@ pub(crate) fn render(header: &[&str], body: &[Vec<String>]) -> String {
     out
 }
 
+/// The width of each column: its widest cell, header included, in characters.
+fn column_widths(header: &[&str], body: &[Vec<String>]) -> Vec<usize> {
+    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in body {
+        for (i, c) in r.iter().enumerate() {
+            width[i] = width[i].max(c.chars().count());
+        }
+    }
+    width
+}
+
 /// The terminal summary of one report: what was run and how it was judged, one headline per
 /// subject (the paper's precision and recall, with what they count), the main table with a
 /// legend line per column, the other recalls in a block of their own, the notes, then the
@@ -82,7 +88,6 @@ pub fn text_table(report: &Report) -> String {
 /// What was run (a scenario's laps, or a real log's scans and metres) and the ground-truth rule.
 fn header(report: &Report) -> String {
     let mut out = String::new();
-    let e = &report.evaluation;
     match &report.log {
         Some(log) => {
             let _ = writeln!(
@@ -99,6 +104,13 @@ fn header(report: &Report) -> String {
             );
         }
     }
+    truth_rule(report, &mut out);
+    out
+}
+
+/// The ground-truth rule the report was counted with, wrapped, and a blank line.
+fn truth_rule(report: &Report, out: &mut String) {
+    let e = &report.evaluation;
     let truth = format!(
         "ground truth: an observation has a revisit when an earlier one, at least {} m of true \
          travel before, lies within {} m facing within {}° (the same way, or the opposite way); \
@@ -109,7 +121,6 @@ fn header(report: &Report) -> String {
         let _ = writeln!(out, "{l}");
     }
     out.push('\n');
-    out
 }
 
 /// The width prose in the terminal summary is wrapped to, characters.
@@ -122,7 +133,29 @@ fn headlines(report: &Report, out: &mut String) {
         out,
         "as the paper's Table I reports them (its recall counts the revisits driven the same way):"
     );
-    let cells: Vec<[String; 3]> = report
+    let cells = headline_cells(report);
+    let width = |i: usize| {
+        cells
+            .iter()
+            .map(|c| c[i].chars().count())
+            .max()
+            .unwrap_or(0)
+    };
+    let (w0, w1) = (width(0), width(1));
+    for [label, precision, recall] in &cells {
+        let _ = writeln!(
+            out,
+            "  {label}{}  {precision}{}  {recall}",
+            " ".repeat(w0 - label.chars().count()),
+            " ".repeat(w1 - precision.chars().count())
+        );
+    }
+    out.push('\n');
+}
+
+/// Per subject: its label, precision and same-direction recall, each with what it counts.
+fn headline_cells(report: &Report) -> Vec<[String; 3]> {
+    report
         .subjects
         .iter()
         .map(|sub| {
@@ -141,24 +174,7 @@ fn headlines(report: &Report, out: &mut String) {
             );
             [sub.label(), precision, recall]
         })
-        .collect();
-    let width = |i: usize| {
-        cells
-            .iter()
-            .map(|c| c[i].chars().count())
-            .max()
-            .unwrap_or(0)
-    };
-    let (w0, w1) = (width(0), width(1));
-    for [label, precision, recall] in &cells {
-        let _ = writeln!(
-            out,
-            "  {label}{}  {precision}{}  {recall}",
-            " ".repeat(w0 - label.chars().count()),
-            " ".repeat(w1 - precision.chars().count())
-        );
-    }
-    out.push('\n');
+        .collect()
 }
 
 /// The main table, a row per subject (and per direction where the other way has revisits or
@@ -254,17 +270,7 @@ fn legend_lines(legend: &[(&str, &str)], out: &mut String) {
 /// The recalls beside the paper's, and match precision, in a block of their own.
 fn other_recalls(report: &Report, out: &mut String) {
     let _ = writeln!(out, "\nother recalls");
-    let body: Vec<Vec<String>> = rows_with_directions(report)
-        .into_iter()
-        .map(|(label, s)| {
-            vec![
-                label,
-                format!("{:.3}", s.visit_recall),
-                format!("{:.3}", s.pair_recall),
-                format!("{:.3}", s.match_precision),
-            ]
-        })
-        .collect();
+    let body = other_recall_rows(report);
     out.push_str(&render(
         &["subject [τ]", "visit R", "pair R", "match P"],
         &body,
@@ -287,6 +293,21 @@ fn other_recalls(report: &Report, out: &mut String) {
         ],
         out,
     );
+}
+
+/// A row of [`other_recalls`] per subject and direction shown.
+fn other_recall_rows(report: &Report) -> Vec<Vec<String>> {
+    rows_with_directions(report)
+        .into_iter()
+        .map(|(label, s)| {
+            vec![
+                label,
+                format!("{:.3}", s.visit_recall),
+                format!("{:.3}", s.pair_recall),
+                format!("{:.3}", s.match_precision),
+            ]
+        })
+        .collect()
 }
 
 /// The field's figures over each subject's match score (`eval::ranking`), in a block of their

@@ -714,6 +714,12 @@ fn legend_entries(world: &World, opts: &RenderOptions) -> Vec<(Sym, String)> {
     if opts.show_areas && !world.areas.is_empty() {
         entries.push((Sym::Area, "walking area".into()));
     }
+    overlay_entries(opts, &mut entries);
+    entries
+}
+
+/// The legend entries the caller drew over the world: labelled paths, extra lines, swatches.
+fn overlay_entries(opts: &RenderOptions, entries: &mut Vec<(Sym, String)>) {
     for p in &opts.paths {
         if !p.label.is_empty() {
             entries.push((Sym::Line(p.color.clone(), 2.0, p.dashed), p.label.clone()));
@@ -725,7 +731,6 @@ fn legend_entries(world: &World, opts: &RenderOptions) -> Vec<(Sym, String)> {
     for sw in &opts.swatches {
         entries.push((Sym::Swatch(sw.color.clone()), sw.label.clone()));
     }
-    entries
 }
 
 /// Where each legend entry goes: (x, y) per entry, wrapping at `x_end`.
@@ -870,34 +875,39 @@ fn grid(svg: &mut Svg, f: &Frame, map_w: f64, map_h: f64) {
 /// The tiles, one rectangle per run of equal cells along a row.
 fn tiles(svg: &mut Svg, f: &Frame, t: &TileLayer) {
     svg.open_group(r#"id="tiles" shape-rendering="crispEdges""#);
-    let side = t.cell_m * f.s;
     for y in 0..t.height {
-        let row = &t.cells[y * t.width..(y + 1) * t.width];
-        let mut x = 0;
-        while x < t.width {
-            let Some(c) = row[x] else {
-                x += 1;
-                continue;
-            };
-            let run = row[x..].iter().take_while(|v| **v == Some(c)).count();
-            let top_left = t.origin + Vec2::new(x as f64, (y + 1) as f64) * t.cell_m;
-            let (px, py) = f.p(top_left);
-            let color = t
-                .palette
-                .get(c as usize)
-                .map(String::as_str)
-                .unwrap_or("#ccc");
-            svg.rect(
-                px,
-                py,
-                side * run as f64 + 0.3,
-                side + 0.3,
-                &format!(r#"fill="{}""#, escape(color)),
-            );
-            x += run;
-        }
+        tile_row(svg, f, t, y);
     }
     svg.close_group();
+}
+
+/// Row `y` of the tiles, a rectangle per run of equal cells.
+fn tile_row(svg: &mut Svg, f: &Frame, t: &TileLayer, y: usize) {
+    let side = t.cell_m * f.s;
+    let row = &t.cells[y * t.width..(y + 1) * t.width];
+    let mut x = 0;
+    while x < t.width {
+        let Some(c) = row[x] else {
+            x += 1;
+            continue;
+        };
+        let run = row[x..].iter().take_while(|v| **v == Some(c)).count();
+        let top_left = t.origin + Vec2::new(x as f64, (y + 1) as f64) * t.cell_m;
+        let (px, py) = f.p(top_left);
+        let color = t
+            .palette
+            .get(c as usize)
+            .map(String::as_str)
+            .unwrap_or("#ccc");
+        svg.rect(
+            px,
+            py,
+            side * run as f64 + 0.3,
+            side + 0.3,
+            &format!(r#"fill="{}""#, escape(color)),
+        );
+        x += run;
+    }
 }
 
 /// A numbered marker per waypoint of every route.
@@ -946,6 +956,20 @@ fn label_offsets(spots: &[(f64, f64)]) -> Vec<((f64, f64), bool)> {
         .collect()
 }
 
+/// The line from the ring (radius `r`) around spot `c` towards its label fanned out by `d`.
+fn leader_line(color: &str, c: (f64, f64), d: (f64, f64), r: f64) -> String {
+    let (dx, dy) = d;
+    let len = dx.hypot(dy);
+    format!(
+        r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{color}" stroke-width="1"/>"#,
+        num(c.0 + dx * r / len),
+        num(c.1 + dy * r / len),
+        num(c.0 + dx * 0.8),
+        num(c.1 + dy * 0.8),
+        color = escape(color),
+    )
+}
+
 fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
     if list.is_empty() {
         return;
@@ -957,15 +981,7 @@ fn marks(svg: &mut Svg, f: &Frame, list: &[MarkOverlay]) {
     for ((m, c), ((dx, dy), fanned)) in list.iter().zip(&spots).zip(label_offsets(&spots)) {
         let r = 7.0;
         let leader = if fanned {
-            let len = dx.hypot(dy);
-            format!(
-                r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{color}" stroke-width="1"/>"#,
-                num(c.0 + dx * r / len),
-                num(c.1 + dy * r / len),
-                num(c.0 + dx * 0.8),
-                num(c.1 + dy * 0.8),
-                color = escape(&m.color),
-            )
+            leader_line(&m.color, *c, (dx, dy), r)
         } else {
             String::new()
         };

@@ -348,23 +348,28 @@ pub(crate) fn read_expect(top: &DeTable<'_>, declared: &[&str], d: &mut Diags) -
             opposite: direction_expectation(lt, "opposite", &ctx, d),
         });
     }
-    if let Some((_, v)) = get(t, "quantile")
-        && let Some(q) = number(v, "quantile", "[expect]", d)
-    {
-        if (0.0..1.0).contains(&q) {
-            ex.quantile = Some(q);
-        } else {
-            d.at(
-                v.span().start,
-                format!(
-                    "quantile = {} is outside 0..1; use 0.1 for the 10th percentile",
-                    fmt_number(q)
-                ),
-            );
-        }
+    if let Some(q) = read_quantile(t, d) {
+        ex.quantile = Some(q);
     }
     ex.regression = read_regression(t, d);
     ex
+}
+
+/// `quantile` of `[expect]` when given and in 0..1; a value outside is reported.
+fn read_quantile(t: &DeTable<'_>, d: &mut Diags) -> Option<f64> {
+    let (_, v) = get(t, "quantile")?;
+    let q = number(v, "quantile", "[expect]", d)?;
+    if (0.0..1.0).contains(&q) {
+        return Some(q);
+    }
+    d.at(
+        v.span().start,
+        format!(
+            "quantile = {} is outside 0..1; use 0.1 for the 10th percentile",
+            fmt_number(q)
+        ),
+    );
+    None
 }
 
 /// The `subject` of one `[[expect.subjects]]` entry (`ctx` names it): a built-in or declared
@@ -373,14 +378,7 @@ pub(crate) fn read_expect(top: &DeTable<'_>, declared: &[&str], d: &mut Diags) -
 fn expect_subject_name(lt: &DeTable<'_>, declared: &[&str], ctx: &str, d: &mut Diags) -> String {
     match get(lt, "subject") {
         None => {
-            d.at(
-                0,
-                format!(
-                    "missing key `subject` in {ctx}; add e.g. `subject = \"words-3\"` \
-                     (one of {})",
-                    KNOWN_SUBJECTS.join(", ")
-                ),
-            );
+            d.at(0, missing_subject(ctx));
             String::new()
         }
         Some((_, v)) => match v.get_ref() {
@@ -389,37 +387,7 @@ fn expect_subject_name(lt: &DeTable<'_>, declared: &[&str], ctx: &str, d: &mut D
             {
                 name.to_string()
             }
-            DeValue::String(name) => {
-                // Any other name is an external subject's (`--recognizer NAME=…`), unless
-                // it looks like a built-in or declared one mistyped.
-                let near = crate::spec::suggest::closest(
-                    name,
-                    KNOWN_SUBJECTS.iter().chain(declared).copied(),
-                );
-                if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
-                    let hint = match near {
-                        Some(k) => format!("did you mean `{k}`? "),
-                        None => String::new(),
-                    };
-                    let own = if declared.is_empty() {
-                        String::new()
-                    } else {
-                        format!(", the scenario's [[subjects]] {}", declared.join(", "))
-                    };
-                    d.at(
-                        v.span().start,
-                        format!(
-                            "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
-                             are {}{own} (an external recognizer's name is made of \
-                             letters, digits, `-` and `_`)",
-                            KNOWN_SUBJECTS.join(", ")
-                        ),
-                    );
-                    String::new()
-                } else {
-                    name.to_string()
-                }
-            }
+            DeValue::String(name) => external_subject(name, v.span().start, declared, ctx, d),
             _ => {
                 d.at(
                     v.span().start,
@@ -432,6 +400,57 @@ fn expect_subject_name(lt: &DeTable<'_>, declared: &[&str], ctx: &str, d: &mut D
             }
         },
     }
+}
+
+/// The message for an entry (`ctx`) without `subject`, listing the built-in ones.
+fn missing_subject(ctx: &str) -> String {
+    format!(
+        "missing key `subject` in {ctx}; add e.g. `subject = \"words-3\"` \
+         (one of {})",
+        KNOWN_SUBJECTS.join(", ")
+    )
+}
+
+/// Any name neither built in nor declared is an external subject's (`--recognizer NAME=…`),
+/// unless it looks like a built-in or declared one mistyped: then it is reported, and empty.
+fn external_subject(name: &str, at: usize, declared: &[&str], ctx: &str, d: &mut Diags) -> String {
+    let near = crate::spec::suggest::closest(name, KNOWN_SUBJECTS.iter().chain(declared).copied());
+    if near.is_some() || is_builtin_subject_name(name) || !is_subject_name(name) {
+        unknown_subject(name, near, at, declared, ctx, d);
+        String::new()
+    } else {
+        name.to_string()
+    }
+}
+
+/// Reports the unknown subject `name` at `at`, with the close name `near` if any and the names
+/// the scenario knows.
+fn unknown_subject(
+    name: &str,
+    near: Option<&str>,
+    at: usize,
+    declared: &[&str],
+    ctx: &str,
+    d: &mut Diags,
+) {
+    let hint = match near {
+        Some(k) => format!("did you mean `{k}`? "),
+        None => String::new(),
+    };
+    let own = if declared.is_empty() {
+        String::new()
+    } else {
+        format!(", the scenario's [[subjects]] {}", declared.join(", "))
+    };
+    d.at(
+        at,
+        format!(
+            "unknown subject `{name}` in {ctx}; {hint}the built-in subjects \
+             are {}{own} (an external recognizer's name is made of \
+             letters, digits, `-` and `_`)",
+            KNOWN_SUBJECTS.join(", ")
+        ),
+    );
 }
 
 /// `[expect.regression]` over [`RegressionSpec::default`]; each bad value reported at its key.
@@ -461,19 +480,7 @@ fn read_regression(expect: &DeTable<'_>, d: &mut Diags) -> Option<RegressionSpec
 /// Refuses the `[expect]` form before subjects, at each old key, saying what to write instead.
 fn old_expect_form(t: &DeTable<'_>, d: &mut Diags) {
     if let Some((kat, v)) = get(t, "levels") {
-        let entries: Vec<String> = match v.get_ref() {
-            DeValue::Array(a) => a
-                .iter()
-                .filter_map(|e| match e.get_ref() {
-                    DeValue::Table(lt) => get(lt, "levels").and_then(|(_, n)| match n.get_ref() {
-                        DeValue::Integer(i) => Some(i.as_str().to_string()),
-                        _ => None,
-                    }),
-                    _ => None,
-                })
-                .collect(),
-            _ => Vec::new(),
-        };
+        let entries = old_levels(v);
         let example = entries.first().map_or("3".to_string(), |n| n.clone());
         d.at(
             kat,
@@ -492,6 +499,23 @@ fn old_expect_form(t: &DeTable<'_>, d: &mut Diags) {
              with `subject = \"icp\"` and the same bounds"
                 .to_string(),
         );
+    }
+}
+
+/// The `levels = N` of each entry of an old `[[expect.levels]]`, as written.
+fn old_levels(v: &Val<'_>) -> Vec<String> {
+    match v.get_ref() {
+        DeValue::Array(a) => a
+            .iter()
+            .filter_map(|e| match e.get_ref() {
+                DeValue::Table(lt) => get(lt, "levels").and_then(|(_, n)| match n.get_ref() {
+                    DeValue::Integer(i) => Some(i.as_str().to_string()),
+                    _ => None,
+                }),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
     }
 }
 
@@ -515,15 +539,7 @@ fn direction_expectation(
         return None;
     };
     let ctx = format!("[expect.subjects.{dir}] of {entry}");
-    if let Some((kat, _)) = get(t, "max_seconds_per_lap") {
-        d.at(
-            kat,
-            format!(
-                "`max_seconds_per_lap` in {ctx}: time is not counted per direction; \
-                 bound it in the subject entry itself"
-            ),
-        );
-    }
+    refuse_direction_time(t, &ctx, d);
     let known = [EXPECT_DIRECTION_KEYS, &["max_seconds_per_lap"]].concat();
     unknown_keys(t, &known, &ctx, d);
     let e = expectation(t, &ctx, d);
@@ -533,6 +549,19 @@ fn direction_expectation(
         min_visit_recall: e.min_visit_recall,
         min_pair_recall: e.min_pair_recall,
     })
+}
+
+/// Refuses `max_seconds_per_lap` in a direction's table (`ctx`): time is per subject only.
+fn refuse_direction_time(t: &DeTable<'_>, ctx: &str, d: &mut Diags) {
+    if let Some((kat, _)) = get(t, "max_seconds_per_lap") {
+        d.at(
+            kat,
+            format!(
+                "`max_seconds_per_lap` in {ctx}: time is not counted per direction; \
+                 bound it in the subject entry itself"
+            ),
+        );
+    }
 }
 
 fn expectation(t: &DeTable<'_>, ctx: &str, d: &mut Diags) -> Expectation {

@@ -24,34 +24,40 @@ pub(crate) fn parse_document<'i>(src: &'i str, d: &mut Diags) -> Option<Spanned<
         .iter()
         .min_by_key(|e| e.span().map(|s| s.start).unwrap_or(0));
     if let Some(e) = first {
-        let msg = e
-            .message()
-            .lines()
-            .map(str::trim)
-            .filter(|l| !l.is_empty())
-            .collect::<Vec<_>>()
-            .join(" ");
-        let msg = lowercase_first(msg.trim_end_matches('.'));
-        let at = e.span().map(|s| s.start).unwrap_or(0);
-        if msg == "duplicate key"
-            && let Some(span) = e.span()
-            && let Some(text) = duplicate_key(src, span)
-        {
-            d.at(at, text);
-            return None;
-        }
-        match unclosed_before(src, at) {
-            Some(end) => d.at(
-                end,
-                format!("toml syntax error: {msg} on the next line; a `]` or `}}` is probably missing at the end of this line"),
-            ),
-            None => d.at(
-                at,
-                format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
-            ),
-        }
+        report_syntax_error(src, e, d);
     }
     None
+}
+
+/// Words one parser error for an author: a key set twice gets its own message, an error just
+/// after an unclosed bracket is put at the end of the line that lacks it.
+fn report_syntax_error(src: &str, e: &toml::de::Error, d: &mut Diags) {
+    let msg = e
+        .message()
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    let msg = lowercase_first(msg.trim_end_matches('.'));
+    let at = e.span().map(|s| s.start).unwrap_or(0);
+    if msg == "duplicate key"
+        && let Some(span) = e.span()
+        && let Some(text) = duplicate_key(src, span)
+    {
+        d.at(at, text);
+        return;
+    }
+    match unclosed_before(src, at) {
+        Some(end) => d.at(
+            end,
+            format!("toml syntax error: {msg} on the next line; a `]` or `}}` is probably missing at the end of this line"),
+        ),
+        None => d.at(
+            at,
+            format!("toml syntax error: {msg}; check quotes, brackets, commas and `=` here"),
+        ),
+    }
 }
 
 /// The message for a key set twice, the second time at `span`: the key, the table it is in
@@ -68,22 +74,39 @@ fn duplicate_key(src: &str, span: std::ops::Range<usize>) -> Option<String> {
             .is_some_and(|rest| rest.trim_start().starts_with('='))
     };
     if header(lines.get(here)?) {
-        // A table header given twice: the first header of the same text.
-        let first = lines[..here]
-            .iter()
-            .position(|l| l.trim() == lines[here].trim())?;
-        return Some(format!(
-            "duplicate table `{}` (first on line {}); merge the two into one",
-            lines[here].trim(),
-            first + 1
-        ));
+        return duplicate_table(&lines, here);
     }
     let start = lines[..here]
         .iter()
         .rposition(|l| header(l))
         .map_or(0, |k| k + 1);
     let first = start + lines[start..here].iter().position(|l| is_key(l))?;
-    let table = match start.checked_sub(1).map(|k| lines[k].trim()) {
+    let table = table_named(&lines, start);
+    Some(format!(
+        "duplicate key `{}` in {table} (first set on line {}); keep one of the two",
+        echo(key),
+        first + 1
+    ))
+}
+
+/// The message for a table header given twice (on line `here`), naming the first header of the
+/// same text.
+fn duplicate_table(lines: &[&str], here: usize) -> Option<String> {
+    let first = lines[..here]
+        .iter()
+        .position(|l| l.trim() == lines[here].trim())?;
+    Some(format!(
+        "duplicate table `{}` (first on line {}); merge the two into one",
+        lines[here].trim(),
+        first + 1
+    ))
+}
+
+/// The table whose keys start on line `start`, as a message names it: "the file" before any
+/// header, "door 'd1'" for an entry of an array of tables with an id, "[kind]" otherwise.
+fn table_named(lines: &[&str], start: usize) -> String {
+    let header = |l: &str| l.trim_start().starts_with('[');
+    match start.checked_sub(1).map(|k| lines[k].trim()) {
         None => "the file".to_string(),
         Some(h) => {
             let kind = h.trim_matches(|c| c == '[' || c == ']');
@@ -103,12 +126,7 @@ fn duplicate_key(src: &str, span: std::ops::Range<usize>) -> Option<String> {
                 _ => format!("[{kind}]"),
             }
         }
-    };
-    Some(format!(
-        "duplicate key `{}` in {table} (first set on line {}); keep one of the two",
-        echo(key),
-        first + 1
-    ))
+    }
 }
 
 /// When an error sits at the start of a line while an array or inline table opened on an
@@ -223,6 +241,11 @@ pub(crate) fn number(v: &Val<'_>, key: &str, ctx: &str, d: &mut Diags) -> Option
             return None;
         }
     };
+    finite(x, at, key, ctx, d)
+}
+
+/// `x` when it was read and is finite; otherwise reports why not at `at`.
+fn finite(x: Option<f64>, at: usize, key: &str, ctx: &str, d: &mut Diags) -> Option<f64> {
     match x {
         Some(x) if x.is_finite() => Some(x),
         Some(_) => {
@@ -287,6 +310,18 @@ pub(crate) fn points(
         );
         return None;
     };
+    each_point(a, key, ctx, d, spans)
+}
+
+/// Reads every point of the list `a` (all of them, so each bad one is reported); `None` if any
+/// is bad or `d` fills up.
+fn each_point(
+    a: &toml::de::DeArray<'_>,
+    key: &str,
+    ctx: &str,
+    d: &mut Diags,
+    spans: &mut Vec<usize>,
+) -> Option<Vec<[f64; 2]>> {
     let mut out = Vec::with_capacity(a.len().min(MAX_SEGMENTS + 1));
     let mut ok = true;
     for p in a.iter() {
@@ -358,6 +393,11 @@ pub(crate) fn id(
     let Some(s) = string(v, "id", ctx, d) else {
         return (None, at);
     };
+    (plain_id(s, at, ctx, d), at)
+}
+
+/// `s` when it is a plain id (non-empty; letters, digits, `-`, `_`, `.`); otherwise reports it.
+fn plain_id(s: String, at: usize, ctx: &str, d: &mut Diags) -> Option<String> {
     if s.is_empty()
         || !s
             .chars()
@@ -370,9 +410,9 @@ pub(crate) fn id(
                 echo(&s)
             ),
         );
-        return (None, at);
+        return None;
     }
-    (Some(s), at)
+    Some(s)
 }
 
 /// The array of tables under `key` (e.g. `[[doors]]`), or an error when it is something else.
@@ -394,6 +434,15 @@ pub(crate) fn table_array<'t, 'i>(
         );
         return Vec::new();
     };
+    tables_of(a, key, d)
+}
+
+/// The tables of the array under `key`; each entry that is not a table is reported.
+fn tables_of<'t, 'i>(
+    a: &'t toml::de::DeArray<'i>,
+    key: &str,
+    d: &mut Diags,
+) -> Vec<(usize, &'t DeTable<'i>)> {
     let mut out = Vec::new();
     for e in a.iter() {
         match e.get_ref() {

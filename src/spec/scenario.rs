@@ -165,26 +165,7 @@ fn check_number_limits(table: &str, s: &Settings, d: &mut Diags) {
         if !a.is_finite() || (a <= l.max && (a == 0.0 || a >= l.min_nonzero)) {
             continue;
         }
-        let unit = if l.unit.is_empty() {
-            String::new()
-        } else {
-            format!(" {}", l.unit)
-        };
-        let what = if x > l.max {
-            format!("more than {}{unit}, the most", fmt_number(l.max))
-        } else if x < -l.max {
-            format!("less than -{}{unit}, the least", fmt_number(l.max))
-        } else {
-            let off = if l.off_at_zero {
-                " (0 turns it off)"
-            } else {
-                ""
-            };
-            format!(
-                "less than {}{unit}{off}, the finest",
-                fmt_number(l.min_nonzero)
-            )
-        };
+        let what = beyond_words(l, x);
         d.at(
             v.span().start,
             format!(
@@ -193,6 +174,30 @@ fn check_number_limits(table: &str, s: &Settings, d: &mut Diags) {
                 l.typical
             ),
         );
+    }
+}
+
+/// How `x` is beyond limit `l`, as "more than 5 m, the most" (followed by "the simulator takes").
+fn beyond_words(l: &NumberLimit, x: f64) -> String {
+    let unit = if l.unit.is_empty() {
+        String::new()
+    } else {
+        format!(" {}", l.unit)
+    };
+    if x > l.max {
+        format!("more than {}{unit}, the most", fmt_number(l.max))
+    } else if x < -l.max {
+        format!("less than -{}{unit}, the least", fmt_number(l.max))
+    } else {
+        let off = if l.off_at_zero {
+            " (0 turns it off)"
+        } else {
+            ""
+        };
+        format!(
+            "less than {}{unit}{off}, the finest",
+            fmt_number(l.min_nonzero)
+        )
     }
 }
 
@@ -446,9 +451,8 @@ pub fn read_scenario(src: &str, d: &mut Diags) -> Option<ScenarioSpec> {
 /// `name`, `description`, `world`, `route`, `seed`.
 type Head = (Option<String>, Option<String>, S<String>, S<String>, S<u64>);
 
-/// `format_version`, then the [`Head`].
-fn read_head(top: &DeTable<'_>, d: &mut Diags) -> Option<Head> {
-    let ctx = "the scenario file";
+/// Reports a missing or unsupported `format_version` (only 1 is read).
+fn check_format_version(top: &DeTable<'_>, ctx: &str, d: &mut Diags) {
     match get(top, "format_version") {
         None => missing(
             top,
@@ -466,6 +470,12 @@ fn read_head(top: &DeTable<'_>, d: &mut Diags) -> Option<Head> {
             ),
         },
     }
+}
+
+/// `format_version`, then the [`Head`].
+fn read_head(top: &DeTable<'_>, d: &mut Diags) -> Option<Head> {
+    let ctx = "the scenario file";
+    check_format_version(top, ctx, d);
     let name = get(top, "name").and_then(|(_, v)| string(v, "name", ctx, d));
     let description = get(top, "description").and_then(|(_, v)| string(v, "description", ctx, d));
     let world = required_string(top, "world", "the world file, relative to this file", d);
@@ -714,20 +724,7 @@ fn read_pedestrians(top: &DeTable<'_>, d: &mut Diags) -> Option<PedestriansSpec>
     let (at, t) = table(top, "pedestrians", d)?;
     let ctx = "[pedestrians]";
     unknown_keys(t, PEDESTRIAN_KEYS, ctx, d);
-    let count = match get(t, "count") {
-        None => {
-            missing(
-                t,
-                "count",
-                PEDESTRIAN_KEYS,
-                at,
-                "missing key `count` in [pedestrians]; add `count = 1`".into(),
-                d,
-            );
-            None
-        }
-        Some((_, v)) => pedestrian_count(v, d),
-    };
+    let count = read_count(t, at, d);
     let areas = get(t, "areas")
         .and_then(|(_, v)| strings(v, "areas", ctx, d))
         .unwrap_or_default();
@@ -741,6 +738,24 @@ fn read_pedestrians(top: &DeTable<'_>, d: &mut Diags) -> Option<PedestriansSpec>
         paths_m,
         settings,
     })
+}
+
+/// The required `count` of `[pedestrians]` (the table at `at`).
+fn read_count(t: &DeTable<'_>, at: usize, d: &mut Diags) -> Option<S<usize>> {
+    match get(t, "count") {
+        None => {
+            missing(
+                t,
+                "count",
+                PEDESTRIAN_KEYS,
+                at,
+                "missing key `count` in [pedestrians]; add `count = 1`".into(),
+                d,
+            );
+            None
+        }
+        Some((_, v)) => pedestrian_count(v, d),
+    }
 }
 
 fn pedestrian_count(v: &Val<'_>, d: &mut Diags) -> Option<S<usize>> {
@@ -775,36 +790,41 @@ fn walk_paths(v: &Val<'_>, d: &mut Diags) -> Vec<S<Vec<[f64; 2]>>> {
     };
     let mut out = Vec::new();
     for p in a.iter() {
-        let mut spans = Vec::new();
-        if let Some(pts) = points(p, "paths_m", "[pedestrians]", d, &mut spans) {
-            let far = pts
-                .iter()
-                .zip(&spans[spans.len() - pts.len()..])
-                .find(|(q, _)| q[0].abs() > MAX_ABS_COORD_M || q[1].abs() > MAX_ABS_COORD_M);
-            if pts.len() < 2 {
-                d.at(
-                    p.span().start,
-                    "a path needs at least two finite points [x, y]".into(),
-                );
-            } else if let Some((q, &at)) = far {
-                d.at(
-                    at,
-                    format!(
-                        "the walking point [{}, {}] is more than {:.0} km from the origin; paths \
-                         are metres in the world's frame: use points inside the world",
-                        fmt_number(q[0]),
-                        fmt_number(q[1]),
-                        MAX_ABS_COORD_M / 1000.0
-                    ),
-                );
-                // Kept, so the file does not also read as having nowhere to walk.
-                out.push(Spanned::new(p.span(), pts));
-            } else {
-                out.push(Spanned::new(p.span(), pts));
-            }
-        }
+        out.extend(walk_path(p, d));
     }
     out
+}
+
+/// One path of `paths_m`, reported when it has fewer than two points or a point far out;
+/// `None` when it is not kept.
+fn walk_path(p: &Val<'_>, d: &mut Diags) -> Option<S<Vec<[f64; 2]>>> {
+    let mut spans = Vec::new();
+    let pts = points(p, "paths_m", "[pedestrians]", d, &mut spans)?;
+    let far = pts
+        .iter()
+        .zip(&spans[spans.len() - pts.len()..])
+        .find(|(q, _)| q[0].abs() > MAX_ABS_COORD_M || q[1].abs() > MAX_ABS_COORD_M);
+    if pts.len() < 2 {
+        d.at(
+            p.span().start,
+            "a path needs at least two finite points [x, y]".into(),
+        );
+        return None;
+    }
+    if let Some((q, &at)) = far {
+        d.at(
+            at,
+            format!(
+                "the walking point [{}, {}] is more than {:.0} km from the origin; paths \
+                 are metres in the world's frame: use points inside the world",
+                fmt_number(q[0]),
+                fmt_number(q[1]),
+                MAX_ABS_COORD_M / 1000.0
+            ),
+        );
+        // Kept, so the file does not also read as having nowhere to walk.
+    }
+    Some(Spanned::new(p.span(), pts))
 }
 
 /// A model table (`[laser]`, `[odometry]`, `[robot]`); absent means all defaults.
