@@ -202,8 +202,9 @@ impl Match {
     }
 }
 
-/// A candidate a recognizer considered and turned down, as one observation pair, so the harness
-/// can tell (by its truth) whether it turned down a true revisit or a look-alike.
+/// A candidate a recognizer considered and turned down, as one observation pair (and, for a
+/// candidate that spans a stretch, the pair at its other end), so the harness can tell (by its
+/// truth) whether it turned down a true revisit or a look-alike.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct RejectedCandidate {
@@ -212,6 +213,10 @@ pub struct RejectedCandidate {
     pub direction: Direction,
     /// The check that turned it down: an index into [`Diagnostics::checks`].
     pub check: usize,
+    /// The pair at the candidate's oldest end, when it spans a stretch (a chain of words): the
+    /// candidate is a true revisit only when both ends are, since two paths that meet at one
+    /// end (the robot arrived from another corridor) make a chain whose older pairs are false.
+    pub oldest: Option<(ObsId, ObsId)>,
 }
 
 impl RejectedCandidate {
@@ -222,6 +227,15 @@ impl RejectedCandidate {
             past,
             direction,
             check,
+            oldest: None,
+        }
+    }
+
+    /// The same candidate, spanning a stretch whose oldest end is the pair `(query, past)`.
+    pub fn with_oldest(self, query: ObsId, past: ObsId) -> Self {
+        RejectedCandidate {
+            oldest: Some((query, past)),
+            ..self
         }
     }
 }

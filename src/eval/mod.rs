@@ -233,7 +233,8 @@ pub struct Recognition {
 }
 
 /// A candidate the recognizer's verification turned down, with the true poses of the
-/// observation pair it was sampled at (`recognizer::RejectedCandidate`).
+/// observation pair it was sampled at (`recognizer::RejectedCandidate`) and of the pair at its
+/// oldest end when it spans a stretch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RejectedTruth {
     pub query: TruePose,
@@ -241,19 +242,27 @@ pub struct RejectedTruth {
     pub direction: Direction,
     /// The check that turned it down ([`Diagnostics::checks`]).
     pub check: usize,
+    /// The true poses of the pair at the candidate's oldest end, when the recognizer gave one.
+    pub oldest: Option<(TruePose, TruePose)>,
 }
 
 impl RejectedTruth {
-    /// Whether the pair is correct with `spec`'s rules: within `tp_radius_m`, facing as the
-    /// candidate's direction claims (a true revisit that verification turned down).
+    /// Whether the candidate is a true revisit with `spec`'s rules: its pair (and the pair at
+    /// its oldest end, when it has one) within `tp_radius_m`, facing as the candidate's
+    /// direction claims. A chain whose newest pair is the same place but whose oldest is not
+    /// (the robot reached one place from two corridors) is a look-alike: accepted, it would
+    /// claim false pairs.
     pub fn is_right(&self, spec: &EvaluationSpec) -> bool {
-        let (q, p) = (self.query.0, self.past.0);
-        q.distance(&p) <= spec.tp_radius_m
-            && pair_recall::Facing::of(self.direction).agrees(
-                q.theta,
-                p.theta,
-                spec.heading_tolerance_deg.to_radians(),
-            )
+        let right = |(q, p): (TruePose, TruePose)| {
+            let (q, p) = (q.0, p.0);
+            q.distance(&p) <= spec.tp_radius_m
+                && pair_recall::Facing::of(self.direction).agrees(
+                    q.theta,
+                    p.theta,
+                    spec.heading_tolerance_deg.to_radians(),
+                )
+        };
+        right((self.query, self.past)) && self.oldest.is_none_or(right)
     }
 }
 
@@ -281,11 +290,17 @@ fn rejected_truth(
     rejected
         .iter()
         .filter_map(|r| {
+            let pose = |id: ObsId| truth.observation_pose(find(id)?);
+            let oldest = match r.oldest {
+                Some((q, p)) => Some((pose(q)?, pose(p)?)),
+                None => None,
+            };
             Some(RejectedTruth {
-                query: truth.observation_pose(find(r.query)?)?,
-                past: truth.observation_pose(find(r.past)?)?,
+                query: pose(r.query)?,
+                past: pose(r.past)?,
                 direction: r.direction,
                 check: r.check,
+                oldest,
             })
         })
         .collect()
@@ -698,5 +713,43 @@ impl Ended {
             ranking,
             ..Recognition::new(self.name, self.observations, r.matches, r.laps, truth)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Pose2;
+
+    /// A turned-down chain is a true revisit only when both its ends are the same place: one
+    /// whose newest pair coincides but whose oldest pair lies 5 m apart (the robot came from
+    /// another corridor) is a look-alike.
+    #[test]
+    fn a_rejected_chain_is_a_true_revisit_only_at_both_ends() {
+        let spec = EvaluationSpec::default();
+        let at = |x: f64, y: f64| TruePose(Pose2::new(x, y, 0.0));
+        let newest_right = RejectedTruth {
+            query: at(0.0, 0.0),
+            past: at(0.2, 0.0),
+            direction: Direction::Same,
+            check: 0,
+            oldest: None,
+        };
+        assert!(newest_right.is_right(&spec));
+        let both_right = RejectedTruth {
+            oldest: Some((at(-10.0, 0.0), at(-9.8, 0.1))),
+            ..newest_right
+        };
+        assert!(both_right.is_right(&spec));
+        let oldest_apart = RejectedTruth {
+            oldest: Some((at(-10.0, 0.0), at(-6.0, 3.0))),
+            ..newest_right
+        };
+        assert!(!oldest_apart.is_right(&spec));
+        let newest_apart = RejectedTruth {
+            past: at(3.0, 0.0),
+            ..both_right
+        };
+        assert!(!newest_apart.is_right(&spec));
     }
 }

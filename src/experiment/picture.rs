@@ -742,6 +742,7 @@ mod tests {
             past: at(p),
             direction: Direction::Same,
             check: reason.index(),
+            oldest: None,
         };
         let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
         let rejected = [

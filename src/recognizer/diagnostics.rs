@@ -7,7 +7,7 @@
 use super::matcher::WordMatcher;
 use super::types::Direction;
 use super::words::WordId;
-use crate::place::{CandidateCounts, Diagnostics, RejectedCandidate};
+use crate::place::{CandidateCounts, Diagnostics, ObsId, RejectedCandidate};
 
 /// Rejected candidates sampled at most (the first ones; 32 bytes each).
 pub(crate) const MAX_REJECTED_SAMPLES: usize = 10_000;
@@ -298,25 +298,32 @@ impl WordMatcher {
         }
     }
 
-    /// A rejected candidate's sample: the middle observation of its newest current word `c`,
-    /// and the past observation the n-gram's shift `anchor` aligns with it (clamped into the
-    /// past word `p`).
+    /// A rejected candidate's sample: at its newest and at its oldest word pair, the middle
+    /// observation of the current word and the past observation the n-gram's shift aligns with
+    /// it (clamped into the past word).
     pub(super) fn sample(
         &self,
-        (c, p): (WordId, WordId),
-        anchor: i64,
+        word_pairs: &[(WordId, WordId)],
+        anchors: &[i64],
         dir: Direction,
         reason: Rejection,
     ) -> RejectedCandidate {
+        let (newest, oldest) = (word_pairs.len() - 1, 0);
+        let (q, p) = self.sample_pair(word_pairs[newest], anchors[newest], dir);
+        let (q0, p0) = self.sample_pair(word_pairs[oldest], anchors[oldest], dir);
+        RejectedCandidate::new(q, p, dir, reason.index()).with_oldest(q0, p0)
+    }
+
+    /// The middle observation of current word `c` and the past observation shift `anchor`
+    /// aligns with it (clamped into past word `p`).
+    fn sample_pair(&self, (c, p): (WordId, WordId), anchor: i64, dir: Direction) -> (ObsId, ObsId) {
         let (cw, pw) = (self.word(c), self.word(p));
         let i = cw.size as i64 / 2;
         let j = (i + anchor).clamp(0, (pw.size as i64 - 1).max(0));
         let obs = self.words.observations();
-        RejectedCandidate {
-            query: obs[cw.first_obs + i as usize].id,
-            past: obs[super::align::PastSide::of(pw, dir).index(j)].id,
-            direction: dir,
-            check: reason.index(),
-        }
+        (
+            obs[cw.first_obs + i as usize].id,
+            obs[super::align::PastSide::of(pw, dir).index(j)].id,
+        )
     }
 }

@@ -337,9 +337,13 @@ impl WordMatcher {
         {
             self.rejections.add(reason);
             if self.rejected.len() < MAX_REJECTED_SAMPLES {
-                let (&newest, &anchor) =
-                    (&scr.word_pairs[pairs.end - 1], &scr.anchors[pairs.end - 1]);
-                self.rejected.push(self.sample(newest, anchor, dir, reason));
+                let sample = self.sample(
+                    &scr.word_pairs[pairs.clone()],
+                    &scr.anchors[pairs.clone()],
+                    dir,
+                    reason,
+                );
+                self.rejected.push(sample);
             }
             scr.truncate(from, placed_from);
             return None;

@@ -78,7 +78,7 @@ fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
     if r.correct == 0 {
         return format!(
             "by the ground truth none of the {} rejected candidates sampled paired the same \
-             place (within {} m): verification turned down look-alikes",
+             place (within {} m, at both ends of a chain): verification turned down look-alikes",
             r.sampled, spec.tp_radius_m
         );
     }
@@ -89,7 +89,7 @@ fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
         .collect();
     format!(
         "by the ground truth {} of the {} rejected candidates sampled paired the same place \
-         (within {} m; {}): verification turned down true revisits",
+         (within {} m, at both ends of a chain; {}): verification turned down true revisits",
         r.correct,
         r.sampled,
         spec.tp_radius_m,
@@ -267,6 +267,7 @@ mod tests {
             past: p,
             direction,
             check: reason.index(),
+            oldest: None,
         };
         let checks: Vec<String> = Rejection::ALL.iter().map(|r| r.name().into()).collect();
         let rejected = [
