@@ -109,22 +109,35 @@ fn centre_loop(rng: &mut SimRng, w: f64, h: f64, cuts: usize) -> Vec<Vec2> {
             out.push(*c);
             continue;
         }
-        let cx = rng.random_range(0.2..0.3) * (x1 - x0);
-        let cy = rng.random_range(0.2..0.3) * (y1 - y0);
-        let (sx, sy) = inward[k];
-        let a = *c + Vec2::new(0.0, sy * cy);
-        let m = *c + Vec2::new(sx * cx, sy * cy);
-        let b = *c + Vec2::new(sx * cx, 0.0);
-        // Counter-clockwise: arrive along the previous edge, leave along the next.
-        if k % 2 == 0 {
-            out.extend([a, m, b]);
-        } else {
-            out.extend([b, m, a]);
-        }
+        out.extend(cut_corner(
+            rng,
+            *c,
+            inward[k],
+            (x1 - x0, y1 - y0),
+            k % 2 == 0,
+        ));
     }
     out.iter()
         .map(|p| Vec2::new(round_cm(p.x), round_cm(p.y)))
         .collect()
+}
+
+/// The three points that replace corner `c` by a notch 20-30 % of the loop's `size` deep in
+/// each direction, going `inward` (signs along x and y); counter-clockwise: arriving along the
+/// previous edge and leaving along the next (`even`: the notch's y side comes first).
+fn cut_corner(
+    rng: &mut SimRng,
+    c: Vec2,
+    (sx, sy): (f64, f64),
+    size: (f64, f64),
+    even: bool,
+) -> [Vec2; 3] {
+    let cx = rng.random_range(0.2..0.3) * size.0;
+    let cy = rng.random_range(0.2..0.3) * size.1;
+    let a = c + Vec2::new(0.0, sy * cy);
+    let m = c + Vec2::new(sx * cx, sy * cy);
+    let b = c + Vec2::new(sx * cx, 0.0);
+    if even { [a, m, b] } else { [b, m, a] }
 }
 
 /// One office slot: corridor edge, start and end along it (metres from the edge's start), and

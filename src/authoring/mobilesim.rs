@@ -500,11 +500,7 @@ fn extend_chain(
             .and_then(|v| v.iter().copied().find(|&j| !used[j]));
         let Some(j) = next else { break };
         used[j] = true;
-        let other = if mm(segs[j].a) == k {
-            segs[j].b
-        } else {
-            segs[j].a
-        };
+        let other = far_end(segs[j], k);
         if forward {
             chain.push_back(other);
         } else {
@@ -513,13 +509,15 @@ fn extend_chain(
     }
 }
 
-/// The world file text for an imported world, with a header naming the source.
-pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser::Error> {
-    // Point lists one `[x, y]` pair per line (toml writes them either on one long line or one
-    // number per line).
-    let body = toml::to_string(spec)?;
-    let body: String = body
-        .lines()
+/// The end of `seg` that is not at `k` (millimetre key).
+fn far_end(seg: &Segment, k: (i64, i64)) -> Vec2 {
+    if mm(seg.a) == k { seg.b } else { seg.a }
+}
+
+/// `body` (toml) with point lists one `[x, y]` pair per line (toml writes them either on one
+/// long line or one number per line) and without empty arrays.
+fn pairs_per_line(body: &str) -> String {
+    body.lines()
         .map(|l| match l.split_once(" = [[") {
             Some((key, rest)) if rest.ends_with("]]") => format!(
                 "{key} = [\n    [{}],\n]\n",
@@ -529,7 +527,12 @@ pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser
             _ if l.ends_with(" = []") => String::new(),
             _ => format!("{l}\n"),
         })
-        .collect();
+        .collect()
+}
+
+/// The world file text for an imported world, with a header naming the source.
+pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser::Error> {
+    let body = pairs_per_line(&toml::to_string(spec)?);
     let route_note = if spec.routes.is_empty() {
         "# NO ROUTE: none could be generated through the free space. Add a [[routes]] block by hand\n\
          # (id = \"loop\", waypoints_m = [[x1, y1], [x2, y2], [x3, y3], ...]: at least 3 waypoints, each\n\
