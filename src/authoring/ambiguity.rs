@@ -249,6 +249,14 @@ impl Drive {
         let along = (mid(c.0, c.1) - mid(p.0, p.1)).rem_euclid(self.loop_m);
         along.min(self.loop_m - along) <= radius_m
     }
+
+    /// The door set of the frame of word `w`'s first observation.
+    fn door_set_of_word(&self, rec: &Recognizer, w: &Word) -> usize {
+        let f = rec.observations()[w.obs_range().start]
+            .frame_id
+            .min(self.frames.len() - 1);
+        self.door_set_of_frame[f]
+    }
 }
 
 /// A word's stretch of the route (start, end, metres along it) and its middle true position.
@@ -274,13 +282,7 @@ struct Confused {
 
 fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64) -> Vec<Confused> {
     let words = rec.words();
-    let obs = rec.observations();
-    let door_set = |w: &Word| {
-        let f = obs[w.obs_range().start]
-            .frame_id
-            .min(drive.frames.len() - 1);
-        drive.door_set_of_frame[f]
-    };
+    let door_set = |w: &Word| drive.door_set_of_word(rec, w);
     let mut out = Vec::new();
     for m in matches {
         for (c, p) in &m.word_pairs {
@@ -437,17 +439,6 @@ fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
 /// partner; each with its cause and score (the confused word pairs merged into it).
 fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
     let places: Vec<Confusion> = conf.iter().map(|c| c.places).collect();
-    let stretch =
-        |arc: &Arc, number: usize, pair: usize, partner: usize, cause, score| AmbiguousStretch {
-            number,
-            pair,
-            from_m: round_dm(arc.start),
-            to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
-            length_m: round_dm(arc.len),
-            partners: vec![partner],
-            cause,
-            score,
-        };
     merged_pairs(&places, loop_m)
         .iter()
         .enumerate()
@@ -458,20 +449,47 @@ fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
                 .filter(|c| merge(pair, &arcs(&[c.places], loop_m)[0], loop_m).is_some())
                 .collect();
             let (a, b) = pair;
-            let cause = if a.touches(b, loop_m) {
-                Cause::Shift
-            } else if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
-                Cause::DoorChange
-            } else {
-                Cause::LookAlike
-            };
+            let cause = cause_of(pair, &inside, loop_m);
             let score = inside.len() as f64;
             [
-                stretch(a, na, k, nb, cause, score),
-                stretch(b, nb, k, na, cause, score),
+                stretch(a, (na, k, nb), cause, score, loop_m),
+                stretch(b, (nb, k, na), cause, score, loop_m),
             ]
         })
         .collect()
+}
+
+/// Stretch `arc` (of a loop `loop_m` long), numbered `number`, half of pair `pair` with
+/// stretch `partner`.
+fn stretch(
+    arc: &Arc,
+    (number, pair, partner): (usize, usize, usize),
+    cause: Cause,
+    score: f64,
+    loop_m: f64,
+) -> AmbiguousStretch {
+    AmbiguousStretch {
+        number,
+        pair,
+        from_m: round_dm(arc.start),
+        to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
+        length_m: round_dm(arc.len),
+        partners: vec![partner],
+        cause,
+        score,
+    }
+}
+
+/// Why the stretches of `pair` look alike: they overlap (a shift), every confusion `inside`
+/// them came with a door change, or they look alike.
+fn cause_of((a, b): &(Arc, Arc), inside: &[&Confused], loop_m: f64) -> Cause {
+    if a.touches(b, loop_m) {
+        Cause::Shift
+    } else if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
+        Cause::DoorChange
+    } else {
+        Cause::LookAlike
+    }
 }
 
 /// Rounded to 0.1 m (the route positions are no more precise).

@@ -313,20 +313,25 @@ fn world_without_route(
             y_m: r3(hy),
             heading_deg: hdeg,
         },
-        walls: chains
-            .into_iter()
-            .enumerate()
-            .map(|(i, (pts, closed))| WallSpec {
-                id: format!("w{}", i + 1),
-                points_m: pts.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
-                closed,
-                thickness_m: WALL_THICKNESS_M,
-            })
-            .collect(),
+        walls: chain_walls(chains),
         doors: Vec::new(),
         routes: Vec::new(),
         areas: Vec::new(),
     }
+}
+
+/// A wall per chain of points (closed or not), named `w1`, `w2`… in their order.
+fn chain_walls(chains: Vec<(Vec<Vec2>, bool)>) -> Vec<WallSpec> {
+    chains
+        .into_iter()
+        .enumerate()
+        .map(|(i, (pts, closed))| WallSpec {
+            id: format!("w{}", i + 1),
+            points_m: pts.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
+            closed,
+            thickness_m: WALL_THICKNESS_M,
+        })
+        .collect()
 }
 
 /// How far outside the walls' bounding box the home may lie, metres.
@@ -352,6 +357,19 @@ fn home_inside_walls(
     if outside <= HOME_MARGIN_M {
         return Ok(());
     }
+    Err(Diagnostic::error(
+        name,
+        robot_home_at(src),
+        format!(
+            "RobotHome ({:.2}, {:.2}) m is {outside:.1} m outside the map's walls (limit {HOME_MARGIN_M} m); \
+         put the home inside the building, in millimetres like the lines",
+            home.x, home.y
+        ),
+    ))
+}
+
+/// The (line, column) of the first `RobotHome` in `src`, 1-based ((1, 1) without one).
+fn robot_home_at(src: &str) -> (usize, usize) {
     let line = src
         .lines()
         .position(|l| l.contains("RobotHome"))
@@ -361,15 +379,7 @@ fn home_inside_walls(
         .nth(line - 1)
         .and_then(|l| l.find("RobotHome"))
         .map_or(1, |c| c + 1);
-    Err(Diagnostic::error(
-        name,
-        (line, col),
-        format!(
-            "RobotHome ({:.2}, {:.2}) m is {outside:.1} m outside the map's walls (limit {HOME_MARGIN_M} m); \
-         put the home inside the building, in millimetres like the lines",
-            home.x, home.y
-        ),
-    ))
+    (line, col)
 }
 
 /// The repairs the import makes so that a map drawn carelessly still gives a world `world

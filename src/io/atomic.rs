@@ -581,6 +581,16 @@ impl Journal {
 /// The file inside a staged replacement folder naming its set's marker (removed once in place).
 const SET_TAG: &str = ".placewords-set";
 
+/// Creates picture folder `dir` when missing and an empty staging folder for it, returned.
+fn fresh_staging(dir: &Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    remove_stale_temps(dir);
+    let staging = temp_path(dir);
+    let _ = std::fs::remove_dir_all(&staging);
+    std::fs::create_dir(&staging)?;
+    Ok(staging)
+}
+
 impl OutputSet {
     /// Begins a set of output `files`, picture folders `dirs` (created if missing; the set's files
     /// are added to them) and folders `replaced`, each replaced whole when it is empty, new or,
@@ -609,11 +619,7 @@ impl OutputSet {
             set.files.push((file.to_path_buf(), temp_path(file)));
         }
         for &dir in dirs {
-            std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-            remove_stale_temps(dir);
-            let staging = temp_path(dir);
-            let _ = std::fs::remove_dir_all(&staging);
-            std::fs::create_dir(&staging).map_err(|e| io(dir, e))?;
+            let staging = fresh_staging(dir).map_err(|e| io(dir, e))?;
             set.dirs.push((dir.to_path_buf(), staging));
         }
         for &(dir, replaceable) in replaced {

@@ -190,24 +190,26 @@ fn required_fields(fields: &[(usize, &str)]) -> Result<[usize; 4], (usize, Strin
     Ok(ints)
 }
 
+/// An error unless a row has from 4 to `most` fields (`found`).
+fn field_count_ok(found: usize, most: usize) -> Result<(), (usize, String)> {
+    if (4..=most).contains(&found) {
+        return Ok(());
+    }
+    let range = if most == 5 {
+        "4 or 5".to_string()
+    } else {
+        format!("4 to {most}")
+    };
+    Err((
+        1,
+        format!("expected {range} comma-separated fields, as the header says; found {found}"),
+    ))
+}
+
 /// One data line laid out as the header says; errors carry the 1-based column.
 fn parse_row(text: &str, layout: &[Optional]) -> Result<MatchRow, (usize, String)> {
     let fields = fields(text);
-    let most = 4 + layout.len();
-    if !(4..=most).contains(&fields.len()) {
-        let range = if most == 5 {
-            "4 or 5".to_string()
-        } else {
-            format!("4 to {most}")
-        };
-        return Err((
-            1,
-            format!(
-                "expected {range} comma-separated fields, as the header says; found {}",
-                fields.len()
-            ),
-        ));
-    }
+    field_count_ok(fields.len(), 4 + layout.len())?;
     let ints = required_fields(&fields)?;
     let mut row = MatchRow {
         query_run: ints[0],

@@ -1290,19 +1290,22 @@ fn waypoints_too_close(
         let worst = nearest_of(all, s, need_wp);
         if let Some((o, c, state)) = worst {
             bad[k] = true;
+            let what = format!("{} {}", fmt_m(c), owner_name(spec, o, state));
             d.at(
                 l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
-                format!(
-                    "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
-                    r.id,
-                    k,
-                    fmt_m(c),
-                    owner_name(spec, o, state)
-                ),
+                waypoint_too_close(&r.id, k, &what, robot_radius_m),
             );
         }
     }
     bad
+}
+
+/// The error for waypoint `k` of route `id` that is `what` (how near to what).
+fn waypoint_too_close(id: &str, k: usize, what: &str, robot_radius_m: f64) -> String {
+    let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
+    format!(
+        "route '{id}' waypoint {k} is {what}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors"
+    )
 }
 
 /// The open heading, degrees, of `door` swung the other way (mirrored in its closed panel),

@@ -367,10 +367,7 @@ pub fn read_bag_bytes(
         Some(t) => truepos_records(&channels, name, t)?,
         None => Vec::new(),
     };
-    let max_range_m = scans
-        .first()
-        .map(|s| f32_decimal(s.range_max))
-        .filter(|r| r.is_finite() && *r > 0.0);
+    let max_range_m = max_range_m(&scans);
     let lasers = laser_records(scans, &odoms, max_range_m, name)?;
     Ok(BagReadout {
         lasers,
@@ -378,6 +375,14 @@ pub fn read_bag_bytes(
         max_range_m,
         topics: list,
     })
+}
+
+/// The first scan's maximum range, metres, when positive and finite.
+fn max_range_m(scans: &[LaserScan]) -> Option<f64> {
+    scans
+        .first()
+        .map(|s| f32_decimal(s.range_max))
+        .filter(|r| r.is_finite() && *r > 0.0)
 }
 
 /// The (time s, pose) of each message of odometry channel `id`, in time order.
@@ -458,19 +463,24 @@ fn laser_records(
                 gap_s,
                 max_gap_s: ODOM_MAX_GAP_S,
             })?;
-            let n = s.ranges.len();
-            Ok(LaserRecord {
-                start_angle_rad: s.angle_min as f64,
-                fov_rad: s.angle_increment as f64 * n.saturating_sub(1) as f64,
-                ranges_m: ranges_m(&s.ranges, no_return),
-                pose,
-                odom: pose,
-                ipc_timestamp: t,
-                host: String::new(),
-                logger_timestamp: t,
-            })
+            Ok(laser_record(&s, pose, no_return))
         })
         .collect()
+}
+
+/// The laser record of scan `s` taken at odometry `pose`.
+fn laser_record(s: &LaserScan, pose: Pose2, no_return: f64) -> LaserRecord {
+    let (n, t) = (s.ranges.len(), s.header.stamp_s);
+    LaserRecord {
+        start_angle_rad: s.angle_min as f64,
+        fov_rad: s.angle_increment as f64 * n.saturating_sub(1) as f64,
+        ranges_m: ranges_m(&s.ranges, no_return),
+        pose,
+        odom: pose,
+        ipc_timestamp: t,
+        host: String::new(),
+        logger_timestamp: t,
+    }
 }
 
 /// A scan's ranges in metres at the log's resolution, a non-finite one as `no_return`.
