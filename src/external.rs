@@ -426,6 +426,36 @@ fn clip(text: &str) -> String {
     s
 }
 
+/// The `frame` request for frame `frame_id` of run `run`: its odometry and scan (a range
+/// without a return as `null`).
+fn frame_request(frame_id: FrameId, run: usize, odom: OdomPose, scan: &Scan) -> String {
+    let ranges: Vec<serde_json::Value> = scan
+        .ranges_m
+        .iter()
+        .map(|&r| {
+            if r.is_finite() {
+                r.into()
+            } else {
+                serde_json::Value::Null
+            }
+        })
+        .collect();
+    serde_json::json!({
+        "type": "frame",
+        "frame": frame_id,
+        "run": run,
+        "odom": {"x_m": odom.0.x, "y_m": odom.0.y, "theta_rad": odom.0.theta},
+        "scan": {
+            "time_s": scan.time_s,
+            "start_angle_rad": scan.layout.start_angle_rad,
+            "step_rad": scan.layout.step_rad,
+            "max_range_m": scan.layout.max_range_m,
+            "ranges_m": ranges,
+        },
+    })
+    .to_string()
+}
+
 impl PlaceRecognizer for ExternalRecognizer {
     fn start_run(&mut self) -> Vec<Match> {
         let run = self.run.map_or(0, |r| r + 1);
@@ -443,31 +473,7 @@ impl PlaceRecognizer for ExternalRecognizer {
             self.travel_m += last.0.distance(&odom.0);
         }
         self.last_odom = Some(odom);
-        let ranges: Vec<serde_json::Value> = scan
-            .ranges_m
-            .iter()
-            .map(|&r| {
-                if r.is_finite() {
-                    r.into()
-                } else {
-                    serde_json::Value::Null
-                }
-            })
-            .collect();
-        let request = serde_json::json!({
-            "type": "frame",
-            "frame": frame_id,
-            "run": self.run.unwrap_or(0),
-            "odom": {"x_m": odom.0.x, "y_m": odom.0.y, "theta_rad": odom.0.theta},
-            "scan": {
-                "time_s": scan.time_s,
-                "start_angle_rad": scan.layout.start_angle_rad,
-                "step_rad": scan.layout.step_rad,
-                "max_range_m": scan.layout.max_range_m,
-                "ranges_m": ranges,
-            },
-        })
-        .to_string();
+        let request = frame_request(frame_id, self.run.unwrap_or(0), odom, scan);
         self.exchange(&request, Some((frame_id, odom)))
     }
 

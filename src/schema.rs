@@ -226,21 +226,7 @@ fn run_schema() -> Value {
             "doors_cycle" => {
                 json!({ "type": "array", "minItems": 1, "items": { "type": "string" } })
             }
-            "doors_random" => {
-                let mut p = Map::new();
-                for &k in sc::DOORS_RANDOM_KEYS {
-                    p.insert(
-                        k.into(),
-                        json!({ "type": "number", "minimum": 0, "maximum": 1 }),
-                    );
-                }
-                json!({
-                    "type": "object",
-                    "properties": p,
-                    "required": ["open_probability"],
-                    "additionalProperties": false,
-                })
-            }
+            "doors_random" => doors_random_schema(),
             _ => json!({}),
         };
         props.insert(key.into(), schema);
@@ -249,6 +235,23 @@ fn run_schema() -> Value {
         "type": "object",
         "properties": props,
         "required": ["laps"],
+        "additionalProperties": false,
+    })
+}
+
+/// The schema of a run's `doors_random` table: probabilities, `open_probability` required.
+fn doors_random_schema() -> Value {
+    let mut p = Map::new();
+    for &k in sc::DOORS_RANDOM_KEYS {
+        p.insert(
+            k.into(),
+            json!({ "type": "number", "minimum": 0, "maximum": 1 }),
+        );
+    }
+    json!({
+        "type": "object",
+        "properties": p,
+        "required": ["open_probability"],
         "additionalProperties": false,
     })
 }
@@ -471,20 +474,26 @@ impl Reference {
             {
                 continue;
             }
-            if in_table {
-                if let Some(t) = tables.last_mut() {
-                    t.rows.push(cells);
-                }
-            } else {
-                in_table = true;
-                tables.push(RefTable {
-                    section: section.clone(),
-                    header: cells.iter().map(|c| c.to_lowercase()).collect(),
-                    rows: Vec::new(),
-                });
-            }
+            Self::push_row(&mut tables, &section, in_table, cells);
+            in_table = true;
         }
         Reference { tables }
+    }
+
+    /// Adds a row of `cells` to the last table when the row `continues` one, else starts a
+    /// table in `section` with `cells` as its (lower-cased) header.
+    fn push_row(tables: &mut Vec<RefTable>, section: &str, continues: bool, cells: Vec<String>) {
+        if continues {
+            if let Some(t) = tables.last_mut() {
+                t.rows.push(cells);
+            }
+        } else {
+            tables.push(RefTable {
+                section: section.to_string(),
+                header: cells.iter().map(|c| c.to_lowercase()).collect(),
+                rows: Vec::new(),
+            });
+        }
     }
 
     /// Sets the description of each property of `t` from its row in the `nth` table of
@@ -501,6 +510,15 @@ impl Reference {
                 p.insert("description".into(), json!(table.describe(row)));
             }
         }
+    }
+}
+
+/// The sentence of a non-empty cell `c` of column `name` (other than the meaning): a default
+/// that says "required" as such, anything else as "Name: c".
+fn column_sentence(name: &str, c: &str) -> String {
+    match name {
+        "default" if c.starts_with("required") => sentence(&format!("R{}", &c[1..])),
+        _ => sentence(&format!("{}{}: {c}", name[..1].to_uppercase(), &name[1..])),
     }
 }
 
@@ -523,16 +541,8 @@ impl RefTable {
             let Some(c) = row.get(i).map(|c| c.trim()).filter(|c| !c.is_empty()) else {
                 continue;
             };
-            match name.as_str() {
-                "meaning" => {}
-                "default" if c.starts_with("required") => {
-                    parts.push(sentence(&format!("R{}", &c[1..])))
-                }
-                _ => parts.push(sentence(&format!(
-                    "{}{}: {c}",
-                    name[..1].to_uppercase(),
-                    &name[1..]
-                ))),
+            if name != "meaning" {
+                parts.push(column_sentence(name, c));
             }
         }
         parts.join(" ")

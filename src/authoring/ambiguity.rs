@@ -160,7 +160,6 @@ impl DriveSettings {
 /// A simulation of one run of two laps over `route` per door set, with every noise off.
 fn noise_free_plan(world: &World, route: &Route, settings: &DriveSettings) -> SimPlan {
     use crate::sim::plan::{DoorPlan, RunPlan};
-    use crate::sim::{laser, odometry};
     let first = settings.door_sets.first().cloned().unwrap_or(DoorChoice {
         name: "all-closed".into(),
         states: DoorStates::all_closed(world),
@@ -175,22 +174,33 @@ fn noise_free_plan(world: &World, route: &Route, settings: &DriveSettings) -> Si
         })
         .collect();
     SimPlan {
-        laser: laser::LaserConfig {
-            range_noise_m: 0.0,
-            angle_error_rad: 0.0,
-            ..laser::LaserConfig::default()
-        },
-        odometry: odometry::OdometryConfig {
-            model: odometry::OdometryModel::Proportional {
-                translation_ratio: 0.0,
-                rotation_ratio: 0.0,
-            },
-            ..odometry::OdometryConfig::default()
-        },
+        laser: exact_laser(),
+        odometry: exact_odometry(),
         robot: settings.robot.clone(),
         seed: settings.seed,
         runs,
         ..base
+    }
+}
+
+/// The default laser without range noise or angle error.
+fn exact_laser() -> crate::sim::laser::LaserConfig {
+    crate::sim::laser::LaserConfig {
+        range_noise_m: 0.0,
+        angle_error_rad: 0.0,
+        ..crate::sim::laser::LaserConfig::default()
+    }
+}
+
+/// The default odometry without drift.
+fn exact_odometry() -> crate::sim::odometry::OdometryConfig {
+    use crate::sim::odometry::{OdometryConfig, OdometryModel};
+    OdometryConfig {
+        model: OdometryModel::Proportional {
+            translation_ratio: 0.0,
+            rotation_ratio: 0.0,
+        },
+        ..OdometryConfig::default()
     }
 }
 
@@ -202,30 +212,51 @@ pub fn drive(
 ) -> Result<Drive, AmbiguityError> {
     let scn = noise_free_plan(world, route, settings);
     let runs = crate::sim::simulate(&scn, None, &|| {})?;
-    let length = RouteTracker::new(route, 0).length_m();
-    let (mut frames, mut route_m) = (Vec::new(), Vec::new());
-    let (mut door_set_of_frame, mut lap_of_frame) = (Vec::new(), Vec::new());
+    let mut drive = Drive {
+        frames: Vec::new(),
+        route_m: Vec::new(),
+        door_set_of_frame: Vec::new(),
+        lap_of_frame: Vec::new(),
+        door_sets: settings.door_sets.clone(),
+        loop_m: RouteTracker::new(route, 0).length_m(),
+    };
     for (k, run) in runs.into_iter().enumerate() {
+        drive.add_run(k, run, route);
+    }
+    Ok(drive)
+}
+
+impl Drive {
+    /// Appends the frames of `run` (with door set `k`), each with where it is along `route`.
+    fn add_run(&mut self, k: usize, run: crate::sim::RunLog, route: &Route) {
         // A tracker per run: each run starts again at waypoint 0.
         let mut tracker = RouteTracker::new(route, 0);
         for lap in run.laps {
             for f in lap.frames {
                 tracker.update(f.truth.0.position());
-                route_m.push(tracker.arc_m().rem_euclid(length));
-                door_set_of_frame.push(k);
-                lap_of_frame.push(lap.lap);
-                frames.push(f);
+                self.route_m.push(tracker.arc_m().rem_euclid(self.loop_m));
+                self.door_set_of_frame.push(k);
+                self.lap_of_frame.push(lap.lap);
+                self.frames.push(f);
             }
         }
     }
-    Ok(Drive {
-        frames,
-        route_m,
-        door_set_of_frame,
-        lap_of_frame,
-        door_sets: settings.door_sets.clone(),
-        loop_m: length,
-    })
+
+    /// Whether the middles of stretches `c` and `p` (route metres, start and end) lie within
+    /// `radius_m` of each other along the loop.
+    fn near_along_route(&self, c: (f64, f64), p: (f64, f64), radius_m: f64) -> bool {
+        let mid = |a: f64, b: f64| a + (b - a).rem_euclid(self.loop_m) / 2.0;
+        let along = (mid(c.0, c.1) - mid(p.0, p.1)).rem_euclid(self.loop_m);
+        along.min(self.loop_m - along) <= radius_m
+    }
+
+    /// The door set of the frame of word `w`'s first observation.
+    fn door_set_of_word(&self, rec: &Recognizer, w: &Word) -> usize {
+        let f = rec.observations()[w.obs_range().start]
+            .frame_id
+            .min(self.frames.len() - 1);
+        self.door_set_of_frame[f]
+    }
 }
 
 /// A word's stretch of the route (start, end, metres along it) and its middle true position.
@@ -251,13 +282,7 @@ struct Confused {
 
 fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64) -> Vec<Confused> {
     let words = rec.words();
-    let obs = rec.observations();
-    let door_set = |w: &Word| {
-        let f = obs[w.obs_range().start]
-            .frame_id
-            .min(drive.frames.len() - 1);
-        drive.door_set_of_frame[f]
-    };
+    let door_set = |w: &Word| drive.door_set_of_word(rec, w);
     let mut out = Vec::new();
     for m in matches {
         for (c, p) in &m.word_pairs {
@@ -268,9 +293,7 @@ fn confusions(rec: &Recognizer, drive: &Drive, matches: &[Match], radius_m: f64)
             let (p0, p1, pa) = word_place(rec, drive, pw);
             // Words at the same place of the route, one lap apart, are the same place even
             // when their alignment is off.
-            let mid = |a: f64, b: f64| a + (b - a).rem_euclid(drive.loop_m) / 2.0;
-            let along = (mid(c0, c1) - mid(p0, p1)).rem_euclid(drive.loop_m);
-            if along.min(drive.loop_m - along) <= radius_m {
+            if drive.near_along_route((c0, c1), (p0, p1), radius_m) {
                 continue;
             }
             if wrong_pair(rec, drive, m, cw, pw, radius_m).unwrap_or((ca - pa).norm() > radius_m) {
@@ -416,17 +439,6 @@ fn merged_pairs(conf: &[Confusion], loop_m: f64) -> Vec<(Arc, Arc)> {
 /// partner; each with its cause and score (the confused word pairs merged into it).
 fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
     let places: Vec<Confusion> = conf.iter().map(|c| c.places).collect();
-    let stretch =
-        |arc: &Arc, number: usize, pair: usize, partner: usize, cause, score| AmbiguousStretch {
-            number,
-            pair,
-            from_m: round_dm(arc.start),
-            to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
-            length_m: round_dm(arc.len),
-            partners: vec![partner],
-            cause,
-            score,
-        };
     merged_pairs(&places, loop_m)
         .iter()
         .enumerate()
@@ -437,20 +449,47 @@ fn stretches(conf: &[Confused], loop_m: f64) -> Vec<AmbiguousStretch> {
                 .filter(|c| merge(pair, &arcs(&[c.places], loop_m)[0], loop_m).is_some())
                 .collect();
             let (a, b) = pair;
-            let cause = if a.touches(b, loop_m) {
-                Cause::Shift
-            } else if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
-                Cause::DoorChange
-            } else {
-                Cause::LookAlike
-            };
+            let cause = cause_of(pair, &inside, loop_m);
             let score = inside.len() as f64;
             [
-                stretch(a, na, k, nb, cause, score),
-                stretch(b, nb, k, na, cause, score),
+                stretch(a, (na, k, nb), cause, score, loop_m),
+                stretch(b, (nb, k, na), cause, score, loop_m),
             ]
         })
         .collect()
+}
+
+/// Stretch `arc` (of a loop `loop_m` long), numbered `number`, half of pair `pair` with
+/// stretch `partner`.
+fn stretch(
+    arc: &Arc,
+    (number, pair, partner): (usize, usize, usize),
+    cause: Cause,
+    score: f64,
+    loop_m: f64,
+) -> AmbiguousStretch {
+    AmbiguousStretch {
+        number,
+        pair,
+        from_m: round_dm(arc.start),
+        to_m: round_dm((arc.start + arc.len).rem_euclid(loop_m)),
+        length_m: round_dm(arc.len),
+        partners: vec![partner],
+        cause,
+        score,
+    }
+}
+
+/// Why the stretches of `pair` look alike: they overlap (a shift), every confusion `inside`
+/// them came with a door change, or they look alike.
+fn cause_of((a, b): &(Arc, Arc), inside: &[&Confused], loop_m: f64) -> Cause {
+    if a.touches(b, loop_m) {
+        Cause::Shift
+    } else if inside.iter().all(|c| c.door_change) && !inside.is_empty() {
+        Cause::DoorChange
+    } else {
+        Cause::LookAlike
+    }
 }
 
 /// Rounded to 0.1 m (the route positions are no more precise).

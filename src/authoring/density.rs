@@ -175,21 +175,9 @@ fn class_color(c: usize, classes: usize) -> String {
 /// The world with its free space coloured by density class, a legend of the classes (Ψ range
 /// and share of the free space) and the doors in `doors`.
 pub fn density_svg(world: &World, doors: &DoorStates, map: &DensityMap, title: &str) -> String {
-    use crate::report::world_render::{RenderOptions, Swatch, TileLayer, render_world_svg};
-    let counts = map.class_counts();
-    let total = counts.iter().sum::<usize>().max(1);
+    use crate::report::world_render::{RenderOptions, TileLayer, render_world_svg};
     let n = map.classes;
-    let swatches = (0..n)
-        .map(|c| Swatch {
-            label: format!(
-                "class {c}: \u{3a8} {:.3}-{:.3} ({:.0} %)",
-                c as f64 / n as f64,
-                (c + 1) as f64 / n as f64,
-                100.0 * counts[c] as f64 / total as f64
-            ),
-            color: class_color(c, n),
-        })
-        .collect();
+    let swatches = class_swatches(map);
     let opts = RenderOptions {
         doors: doors.clone(),
         title: Some(title.to_string()),
@@ -207,6 +195,24 @@ pub fn density_svg(world: &World, doors: &DoorStates, map: &DensityMap, title: &
         ..RenderOptions::default()
     };
     render_world_svg(world, &opts)
+}
+
+/// A legend entry per density class: its range of Ψ and its share of the cells.
+fn class_swatches(map: &DensityMap) -> Vec<crate::report::world_render::Swatch> {
+    let counts = map.class_counts();
+    let total = counts.iter().sum::<usize>().max(1);
+    let n = map.classes;
+    (0..n)
+        .map(|c| crate::report::world_render::Swatch {
+            label: format!(
+                "class {c}: \u{3a8} {:.3}-{:.3} ({:.0} %)",
+                c as f64 / n as f64,
+                (c + 1) as f64 / n as f64,
+                100.0 * counts[c] as f64 / total as f64
+            ),
+            color: class_color(c, n),
+        })
+        .collect()
 }
 
 /// The density picture of `world` with the default recognizer settings (what `placewords world

@@ -109,22 +109,35 @@ fn centre_loop(rng: &mut SimRng, w: f64, h: f64, cuts: usize) -> Vec<Vec2> {
             out.push(*c);
             continue;
         }
-        let cx = rng.random_range(0.2..0.3) * (x1 - x0);
-        let cy = rng.random_range(0.2..0.3) * (y1 - y0);
-        let (sx, sy) = inward[k];
-        let a = *c + Vec2::new(0.0, sy * cy);
-        let m = *c + Vec2::new(sx * cx, sy * cy);
-        let b = *c + Vec2::new(sx * cx, 0.0);
-        // Counter-clockwise: arrive along the previous edge, leave along the next.
-        if k % 2 == 0 {
-            out.extend([a, m, b]);
-        } else {
-            out.extend([b, m, a]);
-        }
+        out.extend(cut_corner(
+            rng,
+            *c,
+            inward[k],
+            (x1 - x0, y1 - y0),
+            k % 2 == 0,
+        ));
     }
     out.iter()
         .map(|p| Vec2::new(round_cm(p.x), round_cm(p.y)))
         .collect()
+}
+
+/// The three points that replace corner `c` by a notch 20-30 % of the loop's `size` deep in
+/// each direction, going `inward` (signs along x and y); counter-clockwise: arriving along the
+/// previous edge and leaving along the next (`even`: the notch's y side comes first).
+fn cut_corner(
+    rng: &mut SimRng,
+    c: Vec2,
+    (sx, sy): (f64, f64),
+    size: (f64, f64),
+    even: bool,
+) -> [Vec2; 3] {
+    let cx = rng.random_range(0.2..0.3) * size.0;
+    let cy = rng.random_range(0.2..0.3) * size.1;
+    let a = c + Vec2::new(0.0, sy * cy);
+    let m = c + Vec2::new(sx * cx, sy * cy);
+    let b = c + Vec2::new(sx * cx, 0.0);
+    if even { [a, m, b] } else { [b, m, a] }
 }
 
 /// One office slot: corridor edge, start and end along it (metres from the edge's start), and
@@ -281,22 +294,27 @@ fn office(
     } else {
         round_cm(rng.random_range(slot.from + 0.3..slot.to - DOOR_M - 0.3))
     };
-    let heading = |v: Vec2| round_cm(v.y.atan2(v.x).to_degrees());
     let wall = WallSpec {
         id: format!("office-{:02}", index + 1),
         points_m: points,
         closed: false,
         thickness_m: crate::spec::world::default_wall_thickness_m(),
     };
-    let door = DoorSpec {
+    (wall, office_door(index, at(g0, front), d, out), g0)
+}
+
+/// The door of office `index`, hinged at `hinge_m`, closed along the corridor (`along`) and
+/// open into the office (`into`).
+fn office_door(index: usize, hinge_m: [f64; 2], along: Vec2, into: Vec2) -> DoorSpec {
+    let heading = |v: Vec2| round_cm(v.y.atan2(v.x).to_degrees());
+    DoorSpec {
         id: format!("d-{:02}", index + 1),
-        hinge_m: at(g0, front),
+        hinge_m,
         width_m: DOOR_M,
-        closed_heading_deg: heading(d),
-        open_heading_deg: heading(out),
+        closed_heading_deg: heading(along),
+        open_heading_deg: heading(into),
         thickness_m: crate::spec::world::default_door_thickness_m(),
-    };
-    (wall, door, g0)
+    }
 }
 
 /// A corridor wall on `side` (1: the outer wall, -1: the courtyard wall), cut at the door
@@ -327,17 +345,23 @@ fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)], side: f64, name: &str
     for (k, &(e, g)) in gaps.iter().enumerate() {
         let (e2, g2) = gaps[(k + 1) % gaps.len()];
         let mut points = vec![on(e, g + DOOR_M)];
-        let ahead_on_edge = e2 == e && g2 > g && gaps.len() > 1;
-        let steps = match (e2 + n - e) % n {
-            _ if ahead_on_edge => 0,
-            0 => n,
-            s => s,
-        };
+        let steps = corners_between((e, g), (e2, g2), n, gaps.len());
         points.extend((1..=steps).map(|j| pt(outer[(e + j) % n])));
         points.push(on(e2, g2));
         walls.push(wall(k + 1, points, false));
     }
     walls
+}
+
+/// How many of the `n` loop corners a wall from the gap at `(edge, along)` to the next of the
+/// `gaps` gaps, at `to`, passes: none when the next is ahead on the same edge.
+fn corners_between((e, g): (usize, f64), (e2, g2): (usize, f64), n: usize, gaps: usize) -> usize {
+    let ahead_on_edge = e2 == e && g2 > g && gaps > 1;
+    match (e2 + n - e) % n {
+        _ if ahead_on_edge => 0,
+        0 => n,
+        s => s,
+    }
 }
 
 /// The floor's size `(w, h)`, metres, when `opts` ask for a floor that can be generated.
@@ -482,10 +506,22 @@ fn walking_areas(loop_pts: &[Vec2]) -> Vec<AreaSpec> {
 pub fn generate_toml(opts: &GenerateOptions) -> Result<String, GenerateError> {
     let spec = generate_spec(opts)?;
     let body = toml::to_string(&spec).map_err(|e| GenerateError::Invalid(e.to_string()))?;
-    let text = format!(
+    let text = format!("{}{body}", header_comment(opts));
+    crate::world::load::parse_world_spec(
+        &text,
+        "generated world",
+        &crate::world::validate::WorldCheck::default(),
+    )
+    .map_err(|e| GenerateError::Invalid(e.to_string()))?;
+    Ok(text)
+}
+
+/// The comment atop a generated world: the command that makes it again and what it holds.
+fn header_comment(opts: &GenerateOptions) -> String {
+    format!(
         "# A generated floor: placewords world generate --seed {} --size-m {},{} --doors {} --corridors {}{}{}\n\
          # A corridor loop (route \"lap\" along its centre line), offices {} with one door\n\
-         # each (swinging into the office), {}; people walk in the areas \"walk-N\".\n{body}",
+         # each (swinging into the office), {}; people walk in the areas \"walk-N\".\n",
         opts.seed,
         opts.size_m.0,
         opts.size_m.1,
@@ -507,14 +543,7 @@ pub fn generate_toml(opts: &GenerateOptions) -> Result<String, GenerateError> {
         } else {
             "niches in the courtyard wall"
         }
-    );
-    crate::world::load::parse_world_spec(
-        &text,
-        "generated world",
-        &crate::world::validate::WorldCheck::default(),
     )
-    .map_err(|e| GenerateError::Invalid(e.to_string()))?;
-    Ok(text)
 }
 
 #[cfg(test)]

@@ -313,20 +313,25 @@ fn world_without_route(
             y_m: r3(hy),
             heading_deg: hdeg,
         },
-        walls: chains
-            .into_iter()
-            .enumerate()
-            .map(|(i, (pts, closed))| WallSpec {
-                id: format!("w{}", i + 1),
-                points_m: pts.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
-                closed,
-                thickness_m: WALL_THICKNESS_M,
-            })
-            .collect(),
+        walls: chain_walls(chains),
         doors: Vec::new(),
         routes: Vec::new(),
         areas: Vec::new(),
     }
+}
+
+/// A wall per chain of points (closed or not), named `w1`, `w2`… in their order.
+fn chain_walls(chains: Vec<(Vec<Vec2>, bool)>) -> Vec<WallSpec> {
+    chains
+        .into_iter()
+        .enumerate()
+        .map(|(i, (pts, closed))| WallSpec {
+            id: format!("w{}", i + 1),
+            points_m: pts.iter().map(|p| [r3(p.x), r3(p.y)]).collect(),
+            closed,
+            thickness_m: WALL_THICKNESS_M,
+        })
+        .collect()
 }
 
 /// How far outside the walls' bounding box the home may lie, metres.
@@ -352,6 +357,19 @@ fn home_inside_walls(
     if outside <= HOME_MARGIN_M {
         return Ok(());
     }
+    Err(Diagnostic::error(
+        name,
+        robot_home_at(src),
+        format!(
+            "RobotHome ({:.2}, {:.2}) m is {outside:.1} m outside the map's walls (limit {HOME_MARGIN_M} m); \
+         put the home inside the building, in millimetres like the lines",
+            home.x, home.y
+        ),
+    ))
+}
+
+/// The (line, column) of the first `RobotHome` in `src`, 1-based ((1, 1) without one).
+fn robot_home_at(src: &str) -> (usize, usize) {
     let line = src
         .lines()
         .position(|l| l.contains("RobotHome"))
@@ -361,15 +379,7 @@ fn home_inside_walls(
         .nth(line - 1)
         .and_then(|l| l.find("RobotHome"))
         .map_or(1, |c| c + 1);
-    Err(Diagnostic::error(
-        name,
-        (line, col),
-        format!(
-            "RobotHome ({:.2}, {:.2}) m is {outside:.1} m outside the map's walls (limit {HOME_MARGIN_M} m); \
-         put the home inside the building, in millimetres like the lines",
-            home.x, home.y
-        ),
-    ))
+    (line, col)
 }
 
 /// The repairs the import makes so that a map drawn carelessly still gives a world `world
@@ -500,11 +510,7 @@ fn extend_chain(
             .and_then(|v| v.iter().copied().find(|&j| !used[j]));
         let Some(j) = next else { break };
         used[j] = true;
-        let other = if mm(segs[j].a) == k {
-            segs[j].b
-        } else {
-            segs[j].a
-        };
+        let other = far_end(segs[j], k);
         if forward {
             chain.push_back(other);
         } else {
@@ -513,13 +519,15 @@ fn extend_chain(
     }
 }
 
-/// The world file text for an imported world, with a header naming the source.
-pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser::Error> {
-    // Point lists one `[x, y]` pair per line (toml writes them either on one long line or one
-    // number per line).
-    let body = toml::to_string(spec)?;
-    let body: String = body
-        .lines()
+/// The end of `seg` that is not at `k` (millimetre key).
+fn far_end(seg: &Segment, k: (i64, i64)) -> Vec2 {
+    if mm(seg.a) == k { seg.b } else { seg.a }
+}
+
+/// `body` (toml) with point lists one `[x, y]` pair per line (toml writes them either on one
+/// long line or one number per line) and without empty arrays.
+fn pairs_per_line(body: &str) -> String {
+    body.lines()
         .map(|l| match l.split_once(" = [[") {
             Some((key, rest)) if rest.ends_with("]]") => format!(
                 "{key} = [\n    [{}],\n]\n",
@@ -529,7 +537,12 @@ pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser
             _ if l.ends_with(" = []") => String::new(),
             _ => format!("{l}\n"),
         })
-        .collect();
+        .collect()
+}
+
+/// The world file text for an imported world, with a header naming the source.
+pub fn world_to_toml(spec: &WorldSpec, source: &str) -> Result<String, toml::ser::Error> {
+    let body = pairs_per_line(&toml::to_string(spec)?);
     let route_note = if spec.routes.is_empty() {
         "# NO ROUTE: none could be generated through the free space. Add a [[routes]] block by hand\n\
          # (id = \"loop\", waypoints_m = [[x1, y1], [x2, y2], [x3, y3], ...]: at least 3 waypoints, each\n\

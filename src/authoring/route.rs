@@ -116,6 +116,19 @@ pub fn generate_route(
             "the free space around the home is too small to drive in; {BY_HAND}"
         ));
     };
+    route_along(&tree, &raster, walls, thickness_m, home, opts)
+}
+
+/// The route along the skeleton `tree` of the free space: a loop through its best cycle, else
+/// out along a branch and back; checked against `walls`.
+fn route_along(
+    tree: &Tree,
+    raster: &Raster,
+    walls: &[Segment],
+    thickness_m: f64,
+    home: Vec2,
+    opts: &RouteOptions,
+) -> Result<Vec<Vec2>, String> {
     let leg_ok = |a: Vec2, b: Vec2| {
         leg_clear(
             walls,
@@ -127,7 +140,7 @@ pub fn generate_route(
     let pt = |k: usize| raster.center(k % raster.nx, k / raster.nx);
     let route = match tree.best_cycle(&pt, home) {
         Some(cycle) => loop_from(&cycle, &pt, home, opts, &leg_ok),
-        None => out_and_back(&tree, &pt, home, opts, &leg_ok)?,
+        None => out_and_back(tree, &pt, home, opts, &leg_ok)?,
     };
     checked(route, walls, thickness_m, opts)
 }

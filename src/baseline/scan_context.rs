@@ -220,21 +220,29 @@ pub struct Descriptor {
     ring_key: [f64; MAX_RINGS],
 }
 
+/// The number of `points` in each bin (sector-major: `sector * rings + ring`) of the polar
+/// grid within `max_radius_m`.
+fn bin_counts(points: impl IntoIterator<Item = Vec2>, cfg: &ScanContextConfig) -> Vec<u32> {
+    let (rings, sectors) = (cfg.rings, cfg.sectors);
+    let mut counts = vec![0u32; rings * sectors];
+    for p in points {
+        let r = p.norm();
+        if !r.is_finite() || r >= cfg.max_radius_m {
+            continue;
+        }
+        let ring = ((r / cfg.max_radius_m * rings as f64) as usize).min(rings - 1);
+        let a = p.y.atan2(p.x).rem_euclid(std::f64::consts::TAU);
+        let sector = ((a / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
+        counts[sector * rings + ring] += 1;
+    }
+    counts
+}
+
 impl Descriptor {
     /// The descriptor of `points` (robot frame, metres) with `cfg`'s rings, sectors and radius.
     pub fn new(points: impl IntoIterator<Item = Vec2>, cfg: &ScanContextConfig) -> Descriptor {
         let (rings, sectors) = (cfg.rings, cfg.sectors);
-        let mut counts = vec![0u32; rings * sectors];
-        for p in points {
-            let r = p.norm();
-            if !r.is_finite() || r >= cfg.max_radius_m {
-                continue;
-            }
-            let ring = ((r / cfg.max_radius_m * rings as f64) as usize).min(rings - 1);
-            let a = p.y.atan2(p.x).rem_euclid(std::f64::consts::TAU);
-            let sector = ((a / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
-            counts[sector * rings + ring] += 1;
-        }
+        let counts = bin_counts(points, cfg);
         let mut by_ring = vec![Vec::new(); rings];
         let mut occupied = vec![false; sectors];
         let mut ring_key = [0.0; MAX_RINGS];
@@ -464,6 +472,20 @@ impl ScanContextRecognizer {
         &self.cfg
     }
 
+    /// Records an observation of frame `frame_id` at `odom`, `travel_m` along the run; its id.
+    fn observe(&mut self, frame_id: FrameId, odom: OdomPose, travel_m: f64) -> usize {
+        let id = self.observations.len();
+        self.observations.push(Observation::new(
+            id,
+            self.run.unwrap_or(0),
+            frame_id,
+            odom,
+            travel_m,
+        ));
+        self.counts.observations += 1;
+        id
+    }
+
     /// Moves the waiting observations that lie `min_gap_m` behind `travel_m` into the tree.
     fn index_up_to(&mut self, travel_m: f64) {
         while let Some(&id) = self.waiting.front() {
@@ -569,15 +591,7 @@ impl PlaceRecognizer for ScanContextRecognizer {
         if !self.schedule.take_due() {
             return Vec::new();
         }
-        let id = self.observations.len();
-        self.observations.push(Observation::new(
-            id,
-            self.run.unwrap_or(0),
-            frame_id,
-            odom,
-            travel_m,
-        ));
-        self.counts.observations += 1;
+        let id = self.observe(frame_id, odom, travel_m);
         let keep_from = travel_m - self.cfg.history_m;
         self.cells.retain(|_, t| *t >= keep_from);
         self.index_up_to(travel_m);

@@ -38,25 +38,7 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
     let report = score::score_file(&logs, &file, &name, &EvaluationSpec::default(), args.levels)?;
     out!("{}", placewords::report::table::text_table(&report))?;
     if let Some(path) = &args.report {
-        use placewords::eval::provenance::{self as p, Input};
-        let mut prov = p::Provenance::new(super::common::command_line());
-        // The logs: the manifest and every log beside it, in name order.
-        let mut logs = vec![args.logdir.join("manifest.json")];
-        let mut files: Vec<PathBuf> = std::fs::read_dir(&args.logdir)
-            .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
-            .unwrap_or_default();
-        files.retain(|f| f.extension().is_some_and(|e| e == "log" || e == "mcap"));
-        files.sort();
-        logs.extend(files);
-        prov.add_inputs(logs.iter().map(|f| p::file_input("logs", f)));
-        prov.add_inputs([
-            p::file_input("matches", &args.matches),
-            Input::new(
-                "evaluation",
-                &name,
-                p::hash_settings(&EvaluationSpec::default()),
-            ),
-        ]);
+        let prov = provenance(&args, &name);
         write_file(
             path,
             placewords::report::json::to_json_with(&report, &prov).as_bytes(),
@@ -64,4 +46,36 @@ pub fn run(args: ScoreArgs) -> anyhow::Result<ExitCode> {
         errln!("report: {}", path.display());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The report's provenance: the logs, the matches file (`name`) and the evaluation settings.
+fn provenance(args: &ScoreArgs, name: &str) -> placewords::eval::provenance::Provenance {
+    use placewords::eval::provenance::{self as p, Input};
+    let mut prov = p::Provenance::new(super::common::command_line());
+    prov.add_inputs(
+        log_files(&args.logdir)
+            .iter()
+            .map(|f| p::file_input("logs", f)),
+    );
+    prov.add_inputs([
+        p::file_input("matches", &args.matches),
+        Input::new(
+            "evaluation",
+            name,
+            p::hash_settings(&EvaluationSpec::default()),
+        ),
+    ]);
+    prov
+}
+
+/// The logs of a folder: its manifest and every log beside it, in name order.
+fn log_files(logdir: &std::path::Path) -> Vec<PathBuf> {
+    let mut logs = vec![logdir.join("manifest.json")];
+    let mut files: Vec<PathBuf> = std::fs::read_dir(logdir)
+        .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+        .unwrap_or_default();
+    files.retain(|f| f.extension().is_some_and(|e| e == "log" || e == "mcap"));
+    files.sort();
+    logs.extend(files);
+    logs
 }

@@ -60,24 +60,34 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<ExitCode> {
         &scn,
         args.laps,
         &args.out,
-        match args.format {
-            FormatArg::Carmen => RunFormat::Carmen,
-            FormatArg::Mcap => RunFormat::Mcap,
-        },
+        run_format(args.format),
         args.svg,
         &super::progress::bar(args.quiet),
         cache.as_deref(),
     )?;
     super::common::report_cache(cache.as_deref());
     if !args.quiet {
-        errln!(
-            "simulated {total} laps and wrote {} files in {:.2} s",
-            files.len(),
-            started.elapsed().as_secs_f64()
-        );
-        for f in &files {
-            errln!("wrote {}", f.display());
-        }
+        print_written(total, &files, started);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The log format named on the command line.
+fn run_format(f: FormatArg) -> RunFormat {
+    match f {
+        FormatArg::Carmen => RunFormat::Carmen,
+        FormatArg::Mcap => RunFormat::Mcap,
+    }
+}
+
+/// How many laps were simulated in how long, and each file written.
+fn print_written(total_laps: usize, files: &[PathBuf], started: std::time::Instant) {
+    errln!(
+        "simulated {total_laps} laps and wrote {} files in {:.2} s",
+        files.len(),
+        started.elapsed().as_secs_f64()
+    );
+    for f in files {
+        errln!("wrote {}", f.display());
+    }
 }

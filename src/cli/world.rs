@@ -185,24 +185,7 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
         let format = placewords::spec::diag::MessageFormat::from_name(&args.format.message_format)
             .unwrap_or_default();
         match placewords::sim::test_drive::check_world(f) {
-            Ok((w, warnings)) => {
-                for line in
-                    placewords::spec::diag::SpecError::Invalid(warnings.clone()).render(format)
-                {
-                    errln!("{line}");
-                }
-                outln!(
-                    "{}: ok ({} walls, {} doors, {} routes{})",
-                    f.display(),
-                    w.walls.len(),
-                    w.doors.len(),
-                    w.routes.len(),
-                    match warnings.len() {
-                        0 => String::new(),
-                        n => format!(", {n} warning(s)"),
-                    }
-                )?
-            }
+            Ok((w, warnings)) => print_world_ok(f, &w, warnings, format)?,
             Err(e) => {
                 super::print_problems(&e, format)?;
                 failed = true;
@@ -214,6 +197,31 @@ fn check(args: CheckArgs) -> anyhow::Result<ExitCode> {
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The warnings of a world file that checked, then its one-line summary.
+fn print_world_ok(
+    f: &std::path::Path,
+    w: &World,
+    warnings: Vec<placewords::spec::diag::Diagnostic>,
+    format: placewords::spec::diag::MessageFormat,
+) -> anyhow::Result<()> {
+    let n = warnings.len();
+    for line in placewords::spec::diag::SpecError::Invalid(warnings).render(format) {
+        errln!("{line}");
+    }
+    outln!(
+        "{}: ok ({} walls, {} doors, {} routes{})",
+        f.display(),
+        w.walls.len(),
+        w.doors.len(),
+        w.routes.len(),
+        match n {
+            0 => String::new(),
+            n => format!(", {n} warning(s)"),
+        }
+    )?;
+    Ok(())
 }
 
 /// Loads a world; on invalid input prints every located problem and returns `None`.
@@ -260,18 +268,7 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
     };
     let world = match placewords::world::parse_world(&src, &path) {
         Ok(w) => w,
-        Err(_) => {
-            let (svg, diags) = placewords::authoring::problems::problems_svg(&src, &path, &base);
-            diags.iter().for_each(|d| errln!("{d}"));
-            if let Some(svg) = svg {
-                super::common::write_file(&args.output, svg.as_bytes())?;
-                errln!(
-                    "wrote {} with the problems above marked 0.. in their order",
-                    args.output.display()
-                );
-            }
-            return Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR));
-        }
+        Err(_) => return render_problems(&src, &path, &base, &args.output),
     };
     let doors = door_states(&world, &args.open, args.all_open)?;
     let opts = RenderOptions { doors, ..base };
@@ -279,6 +276,26 @@ fn render(args: RenderArgs) -> anyhow::Result<ExitCode> {
     super::common::write_file(&args.output, svg.as_bytes())?;
     errln!("wrote {}", args.output.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// For a world file that does not load: its problems on stderr and, when it can be drawn,
+/// a picture of them at `output`; exit code 2.
+fn render_problems(
+    src: &str,
+    path: &str,
+    base: &RenderOptions,
+    output: &std::path::Path,
+) -> anyhow::Result<ExitCode> {
+    let (svg, diags) = placewords::authoring::problems::problems_svg(src, path, base);
+    diags.iter().for_each(|d| errln!("{d}"));
+    if let Some(svg) = svg {
+        super::common::write_file(output, svg.as_bytes())?;
+        errln!(
+            "wrote {} with the problems above marked 0.. in their order",
+            output.display()
+        );
+    }
+    Ok(ExitCode::from(placewords::eval::gate::EXIT_ERROR))
 }
 
 fn info(args: InfoArgs) -> anyhow::Result<ExitCode> {

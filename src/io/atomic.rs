@@ -382,6 +382,27 @@ fn take_lock(lock: &Path) -> std::io::Result<Option<u32>> {
     Err(std::io::Error::other("the lock file could not be taken"))
 }
 
+/// Refuses a `dir` that is a file, or a folder that is neither empty nor, by `replaceable`,
+/// an earlier output of the same kind.
+fn check_replaceable(dir: &Path, replaceable: &dyn Fn(&Path) -> bool) -> Result<(), StageError> {
+    if !dir.exists() {
+        return Ok(());
+    }
+    let io = |source| StageError::Io {
+        path: dir.display().to_string(),
+        source,
+    };
+    if !dir.is_dir() {
+        let e = std::io::Error::other("it is a file; give a folder name");
+        return Err(io(e));
+    }
+    let empty = std::fs::read_dir(dir).map_err(io)?.next().is_none();
+    if !empty && !replaceable(dir) {
+        return Err(StageError::Foreign(dir.display().to_string()));
+    }
+    Ok(())
+}
+
 impl StagedDir {
     /// Stages output for `dir`. An existing `dir` must be empty or, by `replaceable`, an earlier
     /// output of the same kind (it is then replaced whole on commit); otherwise an error, before
@@ -392,19 +413,7 @@ impl StagedDir {
             path: path.display().to_string(),
             source,
         };
-        if dir.exists() {
-            if !dir.is_dir() {
-                let e = std::io::Error::other("it is a file; give a folder name");
-                return Err(io(dir, e));
-            }
-            let empty = std::fs::read_dir(dir)
-                .map_err(|e| io(dir, e))?
-                .next()
-                .is_none();
-            if !empty && !replaceable(dir) {
-                return Err(StageError::Foreign(dir.display().to_string()));
-            }
-        }
+        check_replaceable(dir, replaceable)?;
         create_parent(dir).map_err(|e| io(dir, e))?;
         let lock = lock_path(dir);
         if let Some(pid) = take_lock(&lock).map_err(|e| io(&lock, e))? {
@@ -572,6 +581,16 @@ impl Journal {
 /// The file inside a staged replacement folder naming its set's marker (removed once in place).
 const SET_TAG: &str = ".placewords-set";
 
+/// Creates picture folder `dir` when missing and an empty staging folder for it, returned.
+fn fresh_staging(dir: &Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    remove_stale_temps(dir);
+    let staging = temp_path(dir);
+    let _ = std::fs::remove_dir_all(&staging);
+    std::fs::create_dir(&staging)?;
+    Ok(staging)
+}
+
 impl OutputSet {
     /// Begins a set of output `files`, picture folders `dirs` (created if missing; the set's files
     /// are added to them) and folders `replaced`, each replaced whole when it is empty, new or,
@@ -593,28 +612,14 @@ impl OutputSet {
             locks: Vec::new(),
             finished: false,
         };
-        for &path in files.iter().chain(dirs) {
-            settle(path);
-            let lock = lock_path(path);
-            if let Some(pid) = take_lock(&lock).map_err(|e| io(&lock, e))? {
-                return Err(StageError::Busy {
-                    path: path.display().to_string(),
-                    pid,
-                    lock: lock.display().to_string(),
-                });
-            }
-            set.locks.push(lock);
-        }
+        set.lock_outputs(files)?;
+        set.lock_outputs(dirs)?;
         for &file in files {
             remove_stale_temps(file);
             set.files.push((file.to_path_buf(), temp_path(file)));
         }
         for &dir in dirs {
-            std::fs::create_dir_all(dir).map_err(|e| io(dir, e))?;
-            remove_stale_temps(dir);
-            let staging = temp_path(dir);
-            let _ = std::fs::remove_dir_all(&staging);
-            std::fs::create_dir(&staging).map_err(|e| io(dir, e))?;
+            let staging = fresh_staging(dir).map_err(|e| io(dir, e))?;
             set.dirs.push((dir.to_path_buf(), staging));
         }
         for &(dir, replaceable) in replaced {
@@ -622,6 +627,27 @@ impl OutputSet {
             set.replaced.push(StagedDir::begin(dir, replaceable)?);
         }
         Ok(set)
+    }
+
+    /// Takes the lock of each of `paths`, after settling what a process left there.
+    fn lock_outputs(&mut self, paths: &[&Path]) -> Result<(), StageError> {
+        for &path in paths {
+            settle(path);
+            let lock = lock_path(path);
+            let taken = take_lock(&lock).map_err(|source| StageError::Io {
+                path: lock.display().to_string(),
+                source,
+            })?;
+            if let Some(pid) = taken {
+                return Err(StageError::Busy {
+                    path: path.display().to_string(),
+                    pid,
+                    lock: lock.display().to_string(),
+                });
+            }
+            self.locks.push(lock);
+        }
+        Ok(())
     }
 
     /// Writes output file `path` (one of the set's files) in full, staged until the commit.
@@ -768,12 +794,7 @@ fn apply(journal: &Journal) -> std::io::Result<()> {
     for (from, to) in &journal.folders {
         let ours = std::fs::read_to_string(from.join(SET_TAG)).is_ok_and(|t| t == tag);
         if ours && to.exists() {
-            if !exchange(from, to)? {
-                let old = from.with_file_name(format!("{}-old", file_name(from)));
-                rename(to, &old)?;
-                rename(from, to)?;
-                let _ = std::fs::remove_dir_all(&old);
-            }
+            replace_folder(from, to)?;
         } else if ours {
             rename(from, to)?;
         }
@@ -788,6 +809,18 @@ fn apply(journal: &Journal) -> std::io::Result<()> {
         let _ = std::fs::remove_dir_all(s);
     }
     let _ = std::fs::remove_file(&journal.marker);
+    Ok(())
+}
+
+/// Puts folder `from` in the place of the existing `to`, atomically where the system can
+/// exchange them; the old `to` ends up at `from` or removed.
+fn replace_folder(from: &Path, to: &Path) -> std::io::Result<()> {
+    if !exchange(from, to)? {
+        let old = from.with_file_name(format!("{}-old", file_name(from)));
+        rename(to, &old)?;
+        rename(from, to)?;
+        let _ = std::fs::remove_dir_all(&old);
+    }
     Ok(())
 }
 

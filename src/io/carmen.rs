@@ -74,19 +74,7 @@ pub enum LogRecord {
 /// Appends one record as a CARMEN line (with trailing newline). Lasers are written as FLASER.
 pub fn write_record(out: &mut String, rec: &LogRecord) {
     match rec {
-        LogRecord::Laser(l) => {
-            let _ = write!(out, "FLASER {}", l.ranges_m.len());
-            for r in &l.ranges_m {
-                push_range(out, *r);
-            }
-            let _ = writeln!(
-                out,
-                " {} {} {}",
-                fmt_pose(&l.pose),
-                fmt_pose(&l.odom),
-                fmt_stamp(l.ipc_timestamp, &l.host, l.logger_timestamp)
-            );
-        }
+        LogRecord::Laser(l) => write_flaser(out, l),
         LogRecord::Odom(o) => {
             let _ = writeln!(
                 out,
@@ -111,6 +99,35 @@ pub fn write_record(out: &mut String, rec: &LogRecord) {
             let _ = writeln!(out, "PARAM {name} {value}");
         }
     }
+}
+
+/// The laser record of a simulated frame: its scan at the odometry pose, sent by `host`.
+fn laser_record(f: &crate::log::Frame, host: String) -> LaserRecord {
+    LaserRecord {
+        start_angle_rad: f.scan.layout.start_angle_rad,
+        fov_rad: f.scan.layout.fov_rad(),
+        ranges_m: f.scan.ranges_m.clone(),
+        pose: f.odom.0,
+        odom: f.odom.0,
+        ipc_timestamp: f.time_s,
+        host,
+        logger_timestamp: f.time_s,
+    }
+}
+
+/// A laser record as a `FLASER` line.
+fn write_flaser(out: &mut String, l: &LaserRecord) {
+    let _ = write!(out, "FLASER {}", l.ranges_m.len());
+    for r in &l.ranges_m {
+        push_range(out, *r);
+    }
+    let _ = writeln!(
+        out,
+        " {} {} {}",
+        fmt_pose(&l.pose),
+        fmt_pose(&l.odom),
+        fmt_stamp(l.ipc_timestamp, &l.host, l.logger_timestamp)
+    );
 }
 
 /// Appends ` r` with three decimals. Ranges in millimetres are written as integers (the same
@@ -181,19 +198,7 @@ impl LapWriter {
                 logger_timestamp: f.time_s,
             }),
         );
-        write_record(
-            out,
-            &LogRecord::Laser(LaserRecord {
-                start_angle_rad: f.scan.layout.start_angle_rad,
-                fov_rad: f.scan.layout.fov_rad(),
-                ranges_m: f.scan.ranges_m.clone(),
-                pose: odom,
-                odom,
-                ipc_timestamp: f.time_s,
-                host: host.clone(),
-                logger_timestamp: f.time_s,
-            }),
-        );
+        write_record(out, &LogRecord::Laser(laser_record(f, host.clone())));
         write_record(
             out,
             &LogRecord::TruePos(TruePosRecord {
@@ -424,6 +429,18 @@ impl<'a> RecordStream<'a> {
         Ok(None)
     }
 
+    /// The error for a next line longer than [`MAX_LINE_BYTES`].
+    fn line_too_long(&self) -> CarmenError {
+        CarmenError::Malformed(Diagnostic::error(
+            &self.name,
+            (self.line_no + 1, 1),
+            format!(
+                "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
+                MAX_LINE_BYTES >> 20
+            ),
+        ))
+    }
+
     /// Reads the next line into `self.bytes`; `false` at the end of the log.
     fn next_line(&mut self) -> Result<bool, CarmenError> {
         self.bytes.clear();
@@ -433,14 +450,7 @@ impl<'a> RecordStream<'a> {
         {
             Ok(0) => Ok(false),
             Ok(n) if n as u64 == MAX_LINE_BYTES && self.bytes.last() != Some(&b'\n') => {
-                Err(CarmenError::Malformed(Diagnostic::error(
-                    &self.name,
-                    (self.line_no + 1, 1),
-                    format!(
-                        "line longer than {} MiB; this is not a CARMEN text log, or it is corrupt",
-                        MAX_LINE_BYTES >> 20
-                    ),
-                )))
+                Err(self.line_too_long())
             }
             Ok(_) => {
                 self.line_no += 1;
@@ -682,10 +692,9 @@ fn parse_flaser(f: &Fields) -> Result<LogRecord, LineErr> {
     }))
 }
 
-/// `ROBOTLASER1 laser_type start_angle fov angular_res max_range accuracy remission_mode
-/// num_readings r… num_remissions rem… laser_pose robot_pose tv rv forward_safety side_safety
-/// turn_axis stamp`; the first positive max_range goes to `out`.
-fn parse_robotlaser1(f: &Fields, out: &mut LogReadout) -> Result<LogRecord, LineErr> {
+/// The start angle, field of view and maximum range of a `ROBOTLASER1` line, its other
+/// settings (type, resolution, accuracy, remission mode) only checked to be numbers.
+fn robotlaser_settings(f: &Fields) -> Result<(f64, f64, f64), LineErr> {
     let _laser_type = f.num(1, "laser_type")?;
     let start = f.num(2, "start_angle")?;
     let fov = f.num(3, "fov")?;
@@ -693,6 +702,26 @@ fn parse_robotlaser1(f: &Fields, out: &mut LogReadout) -> Result<LogRecord, Line
     let max_range = f.num(5, "max_range")?;
     let _acc = f.num(6, "accuracy")?;
     let _rem_mode = f.num(7, "remission_mode")?;
+    Ok((start, fov, max_range))
+}
+
+/// Checks that the five motion fields of a `ROBOTLASER1` line from `k` on (tv, rv, forward and
+/// side safety, turn axis) are numbers.
+fn robot_motion_fields(f: &Fields, k: usize) -> Result<(), LineErr> {
+    for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
+        .iter()
+        .enumerate()
+    {
+        f.num(k + j, what)?;
+    }
+    Ok(())
+}
+
+/// `ROBOTLASER1 laser_type start_angle fov angular_res max_range accuracy remission_mode
+/// num_readings r… num_remissions rem… laser_pose robot_pose tv rv forward_safety side_safety
+/// turn_axis stamp`; the first positive max_range goes to `out`.
+fn parse_robotlaser1(f: &Fields, out: &mut LogReadout) -> Result<LogRecord, LineErr> {
+    let (start, fov, max_range) = robotlaser_settings(f)?;
     let n = f.count(8, "num_readings")?;
     let ranges = f.announced(9, n, ("readings", "the count", "range"))?;
     let k = 9 + n;
@@ -701,12 +730,7 @@ fn parse_robotlaser1(f: &Fields, out: &mut LogReadout) -> Result<LogRecord, Line
     let k = k + 1 + m;
     let laser_pose = f.pose(k, "laser pose")?;
     let _robot = f.pose(k + 3, "robot pose")?;
-    for (j, what) in ["tv", "rv", "forward_safety", "side_safety", "turn_axis"]
-        .iter()
-        .enumerate()
-    {
-        f.num(k + 6 + j, what)?;
-    }
+    robot_motion_fields(f, k + 6)?;
     let (ipc, host, logger) = f.stamp(k + 11)?;
     if out.robotlaser_max_range_m.is_none() && max_range > 0.0 {
         out.robotlaser_max_range_m = Some(max_range);

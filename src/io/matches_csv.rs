@@ -136,6 +136,21 @@ fn fields(text: &str) -> Vec<(usize, &str)> {
     out
 }
 
+/// The optional column named `name` (at column `col`).
+fn optional_column(col: usize, name: &str) -> Result<Optional, (usize, String)> {
+    match name {
+        "score" => Ok(Optional::Score),
+        "direction" => Ok(Optional::Direction),
+        _ => Err((
+            col,
+            format!(
+                "unknown column `{name}`; after matched_scan come the optional \
+                 columns `score` and `direction`"
+            ),
+        )),
+    }
+}
+
 /// The header: the required columns, then the optional ones it names, in its order. A header
 /// without optional columns takes a score as fifth field (as before `direction` existed).
 fn parse_header(text: &str) -> Result<Vec<Optional>, (usize, String)> {
@@ -151,19 +166,7 @@ fn parse_header(text: &str) -> Result<Vec<Optional>, (usize, String)> {
     }
     let mut cols = Vec::new();
     for &(col, name) in &got[4..] {
-        let c = match name {
-            "score" => Optional::Score,
-            "direction" => Optional::Direction,
-            _ => {
-                return Err((
-                    col,
-                    format!(
-                        "unknown column `{name}`; after matched_scan come the optional \
-                         columns `score` and `direction`"
-                    ),
-                ));
-            }
-        };
+        let c = optional_column(col, name)?;
         if cols.contains(&c) {
             return Err((col, format!("column `{name}` appears twice")));
         }
@@ -175,24 +178,8 @@ fn parse_header(text: &str) -> Result<Vec<Optional>, (usize, String)> {
     Ok(cols)
 }
 
-/// One data line laid out as the header says; errors carry the 1-based column.
-fn parse_row(text: &str, layout: &[Optional]) -> Result<MatchRow, (usize, String)> {
-    let fields = fields(text);
-    let most = 4 + layout.len();
-    if !(4..=most).contains(&fields.len()) {
-        let range = if most == 5 {
-            "4 or 5".to_string()
-        } else {
-            format!("4 to {most}")
-        };
-        return Err((
-            1,
-            format!(
-                "expected {range} comma-separated fields, as the header says; found {}",
-                fields.len()
-            ),
-        ));
-    }
+/// The four required whole numbers of a row (query run and scan, matched run and scan).
+fn required_fields(fields: &[(usize, &str)]) -> Result<[usize; 4], (usize, String)> {
     let mut ints = [0usize; 4];
     for (k, name) in REQUIRED.iter().enumerate() {
         let (c, f) = fields[k];
@@ -200,6 +187,30 @@ fn parse_row(text: &str, layout: &[Optional]) -> Result<MatchRow, (usize, String
             .parse()
             .map_err(|_| (c, format!("{name} `{f}` is not a whole number ≥ 0")))?;
     }
+    Ok(ints)
+}
+
+/// An error unless a row has from 4 to `most` fields (`found`).
+fn field_count_ok(found: usize, most: usize) -> Result<(), (usize, String)> {
+    if (4..=most).contains(&found) {
+        return Ok(());
+    }
+    let range = if most == 5 {
+        "4 or 5".to_string()
+    } else {
+        format!("4 to {most}")
+    };
+    Err((
+        1,
+        format!("expected {range} comma-separated fields, as the header says; found {found}"),
+    ))
+}
+
+/// One data line laid out as the header says; errors carry the 1-based column.
+fn parse_row(text: &str, layout: &[Optional]) -> Result<MatchRow, (usize, String)> {
+    let fields = fields(text);
+    field_count_ok(fields.len(), 4 + layout.len())?;
+    let ints = required_fields(&fields)?;
     let mut row = MatchRow {
         query_run: ints[0],
         query_scan: ints[1],

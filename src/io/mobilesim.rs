@@ -11,7 +11,7 @@ use crate::geom::{Segment, Vec2};
 use crate::spec::diag::Diagnostic;
 
 /// A parsed MobileSim map, in metres and degrees.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct MobileSimMap {
     pub segments: Vec<Segment>,
     /// The 1-based line of each segment.
@@ -104,33 +104,16 @@ enum Section {
 
 /// Parses a MobileSim map; `name` only names it in messages, each error at its line and column.
 pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, Diagnostic> {
-    let mut map = MobileSimMap {
-        segments: Vec::new(),
-        segment_lines: Vec::new(),
-        home: None,
-        home_line: 0,
-    };
+    let mut map = MobileSimMap::default();
     let mut section = None;
     for (idx, raw) in src.lines().enumerate() {
         let line_no = idx + 1;
         let toks = tokens(raw);
-        let Some(&(col0, first)) = toks.first() else {
+        let Some(&(col0, first)) = toks.first().filter(|(_, t)| !is_comment(t)) else {
             continue;
         };
-        if first.starts_with(';') || first.starts_with('#') {
-            continue;
-        }
         let Some(current) = section else {
-            if first != "2D-Map" {
-                return Err(malformed(
-                    name,
-                    line_no,
-                    col0,
-                    format!(
-                        "expected `2D-Map` as the first line, found `{first}`; is this a MobileSim .map file?"
-                    ),
-                ));
-            }
+            expect_map_start(name, line_no, col0, first)?;
             section = Some(Section::Header);
             continue;
         };
@@ -144,14 +127,44 @@ pub fn parse_map(src: &str, name: &str) -> Result<MobileSimMap, Diagnostic> {
         }
     }
     if section.is_none() {
-        return Err(malformed(
-            name,
-            1,
-            1,
-            "the file is empty; expected a MobileSim map starting with `2D-Map`",
-        ));
+        return Err(empty_map(name));
     }
     Ok(map)
+}
+
+/// Whether a line whose first token is `first` is a comment.
+fn is_comment(first: &str) -> bool {
+    first.starts_with(';') || first.starts_with('#')
+}
+
+/// The error for a map without a line that is not blank or a comment.
+fn empty_map(name: &str) -> Diagnostic {
+    malformed(
+        name,
+        1,
+        1,
+        "the file is empty; expected a MobileSim map starting with `2D-Map`",
+    )
+}
+
+/// An error unless the first line's first token, `first`, is `2D-Map`.
+fn expect_map_start(
+    name: &str,
+    line_no: usize,
+    col0: usize,
+    first: &str,
+) -> Result<(), Diagnostic> {
+    if first == "2D-Map" {
+        return Ok(());
+    }
+    Err(malformed(
+        name,
+        line_no,
+        col0,
+        format!(
+            "expected `2D-Map` as the first line, found `{first}`; is this a MobileSim .map file?"
+        ),
+    ))
 }
 
 /// A header line: the first `Cairn: RobotHome x y heading` gives the home. Other header lines
@@ -165,9 +178,21 @@ fn read_header_line(
     {
         return Ok(());
     }
-    let v: [f64; 3] = numbers(
-        (name, line_no, raw),
-        &toks[2..],
+    let v = home_numbers((name, line_no, raw), &toks[2..])?;
+    far_coordinate((name, line_no), &toks[2..], &v[..2], &["x", "y"])?;
+    if map.home.is_none() {
+        map.home = Some((v[0] / 1000.0, v[1] / 1000.0, v[2]));
+        map.home_line = line_no;
+    }
+    Ok(())
+}
+
+/// The x (mm), y (mm) and heading (degrees) of a RobotHome cairn, from its tokens after
+/// `Cairn: RobotHome`.
+fn home_numbers(at: (&str, usize, &str), toks: &[(usize, &str)]) -> Result<[f64; 3], Diagnostic> {
+    numbers(
+        at,
+        toks,
         ["x (mm)", "y (mm)", "heading (degrees)"],
         |what| {
             format!(
@@ -179,13 +204,7 @@ fn read_header_line(
                 "RobotHome {what} is `{s}`, not a number; write `Cairn: RobotHome x y heading …`"
             )
         },
-    )?;
-    far_coordinate((name, line_no), &toks[2..], &v[..2], &["x", "y"])?;
-    if map.home.is_none() {
-        map.home = Some((v[0] / 1000.0, v[1] / 1000.0, v[2]));
-        map.home_line = line_no;
-    }
-    Ok(())
+    )
 }
 
 /// A line after `LINES`: one segment `x1 y1 x2 y2` in millimetres, nothing after it.
@@ -194,21 +213,7 @@ fn read_segment_line(
     toks: &[(usize, &str)],
     map: &mut MobileSimMap,
 ) -> Result<(), Diagnostic> {
-    let v: [f64; 4] = numbers(
-        (name, line_no, raw),
-        toks,
-        ["x1", "y1", "x2", "y2"],
-        |what| {
-            format!(
-                "line segment ends before its {what}; each line after LINES is `x1 y1 x2 y2` in millimetres"
-            )
-        },
-        |what, s| {
-            format!(
-                "segment {what} is `{s}`, not a number; each line after LINES is `x1 y1 x2 y2` in millimetres"
-            )
-        },
-    )?;
+    let v = segment_numbers((name, line_no, raw), toks)?;
     far_coordinate((name, line_no), toks, &v, &["x1", "y1", "x2", "y2"])?;
     if let Some(&(c, s)) = toks.get(4) {
         return Err(malformed(
@@ -226,6 +231,28 @@ fn read_segment_line(
     ));
     map.segment_lines.push(line_no);
     Ok(())
+}
+
+/// The four coordinates (mm) of a segment line.
+fn segment_numbers(
+    at: (&str, usize, &str),
+    toks: &[(usize, &str)],
+) -> Result<[f64; 4], Diagnostic> {
+    numbers(
+        at,
+        toks,
+        ["x1", "y1", "x2", "y2"],
+        |what| {
+            format!(
+                "line segment ends before its {what}; each line after LINES is `x1 y1 x2 y2` in millimetres"
+            )
+        },
+        |what, s| {
+            format!(
+                "segment {what} is `{s}`, not a number; each line after LINES is `x1 y1 x2 y2` in millimetres"
+            )
+        },
+    )
 }
 
 #[cfg(test)]

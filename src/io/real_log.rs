@@ -353,21 +353,7 @@ impl<'a, P: FnMut(Pose2) -> Pose2> FrameMaker<'a, P> {
 
     /// The frame of the next laser `l`.
     fn make(&mut self, l: &LaserRecord) -> Result<Frame, RealLogError> {
-        match self.prev {
-            Some(prev) => {
-                self.odom = self.odom.compose(&(self.perturb)(prev.between(&l.pose)));
-                self.travelled_m += prev.distance(&l.pose);
-            }
-            None => (self.odom, self.t0) = (l.pose, l.ipc_timestamp),
-        }
-        self.prev = Some(l.pose);
-        let raw = if self.use_stamps {
-            l.ipc_timestamp - self.t0
-        } else {
-            self.travelled_m / NOMINAL_SPEED_M_S
-        };
-        let time_s = raw.max(self.last_time_s);
-        self.last_time_s = time_s;
+        let time_s = self.advance(l);
         let true_pose = self.true_pose(l)?;
         self.k += 1;
         let n = l.ranges_m.len();
@@ -383,6 +369,27 @@ impl<'a, P: FnMut(Pose2) -> Pose2> FrameMaker<'a, P> {
                 time_s,
             },
         })
+    }
+
+    /// Moves the odometry on to laser `l` (by its perturbed motion) and returns its time:
+    /// from its stamp or the distance travelled, never before the previous frame's.
+    fn advance(&mut self, l: &LaserRecord) -> f64 {
+        match self.prev {
+            Some(prev) => {
+                self.odom = self.odom.compose(&(self.perturb)(prev.between(&l.pose)));
+                self.travelled_m += prev.distance(&l.pose);
+            }
+            None => (self.odom, self.t0) = (l.pose, l.ipc_timestamp),
+        }
+        self.prev = Some(l.pose);
+        let raw = if self.use_stamps {
+            l.ipc_timestamp - self.t0
+        } else {
+            self.travelled_m / NOMINAL_SPEED_M_S
+        };
+        let time_s = raw.max(self.last_time_s);
+        self.last_time_s = time_s;
+        time_s
     }
 
     /// The truth of laser `l` (the `k`-th): its corrected pose or the nearest TRUEPOS.
@@ -465,6 +472,15 @@ impl LogSurvey {
     }
 }
 
+/// The lasers' maximum range, metres: the log's parameter, else the first ROBOTLASER1's, else
+/// the default.
+fn survey_max_range_m(survey: &LogSurvey) -> f64 {
+    max_range_or_default(
+        survey.param_max_range_m,
+        survey.counts.robotlaser_max_range_m,
+    )
+}
+
 /// Reads the log at `path` a second time, after its [`LogSurvey`], and hands each frame of its
 /// run to `on_frame` in order: the frames [`load_run`] gives, one at a time, so memory holds one
 /// line and one frame whatever the log's size. `perturb` as for [`log_to_run`].
@@ -483,10 +499,7 @@ pub fn stream_frames(
     if truth == TruthSource::TruePos && survey.truepos.is_empty() {
         return Err(RealLogError::NoTruePos(name));
     }
-    let max_range_m = max_range_or_default(
-        survey.param_max_range_m,
-        survey.counts.robotlaser_max_range_m,
-    );
+    let max_range_m = survey_max_range_m(survey);
     let use_stamps = survey.stamps().usable();
     let tp = &survey.truepos;
     let mut maker = FrameMaker::new(&name, truth, tp, max_range_m, use_stamps, perturb);

@@ -143,26 +143,39 @@ impl RecognizerConfig {
     /// The problems between components: the kernel must fit in the local grid, and the grid's
     /// torus must reach a kernel centred `max_interpolation_m` back along a step.
     fn cross_problems(&self) -> Vec<ConfigProblem> {
+        [self.kernel_in_grid(), self.interpolation_in_grid()]
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+
+    /// A problem when the density kernel is wider than the local grid.
+    fn kernel_in_grid(&self) -> Option<ConfigProblem> {
         let (grid, kernel_m) = (&self.grid, self.density.kernel_radius_m);
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        let mut out = Vec::new();
-        if positive(kernel_m) && positive(grid.grid_radius_m) && kernel_m > grid.grid_radius_m {
-            out.push(ConfigProblem::new(
+        (positive(kernel_m) && positive(grid.grid_radius_m) && kernel_m > grid.grid_radius_m).then(|| {
+            ConfigProblem::new(
                 "density",
                 "kernel_radius_m",
                 format!(
                     "{kernel_m} m is larger than grid_radius_m ({} m); the kernel must fit in the local grid",
                     grid.grid_radius_m
                 ),
-            ));
-        }
+            )
+        })
+    }
+
+    /// A problem when interpolating plus the kernel reaches past [`MAX_GRID_HALF_CELLS`] cells.
+    fn interpolation_in_grid(&self) -> Option<ConfigProblem> {
+        let (grid, kernel_m) = (&self.grid, self.density.kernel_radius_m);
+        let positive = |v: f64| v.is_finite() && v > 0.0;
         let interpolation_m = self.front_end.max_interpolation_m;
         if (0.0..=20.0).contains(&interpolation_m)
             && positive(grid.grid_cell_m)
             && positive(kernel_m)
             && (interpolation_m + kernel_m) / grid.grid_cell_m > MAX_GRID_HALF_CELLS
         {
-            out.push(ConfigProblem::new(
+            return Some(ConfigProblem::new(
                 "front_end",
                 "max_interpolation_m",
                 format!(
@@ -172,7 +185,7 @@ impl RecognizerConfig {
                 ),
             ));
         }
-        out
+        None
     }
 
     /// `Ok` when the settings are usable, else every problem.

@@ -133,6 +133,18 @@ fn is_zero(n: &usize) -> bool {
     *n == 0
 }
 
+/// The sentence saying how far a chain of `tau` words (`backwards` when read backwards) reaches.
+fn need_sentence(tau: usize, backwards: usize, same_need_m: f64, opposite_need_m: f64) -> String {
+    if backwards == tau {
+        format!("τ = {tau} words need about {same_need_m:.0} m")
+    } else {
+        format!(
+            "τ = {tau} words need about {same_need_m:.0} m ({backwards} read backwards, about \
+             {opposite_need_m:.0} m)"
+        )
+    }
+}
+
 impl Diagnostics for MatchDiagnostics {
     /// The matcher's side of a run without pairs, with a word on steps too long to observe
     /// along their length when there were any.
@@ -188,14 +200,7 @@ impl Diagnostics for MatchDiagnostics {
              average",
             self.mean_word_m
         );
-        let need = if backwards == tau {
-            format!("τ = {tau} words need about {same_need_m:.0} m")
-        } else {
-            format!(
-                "τ = {tau} words need about {same_need_m:.0} m ({backwards} read backwards, about \
-                 {opposite_need_m:.0} m)"
-            )
-        };
+        let need = need_sentence(tau, backwards, same_need_m, opposite_need_m);
         Some(if same_m < same_need_m && opposite_m < opposite_need_m {
             format!("{stretch}: {need}, so the revisits are too short for a chain")
         } else {

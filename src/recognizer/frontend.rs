@@ -82,13 +82,7 @@ impl ObservationClock {
     /// Moves to the next scan, taken at `odom`.
     pub fn step(&mut self, odom: OdomPose) -> Due {
         let previous = self.last_odom.map(|last| (last, self.travel_m));
-        if let Some(last) = self.last_odom {
-            let step = last.0.distance(&odom.0);
-            if step.is_finite() {
-                self.travel_m += step;
-            }
-        }
-        self.last_odom = Some(odom);
+        self.travel_to(odom);
         let first_travel_m = self.next_obs_travel_m;
         if self.travel_m + 1e-9 < self.next_obs_travel_m {
             return Due {
@@ -110,6 +104,18 @@ impl ObservationClock {
             first_travel_m,
             along_step,
         }
+    }
+
+    /// Adds the distance from the last scan's odometry to `odom` to the travel (a non-finite
+    /// step adds nothing), and makes `odom` the last.
+    fn travel_to(&mut self, odom: OdomPose) {
+        if let Some(last) = self.last_odom {
+            let step = last.0.distance(&odom.0);
+            if step.is_finite() {
+                self.travel_m += step;
+            }
+        }
+        self.last_odom = Some(odom);
     }
 
     /// Starts a new run: the jump to the new start is not travel. Returns false (and does

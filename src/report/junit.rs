@@ -231,23 +231,27 @@ fn testcase(o: &Outcome, s: &Suite) -> String {
     }
     x.push_str("      </properties>\n");
     if !o.passed {
-        let mut text = outcome_line(o);
-        if let Some(seed) = o.seed {
-            let _ = write!(
-                text,
-                "; reproduce: {}",
-                reproduce_command(file, seed, &s.reproduce_flags)
-            );
-        }
-        let line = escape(&outcome_line(o));
-        let _ = writeln!(
-            x,
-            "      <failure message=\"{line}\" type=\"expectation\">{}</failure>",
-            escape(&text)
-        );
+        x.push_str(&failure(o, s));
     }
     x.push_str("    </testcase>\n");
     x
+}
+
+/// The `<failure>` element of a failed outcome: what missed, and how to reproduce it.
+fn failure(o: &Outcome, s: &Suite) -> String {
+    let mut text = outcome_line(o);
+    if let Some(seed) = o.seed {
+        let _ = write!(
+            text,
+            "; reproduce: {}",
+            reproduce_command(&s.file, seed, &s.reproduce_flags)
+        );
+    }
+    let line = escape(&outcome_line(o));
+    format!(
+        "      <failure message=\"{line}\" type=\"expectation\">{}</failure>\n",
+        escape(&text)
+    )
 }
 
 fn first_line(s: &str) -> &str {

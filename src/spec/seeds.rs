@@ -115,6 +115,22 @@ impl TryFrom<RawShard> for Shard {
     }
 }
 
+/// Environment variable `name`, when set and not blank.
+fn env_var(name: &str) -> Option<String> {
+    std::env::var(name).ok().filter(|v| !v.trim().is_empty())
+}
+
+/// The number of parts from `PLACEWORDS_SHARD_COUNT`.
+fn shard_count_from_env() -> Result<usize, String> {
+    let n = env_var("PLACEWORDS_SHARD_COUNT").ok_or(
+        "--shard auto needs the number of parts: --shard-count N or \
+         PLACEWORDS_SHARD_COUNT=N (the Job's completions)",
+    )?;
+    n.trim()
+        .parse()
+        .map_err(|_| format!("PLACEWORDS_SHARD_COUNT = `{n}` is not a positive integer"))
+}
+
 impl Shard {
     /// Whether the work item at position `item` (0-based, in plan order) is this shard's. Items
     /// are dealt round-robin, so every shard gets a share of every scenario's seeds.
@@ -125,8 +141,7 @@ impl Shard {
     /// The shard of a Kubernetes Indexed Job: `JOB_COMPLETION_INDEX` (0-based) is the part,
     /// `count` (a flag) or else `PLACEWORDS_SHARD_COUNT` the number of parts.
     pub fn from_env(count: Option<usize>) -> Result<Self, String> {
-        let var = |name: &str| std::env::var(name).ok().filter(|v| !v.trim().is_empty());
-        let index = var("JOB_COMPLETION_INDEX").ok_or(
+        let index = env_var("JOB_COMPLETION_INDEX").ok_or(
             "--shard auto needs JOB_COMPLETION_INDEX (set by a Kubernetes Indexed Job); \
              or give --shard K/N",
         )?;
@@ -135,15 +150,7 @@ impl Shard {
         })?;
         let count = match count {
             Some(n) => n,
-            None => {
-                let n = var("PLACEWORDS_SHARD_COUNT").ok_or(
-                    "--shard auto needs the number of parts: --shard-count N or \
-                     PLACEWORDS_SHARD_COUNT=N (the Job's completions)",
-                )?;
-                n.trim().parse().map_err(|_| {
-                    format!("PLACEWORDS_SHARD_COUNT = `{n}` is not a positive integer")
-                })?
-            }
+            None => shard_count_from_env()?,
         };
         // JOB_COMPLETION_INDEX counts from 0: part index + 1 (checked: u64::MAX must not wrap
         // to part 0).

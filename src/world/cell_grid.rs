@@ -59,24 +59,8 @@ impl CellGrid {
     /// the cells of its padded bounding box.
     fn fill(&mut self, segs: &[PaddedSegment]) {
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(segs.len() * 4);
-        for (k, (s, pad)) in segs.iter().enumerate() {
-            let (dx, dy) = (s[2] - s[0], s[3] - s[1]);
-            let pieces = ((dx.hypot(dy) / self.cell_m).ceil() as usize).clamp(1, 1 << 24);
-            let pad = pad.max(0.0) + EPS_M;
-            let at = |t: f64| [s[0] + dx * t, s[1] + dy * t];
-            for p in 0..pieces {
-                let (a, b) = (
-                    at(p as f64 / pieces as f64),
-                    at((p + 1) as f64 / pieces as f64),
-                );
-                let (i0, j0) = self.clamped_cell(a[0].min(b[0]) - pad, a[1].min(b[1]) - pad);
-                let (i1, j1) = self.clamped_cell(a[0].max(b[0]) + pad, a[1].max(b[1]) + pad);
-                for j in j0..=j1 {
-                    for i in i0..=i1 {
-                        pairs.push(((j * self.nx + i) as u32, k as u32));
-                    }
-                }
-            }
+        for (k, seg) in segs.iter().enumerate() {
+            self.push_cells_of(k, seg, &mut pairs);
         }
         pairs.sort_unstable();
         pairs.dedup();
@@ -88,6 +72,28 @@ impl CellGrid {
             self.start[c + 1] += self.start[c];
         }
         self.items = pairs.into_iter().map(|(_, k)| k).collect();
+    }
+
+    /// Pushes (cell, `k`) for every cell the padded segment `(s, pad)` may touch: the boxes
+    /// around pieces of it about a cell long.
+    fn push_cells_of(&self, k: usize, &(s, pad): &PaddedSegment, pairs: &mut Vec<(u32, u32)>) {
+        let (dx, dy) = (s[2] - s[0], s[3] - s[1]);
+        let pieces = ((dx.hypot(dy) / self.cell_m).ceil() as usize).clamp(1, 1 << 24);
+        let pad = pad.max(0.0) + EPS_M;
+        let at = |t: f64| [s[0] + dx * t, s[1] + dy * t];
+        for p in 0..pieces {
+            let (a, b) = (
+                at(p as f64 / pieces as f64),
+                at((p + 1) as f64 / pieces as f64),
+            );
+            let (i0, j0) = self.clamped_cell(a[0].min(b[0]) - pad, a[1].min(b[1]) - pad);
+            let (i1, j1) = self.clamped_cell(a[0].max(b[0]) + pad, a[1].max(b[1]) + pad);
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    pairs.push(((j * self.nx + i) as u32, k as u32));
+                }
+            }
+        }
     }
 
     /// The cell of a point, clamped into the grid.

@@ -22,6 +22,24 @@ pub struct Raster {
     pub occupied: Vec<bool>,
 }
 
+/// The lowest and highest corners of the box around `items` and `also` (at the origin when
+/// there are none).
+fn bounds(items: &[ThickSegment], also: &[Vec2]) -> (Vec2, Vec2) {
+    let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
+    for t in items {
+        lo = lo.inf(&t.seg.a).inf(&t.seg.b);
+        hi = hi.sup(&t.seg.a).sup(&t.seg.b);
+    }
+    for p in also {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if !lo.x.is_finite() {
+        (lo, hi) = (Vec2::zeros(), Vec2::zeros());
+    }
+    (lo, hi)
+}
+
 impl Raster {
     /// Draws `items` into cells of `cell_m` (grown when the area would exceed [`MAX_CELLS`])
     /// over their bounds and the points `also`, plus `margin_m` on every side. A cell is
@@ -34,18 +52,7 @@ impl Raster {
         margin_m: f64,
         dilate_m: f64,
     ) -> Self {
-        let (mut lo, mut hi) = (Vec2::repeat(f64::INFINITY), Vec2::repeat(f64::NEG_INFINITY));
-        for t in items {
-            lo = lo.inf(&t.seg.a).inf(&t.seg.b);
-            hi = hi.sup(&t.seg.a).sup(&t.seg.b);
-        }
-        for p in also {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        if !lo.x.is_finite() {
-            (lo, hi) = (Vec2::zeros(), Vec2::zeros());
-        }
+        let (mut lo, mut hi) = bounds(items, also);
         lo -= Vec2::repeat(margin_m);
         hi += Vec2::repeat(margin_m);
         let area = (hi.x - lo.x).max(cell_m) * (hi.y - lo.y).max(cell_m);
@@ -103,16 +110,7 @@ impl Raster {
     /// row-major like `occupied`.
     pub fn reachable(&self, seeds: &[Vec2]) -> Vec<bool> {
         let mut seen = vec![false; self.occupied.len()];
-        let mut stack: Vec<usize> = Vec::new();
-        for s in seeds {
-            if let Some((x, y)) = self.cell(*s) {
-                let i = y * self.width + x;
-                if !self.occupied[i] && !seen[i] {
-                    seen[i] = true;
-                    stack.push(i);
-                }
-            }
-        }
+        let mut stack = self.free_seed_cells(seeds, &mut seen);
         while let Some(i) = stack.pop() {
             let (x, y) = (i % self.width, i / self.width);
             let mut visit = |j: usize| {
@@ -135,6 +133,21 @@ impl Raster {
             }
         }
         seen
+    }
+
+    /// The free cells of `seeds` (inside the raster), each once, marked in `seen`.
+    fn free_seed_cells(&self, seeds: &[Vec2], seen: &mut [bool]) -> Vec<usize> {
+        let mut cells = Vec::new();
+        for s in seeds {
+            if let Some((x, y)) = self.cell(*s) {
+                let i = y * self.width + x;
+                if !self.occupied[i] && !seen[i] {
+                    seen[i] = true;
+                    cells.push(i);
+                }
+            }
+        }
+        cells
     }
 
     /// Whether any cell of `region` lies on the raster's border.

@@ -11,7 +11,9 @@
 use crate::geom::{Segment, Vec2, wrap_angle};
 use crate::spec::diag::{Diags, fmt_number};
 use crate::spec::suggest::{length_unit_hint, radians_as_degrees, radians_hint};
-use crate::spec::world::{DoorSpec, Unread, WorldLoc, WorldSpec};
+use crate::spec::world::{
+    DoorLoc, DoorSpec, RouteLoc, RouteSpec, Unread, WallLoc, WallSpec, WorldLoc, WorldSpec,
+};
 use crate::world::geometry::{SegmentIndex, ThickSegment};
 use std::collections::HashMap;
 
@@ -124,33 +126,9 @@ fn usable(
     good_doors: &[bool],
     unread: &mut Vec<Unread>,
 ) -> (WorldSpec, WorldLoc) {
+    set_aside_walls(spec, loc, good_walls, unread);
+    set_aside_doors(spec, loc, good_doors, unread);
     let (mut spec, mut loc) = (spec.clone(), loc.clone());
-    for (w, (l, _)) in spec
-        .walls
-        .iter()
-        .zip(loc.walls.iter().zip(good_walls))
-        .filter(|(_, (_, g))| !**g)
-    {
-        unread.push(Unread {
-            kind: "wall",
-            name: format!("wall '{}'", w.id),
-            at: l.table,
-            points_m: w.points_m.clone(),
-        });
-    }
-    for (door, (l, _)) in spec
-        .doors
-        .iter()
-        .zip(loc.doors.iter().zip(good_doors))
-        .filter(|(_, (_, g))| !**g)
-    {
-        unread.push(Unread {
-            kind: "door",
-            name: format!("door '{}'", door.id),
-            at: l.table,
-            points_m: vec![door.hinge_m],
-        });
-    }
     let keep = |good: &[bool], i: usize| good.get(i).copied().unwrap_or(true);
     let mut i = 0;
     spec.walls.retain(|_| (keep(good_walls, i), i += 1).0);
@@ -161,6 +139,40 @@ fn usable(
     i = 0;
     loc.doors.retain(|_| (keep(good_doors, i), i += 1).0);
     (spec, loc)
+}
+
+/// Adds to `unread` the walls whose values are out of range (`good` false).
+fn set_aside_walls(spec: &WorldSpec, loc: &WorldLoc, good: &[bool], unread: &mut Vec<Unread>) {
+    for (w, (l, _)) in spec
+        .walls
+        .iter()
+        .zip(loc.walls.iter().zip(good))
+        .filter(|(_, (_, g))| !**g)
+    {
+        unread.push(Unread {
+            kind: "wall",
+            name: format!("wall '{}'", w.id),
+            at: l.table,
+            points_m: w.points_m.clone(),
+        });
+    }
+}
+
+/// Adds to `unread` the doors whose values are out of range (`good` false).
+fn set_aside_doors(spec: &WorldSpec, loc: &WorldLoc, good: &[bool], unread: &mut Vec<Unread>) {
+    for (door, (l, _)) in spec
+        .doors
+        .iter()
+        .zip(loc.doors.iter().zip(good))
+        .filter(|(_, (_, g))| !**g)
+    {
+        unread.push(Unread {
+            kind: "door",
+            name: format!("door '{}'", door.id),
+            at: l.table,
+            points_m: vec![door.hinge_m],
+        });
+    }
 }
 
 /// The centre-line segments of what read of an unread wall or door (a closed wall's closing
@@ -227,10 +239,9 @@ fn duplicate_ids(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     );
 }
 
-/// Whether the world holds at most [`MAX_SEGMENTS`] wall segments, door panels and route legs.
-fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
-    let segments: usize = spec
-        .walls
+/// The number of wall segments, door panels and route legs.
+fn segment_count(spec: &WorldSpec) -> usize {
+    spec.walls
         .iter()
         .map(|w| {
             let n = w.points_m.len();
@@ -242,7 +253,12 @@ fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
             .routes
             .iter()
             .map(|r| r.waypoints_m.len())
-            .sum::<usize>();
+            .sum::<usize>()
+}
+
+/// Whether the world holds at most [`MAX_SEGMENTS`] wall segments, door panels and route legs.
+fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
+    let segments = segment_count(spec);
     if segments > MAX_SEGMENTS {
         // Reported on the wall that holds most of them, when one does.
         let biggest = spec
@@ -275,20 +291,7 @@ fn segment_count_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
 fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
     let mut good = Vec::with_capacity(spec.walls.len());
     for (w, l) in spec.walls.iter().zip(&loc.walls) {
-        let mut ok = true;
-        if !(w.thickness_m > 0.0 && w.thickness_m < MAX_WALL_THICKNESS_M) {
-            d.at(
-                l.thickness,
-                format!(
-                    "wall '{}' has thickness_m = {}, outside (0, {MAX_WALL_THICKNESS_M}) m; {}",
-                    w.id,
-                    fmt_number(w.thickness_m),
-                    length_unit_hint("thickness_m", w.thickness_m, TYPICAL_WALL_THICKNESS_M)
-                        .unwrap_or_else(|| "use the wall's real thickness, e.g. 0.1".into())
-                ),
-            );
-            ok = false;
-        }
+        let ok = wall_thickness_ok(w, l, d);
         let n = w.points_m.len();
         if n < 2 || (w.closed && n < 3) {
             let need = if w.closed { 3 } else { 2 };
@@ -304,24 +307,48 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
             continue;
         }
         good.push(ok);
-        let m = if w.closed { n } else { n - 1 };
-        for j in 0..m {
-            let (a, b) = (w.points_m[j], w.points_m[(j + 1) % n]);
-            if a == b {
-                let at = l.points.get((j + 1) % n).copied().unwrap_or(l.points_key);
-                d.at(
-                    at,
-                    format!(
-                        "wall '{}' has a zero-length segment (point {} repeats point {}); remove the repeated point",
-                        w.id,
-                        (j + 1) % n,
-                        j
-                    ),
-                );
-            }
-        }
+        repeated_wall_points(w, l, d);
     }
     good
+}
+
+/// Whether a wall's thickness is in range; an error when not.
+fn wall_thickness_ok(w: &WallSpec, l: &WallLoc, d: &mut Diags) -> bool {
+    if w.thickness_m > 0.0 && w.thickness_m < MAX_WALL_THICKNESS_M {
+        return true;
+    }
+    d.at(
+        l.thickness,
+        format!(
+            "wall '{}' has thickness_m = {}, outside (0, {MAX_WALL_THICKNESS_M}) m; {}",
+            w.id,
+            fmt_number(w.thickness_m),
+            length_unit_hint("thickness_m", w.thickness_m, TYPICAL_WALL_THICKNESS_M)
+                .unwrap_or_else(|| "use the wall's real thickness, e.g. 0.1".into())
+        ),
+    );
+    false
+}
+
+/// An error per zero-length segment of a wall of at least two points.
+fn repeated_wall_points(w: &WallSpec, l: &WallLoc, d: &mut Diags) {
+    let n = w.points_m.len();
+    let m = if w.closed { n } else { n - 1 };
+    for j in 0..m {
+        let (a, b) = (w.points_m[j], w.points_m[(j + 1) % n]);
+        if a == b {
+            let at = l.points.get((j + 1) % n).copied().unwrap_or(l.points_key);
+            d.at(
+                at,
+                format!(
+                    "wall '{}' has a zero-length segment (point {} repeats point {}); remove the repeated point",
+                    w.id,
+                    (j + 1) % n,
+                    j
+                ),
+            );
+        }
+    }
 }
 
 /// Door widths, thicknesses, headings and swings; per door, whether its geometry can be
@@ -329,118 +356,121 @@ fn walls_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
 fn doors_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> Vec<bool> {
     let mut good = Vec::with_capacity(spec.doors.len());
     for (door, l) in spec.doors.iter().zip(&loc.doors) {
-        let mut ok = true;
-        let (lo, hi) = DOOR_WIDTH_RANGE_M;
-        if !(door.width_m >= lo && door.width_m <= hi) {
-            d.at(
-                l.width,
-                format!(
-                    "door '{}' has width_m = {}, outside {lo}-{hi} m; {}",
-                    door.id,
-                    fmt_number(door.width_m),
-                    length_unit_hint("width_m", door.width_m, TYPICAL_DOOR_WIDTH_M)
-                        .unwrap_or_else(|| "doors are usually 0.8-1.0 m wide".into())
-                ),
-            );
-            ok = false;
-        }
-        if !(door.thickness_m > 0.0 && door.thickness_m <= MAX_DOOR_THICKNESS_M) {
-            d.at(
-                l.thickness,
-                format!(
-                    "door '{}' has thickness_m = {}, outside (0, {MAX_DOOR_THICKNESS_M}] m; {}",
-                    door.id,
-                    fmt_number(door.thickness_m),
-                    length_unit_hint("thickness_m", door.thickness_m, TYPICAL_DOOR_THICKNESS_M)
-                        .unwrap_or_else(|| "leave it out for the default 0.04".into())
-                ),
-            );
-            ok = false;
-        }
-        for (h, at, key) in [
-            (
-                door.closed_heading_deg,
-                l.closed_heading,
-                "closed_heading_deg",
-            ),
-            (door.open_heading_deg, l.open_heading, "open_heading_deg"),
-        ] {
-            if h.abs() > 360.0 {
-                d.at(
-                    at,
-                    format!(
-                        "door '{}' has {key} = {}, outside -360..360; give the heading in degrees",
-                        door.id,
-                        fmt_number(h)
-                    ),
-                );
-                ok = false;
-            }
-        }
-        let swing = wrap_angle((door.open_heading_deg - door.closed_heading_deg).to_radians())
-            .to_degrees()
-            .abs();
-        if swing < MIN_DOOR_SWING_DEG {
-            // Headings written in radians swing a few degrees: say so rather than "differ".
-            let radians: Vec<String> = [
-                ("closed_heading_deg", door.closed_heading_deg),
-                ("open_heading_deg", door.open_heading_deg),
-            ]
-            .into_iter()
-            .filter_map(|(key, h)| radians_hint(key, h))
-            .collect();
-            let fix = if radians.is_empty() {
-                "make open_heading_deg differ from closed_heading_deg, usually by 90".to_string()
-            } else {
-                radians.join("; ")
-            };
-            d.at(
-                l.open_heading,
-                format!(
-                    "door '{}' swings only {swing:.1} degrees between closed and open; {fix}",
-                    door.id
-                ),
-            );
-            ok = false;
-        }
-        good.push(ok);
+        // Every check runs, so that each problem is reported.
+        let ok = [
+            door_width_ok(door, l, d),
+            door_thickness_ok(door, l, d),
+            door_headings_ok(door, l, d),
+            door_swing_ok(door, l, d),
+        ];
+        good.push(ok.iter().all(|&o| o));
     }
     good
+}
+
+/// Whether a door's width is in [`DOOR_WIDTH_RANGE_M`]; an error when not.
+fn door_width_ok(door: &DoorSpec, l: &DoorLoc, d: &mut Diags) -> bool {
+    let (lo, hi) = DOOR_WIDTH_RANGE_M;
+    if door.width_m >= lo && door.width_m <= hi {
+        return true;
+    }
+    d.at(
+        l.width,
+        format!(
+            "door '{}' has width_m = {}, outside {lo}-{hi} m; {}",
+            door.id,
+            fmt_number(door.width_m),
+            length_unit_hint("width_m", door.width_m, TYPICAL_DOOR_WIDTH_M)
+                .unwrap_or_else(|| "doors are usually 0.8-1.0 m wide".into())
+        ),
+    );
+    false
+}
+
+/// Whether a door's thickness is in range; an error when not.
+fn door_thickness_ok(door: &DoorSpec, l: &DoorLoc, d: &mut Diags) -> bool {
+    if door.thickness_m > 0.0 && door.thickness_m <= MAX_DOOR_THICKNESS_M {
+        return true;
+    }
+    d.at(
+        l.thickness,
+        format!(
+            "door '{}' has thickness_m = {}, outside (0, {MAX_DOOR_THICKNESS_M}] m; {}",
+            door.id,
+            fmt_number(door.thickness_m),
+            length_unit_hint("thickness_m", door.thickness_m, TYPICAL_DOOR_THICKNESS_M)
+                .unwrap_or_else(|| "leave it out for the default 0.04".into())
+        ),
+    );
+    false
+}
+
+/// Whether a door's closed and open headings are within -360..360; an error per one that is not.
+fn door_headings_ok(door: &DoorSpec, l: &DoorLoc, d: &mut Diags) -> bool {
+    let mut ok = true;
+    for (h, at, key) in [
+        (
+            door.closed_heading_deg,
+            l.closed_heading,
+            "closed_heading_deg",
+        ),
+        (door.open_heading_deg, l.open_heading, "open_heading_deg"),
+    ] {
+        if h.abs() > 360.0 {
+            d.at(
+                at,
+                format!(
+                    "door '{}' has {key} = {}, outside -360..360; give the heading in degrees",
+                    door.id,
+                    fmt_number(h)
+                ),
+            );
+            ok = false;
+        }
+    }
+    ok
+}
+
+/// Whether a door swings at least [`MIN_DOOR_SWING_DEG`]; an error when not.
+fn door_swing_ok(door: &DoorSpec, l: &DoorLoc, d: &mut Diags) -> bool {
+    let swing = wrap_angle((door.open_heading_deg - door.closed_heading_deg).to_radians())
+        .to_degrees()
+        .abs();
+    if swing < MIN_DOOR_SWING_DEG {
+        d.at(
+            l.open_heading,
+            format!(
+                "door '{}' swings only {swing:.1} degrees between closed and open; {}",
+                door.id,
+                small_swing_fix(door)
+            ),
+        );
+        return false;
+    }
+    true
+}
+
+/// How to fix a door that swings too little: headings written in radians swing a few
+/// degrees, so say so rather than "differ".
+fn small_swing_fix(door: &DoorSpec) -> String {
+    let radians: Vec<String> = [
+        ("closed_heading_deg", door.closed_heading_deg),
+        ("open_heading_deg", door.open_heading_deg),
+    ]
+    .into_iter()
+    .filter_map(|(key, h)| radians_hint(key, h))
+    .collect();
+    if radians.is_empty() {
+        "make open_heading_deg differ from closed_heading_deg, usually by 90".to_string()
+    } else {
+        radians.join("; ")
+    }
 }
 
 /// Route waypoints, area corners and the home heading.
 fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     for (r, l) in spec.routes.iter().zip(&loc.routes) {
-        let n = r.waypoints_m.len();
-        if n < 3 {
-            d.at(
-                l.waypoints_key,
-                format!(
-                    "route '{}' has {n} waypoint(s) but a route is a closed loop of at least 3; add waypoints",
-                    r.id
-                ),
-            );
-            continue;
-        }
-        for j in 0..n {
-            if r.waypoints_m[j] == r.waypoints_m[(j + 1) % n] {
-                let k = (j + 1) % n;
-                d.at(
-                    l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
-                    format!(
-                        "route '{}' waypoint {} repeats waypoint {} (a zero-length leg); remove it{}",
-                        r.id,
-                        k,
-                        j,
-                        if k == 0 {
-                            " (the route closes by itself: do not repeat the first waypoint at the end)"
-                        } else {
-                            ""
-                        }
-                    ),
-                );
-            }
-        }
+        route_waypoints(r, l, d);
     }
     for (a, l) in spec.areas.iter().zip(&loc.areas) {
         if !(a.min_m[0] < a.max_m[0] && a.min_m[1] < a.max_m[1]) {
@@ -453,6 +483,51 @@ fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
             );
         }
     }
+    home_heading(spec, loc, d);
+}
+
+/// A route's waypoint count and repeated waypoints.
+fn route_waypoints(r: &RouteSpec, l: &RouteLoc, d: &mut Diags) {
+    let n = r.waypoints_m.len();
+    if n < 3 {
+        d.at(
+            l.waypoints_key,
+            format!(
+                "route '{}' has {n} waypoint(s) but a route is a closed loop of at least 3; add waypoints",
+                r.id
+            ),
+        );
+        return;
+    }
+    repeated_waypoints(r, l, d);
+}
+
+/// An error per waypoint of a route (of at least 3) that repeats the one before it.
+fn repeated_waypoints(r: &RouteSpec, l: &RouteLoc, d: &mut Diags) {
+    let n = r.waypoints_m.len();
+    for j in 0..n {
+        if r.waypoints_m[j] == r.waypoints_m[(j + 1) % n] {
+            let k = (j + 1) % n;
+            d.at(
+                l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
+                format!(
+                    "route '{}' waypoint {} repeats waypoint {} (a zero-length leg); remove it{}",
+                    r.id,
+                    k,
+                    j,
+                    if k == 0 {
+                        " (the route closes by itself: do not repeat the first waypoint at the end)"
+                    } else {
+                        ""
+                    }
+                ),
+            );
+        }
+    }
+}
+
+/// The robot home's heading: an error outside -360..360, a warning when it looks like radians.
+fn home_heading(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
     if loc.home.valid && spec.robot_home.heading_deg.abs() > 360.0 {
         d.at(
             loc.home.heading,
@@ -468,6 +543,31 @@ fn routes_and_areas(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) {
 
 /// Rejects worlds more than [`MAX_EXTENT_M`] across, pointing at the farthest coordinate.
 fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
+    let pts = located_points(spec, loc);
+    if pts.is_empty() {
+        return true;
+    }
+    if let Some((p, at)) = pts
+        .iter()
+        .find(|(p, _)| p[0].abs() > MAX_ABS_COORD_M || p[1].abs() > MAX_ABS_COORD_M)
+    {
+        d.at(
+            *at,
+            format!(
+                "the point [{}, {}] is more than {:.0} km from the origin; coordinates are metres: check this value or move the world near [0, 0]",
+                fmt_number(p[0]),
+                fmt_number(p[1]),
+                MAX_ABS_COORD_M / 1000.0
+            ),
+        );
+        return false;
+    }
+    span_ok(&pts, d)
+}
+
+/// Every coordinate of the world with where it was written: wall points, door hinges, route
+/// waypoints, area corners and the robot's home.
+fn located_points(spec: &WorldSpec, loc: &WorldLoc) -> Vec<([f64; 2], usize)> {
     let mut pts: Vec<([f64; 2], usize)> = Vec::new();
     for (w, l) in spec.walls.iter().zip(&loc.walls) {
         for (k, p) in w.points_m.iter().enumerate() {
@@ -489,46 +589,23 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
     if loc.home.valid {
         pts.push(([spec.robot_home.x_m, spec.robot_home.y_m], loc.home.x));
     }
-    if pts.is_empty() {
-        return true;
-    }
-    if let Some((p, at)) = pts
-        .iter()
-        .find(|(p, _)| p[0].abs() > MAX_ABS_COORD_M || p[1].abs() > MAX_ABS_COORD_M)
-    {
-        d.at(
-            *at,
-            format!(
-                "the point [{}, {}] is more than {:.0} km from the origin; coordinates are metres: check this value or move the world near [0, 0]",
-                fmt_number(p[0]),
-                fmt_number(p[1]),
-                MAX_ABS_COORD_M / 1000.0
-            ),
-        );
-        return false;
-    }
+    pts
+}
+
+/// Whether the points span at most [`MAX_EXTENT_M`] in x and in y; an error at the point
+/// farthest from the median when not.
+fn span_ok(pts: &[([f64; 2], usize)], d: &mut Diags) -> bool {
     let span = |axis: usize| {
         let vals = pts.iter().map(|(p, _)| p[axis]);
         vals.clone().fold(f64::NEG_INFINITY, f64::max) - vals.fold(f64::INFINITY, f64::min)
     };
-    let millimetres = millimetre_hint(&pts, [span(0), span(1)]);
+    let millimetres = millimetre_hint(pts, [span(0), span(1)]);
     for axis in 0..2 {
         let mut vals: Vec<f64> = pts.iter().map(|(p, _)| p[axis]).collect();
         let lo = vals.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = vals.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         if hi - lo > MAX_EXTENT_M {
-            let mid = vals.len() / 2;
-            vals.select_nth_unstable_by(mid, f64::total_cmp);
-            let median = vals[mid];
-            let (p, at) = pts
-                .iter()
-                .max_by(|a, b| {
-                    (a.0[axis] - median)
-                        .abs()
-                        .total_cmp(&(b.0[axis] - median).abs())
-                })
-                .copied()
-                .unwrap_or(([0.0, 0.0], 0));
+            let (p, at) = farthest_from_median(pts, &mut vals, axis);
             d.at(
                 at,
                 format!(
@@ -544,6 +621,25 @@ fn extent_ok(spec: &WorldSpec, loc: &WorldLoc, d: &mut Diags) -> bool {
         }
     }
     true
+}
+
+/// The point farthest along `axis` from the median of `vals` (the points' values on that axis).
+fn farthest_from_median(
+    pts: &[([f64; 2], usize)],
+    vals: &mut [f64],
+    axis: usize,
+) -> ([f64; 2], usize) {
+    let mid = vals.len() / 2;
+    vals.select_nth_unstable_by(mid, f64::total_cmp);
+    let median = vals[mid];
+    pts.iter()
+        .max_by(|a, b| {
+            (a.0[axis] - median)
+                .abs()
+                .total_cmp(&(b.0[axis] - median).abs())
+        })
+        .copied()
+        .unwrap_or(([0.0, 0.0], 0))
 }
 
 /// `the coordinates look like millimetres…` when a world too large in metres is an ordinary
@@ -638,19 +734,7 @@ fn routes_near_unread(
     d: &mut Diags,
 ) {
     for u in unread.iter().filter(|u| matches!(u.kind, "wall" | "door")) {
-        // A door reaches its width around its hinge whichever way it swings: the hinge to
-        // tip distance when both read, the widest door otherwise.
-        let (segs, reach) = match (u.kind, u.points_m.as_slice()) {
-            ("door", [h, tip, ..]) => (
-                vec![Segment::new(v(h), v(h))],
-                robot_radius_m + (v(tip) - v(h)).norm(),
-            ),
-            ("door", [h]) => (
-                vec![Segment::new(v(h), v(h))],
-                robot_radius_m + DOOR_WIDTH_RANGE_M.1,
-            ),
-            _ => (unread_segments(u), robot_radius_m),
-        };
+        let (segs, reach) = unread_reach(u, robot_radius_m);
         for (r, l) in spec.routes.iter().zip(&loc.routes) {
             let n = r.waypoints_m.len();
             if n < 3 {
@@ -665,28 +749,58 @@ fn routes_near_unread(
             });
             let Some(k) = near else { continue };
             let line = d.line_of(u.at);
-            let (at, message) = if segs.is_empty() {
-                (
-                    l.waypoints_key,
-                    format!(
-                        "route '{}' was not checked against {}, whose place did not read (line {line}); fix it and check again",
-                        r.id, u.name
-                    ),
-                )
-            } else {
-                (
-                    l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
-                    format!(
-                        "route '{}' leg from waypoint {k} to {} passes near {} and was not checked against it: that {} has errors (line {line}); fix them and check again",
-                        r.id,
-                        (k + 1) % n,
-                        u.name,
-                        u.kind
-                    ),
-                )
-            };
+            let (at, message) = unchecked_leg_note(r, l, u, k, segs.is_empty(), line);
             d.note(at, message);
         }
+    }
+}
+
+/// Where and what to note about route `r`'s leg from waypoint `k` that was not checked against
+/// `u` (written on `line`): the whole route when where `u` lies is unknown (`nowhere`).
+fn unchecked_leg_note(
+    r: &RouteSpec,
+    l: &RouteLoc,
+    u: &Unread,
+    k: usize,
+    nowhere: bool,
+    line: usize,
+) -> (usize, String) {
+    if nowhere {
+        (
+            l.waypoints_key,
+            format!(
+                "route '{}' was not checked against {}, whose place did not read (line {line}); fix it and check again",
+                r.id, u.name
+            ),
+        )
+    } else {
+        (
+            l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
+            format!(
+                "route '{}' leg from waypoint {k} to {} passes near {} and was not checked against it: that {} has errors (line {line}); fix them and check again",
+                r.id,
+                (k + 1) % r.waypoints_m.len(),
+                u.name,
+                u.kind
+            ),
+        )
+    }
+}
+
+/// What of an unread wall or door a route leg must keep clear of, and how far: a door reaches
+/// its width around its hinge whichever way it swings (the hinge to tip distance when both
+/// read, the widest door otherwise).
+fn unread_reach(u: &Unread, robot_radius_m: f64) -> (Vec<Segment>, f64) {
+    match (u.kind, u.points_m.as_slice()) {
+        ("door", [h, tip, ..]) => (
+            vec![Segment::new(v(h), v(h))],
+            robot_radius_m + (v(tip) - v(h)).norm(),
+        ),
+        ("door", [h]) => (
+            vec![Segment::new(v(h), v(h))],
+            robot_radius_m + DOOR_WIDTH_RANGE_M.1,
+        ),
+        _ => (unread_segments(u), robot_radius_m),
     }
 }
 
@@ -785,32 +899,137 @@ fn closed_door_spans(
     d: &mut Diags,
 ) -> bool {
     let panel = door_panel(door, false);
-    let point = |p: Vec2| Segment::new(p, p);
     let probe = 1.0;
-    let off = |p: Vec2| wall_clearance(walls, p, probe).is_none_or(|c| c > DOOR_GAP_TOLERANCE_M);
-    let mid = (panel.a + panel.b) / 2.0;
-    let along = match walls.nearest(point(mid), 0.0) {
-        Some((Owner::Wall(wi), c)) if c < -0.001 => Some(wi),
-        _ => None,
-    };
-    if !off(panel.a)
-        && (off(panel.b) || along.is_some())
+    let along = wall_along(walls, panel);
+    if !off_wall(walls, panel.a, probe)
+        && (off_wall(walls, panel.b, probe) || along.is_some())
         && let Some(gap) = gap_heading(door, walls)
     {
-        let what = panel_miss(spec, along, panel.b, walls, probe);
-        d.at(
-            l.closed_heading,
-            format!(
-                "closed door '{}' does not span the gap at its hinge: {what}; {}",
-                door.id,
-                heading_cause(door.closed_heading_deg, gap)
-            ),
-        );
+        let message = misses_hinge_gap(spec, door, along, panel.b, walls, probe, gap);
+        d.at(l.closed_heading, message);
         return false;
     }
-    let mut ok = true;
+    let ends_ok = panel_ends_on_walls(door, l, panel, walls, unread, probe, d);
+    if let Some(wi) = along {
+        lies_along(door, l, &spec.walls[wi], d);
+        return false;
+    }
+    ends_ok
+}
+
+/// The error for a closed door that lies along `wall` rather than in a gap of it.
+fn lies_along(door: &DoorSpec, l: &crate::spec::world::DoorLoc, wall: &WallSpec, d: &mut Diags) {
+    d.at(
+        l.hinge,
+        format!(
+            "closed door '{}' lies along wall '{}' instead of filling a gap in it; leave a gap in the wall where the door is",
+            door.id, wall.id
+        ),
+    );
+}
+
+/// The error for a closed door whose hinge is on a wall but whose panel (ending at `tip`)
+/// misses the gap there, which heading `gap` would span.
+fn misses_hinge_gap(
+    spec: &WorldSpec,
+    door: &DoorSpec,
+    along: Option<usize>,
+    tip: Vec2,
+    walls: &Obstacles,
+    probe: f64,
+    gap: f64,
+) -> String {
+    let what = panel_miss(spec, along, tip, walls, probe);
+    format!(
+        "closed door '{}' does not span the gap at its hinge: {what}; {}",
+        door.id,
+        heading_cause(door.closed_heading_deg, gap)
+    )
+}
+
+/// Whether `p` is farther than [`DOOR_GAP_TOLERANCE_M`] from every wall (within `probe` m).
+fn off_wall(walls: &Obstacles, p: Vec2, probe: f64) -> bool {
+    wall_clearance(walls, p, probe).is_none_or(|c| c > DOOR_GAP_TOLERANCE_M)
+}
+
+/// The wall whose inside holds the middle of `panel`, when one does.
+fn wall_along(walls: &Obstacles, panel: Segment) -> Option<usize> {
+    let mid = (panel.a + panel.b) / 2.0;
+    match walls.nearest(Segment::new(mid, mid), 0.0) {
+        Some((Owner::Wall(wi), c)) if c < -0.001 => Some(wi),
+        _ => None,
+    }
+}
+
+/// Whether both ends of a closed door's `panel` touch a wall; an error per end that does not,
+/// or a single note when a wall that did not read may be the one it touches.
+fn panel_ends_on_walls(
+    door: &DoorSpec,
+    l: &crate::spec::world::DoorLoc,
+    panel: Segment,
+    walls: &Obstacles,
+    unread: &[Unread],
+    probe: f64,
+    d: &mut Diags,
+) -> bool {
+    let off_ends: Vec<_> = panel_ends(panel, l)
+        .into_iter()
+        .filter(|&(end, ..)| off_wall(walls, end, probe))
+        .collect();
     let mut noted = false;
-    for (end, at, which, fix) in [
+    for &(end, at, which, fix) in &off_ends {
+        if let Some(u) = unread_near(unread, "wall", Segment::new(end, end), probe) {
+            // Its wall may be the one that did not read: not checked, said once.
+            if !noted {
+                note_unread_wall(door, l.hinge, u, d);
+            }
+            noted = true;
+        } else {
+            let clearance = wall_clearance(walls, end, probe);
+            d.at(at, end_off_wall(door, end, which, fix, clearance, probe));
+        }
+    }
+    off_ends.is_empty()
+}
+
+/// Notes at `at` that closed `door` was not checked for spanning a gap, as its wall may be `u`.
+fn note_unread_wall(door: &DoorSpec, at: usize, u: &Unread, d: &mut Diags) {
+    let line = d.line_of(u.at);
+    d.note(
+        at,
+        format!(
+            "closed door '{}' not checked for spanning a wall gap: its wall may be {}, which has errors (line {line}); fix them and check again",
+            door.id, u.name
+        ),
+    );
+}
+
+/// The error for a closed door's end (`which`) that lies `clearance` m from the nearest wall
+/// (unknown: more than `probe` m).
+fn end_off_wall(
+    door: &DoorSpec,
+    end: Vec2,
+    which: &str,
+    fix: &str,
+    clearance: Option<f64>,
+    probe: f64,
+) -> String {
+    let dist = clearance
+        .map(|c| format!("{c:.2} m"))
+        .unwrap_or_else(|| format!("more than {probe} m"));
+    format!(
+        "closed door '{}' does not span a wall gap: its {which} at [{:.2}, {:.2}] is {dist} from the nearest wall (at most {DOOR_GAP_TOLERANCE_M} m); {fix}",
+        door.id, end.x, end.y
+    )
+}
+
+/// A closed panel's hinge and tip: each with where it is written, its name and how to fix it
+/// when it does not touch a wall.
+fn panel_ends(
+    panel: Segment,
+    l: &crate::spec::world::DoorLoc,
+) -> [(Vec2, usize, &'static str, &'static str); 2] {
+    [
         (
             panel.a,
             l.hinge,
@@ -823,49 +1042,7 @@ fn closed_door_spans(
             "tip",
             "check width_m and closed_heading_deg so the panel reaches the wall across the gap",
         ),
-    ] {
-        if !off(end) {
-            continue;
-        }
-        ok = false;
-        if let Some(u) = unread_near(unread, "wall", point(end), probe) {
-            // Its wall may be the one that did not read: not checked, said once.
-            if !noted {
-                d.note(
-                    l.hinge,
-                    format!(
-                        "closed door '{}' not checked for spanning a wall gap: its wall may be {}, which has errors (line {}); fix them and check again",
-                        door.id,
-                        u.name,
-                        d.line_of(u.at)
-                    ),
-                );
-            }
-            noted = true;
-        } else {
-            let dist = wall_clearance(walls, end, probe)
-                .map(|c| format!("{c:.2} m"))
-                .unwrap_or_else(|| format!("more than {probe} m"));
-            d.at(
-                at,
-                format!(
-                    "closed door '{}' does not span a wall gap: its {which} at [{:.2}, {:.2}] is {dist} from the nearest wall (at most {DOOR_GAP_TOLERANCE_M} m); {fix}",
-                    door.id, end.x, end.y
-                ),
-            );
-        }
-    }
-    if let Some(wi) = along {
-        ok = false;
-        d.at(
-            l.hinge,
-            format!(
-                "closed door '{}' lies along wall '{}' instead of filling a gap in it; leave a gap in the wall where the door is",
-                door.id, spec.walls[wi].id
-            ),
-        );
-    }
-    ok
+    ]
 }
 
 /// What keeps a closed panel from spanning the gap at its hinge: it lies along wall `along`,
@@ -1113,19 +1290,22 @@ fn waypoints_too_close(
         let worst = nearest_of(all, s, need_wp);
         if let Some((o, c, state)) = worst {
             bad[k] = true;
+            let what = format!("{} {}", fmt_m(c), owner_name(spec, o, state));
             d.at(
                 l.waypoints.get(k).copied().unwrap_or(l.waypoints_key),
-                format!(
-                    "route '{}' waypoint {} is {} {}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors",
-                    r.id,
-                    k,
-                    fmt_m(c),
-                    owner_name(spec, o, state)
-                ),
+                waypoint_too_close(&r.id, k, &what, robot_radius_m),
             );
         }
     }
     bad
+}
+
+/// The error for waypoint `k` of route `id` that is `what` (how near to what).
+fn waypoint_too_close(id: &str, k: usize, what: &str, robot_radius_m: f64) -> String {
+    let need_wp = robot_radius_m + WAYPOINT_MARGIN_M;
+    format!(
+        "route '{id}' waypoint {k} is {what}; keep waypoints at least {need_wp:.2} m (robot radius {robot_radius_m} m + {WAYPOINT_MARGIN_M} m) from walls and doors"
+    )
 }
 
 /// The open heading, degrees, of `door` swung the other way (mirrored in its closed panel),

@@ -114,6 +114,12 @@ impl Thinning {
         for &k in &self.del {
             self.img[k] = false;
         }
+        self.queue_neighbours_of_deleted();
+        true
+    }
+
+    /// Queues for both rules every set pixel next to one just deleted, once.
+    fn queue_neighbours_of_deleted(&mut self) {
         for &k in &self.del {
             for q in ring(k, self.nx) {
                 if self.img[q] {
@@ -126,7 +132,6 @@ impl Thinning {
                 }
             }
         }
-        true
     }
 }
 

@@ -361,35 +361,55 @@ pub fn read_bag_bytes(
     let scan = pick("scan", msg::LASER_SCAN, &topics.scan, "--scan-topic")?;
     let odom = pick("odometry", msg::ODOMETRY, &topics.odom, "--odom-topic")?;
     let truth = truth_channel(&channels);
-    let mut odoms = decode_all(&channels, name, odom, |d| {
-        let o = Odometry::decode(d)?;
-        Ok((o.header.stamp_s, pose_at_log_resolution(o.pose)))
-    })?;
-    odoms.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let odoms = odometry(&channels, name, odom)?;
     let scans = decode_all(&channels, name, scan, LaserScan::decode)?;
     let truepos = match truth {
-        Some(t) => decode_all(&channels, name, t, |d| {
-            let p = PoseStamped::decode(d)?;
-            Ok(TruePosRecord {
-                truth: pose_at_log_resolution(p.pose),
-                odom: Pose2::IDENTITY,
-                ipc_timestamp: p.header.stamp_s,
-                host: String::new(),
-                logger_timestamp: p.header.stamp_s,
-            })
-        })?,
+        Some(t) => truepos_records(&channels, name, t)?,
         None => Vec::new(),
     };
-    let max_range_m = scans
-        .first()
-        .map(|s| f32_decimal(s.range_max))
-        .filter(|r| r.is_finite() && *r > 0.0);
+    let max_range_m = max_range_m(&scans);
     let lasers = laser_records(scans, &odoms, max_range_m, name)?;
     Ok(BagReadout {
         lasers,
         truepos,
         max_range_m,
         topics: list,
+    })
+}
+
+/// The first scan's maximum range, metres, when positive and finite.
+fn max_range_m(scans: &[LaserScan]) -> Option<f64> {
+    scans
+        .first()
+        .map(|s| f32_decimal(s.range_max))
+        .filter(|r| r.is_finite() && *r > 0.0)
+}
+
+/// The (time s, pose) of each message of odometry channel `id`, in time order.
+fn odometry(channels: &Channels, name: &str, id: u16) -> Result<Vec<(f64, Pose2)>, BagError> {
+    let mut odoms = decode_all(channels, name, id, |d| {
+        let o = Odometry::decode(d)?;
+        Ok((o.header.stamp_s, pose_at_log_resolution(o.pose)))
+    })?;
+    odoms.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(odoms)
+}
+
+/// The poses of channel `id` (ground truth) as TRUEPOS records.
+fn truepos_records(
+    channels: &Channels,
+    name: &str,
+    id: u16,
+) -> Result<Vec<TruePosRecord>, BagError> {
+    decode_all(channels, name, id, |d| {
+        let p = PoseStamped::decode(d)?;
+        Ok(TruePosRecord {
+            truth: pose_at_log_resolution(p.pose),
+            odom: Pose2::IDENTITY,
+            ipc_timestamp: p.header.stamp_s,
+            host: String::new(),
+            logger_timestamp: p.header.stamp_s,
+        })
     })
 }
 
@@ -443,27 +463,36 @@ fn laser_records(
                 gap_s,
                 max_gap_s: ODOM_MAX_GAP_S,
             })?;
-            let n = s.ranges.len();
-            Ok(LaserRecord {
-                start_angle_rad: s.angle_min as f64,
-                fov_rad: s.angle_increment as f64 * n.saturating_sub(1) as f64,
-                ranges_m: s
-                    .ranges
-                    .iter()
-                    .map(|r| {
-                        if r.is_finite() {
-                            f32_decimal(*r)
-                        } else {
-                            no_return
-                        }
-                    })
-                    .collect(),
-                pose,
-                odom: pose,
-                ipc_timestamp: t,
-                host: String::new(),
-                logger_timestamp: t,
-            })
+            Ok(laser_record(&s, pose, no_return))
+        })
+        .collect()
+}
+
+/// The laser record of scan `s` taken at odometry `pose`.
+fn laser_record(s: &LaserScan, pose: Pose2, no_return: f64) -> LaserRecord {
+    let (n, t) = (s.ranges.len(), s.header.stamp_s);
+    LaserRecord {
+        start_angle_rad: s.angle_min as f64,
+        fov_rad: s.angle_increment as f64 * n.saturating_sub(1) as f64,
+        ranges_m: ranges_m(&s.ranges, no_return),
+        pose,
+        odom: pose,
+        ipc_timestamp: t,
+        host: String::new(),
+        logger_timestamp: t,
+    }
+}
+
+/// A scan's ranges in metres at the log's resolution, a non-finite one as `no_return`.
+fn ranges_m(ranges: &[f32], no_return: f64) -> Vec<f64> {
+    ranges
+        .iter()
+        .map(|r| {
+            if r.is_finite() {
+                f32_decimal(*r)
+            } else {
+                no_return
+            }
         })
         .collect()
 }
