@@ -666,7 +666,10 @@ fn motion_compares_a_real_log_with_simulated_laps() {
         "the real robot weaves more than the smooth laps:\n{out}"
     );
     assert!(out.contains("Kolmogorov–Smirnov distance to"), "{out}");
-    assert!(row("csail-corrected").contains("– (stamps unusable)"), "{out}");
+    assert!(
+        row("csail-corrected").contains("– (stamps unusable)"),
+        "{out}"
+    );
     assert!(!row("intel-corrected").contains("stamps unusable"), "{out}");
     assert!(out.contains("smoke.toml: speed "), "{out}");
     let o = placewords(&["motion", "no-such.log"]);
