@@ -667,4 +667,43 @@ mod tests {
         assert!((200..400).contains(&stops), "{stops}");
         assert!((30..95).contains(&spins), "{spins}");
     }
+
+    #[test]
+    fn every_preset_resolves_and_real_weave_targets_keep_clear_of_the_walls() {
+        for name in LapVariationConfig::PRESETS {
+            assert!(LapVariationConfig::preset(name).is_some(), "{name}");
+        }
+        assert_eq!(
+            LapVariationConfig::preset("smooth")
+                .unwrap()
+                .weave_heading_rad,
+            0.0
+        );
+        let cfg = LapVariationConfig::preset("real-weave").unwrap();
+        let (route, obs) = corridor();
+        let room = LaneRoom::measure(&route, &obs, 0.5);
+        let tracker = RouteTracker::new(&route, 0);
+        let mut widest = 0.0f64;
+        for lap in 0..20 {
+            let mut rng = stream(3, 0, lap, Purpose::LapVariation);
+            let plan = LapPlan::draw(
+                &cfg,
+                (&room, &route, &obs, 0.5),
+                (0.0, 60.0),
+                Wander::default(),
+                &mut rng,
+            );
+            for k in 0..600 {
+                let s = k as f64 * 0.1;
+                let p = plan.target(&tracker, s);
+                let near = obs.nearest_within(Segment::new(p, p), 0.5 - 1e-9);
+                assert!(
+                    near.is_none(),
+                    "lap {lap}, arc {s} m: target {p:?} too close"
+                );
+                widest = widest.max(plan.weave_offset_m(&tracker, s).abs());
+            }
+        }
+        assert!(widest > 0.1, "the weave sways: at most {widest} m");
+    }
 }
