@@ -949,4 +949,8 @@ fn real_weave_laps_weave_more_than_smooth_ones_and_keep_off_walls() {
         msg.contains("real-weave"),
         "a misspelt preset names the real one: {msg}"
     );
+    let swapped = "[robot]\nweave_wavelength_min_m = 6.0\nweave_wavelength_max_m = 4.0\n";
+    let err = scenario(LOOP_WORLD, &format!("{base}{swapped}"));
+    let msg = err.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(msg.contains(":9:26") && msg.contains("swap"), "{msg}");
 }
