@@ -405,7 +405,11 @@ fn bounded(d: &mut Diags, s: &Settings, key: &str, default: f64, max: f64) -> f6
 /// The lap variation keys of `[robot]` (see [`crate::sim::variation`]); off unless given.
 fn lap_variation(s: &Settings, d: &mut Diags) -> LapVariationConfig {
     use Rule::NonNegative;
-    let v = LapVariationConfig::default();
+    let v = s
+        .word("lap_variation")
+        .and_then(|w| named(d, w, &LapVariationConfig::PRESETS, "lap_variation preset"))
+        .and_then(LapVariationConfig::preset)
+        .unwrap_or_default();
     LapVariationConfig {
         lane_offset_ratio: bounded(d, s, "lane_offset_ratio", v.lane_offset_ratio, 1.0),
         lane_margin_m: value(d, s, "lane_margin_m", v.lane_margin_m, NonNegative),
@@ -422,7 +426,30 @@ fn lap_variation(s: &Settings, d: &mut Diags) -> LapVariationConfig {
         spin_spacing_m: value(d, s, "spin_spacing_m", v.spin_spacing_m, NonNegative),
         spin_angle_rad: bounded(d, s, "spin_angle_deg", v.spin_angle_rad.to_degrees(), 720.0)
             .to_radians(),
+        spin_angle_min_rad: deg(d, s, "spin_angle_min_deg", v.spin_angle_min_rad, 360.0),
+        corner_spin_ratio: bounded(d, s, "corner_spin_ratio", v.corner_spin_ratio, 1.0),
+        weave_heading_rad: deg(d, s, "weave_heading_deg", v.weave_heading_rad, 60.0),
+        weave_wavelength_min_m: value(
+            d,
+            s,
+            "weave_wavelength_min_m",
+            v.weave_wavelength_min_m,
+            NonNegative,
+        ),
+        weave_wavelength_max_m: value(
+            d,
+            s,
+            "weave_wavelength_max_m",
+            v.weave_wavelength_max_m,
+            NonNegative,
+        ),
+        weave_envelope_ratio: bounded(d, s, "weave_envelope_ratio", v.weave_envelope_ratio, 1.0),
     }
+}
+
+/// An angle key in degrees within `[0, max_deg]`, returned in radians.
+fn deg(d: &mut Diags, s: &Settings, key: &str, default_rad: f64, max_deg: f64) -> f64 {
+    bounded(d, s, key, default_rad.to_degrees(), max_deg).to_radians()
 }
 
 fn robot(s: &Settings, d: &mut Diags) -> RobotConfig {
@@ -465,6 +492,21 @@ fn robot_cross_checks(s: &Settings, r: &RobotConfig, d: &mut Diags) {
             format!(
                 "cruise_speed_m_s exceeds max_speed_m_s ({}); lower it",
                 r.max_speed_m_s
+            ),
+        );
+    }
+    let v = &r.variation;
+    if let Some(w) = ["weave_wavelength_min_m", "weave_wavelength_max_m"]
+        .iter()
+        .find_map(|k| s.get(k))
+        .filter(|_| v.weave_wavelength_min_m > v.weave_wavelength_max_m)
+    {
+        d.at(
+            w.span().start,
+            format!(
+                "weave_wavelength_min_m ({}) exceeds weave_wavelength_max_m ({}); swap them",
+                fmt_number(v.weave_wavelength_min_m),
+                fmt_number(v.weave_wavelength_max_m)
             ),
         );
     }

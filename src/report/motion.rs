@@ -34,7 +34,11 @@ pub fn text(inputs: &[(String, Motion)]) -> String {
          wavelength",
     );
     let bands: Vec<String> = BANDS_M.iter().map(|(a, b)| format!("{a}-{b} m")).collect();
-    let _ = writeln!(out, " ({})", bands.join(", "));
+    let _ = writeln!(
+        out,
+        " ({}) | turn on the spot deg p10 / p50 / p90",
+        bands.join(", ")
+    );
     for (name, m) in inputs {
         let spectrum: Vec<String> = m
             .spectrum
@@ -43,7 +47,7 @@ pub fn text(inputs: &[(String, Motion)]) -> String {
             .collect();
         let _ = writeln!(
             out,
-            "{name}: {:.0} | {} | {} | {} | {:.1} | {}",
+            "{name}: {:.0} | {} | {} | {} | {:.1} | {} | {}",
             m.travel_m,
             if m.speed_unknown && m.speed_m_s.is_empty() {
                 "– (stamps unusable)".to_string()
@@ -53,7 +57,8 @@ pub fn text(inputs: &[(String, Motion)]) -> String {
             spread(&abs(&m.heading_deviation_rad), 1f64.to_degrees(), 1),
             spread(&m.weave_m, 100.0, 1),
             m.spins_per_100_m(),
-            spectrum.join(", ")
+            spectrum.join(", "),
+            spread(&m.spin_rad, 1f64.to_degrees(), 0)
         );
     }
     if let [(first, a), rest @ ..] = inputs

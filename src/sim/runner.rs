@@ -22,7 +22,7 @@ use crate::sim::robot::{
     Controller, RouteTracker, Wander, free_ahead, integrate, spin_waypoints, waypoint_room,
     wheel_speeds,
 };
-use crate::sim::variation::{LaneRoom, LapPlan, obstacles};
+use crate::sim::variation::{LaneRoom, LapPlan, PathShape, corner_spins, obstacles};
 use crate::world::geometry::SegmentIndex;
 use crate::world::physics::Physics;
 use crate::world::raycast::{Disc, SweepCaster};
@@ -249,6 +249,12 @@ impl<'a> RunSim<'a> {
             wander,
             &mut vrng,
         );
+        if scn.robot.variation.corner_spin_ratio > 0.0 {
+            let room_m = waypoint_room(&self.route, &self.lanes.0);
+            let base = spin_waypoints(&self.route, &scn.robot, &room_m);
+            let gates = corner_spins(&self.route, &scn.robot, (&base, &room_m), &mut vrng);
+            self.tracker.set_gates(&gates);
+        }
         self.lap = lap;
         self.lap_start_s = self.time_s;
         self.stall_mark = (self.tracker.progress_m(), self.time_s);
@@ -353,11 +359,13 @@ impl<'a> RunSim<'a> {
         let cfg = &self.scn.robot;
         let arc = self.tracker.arc_m();
         if self.hold == Hold::Drive {
-            if let Some(gate) = self
-                .tracker
-                .next_gate_m()
-                .filter(|g| g - arc <= TURN_CAPTURE_M)
-            {
+            if let Some(gate) = self.tracker.next_gate_m().filter(|&g| {
+                // A lane shifted off a corner projects short of it: its own point counts
+                // (only with corners on the spot, so other laps keep their turns).
+                let off = self.plan.target(&self.tracker, g) - self.truth.position();
+                g - arc <= TURN_CAPTURE_M
+                    || (cfg.variation.corner_spin_ratio > 0.0 && g - arc < 1.0 && off.norm() < 0.15)
+            }) {
                 let (_, out) = self.tracker.point_at(gate + 1e-6);
                 let turn = wrap_angle(out.y.atan2(out.x) - self.truth.theta);
                 self.hold = Hold::TurnAtWaypoint(turn);

@@ -14,10 +14,23 @@
 //!   `stop_spacing_m`, each lasting `U(0.3, 1) · stop_duration_s`;
 //! - **turns on the spot**: at places drawn with exponential gaps of mean `spin_spacing_m`, the
 //!   robot stops and turns on the spot by `U(90°, spin_angle_deg)` either way, then the
-//!   controller turns it back onto its path.
+//!   controller turns it back onto its path;
+//! - **corners on the spot**: each lap turns on the spot at a share `corner_spin_ratio` of the
+//!   route's corners of 60° or more ([`corner_spins`]), where it would otherwise drive an arc;
+//! - **weave**: real robots sway about their lane (issue 28: median heading 2–10° off the
+//!   corridor on five real logs, 2–7 cm of weave per metre, most of the heading's variance at
+//!   wavelengths of 0.5–5 m). The lane is offset sideways by a sum of [`WEAVE_WAVES`] sinusoids
+//!   of arc length with wavelengths drawn log-uniformly in `weave_wavelength_min_m` to
+//!   `weave_wavelength_max_m`, whose slopes add up to at most `weave_heading_deg`, under a slow
+//!   envelope (wavelengths 10–40 m) that calms `weave_envelope_ratio` of it in stretches, as real
+//!   robots weave in some places and drive straight in others. The offset never exceeds the room
+//!   a shifted leg leaves beyond the lane margin (measured along the whole leg), so the weave
+//!   keeps the same clearance from walls and doors as the lanes; the controller follows its
+//!   curvature as well as its offset (see [`PathShape::curvature`]).
 //!
 //! Everything is off by default ([`LapVariationConfig::default`]); scenarios A, B and C turn it
-//! on in their `[robot]` tables.
+//! on in their `[robot]` tables, or name a preset (`lap_variation = "smooth"` or
+//! `"real-weave"`, [`LapVariationConfig::preset`]).
 
 use crate::geom::{Segment, Vec2};
 use crate::sim::rng::SimRng;
@@ -47,6 +60,22 @@ pub struct LapVariationConfig {
     pub spin_spacing_m: f64,
     /// Largest turn on the spot, radians (file: `spin_angle_deg`). Default 360°.
     pub spin_angle_rad: f64,
+    /// Smallest turn on the spot, radians (file: `spin_angle_min_deg`). Default 90°.
+    pub spin_angle_min_rad: f64,
+    /// Share (0–1) of the route's corners (a heading change of at least the robot's
+    /// `short_leg_spin_turn_rad`, 60°) a lap turns on the spot at, as real robots often do,
+    /// rather than on an arc; drawn per lap and corner. Default 0.
+    pub corner_spin_ratio: f64,
+    /// Largest heading the weave asks of the robot against its lane (the sum of its waves'
+    /// slopes), radians (file: `weave_heading_deg`); 0 means no weave. Default 0.
+    pub weave_heading_rad: f64,
+    /// Shortest wavelength of the weave, metres. Default 0.5.
+    pub weave_wavelength_min_m: f64,
+    /// Longest wavelength of the weave, metres. Default 5.
+    pub weave_wavelength_max_m: f64,
+    /// Share (0–1) of the weave a slow envelope takes away in calm stretches (0: the weave is
+    /// as strong everywhere). Default 0.
+    pub weave_envelope_ratio: f64,
 }
 
 impl Default for LapVariationConfig {
@@ -60,6 +89,51 @@ impl Default for LapVariationConfig {
             stop_duration_s: 4.0,
             spin_spacing_m: 0.0,
             spin_angle_rad: std::f64::consts::TAU,
+            spin_angle_min_rad: std::f64::consts::FRAC_PI_2,
+            corner_spin_ratio: 0.0,
+            weave_heading_rad: 0.0,
+            weave_wavelength_min_m: 0.5,
+            weave_wavelength_max_m: 5.0,
+            weave_envelope_ratio: 0.0,
+        }
+    }
+}
+
+/// Number of sinusoids in a lap's weave.
+pub const WEAVE_WAVES: usize = 6;
+
+impl LapVariationConfig {
+    /// The names [`LapVariationConfig::preset`] knows (`lap_variation = "…"` in `[robot]`).
+    pub const PRESETS: [&'static str; 3] = ["none", "smooth", "real-weave"];
+
+    /// A named set of lap variation keys, which the `[robot]` table's own keys then override:
+    /// `none` (all off), `smooth` (the lanes, speeds, stops and rare turns on the spot of
+    /// scenarios A, B and C: laps that do not weave), `real-weave` (`smooth` plus a weave and
+    /// turns on the spot tuned on the Intel log's corrected path; RESULTS.md gives the figures
+    /// and the Kolmogorov–Smirnov distances to the five real logs).
+    pub fn preset(name: &str) -> Option<Self> {
+        let smooth = LapVariationConfig {
+            lane_offset_ratio: 0.8,
+            lap_speed_spread_ratio: 0.2,
+            speed_wave_ratio: 0.25,
+            stop_spacing_m: 60.0,
+            stop_duration_s: 4.0,
+            spin_spacing_m: 200.0,
+            ..LapVariationConfig::default()
+        };
+        match name {
+            "none" => Some(LapVariationConfig::default()),
+            "smooth" => Some(smooth),
+            "real-weave" => Some(LapVariationConfig {
+                spin_spacing_m: 20.0,
+                spin_angle_min_rad: 45f64.to_radians(),
+                spin_angle_rad: 180f64.to_radians(),
+                corner_spin_ratio: 1.0,
+                weave_heading_rad: 50f64.to_radians(),
+                weave_envelope_ratio: 0.8,
+                ..smooth
+            }),
+            _ => None,
         }
     }
 }
@@ -147,6 +221,11 @@ pub struct LapPlan {
     stops: Vec<(f64, f64)>,
     /// (absolute arc length, signed radians), in arc order.
     spins: Vec<(f64, f64)>,
+    /// The sway about the lane (none unless `weave_heading_deg` is set).
+    weave: Weave,
+    /// Largest weave offset at each waypoint, metres: the room the shifted legs on either side
+    /// leave beyond the clearance.
+    weave_room_m: Vec<f64>,
 }
 
 /// Where a lap plan says the robot should be and how fast.
@@ -155,6 +234,12 @@ pub trait PathShape {
     fn target(&self, tracker: &RouteTracker, s: f64) -> Vec2;
     /// Factor on the cruise speed at absolute arc length `s`.
     fn speed_factor(&self, s: f64) -> f64;
+    /// Curvature the path adds to the route's at absolute arc length `s`, 1/m (positive to
+    /// the left): the controller steers it ahead of its pursuit, so a short sway is driven
+    /// rather than cut.
+    fn curvature(&self, _tracker: &RouteTracker, _s: f64) -> f64 {
+        0.0
+    }
 }
 
 impl LapPlan {
@@ -190,7 +275,7 @@ impl LapPlan {
             .into_iter()
             .map(|s| (s, cfg.stop_duration_s * rng.random_range(0.3..1.0)))
             .collect();
-        let lo = std::f64::consts::FRAC_PI_2.min(cfg.spin_angle_rad);
+        let lo = cfg.spin_angle_min_rad.min(cfg.spin_angle_rad);
         let spins = events(cfg.spin_spacing_m, (start_m, length_m), rng)
             .into_iter()
             .map(|s| {
@@ -202,6 +287,9 @@ impl LapPlan {
                 (s, if rng.random_bool(0.5) { a } else { -a })
             })
             .collect();
+        // Drawn last, and only when on, so laps without a weave keep their draws.
+        let weave = Weave::draw(cfg, rng);
+        let weave_room_m = weave_room(route, obstacles, clearance_m, &shifts, weave.reach_m);
         LapPlan {
             shifts,
             wander,
@@ -210,7 +298,20 @@ impl LapPlan {
             speed_wave,
             stops,
             spins,
+            weave,
+            weave_room_m,
         }
+    }
+
+    /// The weave's sideways offset at absolute arc `s`, metres: within the room of the leg.
+    fn weave_offset_m(&self, tracker: &RouteTracker, s: f64) -> f64 {
+        if self.weave.reach_m <= 0.0 || self.weave_room_m.is_empty() {
+            return 0.0;
+        }
+        let (i, t) = tracker.locate(s);
+        let j = (i + 1) % self.weave_room_m.len();
+        let room = self.weave_room_m[i] * (1.0 - t) + self.weave_room_m[j] * t;
+        self.weave.offset_m(s) * (room / self.weave.reach_m).min(1.0)
     }
 
     /// The first stop at or before arc `s` not taken yet (removes it): its duration.
@@ -238,7 +339,18 @@ impl LapPlan {
 impl PathShape for LapPlan {
     fn target(&self, tracker: &RouteTracker, s: f64) -> Vec2 {
         let (on_route, dir) = tracker.point_at(s);
-        on_route + self.shift_at(tracker, s) + Vec2::new(-dir.y, dir.x) * self.wander.offset_m(s)
+        let side = self.wander.offset_m(s) + self.weave_offset_m(tracker, s);
+        on_route + self.shift_at(tracker, s) + Vec2::new(-dir.y, dir.x) * side
+    }
+
+    fn curvature(&self, tracker: &RouteTracker, s: f64) -> f64 {
+        if self.weave.reach_m <= 0.0 {
+            return 0.0;
+        }
+        // The offset's second derivative (the curvature of a gentle sway), by differences.
+        let h = 0.05;
+        let y = |s| self.weave_offset_m(tracker, s);
+        (y(s + h) - 2.0 * y(s) + y(s - h)) / (h * h)
     }
 
     fn speed_factor(&self, s: f64) -> f64 {
@@ -274,6 +386,113 @@ fn events(spacing_m: f64, (start_m, length_m): (f64, f64), rng: &mut SimRng) -> 
         }
         out.push(s);
     }
+}
+
+/// The waypoints a lap turns on the spot at: those `base` marks (the route's own rule), and
+/// each other corner of at least `robot.short_leg_spin_turn_rad` with probability
+/// `corner_spin_ratio` (nothing is drawn when it is 0).
+pub fn corner_spins(
+    route: &Route,
+    robot: &crate::sim::robot::RobotConfig,
+    (base, room_m): (&[bool], &[f64]),
+    rng: &mut SimRng,
+) -> Vec<bool> {
+    let ratio = robot.variation.corner_spin_ratio.clamp(0.0, 1.0);
+    if ratio == 0.0 {
+        return base.to_vec();
+    }
+    let sharp = crate::sim::robot::RobotConfig {
+        spin_turn_rad: robot.short_leg_spin_turn_rad,
+        ..robot.clone()
+    };
+    let corners = crate::sim::robot::spin_waypoints(route, &sharp, room_m);
+    base.iter()
+        .zip(corners)
+        .map(|(&b, c)| b || (c && rng.random_bool(ratio)))
+        .collect()
+}
+
+/// A lap's sway about its lane: `offset(s) = e(s) · Σₖ (θₖ λₖ / 2π) sin(2π s / λₖ + φₖ)`, so
+/// its slope is at most Σ θₖ = `weave_heading_rad`; `e(s)` in [1 − r, 1] is the slow envelope.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Weave {
+    /// (heading amplitude rad, wavelength m, phase rad) of each wave.
+    waves: Vec<(f64, f64, f64)>,
+    envelope: Wander,
+    envelope_ratio: f64,
+    /// The largest offset the waves can reach, metres.
+    reach_m: f64,
+}
+
+impl Weave {
+    /// The weave of one lap (none when `weave_heading_rad` is 0; then nothing is drawn).
+    fn draw(cfg: &LapVariationConfig, rng: &mut SimRng) -> Self {
+        let heading = cfg.weave_heading_rad;
+        if heading <= 0.0 {
+            return Weave::default();
+        }
+        let lo = cfg.weave_wavelength_min_m.max(0.1);
+        let hi = cfg.weave_wavelength_max_m.max(lo * 1.001);
+        let mut waves: Vec<(f64, f64, f64)> = (0..WEAVE_WAVES)
+            .map(|_| {
+                let a: f64 = rng.random_range(0.2..1.0);
+                let lambda = lo * (hi / lo).powf(rng.random_range(0.0..1.0));
+                (a, lambda, rng.random_range(0.0..std::f64::consts::TAU))
+            })
+            .collect();
+        let total: f64 = waves.iter().map(|w| w.0).sum();
+        for w in &mut waves {
+            w.0 *= heading / total;
+        }
+        let reach_m = waves.iter().map(|w| amplitude_m(*w)).sum();
+        Weave {
+            waves,
+            envelope: Wander::draw_with_wavelengths(1.0, (10.0, 40.0), rng),
+            envelope_ratio: cfg.weave_envelope_ratio.clamp(0.0, 1.0),
+            reach_m,
+        }
+    }
+
+    /// Sideways offset at arc `s`, metres (positive to the left), |offset| ≤ `reach_m`.
+    fn offset_m(&self, s: f64) -> f64 {
+        let e = 1.0 - self.envelope_ratio * 0.5 * (1.0 + self.envelope.offset_m(s));
+        e * self
+            .waves
+            .iter()
+            .map(|&w| amplitude_m(w) * (std::f64::consts::TAU * s / w.1 + w.2).sin())
+            .sum::<f64>()
+    }
+}
+
+/// The sideways amplitude of a wave whose slope peaks at `heading` radians.
+fn amplitude_m((heading, lambda, _): (f64, f64, f64)) -> f64 {
+    heading * lambda / std::f64::consts::TAU
+}
+
+/// The largest weave offset at each waypoint: on each shifted leg, the clearance beyond
+/// `clearance_m` from every obstacle (at most `reach_m`), the smaller of the two legs meeting
+/// at the waypoint. Empty when there is no weave.
+fn weave_room(
+    route: &Route,
+    obstacles: &SegmentIndex,
+    clearance_m: f64,
+    shifts: &[Vec2],
+    reach_m: f64,
+) -> Vec<f64> {
+    let n = route.waypoints.len();
+    if reach_m <= 0.0 || n == 0 {
+        return Vec::new();
+    }
+    let at = |i: usize| route.waypoints[i] + shifts.get(i).copied().unwrap_or_else(Vec2::zeros);
+    let legs: Vec<f64> = (0..n)
+        .map(|i| {
+            let leg = Segment::new(at(i), at((i + 1) % n));
+            obstacles
+                .nearest_within(leg, clearance_m + reach_m)
+                .map_or(reach_m, |(_, c)| (c - clearance_m).clamp(0.0, reach_m))
+        })
+        .collect();
+    (0..n).map(|i| legs[i].min(legs[(i + n - 1) % n])).collect()
 }
 
 /// Per-waypoint shifts: a lean of the whole lap plus a draw per waypoint, in [-1, 1] of the
@@ -447,5 +666,44 @@ mod tests {
         // 50 laps × 60 m: about 300 stops and 60 spins.
         assert!((200..400).contains(&stops), "{stops}");
         assert!((30..95).contains(&spins), "{spins}");
+    }
+
+    #[test]
+    fn every_preset_resolves_and_real_weave_targets_keep_clear_of_the_walls() {
+        for name in LapVariationConfig::PRESETS {
+            assert!(LapVariationConfig::preset(name).is_some(), "{name}");
+        }
+        assert_eq!(
+            LapVariationConfig::preset("smooth")
+                .unwrap()
+                .weave_heading_rad,
+            0.0
+        );
+        let cfg = LapVariationConfig::preset("real-weave").unwrap();
+        let (route, obs) = corridor();
+        let room = LaneRoom::measure(&route, &obs, 0.5);
+        let tracker = RouteTracker::new(&route, 0);
+        let mut widest = 0.0f64;
+        for lap in 0..20 {
+            let mut rng = stream(3, 0, lap, Purpose::LapVariation);
+            let plan = LapPlan::draw(
+                &cfg,
+                (&room, &route, &obs, 0.5),
+                (0.0, 60.0),
+                Wander::default(),
+                &mut rng,
+            );
+            for k in 0..600 {
+                let s = k as f64 * 0.1;
+                let p = plan.target(&tracker, s);
+                let near = obs.nearest_within(Segment::new(p, p), 0.5 - 1e-9);
+                assert!(
+                    near.is_none(),
+                    "lap {lap}, arc {s} m: target {p:?} too close"
+                );
+                widest = widest.max(plan.weave_offset_m(&tracker, s).abs());
+            }
+        }
+        assert!(widest > 0.1, "the weave sways: at most {widest} m");
     }
 }

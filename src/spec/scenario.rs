@@ -142,6 +142,8 @@ pub const NUMBER_LIMITS: &[NumberLimit] = &[
     off("robot", "stop_spacing_m", (1.0, 1e6), "m", "10"),
     lim("robot", "stop_duration_s", (0.0, 60.0), "s", "4"),
     off("robot", "spin_spacing_m", (1.0, 1e6), "m", "50"),
+    lim("robot", "weave_wavelength_min_m", (0.2, 50.0), "m", "0.5"),
+    lim("robot", "weave_wavelength_max_m", (0.2, 50.0), "m", "5"),
     lim("pedestrians", "speed_min_m_s", (0.0, 5.0), "m/s", "0.5"),
     lim("pedestrians", "speed_max_m_s", (0.0, 5.0), "m/s", "1.2"),
     lim("pedestrians", "radius_m", (0.01, 1.0), "m", "0.2"),
@@ -300,13 +302,20 @@ pub const ROBOT_KEYS: &[&str] = &[
     "stop_duration_s",
     "spin_spacing_m",
     "spin_angle_deg",
+    "spin_angle_min_deg",
+    "corner_spin_ratio",
+    "lap_variation",
+    "weave_heading_deg",
+    "weave_wavelength_min_m",
+    "weave_wavelength_max_m",
+    "weave_envelope_ratio",
 ];
 /// Keys of the recognizer's settings that the harness sets itself, never a file's
 /// `[recognizer]` table: `levels` (each level configuration is run; `--levels` and
 /// `[[expect.subjects]]` (`subject = "words-N"`) choose). A file that sets one is refused.
 pub const RECOGNIZER_HARNESS_KEYS: &[&str] = &["levels"];
 /// Keys whose value is a word rather than a number (besides a table's `model`/`preset`).
-pub const WORD_KEYS: &[&str] = &["proportional_error"];
+pub const WORD_KEYS: &[&str] = &["proportional_error", "lap_variation"];
 
 /// A whole scenario file, as written.
 #[derive(Clone, Debug)]

@@ -882,3 +882,75 @@ fn a_run_without_pairs_says_why() {
     let words = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
     assert!(words(&table).contains(&words(why)), "{table}");
 }
+
+/// The `real-weave` lap preset (issue 28 point 1): its laps sway about their lane and turn on
+/// the spot as real robots do (median heading off the corridor, weave per metre and turns on
+/// the spot above the smooth laps' on every seed), keep the robot's body off every wall and
+/// door of 2 m corridors, and one seed drives the same laps twice.
+#[test]
+fn real_weave_laps_weave_more_than_smooth_ones_and_keep_off_walls() {
+    use placewords::eval::motion::{Motion, measure};
+    let base = "format_version = 1\nworld = \"w\"\nroute = \"lap\"\nseed = 1\n[[runs]]\nlaps = 3\ndoors = \"all-open\"\n";
+    let drive = |preset: &str, seed: u64| -> (Motion, Vec<Pose2>) {
+        let text = format!("{base}[robot]\nlap_variation = \"{preset}\"\n");
+        let mut scn = scenario(LOOP_WORLD, &text).unwrap();
+        scn.sim.seed = seed;
+        let mut sim = placewords::sim::runner::RunSim::new(&scn.sim, 0);
+        let (mut m, mut path) = (Motion::default(), Vec::new());
+        for lap in 0..3 {
+            let log = sim.run_lap(lap).unwrap();
+            let p: Vec<_> = log.frames.iter().map(|f| (f.time_s, f.truth.0)).collect();
+            m.add(&measure(&p));
+            path.extend(p.iter().map(|x| x.1));
+        }
+        let contact = sim.contact_steps();
+        assert_eq!(
+            contact, 0,
+            "{preset}, seed {seed}: the robot touched a wall or door"
+        );
+        (m, path)
+    };
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let deviation = |m: &Motion| median(m.heading_deviation_rad.iter().map(|d| d.abs()).collect());
+    for seed in 1..=3 {
+        let (weave, path) = drive("real-weave", seed);
+        let (smooth, _) = drive("smooth", seed);
+        let (dw, ds) = (deviation(&weave), deviation(&smooth));
+        assert!(
+            dw > 2.0 * ds && dw > 1f64.to_radians(),
+            "seed {seed}: median heading deviation {dw} rad, smooth {ds}"
+        );
+        let (ww, ws) = (
+            median(weave.weave_m.clone()),
+            median(smooth.weave_m.clone()),
+        );
+        assert!(
+            ww > ws + 0.005,
+            "seed {seed}: median weave {ww} m/m, smooth {ws}"
+        );
+        assert!(weave.spins_per_100_m() > smooth.spins_per_100_m());
+        if seed == 1 {
+            assert_eq!(
+                drive("real-weave", 1).1,
+                path,
+                "the same seed drives the same laps"
+            );
+        }
+    }
+    let err = scenario(
+        LOOP_WORLD,
+        &format!("{base}[robot]\nlap_variation = \"real-wave\"\n"),
+    );
+    let msg = err.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(
+        msg.contains("real-weave"),
+        "a misspelt preset names the real one: {msg}"
+    );
+    let swapped = "[robot]\nweave_wavelength_min_m = 6.0\nweave_wavelength_max_m = 4.0\n";
+    let err = scenario(LOOP_WORLD, &format!("{base}{swapped}"));
+    let msg = err.err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(msg.contains(":9:26") && msg.contains("swap"), "{msg}");
+}
