@@ -18,7 +18,7 @@
 //!   wavelength bands ([`BANDS_M`]), from a periodogram of the deviation sampled every
 //!   [`STEP_M`].
 
-use crate::geom::Pose2;
+use crate::geom::{Pose2, wrap_angle};
 
 /// Arc-length step of the heading-deviation series, metres.
 pub const STEP_M: f64 = 0.1;
@@ -103,20 +103,10 @@ pub fn measure(path: &[(f64, Pose2)]) -> Motion {
     m
 }
 
-fn dist(a: Pose2, b: Pose2) -> f64 {
-    (a.x - b.x).hypot(a.y - b.y)
-}
-
-fn wrap(a: f64) -> f64 {
-    let t = std::f64::consts::TAU;
-    let r = a.rem_euclid(t);
-    if r > std::f64::consts::PI { r - t } else { r }
-}
-
 fn speeds(path: &[(f64, Pose2)]) -> Vec<f64> {
     path.windows(2)
         .filter_map(|w| {
-            let (d, dt) = (dist(w[0].1, w[1].1), w[1].0 - w[0].0);
+            let (d, dt) = (w[0].1.distance(&w[1].1), w[1].0 - w[0].0);
             ((0.01..=2.0).contains(&d) && (0.01..=2.0).contains(&dt)).then(|| d / dt)
         })
         .collect()
@@ -131,13 +121,13 @@ fn walk(path: &[(f64, Pose2)]) -> (Vec<PathPoint>, Vec<f64>) {
     let (mut turn, mut turn_from_s, mut last_theta) = (0.0f64, 0.0f64, None::<f64>);
     for &(_, pose) in path {
         if let Some(t) = last_theta {
-            turn += wrap(pose.theta - t);
+            turn += wrap_angle(pose.theta - t);
         }
         last_theta = Some(pose.theta);
         let s = match points.last() {
             None => 0.0,
-            Some(p) if dist(p.pose, pose) < 0.01 => continue,
-            Some(p) => p.s_m + dist(p.pose, pose),
+            Some(p) if p.pose.distance(&pose) < 0.01 => continue,
+            Some(p) => p.s_m + p.pose.distance(&pose),
         };
         points.push(PathPoint { s_m: s, pose });
         if s - turn_from_s >= SPIN_MAX_TRAVEL_M {
@@ -166,7 +156,7 @@ fn at(points: &[PathPoint], s: f64, i: &mut usize) -> Pose2 {
     Pose2 {
         x: a.pose.x + f * (b.pose.x - a.pose.x),
         y: a.pose.y + f * (b.pose.y - a.pose.y),
-        theta: a.pose.theta + f * wrap(b.pose.theta - a.pose.theta),
+        theta: a.pose.theta + f * wrap_angle(b.pose.theta - a.pose.theta),
     }
 }
 
@@ -184,7 +174,7 @@ fn heading_deviation(points: &[PathPoint]) -> Vec<f64> {
             at(points, s, &mut i1),
             at(points, s + h, &mut i2),
         );
-        out.push(wrap(p.theta - (b.y - a.y).atan2(b.x - a.x)));
+        out.push(wrap_angle(p.theta - (b.y - a.y).atan2(b.x - a.x)));
         s += STEP_M;
     }
     out
