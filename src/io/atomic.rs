@@ -593,12 +593,16 @@ impl Journal {
 const SET_TAG: &str = ".placewords-set";
 
 /// Creates picture folder `dir` when missing and an empty staging folder for it, returned.
-fn fresh_staging(dir: &Path) -> std::io::Result<PathBuf> {
-    std::fs::create_dir_all(dir)?;
+fn fresh_staging(dir: &Path) -> Result<PathBuf, StageError> {
+    let io = |source| StageError::Io {
+        path: dir.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(io)?;
     remove_stale_temps(dir);
     let staging = temp_path(dir);
     let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir(&staging)?;
+    std::fs::create_dir(&staging).map_err(io)?;
     Ok(staging)
 }
 
@@ -612,10 +616,6 @@ impl OutputSet {
         dirs: &[&Path],
         replaced: &[Replaced<'_>],
     ) -> Result<OutputSet, StageError> {
-        let io = |path: &Path, source| StageError::Io {
-            path: path.display().to_string(),
-            source,
-        };
         let mut set = OutputSet {
             files: Vec::new(),
             dirs: Vec::new(),
@@ -630,7 +630,7 @@ impl OutputSet {
             set.files.push((file.to_path_buf(), temp_path(file)));
         }
         for &dir in dirs {
-            let staging = fresh_staging(dir).map_err(|e| io(dir, e))?;
+            let staging = fresh_staging(dir)?;
             set.dirs.push((dir.to_path_buf(), staging));
         }
         for &(dir, replaceable) in replaced {
