@@ -313,23 +313,7 @@ impl ExternalRecognizer {
                 Ok(l)
             }
             Ok(Line::Closed) | Err(RecvTimeoutError::Disconnected) => {
-                // Give the exit status a moment to arrive.
-                std::thread::sleep(Duration::from_millis(50));
-                let status = match self.child.try_wait() {
-                    Ok(Some(s)) => format!("exited ({s})"),
-                    _ => "closed its standard output".to_string(),
-                };
-                let during = if written.is_err() {
-                    " before it read its input"
-                } else {
-                    ""
-                };
-                Err(self.error(format!(
-                    "{status}{during} after printing {} line(s), while the harness waited for \
-                     the answer to `{}`",
-                    self.printed,
-                    clip(request)
-                )))
+                Err(self.closed(request, written.is_ok()))
             }
             Err(RecvTimeoutError::Timeout) => {
                 let _ = self.child.kill();
@@ -341,6 +325,28 @@ impl ExternalRecognizer {
                 )))
             }
         }
+    }
+
+    /// The error for a recognizer that closed its output while `request` (`read`: written to
+    /// it) waited for an answer: its exit status when it has one.
+    fn closed(&mut self, request: &str, read: bool) -> ExternalError {
+        // Give the exit status a moment to arrive.
+        std::thread::sleep(Duration::from_millis(50));
+        let status = match self.child.try_wait() {
+            Ok(Some(s)) => format!("exited ({s})"),
+            _ => "closed its standard output".to_string(),
+        };
+        let during = if read {
+            ""
+        } else {
+            " before it read its input"
+        };
+        self.error(format!(
+            "{status}{during} after printing {} line(s), while the harness waited for \
+             the answer to `{}`",
+            self.printed,
+            clip(request)
+        ))
     }
 
     /// Sends `request` and turns the answer into matches; a failure is kept (and ends every

@@ -324,15 +324,8 @@ fn office_door(index: usize, hinge_m: [f64; 2], along: Vec2, into: Vec2) -> Door
 fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)], side: f64, name: &str) -> Vec<WallSpec> {
     let outer = offset(loop_pts, -side * CORRIDOR_M / 2.0);
     let n = outer.len();
-    let wall = |k: usize, points_m: Vec<[f64; 2]>, closed: bool| WallSpec {
-        id: if closed && side < 0.0 {
-            name.to_string()
-        } else {
-            format!("{name}-{k}")
-        },
-        points_m,
-        closed,
-        thickness_m: crate::spec::world::default_wall_thickness_m(),
+    let wall = |k: usize, points_m: Vec<[f64; 2]>, closed: bool| {
+        corridor_wall_spec(name, k, side, points_m, closed)
     };
     if gaps.is_empty() {
         return vec![wall(1, outer.iter().map(|p| pt(*p)).collect(), true)];
@@ -351,6 +344,27 @@ fn corridor_wall(loop_pts: &[Vec2], gaps: &[(usize, f64)], side: f64, name: &str
         walls.push(wall(k + 1, points, false));
     }
     walls
+}
+
+/// Wall `k` of the corridor side `name`: a closed wall on the negative `side` is named `name`
+/// alone, the others `name-k`.
+fn corridor_wall_spec(
+    name: &str,
+    k: usize,
+    side: f64,
+    points_m: Vec<[f64; 2]>,
+    closed: bool,
+) -> WallSpec {
+    WallSpec {
+        id: if closed && side < 0.0 {
+            name.to_string()
+        } else {
+            format!("{name}-{k}")
+        },
+        points_m,
+        closed,
+        thickness_m: crate::spec::world::default_wall_thickness_m(),
+    }
 }
 
 /// How many of the `n` loop corners a wall from the gap at `(edge, along)` to the next of the

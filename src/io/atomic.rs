@@ -382,6 +382,24 @@ fn take_lock(lock: &Path) -> std::io::Result<Option<u32>> {
     Err(std::io::Error::other("the lock file could not be taken"))
 }
 
+/// Takes the lock of output `path` and returns the lock file's path; [`StageError::Busy`] when
+/// another live process holds it.
+fn lock_for(path: &Path) -> Result<PathBuf, StageError> {
+    let lock = lock_path(path);
+    let taken = take_lock(&lock).map_err(|source| StageError::Io {
+        path: lock.display().to_string(),
+        source,
+    })?;
+    if let Some(pid) = taken {
+        return Err(StageError::Busy {
+            path: path.display().to_string(),
+            pid,
+            lock: lock.display().to_string(),
+        });
+    }
+    Ok(lock)
+}
+
 /// Refuses a `dir` that is a file, or a folder that is neither empty nor, by `replaceable`,
 /// an earlier output of the same kind.
 fn check_replaceable(dir: &Path, replaceable: &dyn Fn(&Path) -> bool) -> Result<(), StageError> {
@@ -415,14 +433,7 @@ impl StagedDir {
         };
         check_replaceable(dir, replaceable)?;
         create_parent(dir).map_err(|e| io(dir, e))?;
-        let lock = lock_path(dir);
-        if let Some(pid) = take_lock(&lock).map_err(|e| io(&lock, e))? {
-            return Err(StageError::Busy {
-                path: dir.display().to_string(),
-                pid,
-                lock: lock.display().to_string(),
-            });
-        }
+        let lock = lock_for(dir)?;
         // From here the lock is ours: the value below releases it on every path.
         let mut staged = StagedDir {
             target: dir.to_path_buf(),
@@ -582,12 +593,16 @@ impl Journal {
 const SET_TAG: &str = ".placewords-set";
 
 /// Creates picture folder `dir` when missing and an empty staging folder for it, returned.
-fn fresh_staging(dir: &Path) -> std::io::Result<PathBuf> {
-    std::fs::create_dir_all(dir)?;
+fn fresh_staging(dir: &Path) -> Result<PathBuf, StageError> {
+    let io = |source| StageError::Io {
+        path: dir.display().to_string(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(io)?;
     remove_stale_temps(dir);
     let staging = temp_path(dir);
     let _ = std::fs::remove_dir_all(&staging);
-    std::fs::create_dir(&staging)?;
+    std::fs::create_dir(&staging).map_err(io)?;
     Ok(staging)
 }
 
@@ -601,10 +616,6 @@ impl OutputSet {
         dirs: &[&Path],
         replaced: &[Replaced<'_>],
     ) -> Result<OutputSet, StageError> {
-        let io = |path: &Path, source| StageError::Io {
-            path: path.display().to_string(),
-            source,
-        };
         let mut set = OutputSet {
             files: Vec::new(),
             dirs: Vec::new(),
@@ -619,7 +630,7 @@ impl OutputSet {
             set.files.push((file.to_path_buf(), temp_path(file)));
         }
         for &dir in dirs {
-            let staging = fresh_staging(dir).map_err(|e| io(dir, e))?;
+            let staging = fresh_staging(dir)?;
             set.dirs.push((dir.to_path_buf(), staging));
         }
         for &(dir, replaceable) in replaced {
@@ -633,19 +644,7 @@ impl OutputSet {
     fn lock_outputs(&mut self, paths: &[&Path]) -> Result<(), StageError> {
         for &path in paths {
             settle(path);
-            let lock = lock_path(path);
-            let taken = take_lock(&lock).map_err(|source| StageError::Io {
-                path: lock.display().to_string(),
-                source,
-            })?;
-            if let Some(pid) = taken {
-                return Err(StageError::Busy {
-                    path: path.display().to_string(),
-                    pid,
-                    lock: lock.display().to_string(),
-                });
-            }
-            self.locks.push(lock);
+            self.locks.push(lock_for(path)?);
         }
         Ok(())
     }

@@ -437,22 +437,7 @@ impl MatcherOptions {
     /// key; empty when they are usable.
     pub fn problems(&self, levels: usize) -> Vec<ConfigProblem> {
         let mut p = Problems::new("matcher");
-        let s = self.size_tolerance_ratio;
-        p.within(
-            "size_tolerance_ratio",
-            s,
-            (0.0..1.0).contains(&s),
-            "[0, 1)",
-            "0.25",
-        );
-        let a = self.angle_tolerance_deg;
-        p.within(
-            "angle_tolerance_deg",
-            a,
-            (0.0..=180.0).contains(&a),
-            "[0, 180]",
-            "30",
-        );
+        self.tolerance_problems(&mut p);
         self.min_ngram_problems(levels, &mut p);
         if !(self.candidate_gap_m.is_finite() && self.candidate_gap_m >= 0.0) {
             p.bad(
@@ -474,6 +459,26 @@ impl MatcherOptions {
         p.non_negative("ngram_travel_m", self.ngram_travel_m);
         p.non_negative("reverse_ngram_travel_m", self.reverse_ngram_travel_m);
         p.out
+    }
+
+    /// The word size and angle tolerances' ranges.
+    fn tolerance_problems(&self, p: &mut Problems) {
+        let s = self.size_tolerance_ratio;
+        p.within(
+            "size_tolerance_ratio",
+            s,
+            (0.0..1.0).contains(&s),
+            "[0, 1)",
+            "0.25",
+        );
+        let a = self.angle_tolerance_deg;
+        p.within(
+            "angle_tolerance_deg",
+            a,
+            (0.0..=180.0).contains(&a),
+            "[0, 180]",
+            "30",
+        );
     }
 
     /// The words an n-gram read backwards needs beyond τ (none when `reverse` is off).
