@@ -46,9 +46,9 @@ struct Cell {
 }
 
 /// The active sites of one sweep in cells, with a witness per lap and facing asked about (see
-/// the module doc).
-pub struct LapGrid<'s, const N: usize> {
-    sites: &'s [Site],
+/// the module doc). The sites are handed to each call (a slice that only grows), so a sweep can
+/// be resumed as sites are made ([`LapSweep`]).
+struct LapGrid<const N: usize> {
     inv_cell_m: f64,
     cells: HashMap<(i64, i64), Cell>,
     /// Per facing asked about, per lap: a copy of the site that last agreed with a query (kept
@@ -56,15 +56,13 @@ pub struct LapGrid<'s, const N: usize> {
     witness: [Vec<Option<Site>>; N],
 }
 
-impl<'s, const N: usize> LapGrid<'s, N> {
-    /// An empty grid over `sites` for queries within `r_m` (positive and finite).
-    fn new(sites: &'s [Site], r_m: f64) -> Self {
-        let laps = sites.iter().map(|s| s.lap + 1).max().unwrap_or(0);
+impl<const N: usize> LapGrid<N> {
+    /// An empty grid for queries within `r_m` (positive and finite).
+    fn new(r_m: f64) -> Self {
         LapGrid {
-            sites,
             inv_cell_m: 1.0 / (r_m * 1.01),
             cells: HashMap::default(),
-            witness: std::array::from_fn(|_| vec![None; laps]),
+            witness: std::array::from_fn(|_| Vec::new()),
         }
     }
 
@@ -75,11 +73,16 @@ impl<'s, const N: usize> LapGrid<'s, N> {
         )
     }
 
-    /// Makes site `k` active.
-    fn activate(&mut self, k: usize) {
-        let s = &self.sites[k];
+    /// Makes site `k` of `sites` active.
+    fn activate(&mut self, sites: &[Site], k: usize) {
+        let s = &sites[k];
         let key = self.cell_of(s);
         let lap = s.lap as u32;
+        for w in &mut self.witness {
+            if w.len() <= s.lap {
+                w.resize(s.lap + 1, None);
+            }
+        }
         let t = wrap_angle(s.theta);
         let cell = self.cells.entry(key).or_default();
         cell.sites.push(k as u32);
@@ -103,7 +106,7 @@ impl<'s, const N: usize> LapGrid<'s, N> {
 
     /// Adds to `laps[f]` the lap of every active site `qs[f]` takes (the queries ask about one
     /// site, each facing its own way: the cells and runs are walked once for all).
-    fn laps(&mut self, qs: &[Query; N], laps: &mut [LapSet; N]) {
+    fn laps(&mut self, sites: &[Site], qs: &[Query; N], laps: &mut [LapSet; N]) {
         let (cx, cy) = self.cell_of(qs[0].site);
         // The query's own cell first: the laps found there are skipped in the others.
         const AROUND: [(i64, i64); 9] = [
@@ -134,14 +137,14 @@ impl<'s, const N: usize> LapGrid<'s, N> {
                         laps.insert(lap);
                         continue;
                     }
-                    let sites = &cell.sites[from..start];
+                    let cell_sites = &cell.sites[from..start];
                     let hit = match cover(run.x, run.y, run.theta, q) {
                         Cover::None => None,
-                        Cover::All => sites.first(),
-                        Cover::Part => sites.iter().find(|&&j| agrees(&self.sites[j as usize])),
+                        Cover::All => cell_sites.first(),
+                        Cover::Part => cell_sites.iter().find(|&&j| agrees(&sites[j as usize])),
                     };
                     if let Some(&j) = hit {
-                        witness[lap] = Some(self.sites[j as usize]);
+                        witness[lap] = Some(sites[j as usize]);
                         laps.insert(lap);
                     }
                 }
@@ -159,28 +162,72 @@ pub fn sweep_laps<const N: usize>(
     r_m: f64,
     facings: [Facing; N],
     tol_rad: f64,
-    mut visit: impl FnMut(usize, [&[usize]; N]),
+    visit: impl FnMut(usize, [&[usize]; N]),
 ) {
-    if r_m <= 0.0 || !r_m.is_finite() {
-        return;
+    if let Some(mut sweep) = LapSweep::new(min_gap_m, r_m, facings, tol_rad) {
+        sweep.advance(sites, sites.len(), visit);
     }
-    let mut grid = LapGrid::<N>::new(sites, r_m);
-    let mut laps: [LapSet; N] = std::array::from_fn(|_| LapSet::default());
-    let mut ready = 0;
-    for (k, s) in sites.iter().enumerate() {
-        while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
-            grid.activate(ready);
-            ready += 1;
+}
+
+/// [`sweep_laps`] resumed as sites are made: each [`LapSweep::advance`] visits the next sites
+/// of a slice that only grows, with the same laps as one sweep over the whole slice (a site's
+/// laps depend on the sites before it alone). What lets visit recall be counted while a run is
+/// scored, rather than holding every (observation, lap) found to the end (`eval::tally`).
+pub struct LapSweep<const N: usize> {
+    grid: LapGrid<N>,
+    laps: [LapSet; N],
+    min_gap_m: f64,
+    r_m: f64,
+    facings: [Facing; N],
+    tol_rad: f64,
+    /// Sites made active, and sites visited.
+    ready: usize,
+    done: usize,
+}
+
+impl<const N: usize> LapSweep<N> {
+    /// A sweep at the start; `None` when `r_m` is not positive and finite (no laps at all).
+    pub fn new(min_gap_m: f64, r_m: f64, facings: [Facing; N], tol_rad: f64) -> Option<Self> {
+        if r_m <= 0.0 || !r_m.is_finite() {
+            return None;
         }
-        laps.iter_mut().for_each(LapSet::clear);
-        let qs = facings.map(|facing| Query {
-            site: s,
-            r2: r_m * r_m,
-            facing,
+        Some(LapSweep {
+            grid: LapGrid::new(r_m),
+            laps: std::array::from_fn(|_| LapSet::default()),
+            min_gap_m,
+            r_m,
+            facings,
             tol_rad,
-        });
-        grid.laps(&qs, &mut laps);
-        visit(k, std::array::from_fn(|f| laps[f].list.as_slice()));
+            ready: 0,
+            done: 0,
+        })
+    }
+
+    /// Visits sites `done()..end` of `sites` in order, as [`sweep_laps`] does (`sites` holds
+    /// at least the sites of every earlier call, unchanged).
+    pub fn advance(
+        &mut self,
+        sites: &[Site],
+        end: usize,
+        mut visit: impl FnMut(usize, [&[usize]; N]),
+    ) {
+        for k in self.done..end.min(sites.len()) {
+            let s = &sites[k];
+            while self.ready < k && s.travel_m - sites[self.ready].travel_m >= self.min_gap_m {
+                self.grid.activate(sites, self.ready);
+                self.ready += 1;
+            }
+            self.laps.iter_mut().for_each(LapSet::clear);
+            let qs = self.facings.map(|facing| Query {
+                site: s,
+                r2: self.r_m * self.r_m,
+                facing,
+                tol_rad: self.tol_rad,
+            });
+            self.grid.laps(sites, &qs, &mut self.laps);
+            visit(k, std::array::from_fn(|f| self.laps[f].list.as_slice()));
+            self.done = k + 1;
+        }
     }
 }
 
@@ -232,5 +279,30 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A sweep resumed in uneven steps, as sites are made, visits every site once with the
+    /// laps of one sweep over all of them (what lets a tally count visit recall as it scores).
+    #[test]
+    fn a_resumed_sweep_visits_each_site_with_the_laps_of_one_sweep() {
+        let sites = passes(5);
+        let facings = [Facing::Same, Facing::Opposite];
+        let mut want = Vec::new();
+        sweep_laps(&sites, 2.0, 1.0, facings, 0.7, |k, [s, o]| {
+            want.push((k, s.to_vec(), o.to_vec()));
+        });
+        let mut got = Vec::new();
+        let mut sweep = LapSweep::new(2.0, 1.0, facings, 0.7).expect("a positive radius");
+        let mut end = 0;
+        while end < sites.len() {
+            end = (end + 1 + end / 3).min(sites.len());
+            // Each call sees only the sites made so far.
+            sweep.advance(&sites[..end], end, |k, [s, o]| {
+                got.push((k, s.to_vec(), o.to_vec()));
+            });
+        }
+        assert_eq!(got, want);
+        assert!(want.iter().any(|w| w.1.len() > 1));
+        assert!(LapSweep::new(2.0, 0.0, facings, 0.7).is_none());
     }
 }

@@ -39,6 +39,7 @@
 //! (the order "first occurrence" refers to); this module holds the figures, the observations
 //! joined with their truth ([`Scorer`]) and the revisit searches.
 
+use super::lap_grid::LapSweep;
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
 use super::site_tree::{Query, Site, sweep};
@@ -360,6 +361,14 @@ impl Dense {
     fn len(&self) -> usize {
         self.len
     }
+
+    /// How many entries are below `v`, for entries in increasing order (site → observation).
+    fn count_below(&self, v: usize) -> usize {
+        match &self.table {
+            None => v.min(self.len),
+            Some(t) => t.partition_point(|&e| (e as usize) < v),
+        }
+    }
 }
 
 /// Marks an observation without truth in `Joined::site_of`.
@@ -645,6 +654,26 @@ impl Scorer {
         super::lap_grid::sweep_laps(&j.sites, gap, r, facings, tol, |k, laps| {
             visit(j.obs_of_site(k), laps)
         });
+    }
+
+    /// A [`Self::sweep_laps`] at radius `r` to be resumed by [`Self::sweep_laps_below`] as
+    /// observations are joined; `None` when `r` is not positive and finite.
+    pub(super) fn lap_sweep(&self, r: f64) -> Option<LapSweep<2>> {
+        let facings = [Facing::Same, Facing::Opposite];
+        LapSweep::new(self.min_gap_m, r, facings, self.heading_tol_rad)
+    }
+
+    /// Resumes `sweep` ([`Self::lap_sweep`]) over the observations below `end_obs` it has not
+    /// visited: the same calls of `visit` as [`Self::sweep_laps`] makes for them.
+    pub(super) fn sweep_laps_below(
+        &self,
+        sweep: &mut LapSweep<2>,
+        end_obs: usize,
+        mut visit: impl FnMut(usize, [&[usize]; 2]),
+    ) {
+        let j = &self.joined;
+        let end = j.site_obs.count_below(end_obs);
+        sweep.advance(&j.sites, end, |k, laps| visit(j.obs_of_site(k), laps));
     }
 
     /// The earlier laps that revisit each observation at radius `r`, facing as this scorer

@@ -33,6 +33,7 @@
 //! and [`super::evaluate`] scores a finished recognition by feeding its matches in order.
 
 use super::GroundTruth;
+use super::lap_grid::LapSweep;
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
 use super::pair_recall::{Facing, PairRecall, count_possible, count_possible_facings};
 use super::pair_set::pack;
@@ -135,6 +136,26 @@ pub struct Tally {
     in_match: HashSet<(ObsId, ObsId)>,
     /// Searches with the k-d tree of every earlier site ([`Self::by_site_tree`]).
     by_site_tree: bool,
+    /// Visit recall counted as the horizon passes ([`VisitStream`]); `None` without visit
+    /// recall (or `tp_radius_m` not positive) and for the reference searches.
+    stream: Option<VisitStream>,
+}
+
+/// Visit recall counted while a run is scored. Once the horizon passes an observation no later
+/// match names it as query, so its visits are final: the lap grid's sweep, resumed up to there
+/// ([`Scorer::sweep_laps_below`]), gives the earlier laps that revisit it, its visits are
+/// counted ([`LapCount`]) and their entries dropped. `Tally::visits` then holds the
+/// observations at or after the horizon, not every (observation, lap) found, which on a
+/// thousand-lap run of one loop with every look-alike a candidate grew with the laps squared
+/// (BENCHMARKS.md). The counts are those of the one sweep at the end, bar a visit of a late
+/// pair (one behind the horizon, [`Metrics::late_pairs`]: a recognizer breaking its promise),
+/// which is not counted.
+struct VisitStream {
+    r_m: f64,
+    sweep: LapSweep<2>,
+    count: LapCount,
+    /// Per facing (as [`facing_bit`]), per observation swept: an earlier lap revisits it.
+    revisits: [Vec<bool>; 3],
 }
 
 impl Tally {
@@ -167,6 +188,15 @@ impl Tally {
             slots.push(Slot::new(Facing::Same, r, false, true));
             slots.push(Slot::new(Facing::Opposite, r, false, true));
         }
+        let stream = match scope {
+            Scope::Full => scorer.lap_sweep(r).map(|sweep| VisitStream {
+                r_m: r,
+                sweep,
+                count: LapCount::default(),
+                revisits: Default::default(),
+            }),
+            Scope::Main => None,
+        };
         Tally {
             spec: spec.clone(),
             scorer,
@@ -181,6 +211,7 @@ impl Tally {
             forgotten: None,
             in_match: HashSet::default(),
             by_site_tree: false,
+            stream,
         }
     }
 
@@ -188,6 +219,7 @@ impl Tally {
     /// earlier site): the reference of `metrics::evaluate_by_site_tree`.
     pub(super) fn by_site_tree(&mut self) {
         self.by_site_tree = true;
+        self.stream = None;
     }
 
     /// Keep the distinct resolved pairs forgotten by [`Self::evict_below`] until
@@ -347,6 +379,36 @@ impl Tally {
             None => self.window.retain(|&k, _| !behind(k)),
         }
         self.evicted_below = h;
+        self.count_visits_below(h);
+    }
+
+    /// Counts the visit recall of the observations below `h` (behind the horizon: their visits
+    /// are final) and drops their visit entries ([`VisitStream`]).
+    fn count_visits_below(&mut self, h: usize) {
+        let Some(mut stream) = self.stream.take() else {
+            return;
+        };
+        compact_visits(&mut self.visits, self.visits_compact);
+        let n = self.scorer.observation_count();
+        let VisitStream {
+            sweep,
+            count,
+            revisits,
+            ..
+        } = &mut stream;
+        revisits.iter_mut().for_each(|v| v.resize(n, false));
+        count.at = 0;
+        self.scorer
+            .sweep_laps_below(sweep, h, |i, [same, opposite]| {
+                revisits[0][i] = !same.is_empty() || !opposite.is_empty();
+                revisits[1][i] = !same.is_empty();
+                revisits[2][i] = !opposite.is_empty();
+                count.add(self, i, same, opposite);
+            });
+        let below = self.visits.partition_point(|&v| ((v >> 32) as usize) < h);
+        self.visits.drain(..below);
+        self.visits_compact = self.visits.len();
+        self.stream = Some(stream);
     }
 
     /// The distinct resolved pairs forgotten since the last call, packed `(query, past)`
@@ -413,6 +475,17 @@ impl Tally {
     pub fn finish_sharing(mut self, truth: &GroundTruth, shared: &mut SharedTruth) -> Evaluation {
         self.evict_below(usize::MAX);
         compact_visits(&mut self.visits, self.visits_compact);
+        let n = self.scorer.observation_count();
+        let streamed = self.stream.take().map(|mut s| {
+            s.revisits.iter_mut().for_each(|v| v.resize(n, false));
+            let sweep = VisitSweep {
+                recall: s.count.recall(),
+                revisits: Some(s.revisits),
+                lists: None,
+            };
+            (s.r_m, sweep)
+        });
+        let own_recall = streamed.as_ref().map(|(r, v)| (*r, v.recall));
         let slots: Vec<(Facing, u64)> = self
             .slots
             .iter()
@@ -431,7 +504,7 @@ impl Tally {
         shared.tallies = shared.tallies.saturating_sub(1);
         let side = match reuse {
             Some(side) => side,
-            None => self.truth_side(sites, slots, keep),
+            None => self.truth_side(sites, slots, keep, streamed),
         };
         let mut metrics: Vec<(Metrics, Vec<DoorConfigMetrics>)> = Vec::new();
         let mut recalls_of: Vec<(f64, [f64; 3])> = Vec::new();
@@ -449,9 +522,10 @@ impl Tally {
                 let recalls = match recalls_of.iter().find(|w| w.0 == s.radius_m) {
                     Some(w) => w.1,
                     None => {
-                        let recall = match swept {
-                            Some(w) if fresh => w.3,
-                            Some((_, _, Some(lists), _)) => lists.recall(&self),
+                        let recall = match (own_recall, swept) {
+                            (Some((r, own)), _) if r == s.radius_m => own,
+                            (_, Some(w)) if fresh => w.3,
+                            (_, Some((_, _, Some(lists), _))) => lists.recall(&self),
                             _ => self.visit_recalls(s.radius_m, false).recall,
                         };
                         recalls_of.push((s.radius_m, recall));
@@ -499,12 +573,14 @@ impl Tally {
     /// What the figures need from the truth and the observations alone (see
     /// [`SharedTruth`]): the revisits of every figure, the laps that revisit each observation
     /// at each radius with visit recall, pair recall's possible pairs.
-    /// `keep`: keep the laps that revisit each observation, for the next tally.
+    /// `keep`: keep the laps that revisit each observation, for the next tally. `streamed`:
+    /// the sweep counted as the run was scored ([`VisitStream`]), at its radius.
     fn truth_side(
         &self,
         frame_sites: Vec<Site>,
         slots: Vec<(Facing, u64)>,
         keep: bool,
+        mut streamed: Option<(f64, VisitSweep)>,
     ) -> TruthSide {
         // Every figure with visit recall is at `tp_radius_m`; its sweep of the earlier laps
         // also tells which observations have a revisit there, of every facing.
@@ -512,7 +588,10 @@ impl Tally {
         let mut swept: Vec<bool> = Vec::new();
         for s in &self.slots {
             if s.recalls && sweeps.iter().all(|w| w.0 != s.radius_m) {
-                let v = self.visit_recalls(s.radius_m, keep);
+                let v = match streamed.take_if(|(r, _)| *r == s.radius_m) {
+                    Some((_, v)) => v,
+                    None => self.visit_recalls(s.radius_m, keep),
+                };
                 sweeps.push((s.radius_m, v.revisits, v.lists, v.recall));
             }
             swept.push(sweeps.iter().any(|w| w.0 == s.radius_m && w.1.is_some()));
