@@ -165,10 +165,20 @@ pub struct RouteTracker {
 
 impl RouteTracker {
     /// A tracker with a gate at each waypoint `spins` marks (see [`spin_waypoints`]).
+    /// Every marked gate is kept, the one at the start waypoint too (a narrow corner there is
+    /// turned on the spot when the lap comes back to it).
     pub fn with_gates(route: &Route, start_waypoint: usize, spins: &[bool]) -> Self {
         let mut t = RouteTracker::new(route, start_waypoint);
-        t.set_gates(spins);
+        t.gates_m = t.gates_at(spins);
         t
+    }
+
+    /// Arc lengths of the waypoints `spins` marks.
+    fn gates_at(&self, spins: &[bool]) -> Vec<f64> {
+        (0..self.starts.len())
+            .filter(|&k| spins.get(k).copied().unwrap_or(false))
+            .map(|k| self.starts[k])
+            .collect()
     }
 
     /// Replaces the gates with the waypoints `spins` marks, from here on (a lap that turns on
@@ -181,9 +191,9 @@ impl RouteTracker {
             d.min(self.length_m - d) < 1.0
         };
         let old = std::mem::take(&mut self.gates_m);
-        self.gates_m = (0..self.starts.len())
-            .filter(|&k| spins.get(k).copied().unwrap_or(false))
-            .map(|k| self.starts[k])
+        self.gates_m = self
+            .gates_at(spins)
+            .into_iter()
             .filter(|&g| !near(g) || old.contains(&g))
             .collect();
         // Every gate behind the robot counts as passed (progress never passes an unturned one).
