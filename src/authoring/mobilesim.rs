@@ -199,24 +199,20 @@ fn within_route_budget(
     map: &MobileSimMap,
     home: Vec2,
 ) -> Result<(), Diagnostic> {
-    use crate::authoring::route::{COARSEST_M, MARGIN_M, MAX_AREA_M2, MAX_CELLS};
-    let bbox = |skip: Option<usize>| {
-        let (mut lo, mut hi) = (home, home);
-        for (_, s) in map
-            .segments
-            .iter()
-            .enumerate()
-            .filter(|(i, _)| Some(*i) != skip)
-        {
-            lo = lo.inf(&s.a).inf(&s.b);
-            hi = hi.sup(&s.a).sup(&s.b);
-        }
-        (lo, hi)
+    use crate::authoring::route::{
+        COARSEST_M, MAX_AREA_M2, MAX_CELLS, bounding_box, cell_size_m, raster_area_m2,
     };
-    let area =
-        |(lo, hi): (Vec2, Vec2)| (hi.x - lo.x + 2.0 * MARGIN_M) * (hi.y - lo.y + 2.0 * MARGIN_M);
+    // The raster's own rule at its coarsest cell, so this refusal and route generation's agree.
+    let bbox = |skip: Option<usize>| {
+        let kept = (map.segments.iter().enumerate())
+            .filter(move |(i, _)| Some(*i) != skip)
+            .map(|(_, s)| s);
+        bounding_box(home, kept)
+    };
+    let area = raster_area_m2;
+    let fits = |b| cell_size_m(area(b), 0.0).is_some();
     let (lo, hi) = bbox(None);
-    if area((lo, hi)) <= MAX_AREA_M2 {
+    if fits((lo, hi)) {
         return Ok(());
     }
     let far = |p: Vec2| (p - home).norm();
@@ -241,7 +237,7 @@ fn within_route_budget(
         .and_then(|l| token_column(l, token))
         .unwrap_or(1);
     let rest = bbox(Some(i));
-    let fits = if area(rest) <= MAX_AREA_M2 {
+    let fits = if fits(rest) {
         let q = p.sup(&rest.0).inf(&rest.1);
         format!(
             "an end within the rest of the map, e.g. `{:.0} {:.0}`, would fit",

@@ -24,7 +24,9 @@ mod thin;
 
 use crate::geom::{Segment, Vec2, segment_distance};
 use raster::Raster;
-pub use raster::{COARSEST_M, MARGIN_M, MAX_AREA_M2, MAX_CELLS};
+pub use raster::{
+    COARSEST_M, MARGIN_M, MAX_AREA_M2, MAX_CELLS, bounding_box, cell_size_m, raster_area_m2,
+};
 use skeleton::Tree;
 
 /// Settings of the route generator.

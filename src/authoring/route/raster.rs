@@ -30,26 +30,43 @@ pub const MAX_AREA_M2: f64 = MAX_CELLS * COARSEST_M * COARSEST_M;
 /// How far the raster reaches beyond the walls' and home's bounding box, metres.
 pub const MARGIN_M: f64 = 1.0;
 
+/// The bounding box (corners lo, hi) of `home` and every end of `walls`: what route generation
+/// rasterises, before [`MARGIN_M`] is added on every side.
+pub fn bounding_box<'a>(home: Vec2, walls: impl IntoIterator<Item = &'a Segment>) -> (Vec2, Vec2) {
+    let (mut lo, mut hi) = (home, home);
+    for w in walls {
+        lo = lo.inf(&w.a).inf(&w.b);
+        hi = hi.sup(&w.a).sup(&w.b);
+    }
+    (lo, hi)
+}
+
+/// The area route generation rasterises for a [`bounding_box`]: the box grown by [`MARGIN_M`]
+/// on every side, square metres.
+pub fn raster_area_m2((lo, hi): (Vec2, Vec2)) -> f64 {
+    (hi.x - lo.x + 2.0 * MARGIN_M) * (hi.y - lo.y + 2.0 * MARGIN_M)
+}
+
+/// The cell size of a raster of `area_m2` asked at `resolution_m`: coarsened so it stays under
+/// [`MAX_CELLS`]; `None` when even [`COARSEST_M`] would not (the work budget, one rule for
+/// route generation and for `world import`'s early refusal).
+pub fn cell_size_m(area_m2: f64, resolution_m: f64) -> Option<f64> {
+    let res = resolution_m.max((area_m2 / MAX_CELLS).sqrt());
+    (!res.is_nan() && res <= COARSEST_M + 1e-12).then_some(res)
+}
+
 impl Raster {
     /// Cells of `resolution_m`, coarsened (up to [`COARSEST_M`]) for large maps so the raster
     /// stays under [`MAX_CELLS`]; larger maps are refused with their size (width, height in
     /// metres). `world import` refuses them earlier, at the map's line
     /// (`authoring::mobilesim`).
     pub fn around(walls: &[Segment], home: Vec2, resolution_m: f64) -> Result<Raster, (f64, f64)> {
-        let (mut lo, mut hi) = (home, home);
-        for w in walls {
-            for p in [w.a, w.b] {
-                lo = lo.inf(&p);
-                hi = hi.sup(&p);
-            }
-        }
-        lo -= Vec2::new(MARGIN_M, MARGIN_M);
-        hi += Vec2::new(MARGIN_M, MARGIN_M);
-        let area = (hi.x - lo.x) * (hi.y - lo.y);
-        let res = resolution_m.max((area / MAX_CELLS).sqrt());
-        if res.is_nan() || res > COARSEST_M + 1e-12 {
+        let (lo, hi) = bounding_box(home, walls);
+        let lo = lo - Vec2::new(MARGIN_M, MARGIN_M);
+        let hi = hi + Vec2::new(MARGIN_M, MARGIN_M);
+        let Some(res) = cell_size_m((hi.x - lo.x) * (hi.y - lo.y), resolution_m) else {
             return Err((hi.x - lo.x, hi.y - lo.y));
-        }
+        };
         Ok(Raster {
             lo,
             res,
