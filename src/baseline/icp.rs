@@ -588,14 +588,8 @@ impl PlaceRecognizer for IcpRecognizer {
             return Vec::new();
         }
         self.forget_far_cells(&pose);
-        let id = self.observations.len();
-        self.observations.push(Observation::new(
-            id,
-            self.run.unwrap_or(0),
-            frame_id,
-            odom,
-            travel_m,
-        ));
+        let id =
+            super::push_observation(&mut self.observations, self.run, frame_id, odom, travel_m);
         self.pending.push(id);
         if self.pending.len() >= self.cfg.region_observations {
             self.close_region()

@@ -474,14 +474,8 @@ impl ScanContextRecognizer {
 
     /// Records an observation of frame `frame_id` at `odom`, `travel_m` along the run; its id.
     fn observe(&mut self, frame_id: FrameId, odom: OdomPose, travel_m: f64) -> usize {
-        let id = self.observations.len();
-        self.observations.push(Observation::new(
-            id,
-            self.run.unwrap_or(0),
-            frame_id,
-            odom,
-            travel_m,
-        ));
+        let id =
+            super::push_observation(&mut self.observations, self.run, frame_id, odom, travel_m);
         self.counts.observations += 1;
         id
     }
