@@ -90,6 +90,31 @@ fn shipped_worlds_meet_their_briefs() {
         lap.length_m
     );
     assert!(small.doors >= 6);
+
+    // The open-space world (issue 28): a wall-free rectangle of at least 40 m x 30 m (the hall,
+    // x 0.5..43.5 m, y 0.5..33.5 m inside its walls) that the lap crosses for at least 40 m.
+    let hall = shipped("hall.toml");
+    let (lo, hi) = ((0.5, 0.5), (43.5, 33.5));
+    assert!(hi.0 - lo.0 >= 40.0 && hi.1 - lo.1 >= 30.0);
+    let inside =
+        |p: placewords::geom::Vec2| (lo.0..=hi.0).contains(&p.x) && (lo.1..=hi.1).contains(&p.y);
+    let on = |s: placewords::geom::Segment, step_m: f64| {
+        let n = (s.length() / step_m).ceil().max(1.0) as usize;
+        (0..=n).map(move |k| s.point_at(k as f64 / n as f64))
+    };
+    for w in &hall.walls {
+        for s in w.segments() {
+            assert!(!on(s, 0.05).any(inside), "wall {} enters the hall", w.id);
+        }
+    }
+    let legs = hall.route("lap").unwrap().legs();
+    let open_m: f64 = (legs.iter())
+        .map(|leg| on(*leg, 0.1).filter(|&p| inside(p)).count() as f64 * 0.1)
+        .sum();
+    assert!(
+        open_m >= 40.0,
+        "the hall's lap crosses only {open_m:.1} m of the hall"
+    );
 }
 
 /// Where the fixtures live, spelt as messages show them (relative to the crate root).
@@ -688,7 +713,7 @@ fn world_check_warns_about_a_tight_leg_and_still_passes() {
     let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
     assert_eq!(v["severity"], "warning");
     assert_eq!(v["line"], 32);
-    for w in ["institute-floor", "loop-small", "two-loops"] {
+    for w in ["institute-floor", "loop-small", "two-loops", "hall"] {
         let p = root().join(format!("worlds/{w}.toml"));
         let out = placewords(&["world", "check", p.to_str().unwrap()]);
         assert_eq!(out.status.code(), Some(0));
