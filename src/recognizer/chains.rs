@@ -65,7 +65,13 @@ impl WordMatcher {
         if d > 180.0 {
             d = 360.0 - d;
         }
-        d <= self.matcher_opts.angle_tolerance_deg + 1e-9
+        let tol = self.matcher_opts.angle_tolerance_deg;
+        let slack = if self.matcher_opts.angle_slack {
+            (a.angle_slack_deg + b.angle_slack_deg).min(tol / 2.0)
+        } else {
+            0.0
+        };
+        d <= tol + slack + 1e-9
     }
 
     /// Records `c` as the successor of each of its predecessors.

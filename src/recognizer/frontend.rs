@@ -219,7 +219,7 @@ impl DensityFrontEnd {
             return Vec::new();
         }
         let travel_now = self.clock.travel_m();
-        let mut at: Vec<(OdomPose, f64)> = Vec::new();
+        let mut at: Vec<(OdomPose, f64, f64)> = Vec::new();
         match due.previous {
             Some((last, last_travel)) if due.along_step => {
                 let span = (travel_now - last_travel).max(1e-12);
@@ -234,16 +234,20 @@ impl DensityFrontEnd {
                             a.theta + crate::geom::wrap_angle(b.theta - a.theta) * f,
                         ),
                     );
-                    at.push((OdomPose(pose), travel.min(travel_now)));
+                    // Where the step's turn took the path off its chord, for a path of constant
+                    // curvature (an arc: span · |Δθ| · f(1 − f) / 2, the sagitta at f = ½).
+                    let turn = crate::geom::wrap_angle(b.theta - a.theta).abs();
+                    let slack_m = span * turn * f * (1.0 - f) / 2.0;
+                    at.push((OdomPose(pose), travel.min(travel_now), slack_m));
                 }
             }
             _ => {
                 self.long_steps += usize::from(due.passed > 1 && due.previous.is_some());
-                at.push((odom, travel_now))
+                at.push((odom, travel_now, 0.0))
             }
         }
         at.into_iter()
-            .map(|(pose, travel_m)| {
+            .map(|(pose, travel_m, position_slack_m)| {
                 debug_assert!(self.grid.kernel_fits(self.kernel_cells, pose.0.x, pose.0.y));
                 let density = self
                     .grid
@@ -254,6 +258,7 @@ impl DensityFrontEnd {
                     psi: density.psi,
                     // On the robot's left axis (−sin θ, cos θ) of the odometry heading.
                     lateral_moment: cos * density.moment.1 - sin * density.moment.0,
+                    position_slack_m,
                 };
                 self.next_id += 1;
                 obs

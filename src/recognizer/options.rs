@@ -354,6 +354,15 @@ pub struct MatcherOptions {
     pub size_tolerance_ratio: f64,
     /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
     pub angle_tolerance_deg: f64,
+    /// Widen the angle tolerance of two words by how far their angle syllables may be off
+    /// because the positions they are measured from were interpolated along long steps between
+    /// sparse scans (each word's `angle_slack_deg`: the step's turn could lie anywhere in it),
+    /// by at most half of `angle_tolerance_deg` more. Where no observation is interpolated
+    /// across a turn (every simulated run: scans 4–10 cm apart) nothing changes. Default true:
+    /// Intel every 3rd scan (1.6 m between scans) gets same-direction pairs where it had none;
+    /// the cap of half the tolerance keeps Intel every 4th scan's precision (the whole
+    /// tolerance lowered it 0.892 → 0.832; RESULTS.md, 2026-12-05).
+    pub angle_slack: bool,
     /// Candidate gap: a past word must end at least this much odometric travel before the
     /// current n-gram begins, metres (not the evaluation's revisit gap, `[evaluation] min_gap_m`,
     /// though both default to 20). Default 20.0.
@@ -419,6 +428,7 @@ impl Default for MatcherOptions {
             min_ngram: vec![6, 9, 12, 15],
             size_tolerance_ratio: 0.25,
             angle_tolerance_deg: 30.0,
+            angle_slack: true,
             candidate_gap_m: 20.0,
             max_candidates: 0,
             reverse: true,

@@ -23,6 +23,14 @@ pub struct DensityObservation {
     /// axis: along the path, the grid knows more ahead than behind, so that moment depends on
     /// the direction of travel.)
     pub lateral_moment: f64,
+    /// How far the robot's true path may lie from this observation's position, metres: 0 at a
+    /// scan's own pose; for an observation interpolated along a step between two scans (sparse
+    /// logs), the distance from the step's chord to an arc turning the step's heading change Δθ
+    /// (step length × |Δθ| × f(1 − f) / 2 at fraction f of the step; 0 on a straight step). A
+    /// word's angle syllable is measured from such positions, so it is uncertain by what this
+    /// moves its chords (`MatcherOptions::angle_slack`).
+    #[serde(default)]
+    pub position_slack_m: f64,
 }
 
 /// A density observation reads as the neutral observation it carries (`o.travel_m`,

@@ -49,6 +49,9 @@ pub struct Word {
     pub size: usize,
     /// A: heading change, degrees in (−180, 180].
     pub angle_deg: f64,
+    /// How far A may be off because the positions it is measured from were interpolated
+    /// between sparse scans, degrees ([`word_angle_slack_deg`]; 0 with dense scans).
+    pub angle_slack_deg: f64,
     /// Index (in the back end's observation list) of the first observation; a word's observations
     /// are consecutive.
     pub first_obs: usize,
@@ -95,6 +98,26 @@ pub fn word_angle_deg(obs: &[Observation]) -> f64 {
     wrap_angle(a2 - a1).to_degrees()
 }
 
+/// How far [`word_angle_deg`] may move when each of the first, median and last observation's
+/// positions may lie up to its slack (`slack_m`, [`DensityObservation::position_slack_m`]) off
+/// the path: each chord's direction by atan((slack at its ends) / its length), degrees; 0 when
+/// every slack is 0.
+pub fn word_angle_slack_deg(obs: &[Observation], slack_m: &[f64]) -> f64 {
+    if obs.is_empty() {
+        return 0.0;
+    }
+    let (i0, im, i1) = (0, (obs.len() - 1) / 2, obs.len() - 1);
+    let chord = |a: usize, b: usize| {
+        let s = slack_m[a] + slack_m[b];
+        if s <= 0.0 {
+            return 0.0;
+        }
+        let (pa, pb) = (obs[a].odom_pose.0, obs[b].odom_pose.0);
+        s.atan2((pb.x - pa.x).hypot(pb.y - pa.y))
+    };
+    (chord(i0, im) + chord(im, i1)).to_degrees()
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Run {
     class: u8,
@@ -114,6 +137,8 @@ pub struct WordLevels {
     psi: Vec<f64>,
     /// Lateral moment of each observation ([`DensityObservation::lateral_moment`]).
     lateral_moments: Vec<f64>,
+    /// [`DensityObservation::position_slack_m`] of each observation.
+    position_slack_m: Vec<f64>,
     /// Index of the first observation of each run.
     run_starts: Vec<usize>,
     obs_class: Vec<u8>,
@@ -150,6 +175,7 @@ impl WordLevels {
             observations: Vec::new(),
             psi: Vec::new(),
             lateral_moments: Vec::new(),
+            position_slack_m: Vec::new(),
             run_starts: vec![0],
             obs_class: Vec::new(),
             words: Vec::new(),
@@ -175,6 +201,7 @@ impl WordLevels {
         self.observations.push(obs.observation);
         self.psi.push(obs.psi);
         self.lateral_moments.push(obs.lateral_moment);
+        self.position_slack_m.push(obs.position_slack_m);
         self.obs_class.push(q);
         let Some(mut open) = self.open else {
             self.open = Some(Run {
@@ -279,6 +306,7 @@ impl WordLevels {
             class,
             size: len,
             angle_deg: word_angle_deg(obs),
+            angle_slack_deg: word_angle_slack_deg(obs, &self.position_slack_m[start..start + len]),
             first_obs: start,
             run: self.run,
             l0_first: l0.0,
@@ -456,5 +484,39 @@ impl WordLevels {
     pub fn level0(&self, i: usize) -> Option<&Word> {
         let id = *self.by_level[0].get(i)?;
         Some(&self.words[id as usize])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{OdomPose, Pose2};
+
+    fn along(points: &[(f64, f64)]) -> Vec<Observation> {
+        (points.iter().enumerate())
+            .map(|(i, &(x, y))| {
+                Observation::new(i, 0, i, OdomPose(Pose2::new(x, y, 0.0)), i as f64)
+            })
+            .collect()
+    }
+
+    /// A word's angle slack is 0 when no position was interpolated, and grows with the slack
+    /// of its first, median and last positions against its chords' lengths.
+    #[test]
+    fn angle_slack_is_zero_at_scan_poses_and_grows_with_interpolation() {
+        let obs = along(&[(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (2.0, 1.0), (2.0, 2.0)]);
+        assert_eq!(word_angle_slack_deg(&obs, &[0.0; 5]), 0.0);
+        let small = word_angle_slack_deg(&obs, &[0.0, 0.0, 0.1, 0.0, 0.0]);
+        let large = word_angle_slack_deg(&obs, &[0.0, 0.0, 0.4, 0.0, 0.0]);
+        // The median (2, 0) is 2 m from the first and from the last position: its 0.1 m moves
+        // each chord by atan(0.1 / 2).
+        let chord = 2.0;
+        assert!(
+            (small - 2.0 * (0.1f64).atan2(chord).to_degrees()).abs() < 1e-9,
+            "{small}"
+        );
+        assert!(large > small);
+        // Slack at a position the angle is not measured from does not count.
+        assert_eq!(word_angle_slack_deg(&obs, &[0.0, 0.3, 0.0, 0.3, 0.0]), 0.0);
     }
 }

@@ -1433,6 +1433,25 @@ fn intel_log_matches_driven_the_other_way() {
     assert!(scores.precision >= 0.95, "precision {}", scores.precision);
 }
 
+/// Intel every 3rd scan (1.6 m between scans) keeps same-direction pairs: a word's angle
+/// syllable there is measured from positions interpolated across turning steps, and
+/// `angle_slack` widens the tolerance by what that interpolation may move it; without it the
+/// words' turn angles differ between visits and no same-direction chain reaches τ.
+#[test]
+fn intel_every_third_scan_keeps_same_direction_pairs() {
+    let Some(scores) = real_log_scores("intel", 3) else {
+        return;
+    };
+    let same = &scores.directions.same;
+    assert!(same.pairs > 0, "no same-direction pair");
+    assert!(same.precision >= 0.95, "same precision {}", same.precision);
+    assert!(same.recall >= 0.15, "same recall {}", same.recall);
+    let mut cfg = RecognizerConfig::default();
+    cfg.matcher.angle_slack = false;
+    let without = real_log_scores_with("intel", 3, 1, &cfg).unwrap();
+    assert_eq!(without.directions.same.pairs, 0, "pairs without the slack");
+}
+
 /// Observations interpolated along long steps (scans 1.5 and 2.9 m apart) have about the Ψ that
 /// dense scans give at the same places: their kernels never read the far side of the grid's
 /// torus.
@@ -1538,6 +1557,7 @@ fn decreasing_travel_is_refused() {
         observation: Observation::new(0, 0, 0, OdomPose(Pose2::IDENTITY), 5.0),
         psi: 0.5,
         lateral_moment: 0.0,
+        position_slack_m: 0.0,
     };
     m.push_observation(&o);
     o.id = 1;

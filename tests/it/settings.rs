@@ -33,6 +33,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ("words.min_word_size", "3", "", Input::Dense),
     ("matcher.size_tolerance_ratio", "0.6", "", Input::Dense),
     ("matcher.angle_tolerance_deg", "90", "", Input::Dense),
+    (
+        "matcher.angle_slack",
+        "false",
+        "matcher.angle_tolerance_deg = 4",
+        Input::Sparse,
+    ),
     ("matcher.min_ngram", "[2, 3, 4, 5]", "", Input::Dense),
     (
         "alignment.max_alignment_offset",

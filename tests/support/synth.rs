@@ -93,6 +93,7 @@ pub fn observations(
                 observation: Observation::new(id, run, input, OdomPose(pose), travel),
                 psi: s.psi,
                 lateral_moment: 0.0,
+                position_slack_m: 0.0,
             });
             id += 1;
             input += 1;
