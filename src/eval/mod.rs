@@ -587,7 +587,10 @@ impl Recording {
     /// later match of the recognizer names one, `PlaceRecognizer::query_horizon`).
     pub fn forget_behind(&mut self, horizon: usize) {
         if let Some((_, tally)) = &mut self.tally {
+            // Forgetting counts the visit recall of what it forgets: scoring, timed as such.
+            let w = Stopwatch::start();
             tally.evict_below(horizon);
+            self.score_seconds += w.cpu_s();
         }
     }
 
