@@ -24,42 +24,46 @@ use super::density::{CellState, DensityKernel, FreeCells, RayDeltas, Visited, ce
 use crate::geom::{OdomPose, Pose2};
 use crate::scan::Scan;
 
-const fn free_next() -> [u8; 16] {
-    let mut t = [0u8; 16];
-    let mut v = 0;
-    while v < 16 {
-        t[v] = if v == 0 {
+/// 256 entries, so that a cell's byte indexes it unmasked (cells hold 0..=15; a larger byte
+/// reads its low four bits' entry).
+const fn free_next() -> [u8; 256] {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        let v = i & 15;
+        t[i] = if v == 0 {
             4
         } else if v > 1 {
             v as u8 - 1
         } else {
             1
         };
-        v += 1;
+        i += 1;
     }
     t
 }
 
-const fn hit_next() -> [u8; 16] {
-    let mut t = [0u8; 16];
-    let mut v = 0;
-    while v < 16 {
-        t[v] = if v == 0 {
+const fn hit_next() -> [u8; 256] {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        let v = i & 15;
+        t[i] = if v == 0 {
             11
         } else if v + 3 > 15 {
             15
         } else {
             v as u8 + 3
         };
-        v += 1;
+        i += 1;
     }
     t
 }
 
 /// Counter after a beam passes the cell.
-const FREE_NEXT: [u8; 16] = free_next();
+const FREE_NEXT: [u8; 256] = free_next();
 /// Counter after a beam ends in the cell.
-const HIT_NEXT: [u8; 16] = hit_next();
+const HIT_NEXT: [u8; 256] = hit_next();
 
 /// floor(v) as i32 without a libm call (v well inside the i32 range).
 #[inline(always)]
@@ -290,11 +294,12 @@ impl LocalGrid {
     #[inline]
     fn mark(&mut self, x: i32, y: i32, hit: bool) {
         let i = self.index(x, y);
-        let v = (self.cells[i] & 15) as usize;
+        let v = self.cells[i] as usize;
         self.cells[i] = if hit { HIT_NEXT[v] } else { FREE_NEXT[v] };
     }
 
-    /// Marks the cells from (x0, y0) to (x1, y1) free, the last one occupied when `hit`.
+    /// Marks the cells from (x0, y0) to (x1, y1) free, the last one occupied when `hit`: n steps
+    /// (n the longer axis's cell count) of a 16.16 fixed-point DDA from the cell's centre.
     #[inline]
     fn trace(&mut self, x0: i32, y0: i32, x1: i32, y1: i32, hit: bool) {
         let (dx, dy) = ((x1 - x0) as i64, (y1 - y0) as i64);
@@ -305,19 +310,47 @@ impl LocalGrid {
                 None => 65536.0 / n as f64,
             };
             let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
-            let mut xf = ((x0 as i64) << 16) + 0x8000;
-            let mut yf = ((y0 as i64) << 16) + 0x8000;
-            let (shift, mask) = (self.shift, self.mask);
-            // Exactly side² cells: indices masked by side² − 1 need no bounds check.
-            let cells = &mut self.cells[..=mask];
-            for _ in 0..n {
-                let i = (((yf >> 16) << shift) + (xf >> 16)) as usize & mask;
-                cells[i] = FREE_NEXT[(cells[i] & 15) as usize];
-                xf += ix;
-                yf += iy;
+            let start = self.index(x0, y0);
+            // The longer axis's increment is ±65536 or, rounded down, ±65535: either way its
+            // coordinate moves exactly one cell per step for fewer than 2¹⁵ steps, and only the
+            // other axis's carry varies. Anything else takes the plain DDA.
+            let (major, minor, minor_inc, major_inc) = if dx.abs() >= dy.abs() {
+                (dx.signum(), 1i64 << self.shift, iy, ix)
+            } else {
+                (dy.signum() << self.shift, 1, ix, iy)
+            };
+            if major_inc.abs() >= 0xFFFF && n < 0x8000 {
+                let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
+                let fraction = (minor_inc & 0xFFFF) as u16;
+                trace_steps(
+                    &mut self.cells,
+                    self.mask,
+                    start,
+                    n,
+                    step,
+                    minor as usize,
+                    fraction,
+                );
+            } else {
+                self.trace_dda(x0, y0, n, ix, iy);
             }
         }
         self.mark(x1, y1, hit);
+    }
+
+    /// The plain DDA: `n` cells from (x0, y0), both coordinates in 16.16 fixed point.
+    fn trace_dda(&mut self, x0: i32, y0: i32, n: i64, ix: i64, iy: i64) {
+        let mut xf = ((x0 as i64) << 16) + 0x8000;
+        let mut yf = ((y0 as i64) << 16) + 0x8000;
+        let (shift, mask) = (self.shift, self.mask);
+        // Exactly side² cells: indices masked by side² − 1 need no bounds check.
+        let cells = &mut self.cells[..=mask];
+        for _ in 0..n {
+            let i = (((yf >> 16) << shift) + (xf >> 16)) as usize & mask;
+            cells[i] = FREE_NEXT[cells[i] as usize];
+            xf += ix;
+            yf += iy;
+        }
     }
 
     /// Free cells the kernel reaches from global cell (cx, cy), with the first moment of the
@@ -373,6 +406,32 @@ impl LocalGrid {
     }
 }
 
+/// `n` free passes along a DDA from torus index `start`: each step moves `step` (the longer
+/// axis's cell, plus the shorter axis's whole cells per step) and `minor` more when the shorter
+/// axis's 16-bit fraction (from the cell's centre, growing by `fraction`) carries over. The
+/// same cells as the 16.16 DDA with one index update per cell instead of two coordinates.
+#[inline(always)]
+fn trace_steps(
+    cells: &mut [u8],
+    mask: usize,
+    start: usize,
+    n: i64,
+    step: usize,
+    minor: usize,
+    fraction: u16,
+) {
+    // Exactly side² cells: indices masked by side² − 1 need no bounds check.
+    let cells = &mut cells[..=mask];
+    let (mut i, mut frac) = (start, 0x8000u16);
+    let step_carry = step.wrapping_add(minor);
+    for _ in 0..n {
+        cells[i] = FREE_NEXT[cells[i] as usize];
+        let (f, carry) = frac.overflowing_add(fraction);
+        frac = f;
+        i = i.wrapping_add(if carry { step_carry } else { step }) & mask;
+    }
+}
+
 /// Ψ at a cell and the first moment of the space the kernel's rays reach from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Density {
@@ -381,4 +440,46 @@ pub struct Density {
     /// Sum of the offsets from the cell (odometry frame axes) of the prefix-tree nodes the
     /// kernel's rays reach (see `FreeCells`), in kernel radii, divided by the tree's node count.
     pub moment: (f64, f64),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recognizer::density::CELL_OCCUPIED_FROM;
+
+    /// The one-index trace updates exactly the cells of the plain 16.16 DDA, in the same order
+    /// (a counter passed twice by one beam moves twice), across the torus's edges too.
+    #[test]
+    fn trace_steps_equal_the_plain_dda() {
+        let mut seed = 7u64;
+        let mut next = |m: i32| {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 33) % m as u64) as i32
+        };
+        let mut fast = LocalGrid::with_memory(0.05, 3.0, 6.4, 7.5);
+        let mut plain = fast.clone();
+        for _ in 0..20_000 {
+            let (x0, y0) = (next(1200) - 600, next(1200) - 600);
+            let (x1, y1) = (x0 + next(161) - 80, y0 + next(161) - 80);
+            let hit = next(2) == 0;
+            fast.trace(x0, y0, x1, y1, hit);
+            let (dx, dy) = ((x1 - x0) as i64, (y1 - y0) as i64);
+            let n = dx.abs().max(dy.abs());
+            if n > 0 {
+                let inv = 65536.0 / n as f64;
+                plain.trace_dda(
+                    x0,
+                    y0,
+                    n,
+                    (dx as f64 * inv) as i64,
+                    (dy as f64 * inv) as i64,
+                );
+            }
+            plain.mark(x1, y1, hit);
+        }
+        assert!(fast.cells.iter().any(|&v| v >= CELL_OCCUPIED_FROM));
+        assert_eq!(fast.cells, plain.cells);
+    }
 }
