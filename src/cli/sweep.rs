@@ -42,6 +42,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
     let work = placewords::experiment::Workload {
         laps: args.laps,
         passes: experiment::sweep_passes(&grid),
+        scan_context: false,
     };
     let scn = placewords::experiment::load_scenario_for(&args.scenario, &work)?;
     let opts = ExperimentOptions {

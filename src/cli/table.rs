@@ -57,10 +57,12 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         progress: super::progress::bar(args.quiet),
         cache: args.cache.open()?,
     };
-    // One back-end pass per level configuration (the baselines' work is not counted).
+    // One back-end pass per level configuration, and Scan Context's descriptors (ICP's work is
+    // not counted).
     let work = placewords::experiment::Workload {
         laps: args.laps,
         passes: opts.levels.len(),
+        scan_context: opts.scan_context,
     };
     // Load every scenario first, so a broken file is reported before minutes of simulation.
     let scenarios = args

@@ -108,6 +108,9 @@ pub struct Workload {
     /// Back-end passes over the observations: one per level configuration run (`check`,
     /// `run`, `table`), one per grid point and score curve (`sweep`). Default 1.
     pub passes: usize,
+    /// Whether the Scan Context baseline runs (it holds a descriptor per observation of its
+    /// own). Default false.
+    pub scan_context: bool,
 }
 
 impl Default for Workload {
@@ -115,6 +118,7 @@ impl Default for Workload {
         Workload {
             laps: None,
             passes: 1,
+            scan_context: false,
         }
     }
 }
@@ -187,6 +191,7 @@ pub fn parse_scenario_for(
             &mut d,
             &mut world_problems,
         )?;
+        let work = (work, scan_context.observation_spacing_m);
         let sim = plan(&spec, world, models, (path, world_path), work, &mut d)?;
         Some((spec, sim, scan_context, subjects))
     });
@@ -599,7 +604,7 @@ fn plan(
     world: World,
     models: Models,
     (path, world_path): (&Path, PathBuf),
-    work: &Workload,
+    work: (&Workload, f64),
     d: &mut Diags,
 ) -> Option<(SimPlan, RecognizerConfig)> {
     let route = route(spec, &world, d);
@@ -633,7 +638,10 @@ fn plan(
         robot: models.robot,
         world,
     };
-    work_budget(spec, &sim, &models.recognizer, work, d);
+    work_budget(spec, &sim, &models.recognizer, work.0, d);
+    if work.0.scan_context {
+        scan_context_budget(spec, &sim, work, d);
+    }
     Some((sim, models.recognizer))
 }
 
@@ -715,6 +723,53 @@ fn work_budget(
         let per_lap = observations / laps.max(1) as f64;
         candidate_budget(spec, &what, per_lap, rec, work, laps_at, d);
     }
+}
+
+/// Most observations the Scan Context baseline may make in one command: each keeps its
+/// descriptor (about 4 kB with its ring key and matches; 395 MB over 96,000 observations of
+/// `table`) for the rest of the run, and its candidate search grows faster than the laps.
+pub const MAX_SCAN_CONTEXT_OBSERVATIONS: f64 = 2.5e5;
+
+/// The Scan Context part of the budget, for a command that runs it: its observations (travel
+/// over `[scan_context] observation_spacing_m`, the spacing given with `work`) at most
+/// [`MAX_SCAN_CONTEXT_OBSERVATIONS`], refused at that key (or the first run's laps).
+fn scan_context_budget(
+    spec: &ScenarioSpec,
+    sim: &SimPlan,
+    (work, spacing_m): (&Workload, f64),
+    d: &mut Diags,
+) {
+    if d.has_errors() || spacing_m.is_nan() || spacing_m <= 0.0 {
+        return;
+    }
+    let what = Drive {
+        laps: sim
+            .runs
+            .iter()
+            .map(|run| work.laps.unwrap_or(run.laps))
+            .sum(),
+        lap_m: sim.route.length_m(),
+        flag: work.laps,
+    };
+    let observations = what.travel_m() / spacing_m;
+    if observations <= MAX_SCAN_CONTEXT_OBSERVATIONS {
+        return;
+    }
+    let laps_at = spec.runs.first().map_or(0, |run| run.laps.span().start);
+    let at = (spec.scan_context.get("observation_spacing_m")).map_or(laps_at, |s| s.span().start);
+    let fits = what.travel_m() / MAX_SCAN_CONTEXT_OBSERVATIONS;
+    d.at(
+        at,
+        format!(
+            "{what} at [scan_context] observation_spacing_m = {} make about {observations:.1e} \
+             Scan Context observations, more than {} (each holds its descriptor); use \
+             observation_spacing_m = {} or more in [scan_context], leave the baseline out \
+             (--no-scan-context), or drive fewer laps",
+            fmt_number(spacing_m),
+            fmt_number(MAX_SCAN_CONTEXT_OBSERVATIONS),
+            fmt_number((fits * 1000.0).ceil() / 1000.0)
+        ),
+    );
 }
 
 /// The laps a command drives, for the budget's messages.

@@ -104,19 +104,22 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
 }
 
 /// Loads the scenario at `path` for the work `opts` implies: its laps (`--laps`) and one
-/// back-end pass per level configuration it runs (known once the file is read, so a file
-/// running several is read again with them counted).
+/// back-end pass per level configuration it runs, and Scan Context's observations when it runs
+/// (known once the file is read, so a file running more is read again with them counted).
 fn load_planned(path: &Path, opts: &StressOptions) -> Result<Scenario, String> {
     let mut work = Workload {
         laps: opts.experiment.laps,
-        passes: 1,
+        ..Workload::default()
     };
     let scn = load_scenario_for(path, &work).map_err(|e| e.to_string())?;
-    let passes = options_for(&scn, opts).map_or(1, |o| o.levels.len());
-    if passes <= 1 {
+    let Some(o) = options_for(&scn, opts) else {
+        return Ok(scn);
+    };
+    if o.levels.len() <= 1 && !o.scan_context {
         return Ok(scn);
     }
-    work.passes = passes;
+    work.passes = o.levels.len().max(1);
+    work.scan_context = o.scan_context;
     load_scenario_for(path, &work).map_err(|e| e.to_string())
 }
 

@@ -36,6 +36,7 @@ fn a_sweep_of_a_thousand_laps_names_the_largest_candidate_bound_that_fits() {
     let work = Workload {
         laps: Some(1000),
         passes: sweep_passes(&fig8_grid()),
+        ..Workload::default()
     };
     let message = refusal(&smoke_with(""), &work).expect("every candidate at 1000 laps is over");
     assert!(message.contains("--laps 1000"), "{message}");
@@ -67,6 +68,7 @@ fn the_file_alone_is_within_the_budget_that_its_laps_flag_exceeds() {
     let sweep = |laps| Workload {
         laps,
         passes: sweep_passes(&fig8_grid()),
+        ..Workload::default()
     };
     assert_eq!(refusal(&src, &sweep(None)), None);
     assert_eq!(refusal(&src, &sweep(Some(20))), None);
@@ -74,9 +76,33 @@ fn the_file_alone_is_within_the_budget_that_its_laps_flag_exceeds() {
     // One pass (`scenario check`, `run --levels 1`) of the same laps is less work.
     let one = Workload {
         laps: Some(400),
-        passes: 1,
+        ..Workload::default()
     };
     assert_eq!(refusal(&src, &one), None);
+}
+
+#[test]
+fn scan_context_observations_are_counted_only_when_it_runs() {
+    let src = smoke_with("[recognizer.matcher]\nmax_candidates = 8\n");
+    let table = |scan_context| Workload {
+        laps: Some(600),
+        passes: 3,
+        scan_context,
+    };
+    assert_eq!(refusal(&src, &table(false)), None);
+    let message = refusal(&src, &table(true)).expect("600 laps a run of Scan Context is over");
+    assert!(message.contains("Scan Context observations"), "{message}");
+    assert!(message.contains("--no-scan-context"), "{message}");
+    let (_, after) = message.split_once("use observation_spacing_m = ").unwrap();
+    let fits: f64 = after.split_whitespace().next().unwrap().parse().unwrap();
+    let wider = smoke_with(&format!(
+        "[recognizer.matcher]\nmax_candidates = 8\n\n[scan_context]\nobservation_spacing_m = {fits}\n"
+    ));
+    assert_eq!(
+        refusal(&wider, &table(true)),
+        None,
+        "the named spacing fits"
+    );
 }
 
 #[test]
