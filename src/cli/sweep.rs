@@ -38,14 +38,20 @@ pub fn run(args: SweepArgs) -> anyhow::Result<ExitCode> {
             matches!(n, "sweep.json" | "pr-curves.svg" | "score-pr.svg")
         })
     })?;
-    let scn = placewords::experiment::load_scenario(&args.scenario)?;
+    let grid = fig8_grid();
+    let work = placewords::experiment::Workload {
+        laps: args.laps,
+        passes: experiment::sweep_passes(&grid),
+        scan_context: false,
+    };
+    let scn = placewords::experiment::load_scenario_for(&args.scenario, &work)?;
     let opts = ExperimentOptions {
         laps: args.laps,
         progress: super::progress::bar(args.quiet),
         cache: args.cache.open()?,
         ..ExperimentOptions::default()
     };
-    let (results, laps, score_curves) = experiment::sweep(&scn, &opts, &fig8_grid())?;
+    let (results, laps, score_curves) = experiment::sweep(&scn, &opts, &grid)?;
     super::common::report_cache(opts.cache.as_deref());
     let report = SweepReport::new(
         &scn.sim.name,

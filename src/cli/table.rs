@@ -57,11 +57,18 @@ pub fn run(args: TableArgs) -> anyhow::Result<ExitCode> {
         progress: super::progress::bar(args.quiet),
         cache: args.cache.open()?,
     };
+    // One back-end pass per level configuration, and Scan Context's descriptors (ICP's work is
+    // not counted).
+    let work = placewords::experiment::Workload {
+        laps: args.laps,
+        passes: opts.levels.len(),
+        scan_context: opts.scan_context,
+    };
     // Load every scenario first, so a broken file is reported before minutes of simulation.
     let scenarios = args
         .scenarios
         .iter()
-        .map(|p| placewords::experiment::load_scenario(p))
+        .map(|p| placewords::experiment::load_scenario_for(p, &work))
         .collect::<Result<Vec<_>, _>>()?;
     let mut reports = Vec::new();
     let command_line = super::common::command_line();

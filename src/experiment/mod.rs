@@ -32,7 +32,10 @@ use crate::spec::evaluation::EvaluationSpec;
 pub use progress::{Progress, ProgressSink};
 use rayon::prelude::*;
 pub use recognizer_settings::{load_recognizer_config, parse_recognizer_config};
-pub use scenario::{Scenario, check_scenario, load_scenario, parse_scenario};
+pub use scenario::{
+    Scenario, Workload, check_scenario, load_scenario, load_scenario_for, parse_scenario,
+    parse_scenario_for,
+};
 pub use stream::run_scenario_streamed;
 
 /// Why an experiment could not be carried out.
@@ -432,6 +435,12 @@ pub fn back_end_stream(
     let found = back.finish_run();
     hand(found, back.query_horizon());
     Ok(())
+}
+
+/// The back-end passes [`sweep`] makes over `grid`, for the work budget: one per grid point,
+/// and at most one per level for the words subjects' score curves.
+pub fn sweep_passes(grid: &[GridPoint]) -> usize {
+    grid.len() + crate::recognizer::words::MAX_LEVELS
 }
 
 /// The paper's Fig. 8 sweep of `scn` (laps per run replaced by `opts.laps`): the laps are

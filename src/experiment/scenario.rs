@@ -99,10 +99,40 @@ pub struct Scenario {
 /// Loads a world file checked for a robot (tests pass a closure that parses a string).
 pub type WorldLoader<'a> = &'a dyn Fn(&Path, &WorldCheck) -> Result<World, SpecError>;
 
+/// What a command will do with a scenario, for its work budget (`work_budget`): the lap count
+/// that replaces every run's, and how many back-end passes read the observations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Workload {
+    /// `--laps`: laps per run, replacing the file's. Default `None` (the file's).
+    pub laps: Option<usize>,
+    /// Back-end passes over the observations: one per level configuration run (`check`,
+    /// `run`, `table`), one per grid point and score curve (`sweep`). Default 1.
+    pub passes: usize,
+    /// Whether the Scan Context baseline runs (it holds a descriptor per observation of its
+    /// own). Default false.
+    pub scan_context: bool,
+}
+
+impl Default for Workload {
+    fn default() -> Self {
+        Workload {
+            laps: None,
+            passes: 1,
+            scan_context: false,
+        }
+    }
+}
+
 /// Reads and checks a scenario file and the world it names.
 pub fn load_scenario(path: &Path) -> Result<Scenario, SpecError> {
+    load_scenario_for(path, &Workload::default())
+}
+
+/// [`load_scenario`] for a command that does `work` with it: the work budget counts its laps
+/// and passes, and refuses the file (at the key that sets the work) beyond its limits.
+pub fn load_scenario_for(path: &Path, work: &Workload) -> Result<Scenario, SpecError> {
     let src = read_text(path)?;
-    parse_scenario(&src, path, &crate::world::load_world_for)
+    parse_scenario_for(&src, path, &crate::world::load_world_for, work)
 }
 
 /// `scenario check` of a file: [`load_scenario`], then a test drive of its route as its runs
@@ -132,6 +162,16 @@ pub fn parse_scenario(
     path: &Path,
     load_world: WorldLoader,
 ) -> Result<Scenario, SpecError> {
+    parse_scenario_for(src, path, load_world, &Workload::default())
+}
+
+/// [`parse_scenario`] for a command that does `work` with it ([`load_scenario_for`]).
+pub fn parse_scenario_for(
+    src: &str,
+    path: &Path,
+    load_world: WorldLoader,
+    work: &Workload,
+) -> Result<Scenario, SpecError> {
     let file = path.display().to_string();
     let mut d = Diags::new(src, &file);
     let mut world_problems = Vec::new();
@@ -151,7 +191,8 @@ pub fn parse_scenario(
             &mut d,
             &mut world_problems,
         )?;
-        let sim = plan(&spec, world, models, path, world_path, &mut d)?;
+        let work = (work, scan_context.observation_spacing_m);
+        let sim = plan(&spec, world, models, (path, world_path), work, &mut d)?;
         Some((spec, sim, scan_context, subjects))
     });
     let mut diags = d.into_sorted();
@@ -562,8 +603,8 @@ fn plan(
     spec: &ScenarioSpec,
     world: World,
     models: Models,
-    path: &Path,
-    world_path: PathBuf,
+    (path, world_path): (&Path, PathBuf),
+    work: (&Workload, f64),
     d: &mut Diags,
 ) -> Option<(SimPlan, RecognizerConfig)> {
     let route = route(spec, &world, d);
@@ -597,7 +638,10 @@ fn plan(
         robot: models.robot,
         world,
     };
-    work_budget(spec, &sim, &models.recognizer, d);
+    work_budget(spec, &sim, &models.recognizer, work.0, d);
+    if work.0.scan_context {
+        scan_context_budget(spec, &sim, work, d);
+    }
     Some((sim, models.recognizer))
 }
 
@@ -605,20 +649,159 @@ fn plan(
 pub const MAX_SIM_STEPS: f64 = 5e7;
 /// Most observations one scenario may make (each holds a local-grid summary until evaluated).
 pub const MAX_OBSERVATIONS: f64 = 1e7;
+/// Most candidate pairs one command may weigh, over all its back-end passes (about ten
+/// minutes of CPU; see [`candidate_pairs`]).
+pub const MAX_CANDIDATE_PAIRS: f64 = 1.5e9;
 
-/// The work the validated numbers imply, estimated before any run: simulation steps (travel
-/// at the slowest cruise speed a lap may draw, plus its stops, over `step_s`) and observations
-/// (travel over `observation_spacing_m`). `--laps` on the command line is not counted here. Beyond [`MAX_SIM_STEPS`] or [`MAX_OBSERVATIONS`] the
-/// file is refused at the key that sets the work, with a value that fits.
-fn work_budget(spec: &ScenarioSpec, sim: &SimPlan, rec: &RecognizerConfig, d: &mut Diags) {
+/// Candidate pairs of one back-end pass over `laps` laps (all runs drive one route) of
+/// `per_lap` observations each: every observation of lap i is weighed against its place in the
+/// min(i, k) most recent earlier laps, every earlier one when k = 0 (`[recognizer.matcher]
+/// max_candidates`). With k = 0 this grows with the laps squared, with k > 0 linearly: the
+/// back end's memo, chains and matches, and the evaluation's pairs, grow the same way.
+pub fn candidate_pairs(per_lap: f64, laps: usize, k: usize) -> f64 {
+    let l = laps as f64;
+    let earlier = if k == 0 || k >= laps {
+        l * (l - 1.0) / 2.0
+    } else {
+        let k = k as f64;
+        k * (k - 1.0) / 2.0 + (l - k) * k
+    };
+    per_lap * earlier
+}
+
+/// The work the validated numbers imply, estimated before any run, for `work` (laps replaced
+/// by `--laps`, the command's back-end passes): simulation steps (travel at the slowest
+/// cruise speed a lap may draw, plus its stops, over `step_s`), observations (travel over
+/// `observation_spacing_m`) and candidate pairs ([`candidate_pairs`]). Beyond
+/// [`MAX_SIM_STEPS`], [`MAX_OBSERVATIONS`] or [`MAX_CANDIDATE_PAIRS`] the file is refused at
+/// the key that sets the work, with a value that fits.
+fn work_budget(
+    spec: &ScenarioSpec,
+    sim: &SimPlan,
+    rec: &RecognizerConfig,
+    work: &Workload,
+    d: &mut Diags,
+) {
     if d.has_errors() {
         // An estimate from numbers already refused would only repeat them.
         return;
     }
+    let laps: usize = sim
+        .runs
+        .iter()
+        .map(|run| work.laps.unwrap_or(run.laps))
+        .sum();
+    let laps_at = spec.runs.first().map_or(0, |run| run.laps.span().start);
+    let what = Drive {
+        laps,
+        lap_m: sim.route.length_m(),
+        flag: work.laps,
+    };
+    step_budget(spec, sim, &what, laps_at, d);
+    let observations = what.travel_m() / rec.front_end.observation_spacing_m;
+    if observations > MAX_OBSERVATIONS {
+        let key = spec
+            .recognizer
+            .iter()
+            .find(|e| e.is("front_end", "observation_spacing_m"));
+        let at = key.map_or(laps_at, |e| e.key.span().start);
+        let fits = what.travel_m() / MAX_OBSERVATIONS;
+        d.at(
+            at,
+            format!(
+                "{what} at observation_spacing_m = {} make about {observations:.1e} \
+                 observations, more than {} held in memory; use observation_spacing_m = {} or \
+                 more, or fewer laps",
+                fmt_number(rec.front_end.observation_spacing_m),
+                fmt_number(MAX_OBSERVATIONS),
+                fmt_number((fits * 1000.0).ceil() / 1000.0)
+            ),
+        );
+    }
+    if !d.has_errors() {
+        // Counted from the observations: only once they fit is the count worth a message.
+        let per_lap = observations / laps.max(1) as f64;
+        candidate_budget(spec, &what, per_lap, rec, work, laps_at, d);
+    }
+}
+
+/// Most observations the Scan Context baseline may make in one command: each keeps its
+/// descriptor (about 4 kB with its ring key and matches; 395 MB over 96,000 observations of
+/// `table`) for the rest of the run, and its candidate search grows faster than the laps.
+pub const MAX_SCAN_CONTEXT_OBSERVATIONS: f64 = 2.5e5;
+
+/// The Scan Context part of the budget, for a command that runs it: its observations (travel
+/// over `[scan_context] observation_spacing_m`, the spacing given with `work`) at most
+/// [`MAX_SCAN_CONTEXT_OBSERVATIONS`], refused at that key (or the first run's laps).
+fn scan_context_budget(
+    spec: &ScenarioSpec,
+    sim: &SimPlan,
+    (work, spacing_m): (&Workload, f64),
+    d: &mut Diags,
+) {
+    if d.has_errors() || spacing_m.is_nan() || spacing_m <= 0.0 {
+        return;
+    }
+    let what = Drive {
+        laps: sim
+            .runs
+            .iter()
+            .map(|run| work.laps.unwrap_or(run.laps))
+            .sum(),
+        lap_m: sim.route.length_m(),
+        flag: work.laps,
+    };
+    let observations = what.travel_m() / spacing_m;
+    if observations <= MAX_SCAN_CONTEXT_OBSERVATIONS {
+        return;
+    }
+    let laps_at = spec.runs.first().map_or(0, |run| run.laps.span().start);
+    let at = (spec.scan_context.get("observation_spacing_m")).map_or(laps_at, |s| s.span().start);
+    let fits = what.travel_m() / MAX_SCAN_CONTEXT_OBSERVATIONS;
+    d.at(
+        at,
+        format!(
+            "{what} at [scan_context] observation_spacing_m = {} make about {observations:.1e} \
+             Scan Context observations, more than {} (each holds its descriptor); use \
+             observation_spacing_m = {} or more in [scan_context], leave the baseline out \
+             (--no-scan-context), or drive fewer laps",
+            fmt_number(spacing_m),
+            fmt_number(MAX_SCAN_CONTEXT_OBSERVATIONS),
+            fmt_number((fits * 1000.0).ceil() / 1000.0)
+        ),
+    );
+}
+
+/// The laps a command drives, for the budget's messages.
+struct Drive {
+    laps: usize,
+    lap_m: f64,
+    /// `--laps`, when it replaced the file's.
+    flag: Option<usize>,
+}
+
+impl Drive {
+    fn travel_m(&self) -> f64 {
+        self.laps as f64 * self.lap_m
+    }
+}
+
+impl std::fmt::Display for Drive {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let s = if self.laps == 1 { "" } else { "s" };
+        write!(f, "{} lap{s} of {:.0} m", self.laps, self.lap_m)?;
+        match self.flag {
+            Some(n) => write!(f, " (--laps {n} per run)"),
+            None => Ok(()),
+        }
+    }
+}
+
+/// The simulation steps of [`work_budget`].
+fn step_budget(spec: &ScenarioSpec, sim: &SimPlan, what: &Drive, laps_at: usize, d: &mut Diags) {
     let r = &sim.robot;
     let v = &r.variation;
-    let laps: usize = sim.runs.iter().map(|run| run.laps).sum();
-    let travel_m = laps as f64 * sim.route.length_m();
+    let travel_m = what.travel_m();
     // The slowest lap's cruise speed; the speed wave averages out along a lap.
     let slowest_m_s = r.cruise_speed_m_s * (1.0 - v.lap_speed_spread_ratio);
     let stops_s = if v.stop_spacing_m > 0.0 {
@@ -628,45 +811,86 @@ fn work_budget(spec: &ScenarioSpec, sim: &SimPlan, rec: &RecognizerConfig, d: &m
     };
     let seconds = travel_m / slowest_m_s.max(1e-9) + stops_s;
     let steps = seconds / r.step_s;
-    let laps_at = spec.runs.first().map_or(0, |run| run.laps.span().start);
     if steps > MAX_SIM_STEPS {
         let at = spec.robot.get("step_s").map_or(laps_at, |s| s.span().start);
         let fits = seconds / MAX_SIM_STEPS;
         d.at(
             at,
             format!(
-                "{laps} lap{} of {:.0} m at step_s = {} take about {steps:.1e} simulation steps, \
-                 more than {} (about ten minutes); use step_s = {} or more, or fewer laps",
-                if laps == 1 { "" } else { "s" },
-                sim.route.length_m(),
+                "{what} at step_s = {} take about {steps:.1e} simulation steps, more than {} \
+                 (about ten minutes); use step_s = {} or more, or fewer laps",
                 fmt_number(r.step_s),
                 fmt_number(MAX_SIM_STEPS),
                 fmt_number((fits * 1000.0).ceil() / 1000.0)
             ),
         );
     }
-    let observations = travel_m / rec.front_end.observation_spacing_m;
-    if observations > MAX_OBSERVATIONS {
-        let key = spec
-            .recognizer
-            .iter()
-            .find(|e| e.is("front_end", "observation_spacing_m"));
-        let at = key.map_or(laps_at, |e| e.key.span().start);
-        let fits = travel_m / MAX_OBSERVATIONS;
-        d.at(
-            at,
-            format!(
-                "{laps} lap{} of {:.0} m at observation_spacing_m = {} make about \
-                 {observations:.1e} observations, more than {} held in memory; use \
-                 observation_spacing_m = {} or more, or fewer laps",
-                if laps == 1 { "" } else { "s" },
-                sim.route.length_m(),
-                fmt_number(rec.front_end.observation_spacing_m),
-                fmt_number(MAX_OBSERVATIONS),
-                fmt_number((fits * 1000.0).ceil() / 1000.0)
-            ),
-        );
+}
+
+/// The candidate pairs of [`work_budget`]: refused at `max_candidates` (or the first run's
+/// laps when the file does not set it) with the largest value that fits, or the laps that fit
+/// when even one candidate per word is too many.
+fn candidate_budget(
+    spec: &ScenarioSpec,
+    what: &Drive,
+    per_lap: f64,
+    rec: &RecognizerConfig,
+    work: &Workload,
+    laps_at: usize,
+    d: &mut Diags,
+) {
+    let k = rec.matcher.max_candidates;
+    let passes = work.passes.max(1) as f64;
+    let total = |laps: usize, k: usize| passes * candidate_pairs(per_lap, laps, k);
+    let pairs = total(what.laps, k);
+    if pairs <= MAX_CANDIDATE_PAIRS {
+        return;
     }
+    // The largest value in 1..=hi that fits, by bisection (the pairs grow with both).
+    let largest = |hi: usize, fits: &dyn Fn(usize) -> bool| {
+        let (mut lo, mut hi) = (0, hi);
+        while lo < hi {
+            let mid = lo + (hi - lo).div_ceil(2);
+            if fits(mid) { lo = mid } else { hi = mid - 1 }
+        }
+        lo
+    };
+    let k_fits = largest(what.laps, &|k| total(what.laps, k) <= MAX_CANDIDATE_PAIRS);
+    let laps_fit = largest(what.laps, &|l| total(l, k) <= MAX_CANDIDATE_PAIRS);
+    let key = spec
+        .recognizer
+        .iter()
+        .find(|e| e.is("matcher", "max_candidates"));
+    let at = key.map_or(laps_at, |e| e.key.span().start);
+    let against = match k {
+        0 => "every earlier lap".to_string(),
+        k => format!("its {k} most recent look-alikes"),
+    };
+    let runs = spec.runs.len().max(1);
+    let fewer = match what.flag {
+        Some(_) => format!(
+            "at most {laps_fit} laps in all (--laps {})",
+            laps_fit / runs
+        ),
+        None => format!("at most {laps_fit} laps in all"),
+    };
+    let fix = match k_fits {
+        0 => format!("drive {fewer}"),
+        k_fits => format!(
+            "set [recognizer.matcher] max_candidates = {k_fits} or less (it is {k}), or drive \
+             {fewer}"
+        ),
+    };
+    d.at(
+        at,
+        format!(
+            "{what}, each observation weighed against {against}, over {} back-end pass{}, make \
+             about {pairs:.1e} candidate pairs, more than {} (about ten minutes of work); {fix}",
+            work.passes.max(1),
+            if work.passes > 1 { "es" } else { "" },
+            fmt_number(MAX_CANDIDATE_PAIRS),
+        ),
+    );
 }
 
 fn route(spec: &ScenarioSpec, world: &World, d: &mut Diags) -> Option<Route> {

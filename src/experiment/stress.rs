@@ -10,7 +10,7 @@
 
 use crate::eval::provenance::{self, Provenance};
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
-use crate::experiment::scenario::{Scenario, load_scenario};
+use crate::experiment::scenario::{Scenario, Workload, load_scenario_for};
 use crate::experiment::{ExperimentOptions, ProgressSink};
 use crate::io::atomic::holds_only;
 use crate::spec::seeds::{SeedRange, Shard};
@@ -67,7 +67,7 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
         .iter()
         .map(|path| {
             let file = path.display().to_string();
-            let scenario = load_scenario(path).map_err(|e| e.to_string());
+            let scenario = load_planned(path, opts);
             let (seeds, options) = match &scenario {
                 Ok(scn) => (
                     opts.seeds
@@ -101,6 +101,26 @@ fn plan(paths: &[PathBuf], opts: &StressOptions) -> Vec<Planned> {
             }
         })
         .collect()
+}
+
+/// Loads the scenario at `path` for the work `opts` implies: its laps (`--laps`) and one
+/// back-end pass per level configuration it runs, and Scan Context's observations when it runs
+/// (known once the file is read, so a file running more is read again with them counted).
+fn load_planned(path: &Path, opts: &StressOptions) -> Result<Scenario, String> {
+    let mut work = Workload {
+        laps: opts.experiment.laps,
+        ..Workload::default()
+    };
+    let scn = load_scenario_for(path, &work).map_err(|e| e.to_string())?;
+    let Some(o) = options_for(&scn, opts) else {
+        return Ok(scn);
+    };
+    if o.levels.len() <= 1 && !o.scan_context {
+        return Ok(scn);
+    }
+    work.passes = o.levels.len().max(1);
+    work.scan_context = o.scan_context;
+    load_scenario_for(path, &work).map_err(|e| e.to_string())
 }
 
 /// The configurations to run for `scn`: the `[expect]` block's under `gate`, else the options'.

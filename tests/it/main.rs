@@ -5,6 +5,7 @@ mod authoring;
 mod bag;
 #[path = "../support/big_world.rs"]
 mod big_world;
+mod budget;
 mod cache;
 mod ci;
 mod cli;
