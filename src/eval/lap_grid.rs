@@ -90,7 +90,9 @@ impl Laps {
     pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
         self.words.iter().enumerate().flat_map(move |(i, &w)| {
             let base = (self.first + i) * 64;
-            (0..64).filter(move |b| w >> b & 1 == 1).map(move |b| base + b)
+            (0..64)
+                .filter(move |b| w >> b & 1 == 1)
+                .map(move |b| base + b)
         })
     }
 
@@ -283,8 +285,10 @@ impl<const N: usize> LapGrid<N> {
     /// one (skipped whole when every lap of the sub-cell is found).
     fn laps(&mut self, sites: &[Site], qs: &[Query; N], laps: &mut [Laps; N]) {
         let ((cx, cy), _) = self.cell_of(qs[0].site);
-        let cells: [Option<&Cell>; 9] =
-            std::array::from_fn(|i| self.cells.get(&(cx + i as i64 / 3 - 1, cy + i as i64 % 3 - 1)));
+        let cells: [Option<&Cell>; 9] = std::array::from_fn(|i| {
+            self.cells
+                .get(&(cx + i as i64 / 3 - 1, cy + i as i64 % 3 - 1))
+        });
         for sub in cells.iter().flatten().flat_map(|c| &c.subs) {
             for (q, laps) in qs.iter().zip(laps.iter_mut()) {
                 if sub.bounds.cover(q) == Cover::All {
@@ -473,7 +477,11 @@ mod tests {
         let facings = [Facing::Same, Facing::Opposite];
         let mut want = Vec::new();
         sweep_laps(&sites, 2.0, 1.0, facings, 0.7, |k, [s, o]| {
-            want.push((k, s.iter().collect::<Vec<_>>(), o.iter().collect::<Vec<_>>()));
+            want.push((
+                k,
+                s.iter().collect::<Vec<_>>(),
+                o.iter().collect::<Vec<_>>(),
+            ));
         });
         let mut got = Vec::new();
         let mut sweep = LapSweep::new(2.0, 1.0, facings, 0.7).expect("a positive radius");
@@ -482,7 +490,11 @@ mod tests {
             end = (end + 1 + end / 3).min(sites.len());
             // Each call sees only the sites made so far.
             sweep.advance(&sites[..end], end, |k, [s, o]| {
-                got.push((k, s.iter().collect::<Vec<_>>(), o.iter().collect::<Vec<_>>()));
+                got.push((
+                    k,
+                    s.iter().collect::<Vec<_>>(),
+                    o.iter().collect::<Vec<_>>(),
+                ));
             });
         }
         assert_eq!(got, want);
