@@ -231,6 +231,25 @@ mod tests {
         assert_eq!(pair_recall(&obs, &[opposite], &gt, Facing::Same), 0.0);
     }
 
+    /// The possible pairs counted over pairs of nodes equal those of a query per site, on
+    /// passes that go both ways, at radii from below the sites' spacing to many leaves wide.
+    #[test]
+    fn possible_pairs_over_node_pairs_equal_a_query_per_site() {
+        let sites = crate::eval::site_tree::tests::passes(3);
+        let facings = [Facing::Either, Facing::Same, Facing::Opposite];
+        for r in [0.05, 0.5, 1.0, 3.0] {
+            for gap in [0.0, 2.0, 30.0] {
+                for tol in [0.3, 0.7, 2.0] {
+                    let mut tree = SiteTree::new(&sites);
+                    let got = count_possible_facings(&mut tree, gap, r, facings, tol);
+                    let want = facings.map(|f| count_possible(&sites, gap, r, f, tol));
+                    assert_eq!(got, want, "r {r} gap {gap} tol {tol}");
+                    assert!(r < 0.5 || want.iter().all(|&n| n > 0), "r {r}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn true_travel_follows_the_true_path() {
         let (_, gt) = circle(2, 40.0);
