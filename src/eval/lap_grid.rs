@@ -6,20 +6,22 @@
 //! way. The answer is a set of laps, so once one site of a lap agrees, the rest of that lap need
 //! not be looked at. The k-d tree of [`super::site_tree`] finds the sites, not the laps, and
 //! grew with the square of the laps on a long run (a thousand laps of one loop). Here the
-//! active sites sit in square cells at least the radius wide, each cell's sites kept as *runs*
-//! of one lap in creation order; a query looks at the 3 × 3 cells around it and, per run of a
-//! lap not yet found, first at the lap's *witness* (the site of that lap that last agreed with a
-//! query: consecutive observations are close, so it usually agrees again), then at the run's
-//! bounds (position and heading: a run wholly outside the query, or wholly inside it, is decided
-//! at once) and only then at the run's sites one by one, stopping at the first that agrees. The work per query is the runs
-//! near it, about one per earlier lap that passes there, plus the sites of laps that pass near
-//! but do not agree.
+//! active sites sit in square cells at least the radius wide, each cut into 4 × 4 sub-cells
+//! that keep the bounds of their sites and their laps as a bit set ([`Laps`]). A query looks at
+//! the 3 × 3 cells around it: first every sub-cell it takes wholly gives all its laps at once;
+//! then, in the sub-cells it takes in part whose laps are not all found yet, per *run* of a lap
+//! not yet found (a sub-cell's sites of one lap, in creation order), first at the lap's
+//! *witness* (the site of that lap that last agreed with a query: consecutive observations are
+//! close, so it usually agrees again), then at the run's bounds and only then at the run's
+//! sites one by one, stopping at the first that agrees. On one loop every earlier lap passes
+//! through a sub-cell wholly within the radius, so the work per query is a few bit-set words
+//! per sub-cell, and the answer is counted (a popcount), not listed.
 //!
 //! The answers are exactly those of testing every active site with the figures' own predicate
 //! ([`Site::agrees_with`]): a site within the radius lies in one of the 3 × 3 cells (the cells
 //! are 1 % wider than the radius, far more than the rounding of a cell index); a lap is taken
-//! from a witness or a site that passes that predicate, or from a run whose bounds are decided
-//! as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
+//! from a witness or a site that passes that predicate, or from a run or sub-cell whose bounds
+//! are decided as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
 
 use super::pair_recall::Facing;
 use super::site_tree::{Cover, Query, Site, cover};
