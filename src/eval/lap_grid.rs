@@ -6,28 +6,177 @@
 //! way. The answer is a set of laps, so once one site of a lap agrees, the rest of that lap need
 //! not be looked at. The k-d tree of [`super::site_tree`] finds the sites, not the laps, and
 //! grew with the square of the laps on a long run (a thousand laps of one loop). Here the
-//! active sites sit in square cells at least the radius wide, each cell's sites kept as *runs*
-//! of one lap in creation order; a query looks at the 3 × 3 cells around it and, per run of a
-//! lap not yet found, first at the lap's *witness* (the site of that lap that last agreed with a
-//! query: consecutive observations are close, so it usually agrees again), then at the run's
-//! bounds (position and heading: a run wholly outside the query, or wholly inside it, is decided
-//! at once) and only then at the run's sites one by one, stopping at the first that agrees. The work per query is the runs
-//! near it, about one per earlier lap that passes there, plus the sites of laps that pass near
-//! but do not agree.
+//! active sites sit in square cells at least the radius wide, each cut into 4 × 4 sub-cells
+//! that keep the bounds of their sites and their laps as a bit set ([`Laps`]). A query looks at
+//! the 3 × 3 cells around it: first every sub-cell it takes wholly gives all its laps at once;
+//! then, in the sub-cells it takes in part whose laps are not all found yet, per *run* of a lap
+//! not yet found (a sub-cell's sites of one lap, in creation order), first at the lap's
+//! *witness* (the site of that lap that last agreed with a query: consecutive observations are
+//! close, so it usually agrees again), then at the run's bounds and only then at the run's
+//! sites one by one, stopping at the first that agrees. On one loop every earlier lap passes
+//! through a sub-cell wholly within the radius, so the work per query is a few bit-set words
+//! per sub-cell, and the answer is counted (a popcount), not listed.
 //!
 //! The answers are exactly those of testing every active site with the figures' own predicate
 //! ([`Site::agrees_with`]): a site within the radius lies in one of the 3 × 3 cells (the cells
 //! are 1 % wider than the radius, far more than the rounding of a cell index); a lap is taken
-//! from a witness or a site that passes that predicate, or from a run whose bounds are decided
-//! as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
+//! from a witness or a site that passes that predicate, or from a run or sub-cell whose bounds
+//! are decided as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
 
 use super::pair_recall::Facing;
-use super::site_tree::{Cover, LapSet, Query, Site, cover};
+use super::site_tree::{Cover, Query, Site, cover};
 use crate::geom::wrap_angle;
 use foldhash::HashMap;
+use std::f64::consts::PI;
 
-/// One run of a lap in a cell: where it ends in the cell's sites, and the bounds of its sites'
-/// positions and wrapped headings (a run wholly in or out of a query is decided at once).
+/// Sub-cells per side of a cell: a sub-cell is a quarter of the radius wide, so one within
+/// about 0.64 radii of a query lies wholly within the radius and all its laps are taken at once.
+const SUBS: i64 = 4;
+
+/// A set of laps, one bit each, from word `first` (64 laps a word) on.
+#[derive(Clone, Debug, Default)]
+pub struct Laps {
+    first: usize,
+    words: Vec<u64>,
+}
+
+impl Laps {
+    /// Whether `lap` is in the set.
+    pub fn contains(&self, lap: usize) -> bool {
+        let w = (lap / 64).wrapping_sub(self.first);
+        self.words.get(w).is_some_and(|b| b >> (lap % 64) & 1 == 1)
+    }
+
+    /// Adds `lap`.
+    pub fn insert(&mut self, lap: usize) {
+        let w = lap / 64;
+        if self.words.is_empty() {
+            self.first = w;
+        } else if w < self.first {
+            let more = self.first - w;
+            self.words.splice(0..0, std::iter::repeat_n(0, more));
+            self.first = w;
+        }
+        let at = w - self.first;
+        if self.words.len() <= at {
+            self.words.resize(at + 1, 0);
+        }
+        self.words[at] |= 1 << (lap % 64);
+    }
+
+    /// Laps in the set.
+    pub fn len(&self) -> usize {
+        self.words.iter().map(|w| w.count_ones() as usize).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.words.iter().all(|&w| w == 0)
+    }
+
+    /// Laps in this set or `other`.
+    pub fn union_len(&self, other: &Laps) -> usize {
+        let (a, b) = (self.first, other.first);
+        let end = (a + self.words.len()).max(b + other.words.len());
+        let word = |l: &Laps, w: usize| {
+            w.checked_sub(l.first)
+                .and_then(|i| l.words.get(i))
+                .copied()
+                .unwrap_or(0)
+        };
+        (a.min(b)..end)
+            .map(|w| (word(self, w) | word(other, w)).count_ones() as usize)
+            .sum()
+    }
+
+    /// The laps in increasing order.
+    pub fn iter(&self) -> impl Iterator<Item = usize> + '_ {
+        self.words.iter().enumerate().flat_map(move |(i, &w)| {
+            let base = (self.first + i) * 64;
+            (0..64)
+                .filter(move |b| w >> b & 1 == 1)
+                .map(move |b| base + b)
+        })
+    }
+
+    /// The set of `laps`, in the room of `reuse`.
+    pub fn of(laps: &[usize], mut reuse: Laps) -> Laps {
+        reuse.words.clear();
+        laps.iter().for_each(|&l| reuse.insert(l));
+        reuse
+    }
+
+    /// Empties the set, keeping its room.
+    fn clear(&mut self) {
+        self.words.fill(0);
+    }
+
+    /// Room for laps `0..n` in a set that starts at lap 0.
+    fn reserve_laps(&mut self, n: usize) {
+        debug_assert_eq!(self.first, 0);
+        if self.words.len() < n.div_ceil(64) {
+            self.words.resize(n.div_ceil(64), 0);
+        }
+    }
+
+    /// Adds every lap of `other` (this set starts at lap 0 and has room for them).
+    fn add_all(&mut self, other: &Laps) {
+        let to = &mut self.words[other.first..other.first + other.words.len()];
+        to.iter_mut().zip(&other.words).for_each(|(a, b)| *a |= b);
+    }
+
+    /// Whether every lap of `other` is in this set (which starts at lap 0).
+    fn holds_all(&self, other: &Laps) -> bool {
+        let from = &self.words[other.first..other.first + other.words.len()];
+        from.iter().zip(&other.words).all(|(a, b)| b & !a == 0)
+    }
+}
+
+/// The bounds of a box of sites: positions, wrapped headings, and the headings turned by π
+/// and wrapped (narrow where the first straddle ±π).
+#[derive(Clone, Copy)]
+struct Bounds {
+    x: [f64; 2],
+    y: [f64; 2],
+    theta: [f64; 2],
+    turned: [f64; 2],
+}
+
+impl Bounds {
+    fn of(s: &Site) -> Self {
+        let (t, u) = (wrap_angle(s.theta), wrap_angle(s.theta - PI));
+        Bounds {
+            x: [s.x; 2],
+            y: [s.y; 2],
+            theta: [t; 2],
+            turned: [u; 2],
+        }
+    }
+
+    fn add(&mut self, s: &Site) {
+        let b = Bounds::of(s);
+        let join = |a: [f64; 2], b: [f64; 2]| [a[0].min(b[0]), a[1].max(b[1])];
+        self.x = join(self.x, b.x);
+        self.y = join(self.y, b.y);
+        self.theta = join(self.theta, b.theta);
+        self.turned = join(self.turned, b.turned);
+    }
+
+    /// How much of the box `q` takes, its headings bounded by the narrower of the two ranges
+    /// (the turned range, turned back, holds the same headings within rounding, far below the
+    /// margin the heading test keeps: [`super::site_tree`]).
+    fn cover(&self, q: &Query) -> Cover {
+        let theta = if self.turned[1] - self.turned[0] < self.theta[1] - self.theta[0] {
+            [self.turned[0] + PI, self.turned[1] + PI]
+        } else {
+            self.theta
+        };
+        cover(self.x, self.y, theta, q)
+    }
+}
+
+/// One run of a lap in a sub-cell: where it ends in the sub-cell's sites, and the bounds of
+/// its sites' positions and wrapped headings (a run wholly in or out of a query is decided at
+/// once).
 #[derive(Clone, Copy)]
 struct Run {
     lap: u32,
@@ -37,19 +186,29 @@ struct Run {
     theta: [f64; 2],
 }
 
-/// One cell: its sites in creation order, as runs of one lap.
-#[derive(Default)]
-struct Cell {
+/// One sub-cell: its sites in creation order, as runs of one lap, their bounds and laps.
+struct Sub {
+    /// Where in its cell (row × [`SUBS`] + column).
+    at: u8,
+    bounds: Bounds,
+    laps: Laps,
     sites: Vec<u32>,
     /// A run starts where the previous one ends.
     runs: Vec<Run>,
 }
 
-/// The active sites of one sweep in cells, with a witness per lap and facing asked about (see
-/// the module doc). The sites are handed to each call (a slice that only grows), so a sweep can
-/// be resumed as sites are made ([`LapSweep`]).
+/// One cell (the radius wide, 1 % more): its sub-cells that hold a site.
+#[derive(Default)]
+struct Cell {
+    subs: Vec<Sub>,
+}
+
+/// The active sites of one sweep in cells of sub-cells, with a witness per lap and facing
+/// asked about (see the module doc). The sites are handed to each call (a slice that only
+/// grows), so a sweep can be resumed as sites are made ([`LapSweep`]).
 struct LapGrid<const N: usize> {
-    inv_cell_m: f64,
+    /// Sub-cells per metre.
+    inv_sub_m: f64,
     cells: HashMap<(i64, i64), Cell>,
     /// Per facing asked about, per lap: a copy of the site that last agreed with a query (kept
     /// beside each other, so testing the witnesses of many laps reads few cache lines).
@@ -60,23 +219,26 @@ impl<const N: usize> LapGrid<N> {
     /// An empty grid for queries within `r_m` (positive and finite).
     fn new(r_m: f64) -> Self {
         LapGrid {
-            inv_cell_m: 1.0 / (r_m * 1.01),
+            inv_sub_m: SUBS as f64 / (r_m * 1.01),
             cells: HashMap::default(),
             witness: std::array::from_fn(|_| Vec::new()),
         }
     }
 
-    fn cell_of(&self, s: &Site) -> (i64, i64) {
-        (
-            (s.x * self.inv_cell_m).floor() as i64,
-            (s.y * self.inv_cell_m).floor() as i64,
-        )
+    /// The cell of `s` and its sub-cell there. A site within the radius of a query lies in
+    /// the 3 × 3 cells around the query's: their sub-cell indices differ by at most
+    /// 4 / 1.01 (plus rounding), so the cells' by at most 1.
+    fn cell_of(&self, s: &Site) -> ((i64, i64), u8) {
+        let fx = (s.x * self.inv_sub_m).floor() as i64;
+        let fy = (s.y * self.inv_sub_m).floor() as i64;
+        let at = fy.rem_euclid(SUBS) * SUBS + fx.rem_euclid(SUBS);
+        ((fx.div_euclid(SUBS), fy.div_euclid(SUBS)), at as u8)
     }
 
     /// Makes site `k` of `sites` active.
     fn activate(&mut self, sites: &[Site], k: usize) {
         let s = &sites[k];
-        let key = self.cell_of(s);
+        let (key, at) = self.cell_of(s);
         let lap = s.lap as u32;
         for w in &mut self.witness {
             if w.len() <= s.lap {
@@ -85,16 +247,31 @@ impl<const N: usize> LapGrid<N> {
         }
         let t = wrap_angle(s.theta);
         let cell = self.cells.entry(key).or_default();
-        cell.sites.push(k as u32);
-        let end = cell.sites.len() as u32;
-        match cell.runs.last_mut() {
+        let sub = match cell.subs.iter().position(|b| b.at == at) {
+            Some(i) => &mut cell.subs[i],
+            None => {
+                cell.subs.push(Sub {
+                    at,
+                    bounds: Bounds::of(s),
+                    laps: Laps::default(),
+                    sites: Vec::new(),
+                    runs: Vec::new(),
+                });
+                cell.subs.last_mut().expect("just pushed")
+            }
+        };
+        sub.bounds.add(s);
+        sub.laps.insert(s.lap);
+        sub.sites.push(k as u32);
+        let end = sub.sites.len() as u32;
+        match sub.runs.last_mut() {
             Some(r) if r.lap == lap => {
                 r.end = end;
                 r.x = [r.x[0].min(s.x), r.x[1].max(s.x)];
                 r.y = [r.y[0].min(s.y), r.y[1].max(s.y)];
                 r.theta = [r.theta[0].min(t), r.theta[1].max(t)];
             }
-            _ => cell.runs.push(Run {
+            _ => sub.runs.push(Run {
                 lap,
                 end,
                 x: [s.x; 2],
@@ -105,50 +282,59 @@ impl<const N: usize> LapGrid<N> {
     }
 
     /// Adds to `laps[f]` the lap of every active site `qs[f]` takes (the queries ask about one
-    /// site, each facing its own way: the cells and runs are walked once for all).
-    fn laps(&mut self, sites: &[Site], qs: &[Query; N], laps: &mut [LapSet; N]) {
-        let (cx, cy) = self.cell_of(qs[0].site);
-        // The query's own cell first: the laps found there are skipped in the others.
-        const AROUND: [(i64, i64); 9] = [
-            (0, 0),
-            (-1, -1),
-            (-1, 0),
-            (-1, 1),
-            (0, -1),
-            (0, 1),
-            (1, -1),
-            (1, 0),
-            (1, 1),
-        ];
-        for (dx, dy) in AROUND {
-            let Some(cell) = self.cells.get(&(cx + dx, cy + dy)) else {
-                continue;
-            };
-            let mut start = 0usize;
-            for run in &cell.runs {
-                let (lap, from) = (run.lap as usize, start);
-                start = run.end as usize;
-                for ((q, laps), witness) in qs.iter().zip(laps.iter_mut()).zip(&mut self.witness) {
-                    if laps.contains(lap) {
-                        continue;
-                    }
-                    let agrees = |p: &Site| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad);
-                    if witness[lap].as_ref().is_some_and(agrees) {
-                        laps.insert(lap);
-                        continue;
-                    }
-                    let cell_sites = &cell.sites[from..start];
-                    let hit = match cover(run.x, run.y, run.theta, q) {
-                        Cover::None => None,
-                        Cover::All => cell_sites.first(),
-                        Cover::Part => cell_sites.iter().find(|&&j| agrees(&sites[j as usize])),
-                    };
-                    if let Some(&j) = hit {
-                        witness[lap] = Some(sites[j as usize]);
-                        laps.insert(lap);
-                    }
+    /// site, each facing its own way). First the sub-cells wholly taken give all their laps at
+    /// once; then, in those taken in part, the runs of laps not yet found are looked at one by
+    /// one (skipped whole when every lap of the sub-cell is found).
+    fn laps(&mut self, sites: &[Site], qs: &[Query; N], laps: &mut [Laps; N]) {
+        let ((cx, cy), _) = self.cell_of(qs[0].site);
+        let cells: [Option<&Cell>; 9] = std::array::from_fn(|i| {
+            self.cells
+                .get(&(cx + i as i64 / 3 - 1, cy + i as i64 % 3 - 1))
+        });
+        for sub in cells.iter().flatten().flat_map(|c| &c.subs) {
+            for (q, laps) in qs.iter().zip(laps.iter_mut()) {
+                if sub.bounds.cover(q) == Cover::All {
+                    laps.add_all(&sub.laps);
                 }
             }
+        }
+        for sub in cells.iter().flatten().flat_map(|c| &c.subs) {
+            for ((q, laps), witness) in qs.iter().zip(laps.iter_mut()).zip(&mut self.witness) {
+                if laps.holds_all(&sub.laps) || sub.bounds.cover(q) != Cover::Part {
+                    continue;
+                }
+                part_laps(sites, sub, q, laps, witness);
+            }
+        }
+    }
+}
+
+/// Adds to `laps` the lap of every site of `sub` that `q` takes, lap by lap: per run of a lap
+/// not yet found, first the lap's witness (the site of that lap that last agreed with a query:
+/// consecutive observations are close, so it usually agrees again), then the run's bounds, and
+/// only then its sites one by one, stopping at the first that agrees.
+fn part_laps(sites: &[Site], sub: &Sub, q: &Query, laps: &mut Laps, witness: &mut [Option<Site>]) {
+    let mut start = 0usize;
+    for run in &sub.runs {
+        let (lap, from) = (run.lap as usize, start);
+        start = run.end as usize;
+        if laps.contains(lap) {
+            continue;
+        }
+        let agrees = |p: &Site| q.site.agrees_with(p, q.r2, q.facing, q.tol_rad);
+        if witness[lap].as_ref().is_some_and(agrees) {
+            laps.insert(lap);
+            continue;
+        }
+        let run_sites = &sub.sites[from..start];
+        let hit = match cover(run.x, run.y, run.theta, q) {
+            Cover::None => None,
+            Cover::All => run_sites.first(),
+            Cover::Part => run_sites.iter().find(|&&j| agrees(&sites[j as usize])),
+        };
+        if let Some(&j) = hit {
+            witness[lap] = Some(sites[j as usize]);
+            laps.insert(lap);
         }
     }
 }
@@ -162,7 +348,7 @@ pub fn sweep_laps<const N: usize>(
     r_m: f64,
     facings: [Facing; N],
     tol_rad: f64,
-    visit: impl FnMut(usize, [&[usize]; N]),
+    visit: impl FnMut(usize, [&Laps; N]),
 ) {
     if let Some(mut sweep) = LapSweep::new(min_gap_m, r_m, facings, tol_rad) {
         sweep.advance(sites, sites.len(), visit);
@@ -175,7 +361,7 @@ pub fn sweep_laps<const N: usize>(
 /// scored, rather than holding every (observation, lap) found to the end (`eval::tally`).
 pub struct LapSweep<const N: usize> {
     grid: LapGrid<N>,
-    laps: [LapSet; N],
+    laps: [Laps; N],
     min_gap_m: f64,
     r_m: f64,
     facings: [Facing; N],
@@ -193,7 +379,7 @@ impl<const N: usize> LapSweep<N> {
         }
         Some(LapSweep {
             grid: LapGrid::new(r_m),
-            laps: std::array::from_fn(|_| LapSet::default()),
+            laps: std::array::from_fn(|_| Laps::default()),
             min_gap_m,
             r_m,
             facings,
@@ -209,7 +395,7 @@ impl<const N: usize> LapSweep<N> {
         &mut self,
         sites: &[Site],
         end: usize,
-        mut visit: impl FnMut(usize, [&[usize]; N]),
+        mut visit: impl FnMut(usize, [&Laps; N]),
     ) {
         for k in self.done..end.min(sites.len()) {
             let s = &sites[k];
@@ -217,7 +403,11 @@ impl<const N: usize> LapSweep<N> {
                 self.grid.activate(sites, self.ready);
                 self.ready += 1;
             }
-            self.laps.iter_mut().for_each(LapSet::clear);
+            let lap_count = self.grid.witness.first().map_or(0, Vec::len);
+            for laps in &mut self.laps {
+                laps.clear();
+                laps.reserve_laps(lap_count);
+            }
             let qs = self.facings.map(|facing| Query {
                 site: s,
                 r2: self.r_m * self.r_m,
@@ -225,7 +415,7 @@ impl<const N: usize> LapSweep<N> {
                 tol_rad: self.tol_rad,
             });
             self.grid.laps(sites, &qs, &mut self.laps);
-            visit(k, std::array::from_fn(|f| self.laps[f].list.as_slice()));
+            visit(k, std::array::from_fn(|f| &self.laps[f]));
             self.done = k + 1;
         }
     }
@@ -234,7 +424,7 @@ impl<const N: usize> LapSweep<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::site_tree::{sweep, tests::passes};
+    use crate::eval::site_tree::{LapSet, sweep, tests::passes};
 
     /// The laps equal the k-d tree's (which equal testing every earlier site) for every site,
     /// radius and facing, on passes that go both ways.
@@ -260,7 +450,7 @@ mod tests {
                 });
                 let mut got = Vec::new();
                 sweep_laps(&sites, 2.0, r, [facing], 0.7, |_, [laps]| {
-                    let mut l = laps.to_vec();
+                    let mut l: Vec<usize> = laps.iter().collect();
                     l.sort_unstable();
                     got.push(l);
                 });
@@ -269,7 +459,7 @@ mod tests {
                 let mut all = Vec::new();
                 let facings = [Facing::Opposite, facing, Facing::Same];
                 sweep_laps(&sites, 2.0, r, facings, 0.7, |_, [_, laps, _]| {
-                    let mut l = laps.to_vec();
+                    let mut l: Vec<usize> = laps.iter().collect();
                     l.sort_unstable();
                     all.push(l);
                 });
@@ -289,7 +479,11 @@ mod tests {
         let facings = [Facing::Same, Facing::Opposite];
         let mut want = Vec::new();
         sweep_laps(&sites, 2.0, 1.0, facings, 0.7, |k, [s, o]| {
-            want.push((k, s.to_vec(), o.to_vec()));
+            want.push((
+                k,
+                s.iter().collect::<Vec<_>>(),
+                o.iter().collect::<Vec<_>>(),
+            ));
         });
         let mut got = Vec::new();
         let mut sweep = LapSweep::new(2.0, 1.0, facings, 0.7).expect("a positive radius");
@@ -298,7 +492,11 @@ mod tests {
             end = (end + 1 + end / 3).min(sites.len());
             // Each call sees only the sites made so far.
             sweep.advance(&sites[..end], end, |k, [s, o]| {
-                got.push((k, s.to_vec(), o.to_vec()));
+                got.push((
+                    k,
+                    s.iter().collect::<Vec<_>>(),
+                    o.iter().collect::<Vec<_>>(),
+                ));
             });
         }
         assert_eq!(got, want);

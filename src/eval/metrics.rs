@@ -39,7 +39,7 @@
 //! (the order "first occurrence" refers to); this module holds the figures, the observations
 //! joined with their truth ([`Scorer`]) and the revisit searches.
 
-use super::lap_grid::LapSweep;
+use super::lap_grid::{LapSweep, Laps};
 use super::pair_recall::Facing;
 use super::pair_set::{PairSet, pack};
 use super::site_tree::{Query, Site, sweep};
@@ -647,7 +647,7 @@ impl Scorer {
     /// Calls `visit(i, [same, opposite])` for every observation `i` with truth, in order, with
     /// the earlier laps that revisit it at radius `r` facing the same and the opposite way,
     /// found lap by lap ([`super::lap_grid`]); the laps of either facing are their union.
-    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, [&[usize]; 2])) {
+    pub(super) fn sweep_laps(&self, r: f64, mut visit: impl FnMut(usize, [&Laps; 2])) {
         let j = &self.joined;
         let facings = [Facing::Same, Facing::Opposite];
         let (gap, tol) = (self.min_gap_m, self.heading_tol_rad);
@@ -669,7 +669,7 @@ impl Scorer {
         &self,
         sweep: &mut LapSweep<2>,
         end_obs: usize,
-        mut visit: impl FnMut(usize, [&[usize]; 2]),
+        mut visit: impl FnMut(usize, [&Laps; 2]),
     ) {
         let j = &self.joined;
         let end = j.site_obs.count_below(end_obs);

@@ -19,7 +19,7 @@
 //!   `eval::tally` (found, as matches arrive) and `count_possible` (the denominator).
 
 use super::GroundTruth;
-use super::site_tree::{Query, Site, SiteTree, sweep, sweep_tree};
+use super::site_tree::{Query, Site, SiteTree, sweep};
 use crate::geom::wrap_angle;
 use crate::place::Direction;
 
@@ -115,8 +115,12 @@ pub(super) fn count_possible(
     n
 }
 
-/// [`count_possible`] of each facing of `facings`, in one sweep of `tree` (built over the
-/// sites, reused: [`sweep_tree`]) that walks the tree once per site for all of them.
+/// [`count_possible`] of each facing of `facings`: every pair within `r` facing so, counted
+/// over pairs of the tree's nodes ([`SiteTree::count_pairs_facings`], no query per site), less
+/// the pairs a sweep would not take, those less than `min_gap_m` of travel apart: per site, the
+/// sites from the sweep's activation frontier up to it, a stretch of `min_gap_m` of travel
+/// that does not grow with the laps. Each pair is tested as the sweep tests it, so the counts
+/// are those of the sweep's (`tree` is built over the sites in creation order).
 pub(super) fn count_possible_facings<const N: usize>(
     tree: &mut SiteTree,
     min_gap_m: f64,
@@ -124,11 +128,23 @@ pub(super) fn count_possible_facings<const N: usize>(
     facings: [Facing; N],
     tol_rad: f64,
 ) -> [u64; N] {
-    let mut n = [0u64; N];
-    sweep_tree(tree, min_gap_m, |k, tree| {
-        let c = tree.count_facings(&tree.site(k), r * r, facings, tol_rad);
-        n.iter_mut().zip(c).for_each(|(n, c)| *n += c);
-    });
+    let r2 = r * r;
+    let mut n = tree.count_pairs_facings(r2, facings, tol_rad);
+    let sites = tree.sites();
+    let mut ready = 0;
+    for (k, s) in sites.iter().enumerate() {
+        while ready < k && s.travel_m - sites[ready].travel_m >= min_gap_m {
+            ready += 1;
+        }
+        for p in &sites[ready..k] {
+            if (s.x - p.x).powi(2) + (s.y - p.y).powi(2) > r2 {
+                continue;
+            }
+            for (n, &facing) in n.iter_mut().zip(&facings) {
+                *n -= u64::from(facing.agrees(s.theta, p.theta, tol_rad));
+            }
+        }
+    }
     n
 }
 
@@ -213,6 +229,25 @@ mod tests {
             assert!(pr > 0.0, "{facing:?}");
         }
         assert_eq!(pair_recall(&obs, &[opposite], &gt, Facing::Same), 0.0);
+    }
+
+    /// The possible pairs counted over pairs of nodes equal those of a query per site, on
+    /// passes that go both ways, at radii from below the sites' spacing to many leaves wide.
+    #[test]
+    fn possible_pairs_over_node_pairs_equal_a_query_per_site() {
+        let sites = crate::eval::site_tree::tests::passes(3);
+        let facings = [Facing::Either, Facing::Same, Facing::Opposite];
+        for r in [0.05, 0.5, 1.0, 3.0] {
+            for gap in [0.0, 2.0, 30.0] {
+                for tol in [0.3, 0.7, 2.0] {
+                    let mut tree = SiteTree::new(&sites);
+                    let got = count_possible_facings(&mut tree, gap, r, facings, tol);
+                    let want = facings.map(|f| count_possible(&sites, gap, r, f, tol));
+                    assert_eq!(got, want, "r {r} gap {gap} tol {tol}");
+                    assert!(r < 0.5 || want.iter().all(|&n| n > 0), "r {r}");
+                }
+            }
+        }
     }
 
     #[test]

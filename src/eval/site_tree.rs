@@ -290,6 +290,110 @@ impl<'s> SiteTree<'s> {
         total
     }
 
+    /// Pairs of sites (every site, active or not) within `r2` of each other and facing each
+    /// way of `facings`, each pair once and tested as (later, earlier) in creation order, as a
+    /// sweep's query tests it. Counted over pairs of nodes (a dual-tree walk): a pair of boxes
+    /// wholly within the radius and facing so adds the product of their sizes, one wholly out
+    /// adds nothing, and only pairs of leaves on the edge test their sites pair by pair. The
+    /// decisions per pair of boxes are those of [`position_cover`] and [`heading_cover`]
+    /// widened to a box at each end (monotone operations, the same heading margin).
+    pub fn count_pairs_facings<const N: usize>(
+        &self,
+        r2: f64,
+        facings: [Facing; N],
+        tol_rad: f64,
+    ) -> [u64; N] {
+        assert!(N <= 8, "at most 8 facings at once");
+        let mut total = [0u64; N];
+        if self.nodes.is_empty() {
+            return total;
+        }
+        let all: u8 = ((1u16 << N) - 1) as u8;
+        let mut stack = vec![(0u32, 0u32, all)];
+        while let Some((a, b, mut open)) = stack.pop() {
+            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+            let Some(inside) = boxes_cover(na, nb, r2) else {
+                continue;
+            };
+            let size = |n: &Node| u64::from(n.end - n.start);
+            let pairs = if a == b {
+                size(na) * (size(na) - 1) / 2
+            } else {
+                size(na) * size(nb)
+            };
+            // Heading widened by b's half-range: every heading pair's difference is within.
+            let half_b = (nb.theta[1] - nb.theta[0]) / 2.0;
+            let mid_b = nb.theta[0] + half_b;
+            let widened = [na.theta[0] - half_b, na.theta[1] + half_b];
+            for (f, &facing) in facings.iter().enumerate() {
+                if open & (1 << f) == 0 {
+                    continue;
+                }
+                match heading_cover(mid_b, widened, facing, tol_rad) {
+                    Cover::None => open &= !(1 << f),
+                    Cover::All if inside => {
+                        total[f] += pairs;
+                        open &= !(1 << f);
+                    }
+                    _ => {}
+                }
+            }
+            if open == 0 {
+                continue;
+            }
+            let (leaf_a, leaf_b) = (na.children[0] == NO_CHILD, nb.children[0] == NO_CHILD);
+            if leaf_a && leaf_b {
+                self.count_leaf_pairs((na, nb, a == b), r2, facings, tol_rad, open, &mut total);
+            } else if a == b {
+                let [l, r] = na.children;
+                stack.extend([(l, l, open), (l, r, open), (r, r, open)]);
+            } else if leaf_a || (!leaf_b && size(nb) > size(na)) {
+                stack.extend(nb.children.map(|c| (a, c, open)));
+            } else {
+                stack.extend(na.children.map(|c| (c, b, open)));
+            }
+        }
+        total
+    }
+
+    /// [`Self::count_pairs_facings`] in two leaves (the same leaf when `same`), site by site,
+    /// for the facings `open` leaves undecided.
+    fn count_leaf_pairs<const N: usize>(
+        &self,
+        (na, nb, same): (&Node, &Node, bool),
+        r2: f64,
+        facings: [Facing; N],
+        tol_rad: f64,
+        open: u8,
+        total: &mut [u64; N],
+    ) {
+        let (a0, a1) = (na.start as usize, na.end as usize);
+        let (b0, b1) = (nb.start as usize, nb.end as usize);
+        for i in a0..a1 {
+            let from = if same { i + 1 } else { b0 };
+            for j in from..b1 {
+                let (later, earlier) = if self.order[i] > self.order[j] {
+                    (&self.placed[i], &self.placed[j])
+                } else {
+                    (&self.placed[j], &self.placed[i])
+                };
+                if (later.x - earlier.x).powi(2) + (later.y - earlier.y).powi(2) > r2 {
+                    continue;
+                }
+                for (f, &facing) in facings.iter().enumerate() {
+                    if open & (1 << f) != 0 && facing.agrees(later.theta, earlier.theta, tol_rad) {
+                        total[f] += 1;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The sites, in creation order.
+    pub fn sites(&self) -> &'s [Site] {
+        self.sites
+    }
+
     /// Site `k` (creation order).
     pub fn site(&self, k: usize) -> Site {
         self.sites[k]
@@ -349,6 +453,26 @@ fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
         return None;
     }
     Some(far(s.x, x) + far(s.y, y) <= r2)
+}
+
+/// Whether every pair of sites of two boxes lies within `r2` (squared) of each other: `None`
+/// when no pair can, `Some(true)` when every pair does, `Some(false)` in part. The bounds use
+/// the site test's own operations, which are monotone (see the module doc).
+fn boxes_cover(a: &Node, b: &Node, r2: f64) -> Option<bool> {
+    let far = |p: [f64; 2], q: [f64; 2]| (p[1] - q[0]).powi(2).max((q[1] - p[0]).powi(2));
+    let near = |p: [f64; 2], q: [f64; 2]| {
+        if q[0] > p[1] {
+            (q[0] - p[1]).powi(2)
+        } else if p[0] > q[1] {
+            (p[0] - q[1]).powi(2)
+        } else {
+            0.0
+        }
+    };
+    if near(a.x, b.x) + near(a.y, b.y) > r2 {
+        return None;
+    }
+    Some(far(a.x, b.x) + far(a.y, b.y) <= r2)
 }
 
 /// How many headings in the wrapped range `range` agree with `theta` as `facing` says.

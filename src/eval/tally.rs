@@ -33,7 +33,7 @@
 //! and [`super::evaluate`] scores a finished recognition by feeding its matches in order.
 
 use super::GroundTruth;
-use super::lap_grid::LapSweep;
+use super::lap_grid::{LapSweep, Laps};
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
 use super::pair_recall::{Facing, PairRecall, count_possible, count_possible_facings};
 use super::pair_set::pack;
@@ -896,8 +896,6 @@ struct VisitSweep {
 /// Visit recall's counts, fed the laps that revisit each observation in order.
 #[derive(Default)]
 struct LapCount {
-    /// Per lap: bit 0 revisits the observation the same way, bit 1 the opposite way.
-    mark: Vec<u8>,
     /// Where [`Tally::visits_of`] stands.
     at: usize,
     /// Per facing (as [`facing_bit`]): the earlier laps that revisit, those paired correctly.
@@ -906,29 +904,19 @@ struct LapCount {
 }
 
 impl LapCount {
-    /// Counts observation `i`, revisited by the earlier laps `same` and `opposite`.
-    fn add(&mut self, tally: &Tally, i: usize, same: &[usize], opposite: &[usize]) {
-        let mark = &mut self.mark;
-        for (laps, bit) in [(same, 1), (opposite, 2)] {
-            for &l in laps {
-                if mark.len() <= l {
-                    mark.resize(l + 1, 0);
-                }
-                mark[l] |= bit;
-            }
-        }
-        let both = same.iter().filter(|&&l| mark[l] == 3).count();
-        self.visits[0] += same.len() + opposite.len() - both;
+    /// Counts observation `i`, revisited by the earlier laps `same` and `opposite` (counted,
+    /// not listed: on one loop every earlier lap revisits each observation).
+    fn add(&mut self, tally: &Tally, i: usize, same: &Laps, opposite: &Laps) {
+        self.visits[0] += same.union_len(opposite);
         self.visits[1] += same.len();
         self.visits[2] += opposite.len();
         for &v in tally.visits_of(i, &mut self.at) {
-            let (m, claims) = (lap_mark(mark, v), v & 3);
+            let lap = ((v & 0xffff_ffff) >> 2) as usize;
+            let m = u8::from(same.contains(lap)) | u8::from(opposite.contains(lap)) << 1;
+            let claims = v & 3;
             self.found[0] += usize::from(m != 0 && claims != 0);
             self.found[1] += usize::from(m & 1 != 0 && claims & 1 != 0);
             self.found[2] += usize::from(m & 2 != 0 && claims & 2 != 0);
-        }
-        for &l in same.iter().chain(opposite) {
-            mark[l] = 0;
         }
     }
 
@@ -950,25 +938,23 @@ impl LapLists {
     /// Laps kept at most (8 bytes each): beyond, the next tally sweeps again.
     const MAX_LAPS: usize = 1 << 24;
 
-    fn push(&mut self, i: usize, same: &[usize], opposite: &[usize]) {
-        self.laps.extend_from_slice(same);
+    fn push(&mut self, i: usize, same: &Laps, opposite: &Laps) {
+        self.laps.extend(same.iter());
         let mid = self.laps.len() as u32;
-        self.laps.extend_from_slice(opposite);
+        self.laps.extend(opposite.iter());
         self.obs.push((i as u32, mid, self.laps.len() as u32));
     }
 
     /// Visit recall of `tally` over these laps, per facing as [`facing_bit`].
     fn recall(&self, tally: &Tally) -> [f64; 3] {
         let mut count = LapCount::default();
+        let (mut same, mut opposite) = (Laps::default(), Laps::default());
         let mut from = 0usize;
         for &(i, mid, end) in &self.obs {
             let (mid, end) = (mid as usize, end as usize);
-            count.add(
-                tally,
-                i as usize,
-                &self.laps[from..mid],
-                &self.laps[mid..end],
-            );
+            same = Laps::of(&self.laps[from..mid], same);
+            opposite = Laps::of(&self.laps[mid..end], opposite);
+            count.add(tally, i as usize, &same, &opposite);
             from = end;
         }
         count.recall()
