@@ -103,7 +103,13 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
         }
         return Ok(ExitCode::SUCCESS);
     }
-    let mut scn = placewords::experiment::load_scenario(&args.scenario)?;
+    // The work budget counts `--laps` and the level configurations this run makes.
+    let work = placewords::experiment::Workload {
+        laps: args.laps,
+        passes: opts.levels.len(),
+        scan_context: opts.scan_context,
+    };
+    let mut scn = placewords::experiment::load_scenario_for(&args.scenario, &work)?;
     if let Some(seed) = args.seeds.seed {
         scn.sim.seed = seed;
     }

@@ -125,6 +125,8 @@ fn over_budget_sweep_table_and_check_exit_2_before_any_work() {
             "table", smoke, "--no-icp", "--laps", "1000", "-q", "-o", out,
         ],
         vec!["check", three, "--laps", "1000", "-q"],
+        // One seed: its three level configurations (words-1 to words-3) are three passes.
+        vec!["run", smoke, "--laps", "1000", "-q"],
     ] {
         let o = placewords(&args);
         let err = String::from_utf8_lossy(&o.stderr);
