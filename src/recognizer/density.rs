@@ -124,7 +124,7 @@ impl Visited {
             .map(|v| u32::from(reached(v)))
             .sum();
         chunks
-            .map(|c| u32::from(c.iter().map(reached).fold(0u8, |a, b| a + b)))
+            .map(|c| u32::from(c.iter().map(reached).sum::<u8>()))
             .sum::<u32>()
             + tail
     }
