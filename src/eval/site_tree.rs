@@ -295,7 +295,7 @@ impl<'s> SiteTree<'s> {
     /// sweep's query tests it. Counted over pairs of nodes (a dual-tree walk): a pair of boxes
     /// wholly within the radius and facing so adds the product of their sizes, one wholly out
     /// adds nothing, and only pairs of leaves on the edge test their sites pair by pair. The
-    /// decisions per pair of boxes are those of [`position_cover`] and [`heading_cover`]
+    /// decisions per pair of boxes are those of `position_cover` and `heading_cover`
     /// widened to a box at each end (monotone operations, the same heading margin).
     pub fn count_pairs_facings<const N: usize>(
         &self,

@@ -50,7 +50,7 @@ pub struct Word {
     /// A: heading change, degrees in (−180, 180].
     pub angle_deg: f64,
     /// How far A may be off because the positions it is measured from were interpolated
-    /// between sparse scans, degrees ([`word_angle_slack_deg`]; 0 with dense scans).
+    /// between sparse scans, degrees (`word_angle_slack_deg`; 0 with dense scans).
     pub angle_slack_deg: f64,
     /// Index (in the back end's observation list) of the first observation; a word's observations
     /// are consecutive.
