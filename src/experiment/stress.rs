@@ -10,10 +10,12 @@
 
 use crate::eval::provenance::{self, Provenance};
 use crate::eval::suite::{ScenarioResult, SeedResult, SuiteReport, labels};
-use crate::experiment::scenario::{Scenario, Workload, load_scenario_for};
+use crate::experiment::scenario::{Scenario, Workload, WorldLoader, parse_scenario_for};
 use crate::experiment::{ExperimentOptions, ProgressSink};
 use crate::io::atomic::holds_only;
+use crate::spec::diag::read_text;
 use crate::spec::seeds::{SeedRange, Shard};
+use crate::world::load_world_for;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -111,7 +113,8 @@ fn load_planned(path: &Path, opts: &StressOptions) -> Result<Scenario, String> {
         laps: opts.experiment.laps,
         ..Workload::default()
     };
-    let scn = load_scenario_for(path, &work).map_err(|e| e.to_string())?;
+    let src = read_text(path).map_err(|e| e.to_string())?;
+    let scn = parse_scenario_for(&src, path, &load_world_for, &work).map_err(|e| e.to_string())?;
     let Some(o) = options_for(&scn, opts) else {
         return Ok(scn);
     };
@@ -120,7 +123,11 @@ fn load_planned(path: &Path, opts: &StressOptions) -> Result<Scenario, String> {
     }
     work.passes = o.levels.len().max(1);
     work.scan_context = o.scan_context;
-    load_scenario_for(path, &work).map_err(|e| e.to_string())
+    // The passes are known only from the parsed file: the budget counts them in a second
+    // parse of the same text, over the world already read and checked (not read again).
+    let world = scn.sim.world.clone();
+    let loaded: WorldLoader = &|_, _| Ok(world.clone());
+    parse_scenario_for(&src, path, loaded, &work).map_err(|e| e.to_string())
 }
 
 /// The configurations to run for `scn`: the `[expect]` block's under `gate`, else the options'.
