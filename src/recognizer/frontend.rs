@@ -25,6 +25,7 @@ use super::config::{RecognizerConfig, RecognizerError};
 use super::density::{DensityKernel, RayDeltas};
 use super::grid::LocalGrid;
 use super::types::{DensityObservation, FrameId, Observation};
+use super::wide::WideWindow;
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
@@ -140,6 +141,21 @@ impl ObservationClock {
     }
 }
 
+/// The word settings the wide window depends on: Φ is measured where Ψ reaches the top class.
+fn wide_window_settings(config: &RecognizerConfig) -> Option<(usize, usize)> {
+    (config.density.wide_radius_m > 0.0 && config.words.wide_classes > 0)
+        .then_some((config.words.classes, config.words.wide_classes))
+}
+
+/// The wide window of `config` and the Ψ at which Φ is read (the top class's lower bound),
+/// when the settings use it.
+fn wide_window(config: &RecognizerConfig) -> Option<(WideWindow, f64)> {
+    let (classes, _) = wide_window_settings(config)?;
+    // A hair below the bound, so rounding never leaves a top-class observation without Φ.
+    let from_psi = (classes - 1) as f64 / classes as f64 - 1e-9;
+    Some((WideWindow::new(config.density.wide_radius_m), from_psi))
+}
+
 /// Local grid + density: makes observations from odometry and scans.
 #[derive(Clone, Debug)]
 pub struct DensityFrontEnd {
@@ -149,6 +165,11 @@ pub struct DensityFrontEnd {
     grid: LocalGrid,
     kernel: DensityKernel,
     deltas: RayDeltas,
+    /// The wide window (`wide_radius_m` > 0 and `wide_classes` > 0), and the Ψ from which the
+    /// word builder reads Φ (its top class): Φ is measured there only.
+    wide: Option<(WideWindow, f64)>,
+    /// Whether the newest observation's Ψ was in the top class (Φ read there).
+    open: bool,
     run: usize,
     inputs: usize,
     next_id: usize,
@@ -158,7 +179,9 @@ pub struct DensityFrontEnd {
 
 impl DensityFrontEnd {
     /// A front end with the `[recognizer.front_end]`, `grid` and `density` settings of
-    /// `config` (checked whole): it reads no other (see [`Self::same_settings`]).
+    /// `config` (checked whole), and with a wide window, `[recognizer.words]` `classes` and
+    /// `wide_classes` (where the wide density Φ is read): it reads no other (see
+    /// [`Self::same_settings`]).
     pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
         config.validate()?;
         let grid = LocalGrid::with_memory(
@@ -176,6 +199,8 @@ impl DensityFrontEnd {
             kernel_cells: config.kernel_radius_cells(),
             integrate_every_scan: config.front_end.integrate_every_scan,
             deltas: kernel.deltas(grid.side()),
+            wide: wide_window(config),
+            open: false,
             grid,
             kernel,
             run: 0,
@@ -186,11 +211,14 @@ impl DensityFrontEnd {
     }
 
     /// Whether the front ends of `a` and `b` make the same observations of the same input: their
-    /// `[recognizer.front_end]`, `grid` and `density` settings, all that [`Self::new`] reads,
-    /// are equal (level configurations differ only past the front end, so a harness may run
+    /// `[recognizer.front_end]`, `grid` and `density` settings and the word settings of the
+    /// wide window, all that [`Self::new`] reads, are equal (level configurations differ only past the front end, so a harness may run
     /// one front end for them all).
     pub fn same_settings(a: &RecognizerConfig, b: &RecognizerConfig) -> bool {
-        a.front_end == b.front_end && a.grid == b.grid && a.density == b.density
+        a.front_end == b.front_end
+            && a.grid == b.grid
+            && a.density == b.density
+            && wide_window_settings(a) == wide_window_settings(b)
     }
 
     /// Integrates one scan taken at `odom`; returns the observations it made: usually none or
@@ -215,10 +243,13 @@ impl DensityFrontEnd {
         if self.integrate_every_scan || due.passed > 0 || due.previous.is_none() {
             self.grid.integrate(&odom, scan);
         }
+        let travel_now = self.clock.travel_m();
+        if let Some((w, _)) = &mut self.wide {
+            w.integrate(odom.0, scan, travel_now, self.open);
+        }
         if due.passed == 0 {
             return Vec::new();
         }
-        let travel_now = self.clock.travel_m();
         let mut at: Vec<(OdomPose, f64, f64)> = Vec::new();
         match due.previous {
             Some((last, last_travel)) if due.along_step => {
@@ -252,6 +283,16 @@ impl DensityFrontEnd {
                 let density = self
                     .grid
                     .density_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
+                let wide_density = match &self.wide {
+                    Some((w, from_psi)) if density.psi >= *from_psi => {
+                        self.open = true;
+                        w.density_at(pose.0.x, pose.0.y)
+                    }
+                    _ => {
+                        self.open = false;
+                        0.0
+                    }
+                };
                 let (sin, cos) = pose.0.theta.sin_cos();
                 let obs = DensityObservation {
                     observation: Observation::new(self.next_id, self.run, frame_id, pose, travel_m),
@@ -259,6 +300,7 @@ impl DensityFrontEnd {
                     // On the robot's left axis (−sin θ, cos θ) of the odometry heading.
                     lateral_moment: cos * density.moment.1 - sin * density.moment.0,
                     position_slack_m,
+                    wide_density,
                 };
                 self.next_id += 1;
                 obs
@@ -273,6 +315,10 @@ impl DensityFrontEnd {
         if self.clock.start_run() {
             self.run += 1;
             self.grid.clear();
+            self.open = false;
+            if let Some((w, _)) = &mut self.wide {
+                w.clear();
+            }
         }
     }
 

@@ -111,8 +111,13 @@ impl WordMatcher {
                 words.min_word_size,
                 config.levels,
                 words.multi_level,
-            ),
-            occurrences: vec![Vec::new(); words.classes],
+            )
+            .with_wide_classes(if config.density.wide_radius_m > 0.0 {
+                words.wide_classes
+            } else {
+                0
+            }),
+            occurrences: vec![Vec::new(); words.classes + words.wide_classes],
             memo: Default::default(),
             successors: Vec::new(),
             memo_forgotten: 0,

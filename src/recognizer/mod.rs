@@ -25,6 +25,7 @@ pub(crate) mod options;
 #[doc(hidden)]
 pub(crate) mod types;
 mod verify;
+pub(crate) mod wide;
 pub(crate) mod words;
 
 pub use config::{
@@ -43,6 +44,7 @@ pub use types::{
     AlignedRun, DensityObservation, Direction, FrameId, ObsId, Observation, WordMatch, WordRef,
     push_pair,
 };
+pub use wide::WideWindow;
 pub use words::{Word, WordId, WordLevels};
 
 use crate::geom::OdomPose;

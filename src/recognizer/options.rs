@@ -237,6 +237,10 @@ pub struct DensityOptions {
     pub kernel_radius_m: f64,
     /// Angle between two density rays, degrees. Default 1.0.
     pub ray_step_deg: f64,
+    /// Radius of the wide window, metres: the share of a disc this wide that the laser has seen
+    /// free lately, the wide density Φ, splits Ψ's top class in open space, where Ψ saturates
+    /// (`wide_classes` in `[recognizer.words]`; `recognizer::wide`). 0 turns it off. Default 20.
+    pub wide_radius_m: f64,
 }
 
 impl Default for DensityOptions {
@@ -244,6 +248,7 @@ impl Default for DensityOptions {
         DensityOptions {
             kernel_radius_m: 2.5,
             ray_step_deg: 1.0,
+            wide_radius_m: 20.0,
         }
     }
 }
@@ -269,6 +274,14 @@ impl DensityOptions {
             "(0, 360]",
             "1.0",
         );
+        let w = self.wide_radius_m;
+        p.within(
+            "wide_radius_m",
+            w,
+            w.is_finite() && (w == 0.0 || (1.0..=100.0).contains(&w)),
+            "0 (off) or [1, 100]",
+            "20",
+        );
         p.out
     }
 }
@@ -291,6 +304,12 @@ pub struct WordOptions {
     /// boundaries at its deepest: `A B A` is level 1, `A B C B A` level 2). Default `boundaries`
     /// (see the `words` module doc for why).
     pub multi_level: MultiLevelRule,
+    /// Classes for open space above Ψ's top class, read from the wide density Φ (the share of a
+    /// disc of `wide_radius_m` in `[recognizer.density]` seen free; Ψ saturates in open space):
+    /// an observation of the top class with Φ ≥ ½ has class
+    /// `classes + min(floor(wide_classes·(2Φ − 1)), wide_classes − 1)`. 0 (or a wide window
+    /// turned off) keeps the top class whole. Default 4.
+    pub wide_classes: usize,
 }
 
 impl Default for WordOptions {
@@ -299,6 +318,7 @@ impl Default for WordOptions {
             classes: 8,
             min_word_size: 5,
             multi_level: MultiLevelRule::Boundaries,
+            wide_classes: 4,
         }
     }
 }
@@ -320,6 +340,16 @@ impl WordOptions {
             p.bad(
                 "min_word_size",
                 "must be at least 1 observation; the default is 5".to_string(),
+            );
+        }
+        if self.classes + self.wide_classes > 256 {
+            p.bad(
+                "wide_classes",
+                format!(
+                    "classes + wide_classes must be at most 256, got {} + {}; the default is 4 \
+                     (0: no open-space classes)",
+                    self.classes, self.wide_classes
+                ),
             );
         }
         p.out

@@ -31,6 +31,11 @@ pub struct DensityObservation {
     /// moves its chords (`MatcherOptions::angle_slack`).
     #[serde(default)]
     pub position_slack_m: f64,
+    /// The wide density Φ in [0, 1]: the share of a disc of `wide_radius_m` around the robot
+    /// that the laser has seen free lately (`recognizer::wide`); 0 when the wide window is off.
+    /// It splits Ψ's top class in open space (`WordOptions::wide_classes`).
+    #[serde(default)]
+    pub wide_density: f64,
 }
 
 /// A density observation reads as the neutral observation it carries (`o.travel_m`,

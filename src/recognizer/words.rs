@@ -129,6 +129,8 @@ struct Run {
 #[derive(Clone, Debug)]
 pub struct WordLevels {
     classes: usize,
+    /// Classes added above the top class for open space, by the wide density Φ (0: none).
+    wide_classes: usize,
     min_word_size: usize,
     levels: usize,
     rule: MultiLevelRule,
@@ -169,6 +171,7 @@ impl WordLevels {
     ) -> Self {
         WordLevels {
             classes: classes.clamp(1, 255),
+            wide_classes: 0,
             min_word_size: min_word_size.max(1),
             levels: levels.clamp(1, MAX_LEVELS),
             rule,
@@ -188,16 +191,45 @@ impl WordLevels {
         }
     }
 
+    /// This builder with `wide_classes` classes above Ψ's top class for open space, read from
+    /// the wide density Φ (`WordOptions::wide_classes`; 0: none).
+    pub fn with_wide_classes(mut self, wide_classes: usize) -> Self {
+        self.wide_classes = wide_classes.min(256 - self.classes);
+        self
+    }
+
+    /// How many classes an observation may have: the density classes and the wide ones.
+    pub fn class_count(&self) -> usize {
+        self.classes + self.wide_classes
+    }
+
     /// Density class of Ψ: min(floor(classes·Ψ), classes − 1) (NaN gives class 0).
     pub fn class_of(&self, psi: f64) -> u8 {
         let c = (psi * self.classes as f64).floor();
         (c.max(0.0) as usize).min(self.classes - 1) as u8
     }
 
+    /// Class of an observation: [`Self::class_of`] its Ψ; in the top class, open space (at
+    /// least half the wide disc seen free, Φ ≥ ½) takes one of the `wide_classes` classes above
+    /// it, by uniform steps of Φ over [½, 1].
+    pub fn class_of_observation(&self, psi: f64, wide_density: f64) -> u8 {
+        let q = self.class_of(psi);
+        if self.wide_classes == 0
+            || usize::from(q) + 1 < self.classes
+            || wide_density.is_nan()
+            || wide_density < 0.5
+        {
+            return q;
+        }
+        let w = ((2.0 * wide_density - 1.0) * self.wide_classes as f64).floor();
+        let extra = (w.max(0.0) as usize).min(self.wide_classes - 1);
+        (usize::from(q) + 1 + extra) as u8
+    }
+
     /// Adds one observation; returns the ids of the words it closed (level 0 first).
     pub fn push(&mut self, obs: &DensityObservation) -> Vec<WordId> {
         let i = self.observations.len();
-        let q = self.class_of(obs.psi);
+        let q = self.class_of_observation(obs.psi, obs.wide_density);
         self.observations.push(obs.observation);
         self.psi.push(obs.psi);
         self.lateral_moments.push(obs.lateral_moment);
@@ -491,6 +523,24 @@ impl WordLevels {
 mod tests {
     use super::*;
     use crate::geom::{OdomPose, Pose2};
+
+    /// Open space (the top class, Φ ≥ ½) takes the classes above the top one, by Φ; no other
+    /// class moves, and without wide classes nothing does.
+    #[test]
+    fn only_the_top_class_in_open_space_is_split_by_the_wide_density() {
+        let w = WordLevels::new(8, 5, 1).with_wide_classes(4);
+        assert_eq!(w.class_count(), 12);
+        assert_eq!(w.class_of_observation(0.5, 1.0), 4, "below the top class");
+        assert_eq!(w.class_of_observation(0.9, 0.2), 7, "a room: Φ under ½");
+        assert_eq!(w.class_of_observation(0.9, f64::NAN), 7);
+        assert_eq!(w.class_of_observation(1.0, 0.5), 8);
+        assert_eq!(w.class_of_observation(1.0, 0.6), 8);
+        assert_eq!(w.class_of_observation(1.0, 0.7), 9);
+        assert_eq!(w.class_of_observation(0.9, 0.8), 10);
+        assert_eq!(w.class_of_observation(1.0, 1.0), 11);
+        let plain = WordLevels::new(8, 5, 1);
+        assert_eq!(plain.class_of_observation(1.0, 1.0), 7);
+    }
 
     fn along(points: &[(f64, f64)]) -> Vec<Observation> {
         (points.iter().enumerate())

@@ -1558,6 +1558,7 @@ fn decreasing_travel_is_refused() {
         psi: 0.5,
         lateral_moment: 0.0,
         position_slack_m: 0.0,
+        wide_density: 0.0,
     };
     m.push_observation(&o);
     o.id = 1;
@@ -1914,4 +1915,38 @@ fn density_equals_the_ray_by_ray_reference_on_shipped_scenarios_and_logs() {
         );
         assert!(n > 100, "{name}: only {n} observations");
     }
+}
+
+/// Open space gives words (issue 28 point 3): in the hall world the lap crosses a 44 × 34 m
+/// hall where every cell within the kernel is free, so Ψ sits in its top class all the way
+/// across. Without the wide window that crossing is one word of over 30 m; with it (the
+/// default), the wide density Φ splits it, and no top-class word is longer than 15 m.
+#[test]
+fn the_wide_window_splits_a_hall_crossing_into_words() {
+    let path = super::common::root().join("scenarios/hall.toml");
+    let mut scn = placewords::experiment::load_scenario(&path).unwrap();
+    scn.sim.runs.truncate(1);
+    // Two laps: the lap starts in the middle of the hall, so only the second crosses it whole.
+    let runs = placewords::sim::simulate(&scn.sim, Some(2), &|| {}).unwrap();
+    let longest_open_word_m = |cfg: RecognizerConfig| {
+        let top = (cfg.words.classes - 1) as u8;
+        let mut rec = Recognizer::new(cfg).unwrap();
+        for f in runs[0].frames() {
+            rec.push(f.odom, &f.scan);
+        }
+        rec.finish();
+        (rec.words().level(0))
+            .filter(|w| w.class >= top)
+            .map(|w| w.end_travel_m - w.start_travel_m)
+            .fold(0.0, f64::max)
+    };
+    let mut off = RecognizerConfig::default();
+    off.density.wide_radius_m = 0.0;
+    let without = longest_open_word_m(off);
+    let with = longest_open_word_m(RecognizerConfig::default());
+    assert!(without > 30.0, "without the wide window: {without:.1} m");
+    assert!(
+        with < 15.0,
+        "with it: {with:.1} m (without: {without:.1} m)"
+    );
 }

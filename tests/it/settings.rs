@@ -30,6 +30,20 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ("density.kernel_radius_m", "1.5", "", Input::Dense),
     ("density.ray_step_deg", "5.0", "", Input::Dense),
     ("words.classes", "5", "", Input::Dense),
+    // Smoke has no open space: with two classes, its junctions reach the top class, and a
+    // 3 m window sees half of it free there.
+    (
+        "density.wide_radius_m",
+        "3",
+        "words.classes = 2",
+        Input::Dense,
+    ),
+    (
+        "words.wide_classes",
+        "0",
+        "words.classes = 2\ndensity.wide_radius_m = 3",
+        Input::Dense,
+    ),
     ("words.min_word_size", "3", "", Input::Dense),
     ("matcher.size_tolerance_ratio", "0.6", "", Input::Dense),
     ("matcher.angle_tolerance_deg", "90", "", Input::Dense),

@@ -94,6 +94,7 @@ pub fn observations(
                 psi: s.psi,
                 lateral_moment: 0.0,
                 position_slack_m: 0.0,
+                wide_density: 0.0,
             });
             id += 1;
             input += 1;
