@@ -54,7 +54,7 @@ const EMPTY: Slot = Slot {
     seen_at_m: f64::NEG_INFINITY,
 };
 
-/// Free space seen within a wide radius of the robot ([module docs](self)).
+/// Free space seen within a wide radius of the robot (the `recognizer::wide` module docs).
 #[derive(Clone, Debug)]
 pub struct WideWindow {
     radius_m: f64,
@@ -90,7 +90,7 @@ impl WideWindow {
     }
 
     /// Takes in the scan made at `robot` (odometric pose) after `travel_m` of travel, when one is
-    /// due (a run's first, then every [`INTEGRATE_M`] of travel, or [`INTEGRATE_OPEN_M`] when
+    /// due (a run's first, then every `INTEGRATE_M` of travel, or `INTEGRATE_OPEN_M` when
     /// `open`: the robot is where Φ is read): the cells its beams cross are marked seen free,
     /// up to half a cell before a hit or to the radius.
     pub fn integrate(&mut self, robot: Pose2, scan: &Scan, travel_m: f64, open: bool) {
