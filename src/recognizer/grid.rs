@@ -321,14 +321,14 @@ impl LocalGrid {
             };
             if major_inc.abs() >= 0xFFFF && n < 0x8000 {
                 let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
-                let fraction = (minor_inc & 0xFFFF) as u16;
+                let fraction = (minor_inc & 0xFFFF) as u32;
                 trace_steps(
                     &mut self.cells,
                     self.mask,
                     start,
                     n,
                     step,
-                    minor as usize,
+                    minor.trailing_zeros(),
                     fraction,
                 );
             } else {
@@ -407,9 +407,12 @@ impl LocalGrid {
 }
 
 /// `n` free passes along a DDA from torus index `start`: each step moves `step` (the longer
-/// axis's cell, plus the shorter axis's whole cells per step) and `minor` more when the shorter
-/// axis's 16-bit fraction (from the cell's centre, growing by `fraction`) carries over. The
-/// same cells as the 16.16 DDA with one index update per cell instead of two coordinates.
+/// axis's cell, plus the shorter axis's whole cells per step), and the shorter axis's cell
+/// (`1 << minor_shift` in the index) once more each time its 16-bit fraction, from the cell's
+/// centre and growing by `fraction`, carries over. The same cells as the 16.16 DDA with one
+/// index per cell instead of two coordinates. Step k's index is computed from k alone (the
+/// carries so far are the high half of 0x8000 + k·fraction, which fits 32 bits for k < 2¹⁵), not
+/// from step k − 1's index: the steps do not wait on each other's carry.
 #[inline(always)]
 fn trace_steps(
     cells: &mut [u8],
@@ -417,18 +420,17 @@ fn trace_steps(
     start: usize,
     n: i64,
     step: usize,
-    minor: usize,
-    fraction: u16,
+    minor_shift: u32,
+    fraction: u32,
 ) {
     // Exactly side² cells: indices masked by side² − 1 need no bounds check.
     let cells = &mut cells[..=mask];
-    let (mut i, mut frac) = (start, 0x8000u16);
-    let step_carry = step.wrapping_add(minor);
+    let (mut whole, mut frac) = (start, 0x8000u32);
     for _ in 0..n {
+        let i = whole.wrapping_add(((frac >> 16) as usize) << minor_shift) & mask;
         cells[i] = FREE_NEXT[cells[i] as usize];
-        let (f, carry) = frac.overflowing_add(fraction);
-        frac = f;
-        i = i.wrapping_add(if carry { step_carry } else { step }) & mask;
+        whole = whole.wrapping_add(step);
+        frac += fraction;
     }
 }
 
