@@ -344,29 +344,36 @@ impl LocalGrid {
                 Some(&inv) => inv,
                 None => 65536.0 / n as f64,
             };
-            let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
             let start = self.index(x0, y0);
-            // The longer axis's increment is ±65536 or, rounded down, ±65535: either way its
-            // coordinate moves exactly one cell per step for fewer than 2¹⁵ steps, and only the
-            // other axis's carry varies. Anything else takes the plain DDA.
-            let (major, minor, minor_inc, major_inc) = if dx.abs() >= dy.abs() {
-                (dx.signum(), 1i64 << self.shift, iy, ix)
+            if n < 0x8000 {
+                // The longer axis's increment, n · inv truncated, is 65536 or 65535 (inv is
+                // 65536 / n rounded, so n · inv ≥ 65536 − 2⁻³⁷): either way its coordinate
+                // moves exactly one cell per step for fewer than 2¹⁵ steps, and only the other
+                // axis's carry varies.
+                let (major, minor, d_minor) = if dx.abs() >= dy.abs() {
+                    (dx.signum(), 1i64 << self.shift, dy)
+                } else {
+                    (dy.signum() << self.shift, 1, dx)
+                };
+                let minor_inc = (d_minor as f64 * inv) as i64;
+                if minor == 1 {
+                    let inc = (major << 16).wrapping_add(minor_inc) as u64;
+                    trace_steps_fixed(&mut self.cells, self.mask, start, n, inc);
+                } else {
+                    let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
+                    let fraction = (minor_inc & 0xFFFF) as u32;
+                    trace_steps(
+                        &mut self.cells,
+                        self.mask,
+                        start,
+                        n,
+                        step,
+                        minor.trailing_zeros(),
+                        fraction,
+                    );
+                }
             } else {
-                (dy.signum() << self.shift, 1, ix, iy)
-            };
-            if major_inc.abs() >= 0xFFFF && n < 0x8000 {
-                let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
-                let fraction = (minor_inc & 0xFFFF) as u32;
-                trace_steps(
-                    &mut self.cells,
-                    self.mask,
-                    start,
-                    n,
-                    step,
-                    minor.trailing_zeros(),
-                    fraction,
-                );
-            } else {
+                let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
                 self.trace_dda(x0, y0, n, ix, iy);
             }
         }
@@ -466,6 +473,23 @@ fn trace_steps(
         cells[i] = FREE_NEXT[cells[i] as usize];
         whole = whole.wrapping_add(step);
         frac += fraction;
+    }
+}
+
+/// `n` free passes along a DDA from torus index `start` whose shorter axis is x (one index per
+/// cell): the index in fixed point, 16 bits of fraction from the cell's centre, grows by `inc`
+/// (the longer axis's index step · 2¹⁶ plus the shorter axis's 16.16 increment), and its whole
+/// part is the cell. The same cells as [`trace_steps`] with one add per step (wrapping: the
+/// whole part is taken modulo the torus).
+#[inline(always)]
+fn trace_steps_fixed(cells: &mut [u8], mask: usize, start: usize, n: i64, inc: u64) {
+    // Exactly side² cells: indices masked by side² − 1 need no bounds check.
+    let cells = &mut cells[..=mask];
+    let mut at = ((start as u64) << 16) | 0x8000;
+    for _ in 0..n {
+        let i = (at >> 16) as usize & mask;
+        cells[i] = FREE_NEXT[cells[i] as usize];
+        at = at.wrapping_add(inc);
     }
 }
 
