@@ -76,7 +76,7 @@ fn floor_i32(v: f64) -> i32 {
 /// low 32 bits of the sum hold in two's complement (no saturating cast).
 const ROUNDER: f64 = 6_755_399_441_055_744.0;
 
-/// Quotients a beam's cells may have for [`floor_div`] (checked once per scan).
+/// Quotients a beam's cells may have for `floor_div` (checked once per scan).
 const SMALL_QUOTIENT: f64 = (1u32 << 29) as f64;
 
 /// floor(v / cell_m) exactly as `floor_i32(v / cell_m)`, for |v / cell_m| < 2²⁹, with a product
@@ -479,7 +479,7 @@ fn trace_steps(
 /// `n` free passes along a DDA from torus index `start` whose shorter axis is x (one index per
 /// cell): the index in fixed point, 16 bits of fraction from the cell's centre, grows by `inc`
 /// (the longer axis's index step · 2¹⁶ plus the shorter axis's 16.16 increment), and its whole
-/// part is the cell. The same cells as [`trace_steps`] with one add per step (wrapping: the
+/// part is the cell. The same cells as `trace_steps` with one add per step (wrapping: the
 /// whole part is taken modulo the torus).
 #[inline(always)]
 fn trace_steps_fixed(cells: &mut [u8], mask: usize, start: usize, n: i64, inc: u64) {
