@@ -102,17 +102,6 @@ fn matching(c: &mut Criterion) {
     g.finish();
 }
 
-/// CPU time of this thread so far, nanoseconds (Linux; `None` elsewhere). Wall-clock figures on
-/// a shared machine include time spent waiting for a core; this does not.
-fn thread_cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()?
-        .split_whitespace()
-        .next()?
-        .parse()
-        .ok()
-}
-
 fn whole_recognizer(c: &mut Criterion) {
     let mut g = c.benchmark_group("recognizer_per_lap");
     g.sample_size(10);
@@ -131,20 +120,26 @@ fn whole_recognizer(c: &mut Criterion) {
         }
         // Lap inputs restart at the same odometry: the loop is closed in odometry too.
         let next = &laps[history % laps.len()];
-        if let Some(c0) = thread_cpu_ns() {
+        // One lap's thread CPU (clock_gettime, sub-microsecond), five times on clones of the
+        // recognizer: criterion's figures below are wall clock.
+        let mut lap_ms = Vec::new();
+        let mut pairs = 0usize;
+        for _ in 0..if full_run() { 5 } else { 1 } {
             let mut r = rec.clone();
-            let c1 = thread_cpu_ns().unwrap_or(c0);
-            let pairs: usize = next
+            let c1 = placewords::clock::thread_cpu_s();
+            pairs = next
                 .iter()
                 .flat_map(|(o, s)| r.push(*o, s))
                 .map(|m| m.pair_count())
                 .sum();
-            let c2 = thread_cpu_ns().unwrap_or(c1);
-            eprintln!(
-                "recognizer_per_lap/3_levels/{history}_laps_history: thread CPU time {:.1} ms for one lap ({pairs} aligned pairs)",
-                (c2 - c1) as f64 / 1e6
-            );
+            lap_ms.push((placewords::clock::thread_cpu_s() - c1) * 1e3);
         }
+        let mean_ms = lap_ms.iter().sum::<f64>() / lap_ms.len() as f64;
+        let min_ms = lap_ms.iter().copied().fold(f64::INFINITY, f64::min);
+        eprintln!(
+            "recognizer_per_lap/3_levels/{history}_laps_history: thread CPU per lap {mean_ms:.1} ms mean, {min_ms:.1} ms least of {} ({pairs} aligned pairs)",
+            lap_ms.len()
+        );
         g.bench_function(format!("3_levels/{history}_laps_history"), |b| {
             b.iter_batched(
                 || rec.clone(),

@@ -72,6 +72,30 @@ fn floor_i32(v: f64) -> i32 {
     if (t as f64) > v { t - 1 } else { t }
 }
 
+/// 1.5 · 2⁵²: a double of magnitude below 2⁵¹ added to it is rounded to an integer, which the
+/// low 32 bits of the sum hold in two's complement (no saturating cast).
+const ROUNDER: f64 = 6_755_399_441_055_744.0;
+
+/// Quotients a beam's cells may have for `floor_div` (checked once per scan).
+const SMALL_QUOTIENT: f64 = (1u32 << 29) as f64;
+
+/// floor(v / cell_m) exactly as `floor_i32(v / cell_m)`, for |v / cell_m| < 2²⁹, with a product
+/// instead of the division: v · inv_cell (inv_cell = 1 / cell_m rounded) is within
+/// |v / cell_m| · 2⁻⁵² < 2⁻²³ of the exact quotient, and the rounded division within 2⁻²⁴ of
+/// it, so when the product is more than 10⁻⁶ from an integer both have the same floor. Nearer
+/// an integer (about 2 quotients in a million) it divides.
+#[inline(always)]
+fn floor_div(v: f64, cell_m: f64, inv_cell: f64) -> i32 {
+    let q = v * inv_cell;
+    let r = q + ROUNDER;
+    let nearest = r - ROUNDER;
+    if (q - nearest).abs() > 1e-6 {
+        (r.to_bits() as i32) - i32::from(nearest > q)
+    } else {
+        floor_i32(v / cell_m)
+    }
+}
+
 /// The rolling local grid.
 #[derive(Clone, Debug)]
 pub struct LocalGrid {
@@ -240,41 +264,52 @@ impl LocalGrid {
             return;
         }
         let n = scan.layout.count.min(scan.ranges_m.len());
+        let ranges = &scan.ranges_m[..n];
+        let max_range_m = scan.layout.max_range_m;
         let step = scan.layout.step_rad.abs();
         // Beam directions by rotation, not a sin_cos per beam (drift over 1000 beams ~1e-13).
         let (mut s, mut c) = (sensor.theta + scan.layout.start_angle_rad).sin_cos();
         let (ds, dc) = scan.layout.step_rad.sin_cos();
-        // Where beams with t trailing zeros start (t < 4; the others start at the sensor): once
-        // per scan rather than a division per beam.
-        let starts: [f64; 4] = std::array::from_fn(|t| {
-            if step <= 0.0 {
+        // Where beam i starts, by i mod 16 (beams with t trailing zeros, t < 4, start where
+        // beams 2^(t+1) steps apart are half a cell apart; the others, i mod 16 = 0, at the
+        // sensor): once per scan rather than a division per beam.
+        let starts: [f64; 16] = std::array::from_fn(|j| {
+            let t = j.trailing_zeros();
+            if j == 0 || step <= 0.0 {
                 0.0
             } else {
                 0.5 * self.cell_m / (step * (1u32 << (t + 1)) as f64)
             }
         });
-        for i in 0..n {
-            let r = scan.ranges_m[i];
+        let (cell_m, inv_cell) = (self.cell_m, 1.0 / self.cell_m);
+        // Every traced point lies within `reach` of the sensor: when their quotients are small
+        // (always, short of 2.6e7 m from the origin at 5 cm cells), cells come from a product.
+        let far = (sensor.x.abs().max(sensor.y.abs()) + reach) / cell_m + 2.0;
+        let small = far < SMALL_QUOTIENT;
+        let cell = |x: f64, y: f64| {
+            if small {
+                (
+                    floor_div(x, cell_m, inv_cell),
+                    floor_div(y, cell_m, inv_cell),
+                )
+            } else {
+                (floor_i32(x / cell_m), floor_i32(y / cell_m))
+            }
+        };
+        for (i, &r) in ranges.iter().enumerate() {
             let (bs, bc) = (s, c);
             (s, c) = (s * dc + c * ds, c * dc - s * ds);
             if r.is_nan() || r <= 0.0 {
                 continue;
             }
-            let (len, hit) = if scan.is_hit(i) && r <= reach {
-                (r, true)
-            } else {
-                (r.min(reach), false)
-            };
+            // A return (`Scan::is_hit`: finite, below the maximum range) within the radius.
+            let hit = r <= reach && r < max_range_m;
+            let len = r.min(reach);
             // Near the sensor neighbouring beams pass through the same cells: beam i starts
             // where beams 2^(t+1) steps apart (t: trailing zeros of i) get more than half a
             // cell apart, so the cells there are still crossed by the sparser beams.
-            let t = if i == 0 {
-                31
-            } else {
-                i.trailing_zeros().min(31)
-            };
-            let start = if t >= 4 { 0.0 } else { starts[t as usize] };
-            let (ex, ey) = self.cell_of(sensor.x + bc * len, sensor.y + bs * len);
+            let start = starts[i & 15];
+            let (ex, ey) = cell(sensor.x + bc * len, sensor.y + bs * len);
             if start >= len {
                 if hit {
                     self.mark(ex, ey, true);
@@ -282,7 +317,7 @@ impl LocalGrid {
                 continue;
             }
             let (bx, by) = if start > 0.0 {
-                self.cell_of(sensor.x + bc * start, sensor.y + bs * start)
+                cell(sensor.x + bc * start, sensor.y + bs * start)
             } else {
                 (sx, sy)
             };
@@ -309,29 +344,36 @@ impl LocalGrid {
                 Some(&inv) => inv,
                 None => 65536.0 / n as f64,
             };
-            let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
             let start = self.index(x0, y0);
-            // The longer axis's increment is ±65536 or, rounded down, ±65535: either way its
-            // coordinate moves exactly one cell per step for fewer than 2¹⁵ steps, and only the
-            // other axis's carry varies. Anything else takes the plain DDA.
-            let (major, minor, minor_inc, major_inc) = if dx.abs() >= dy.abs() {
-                (dx.signum(), 1i64 << self.shift, iy, ix)
+            if n < 0x8000 {
+                // The longer axis's increment, n · inv truncated, is 65536 or 65535 (inv is
+                // 65536 / n rounded, so n · inv ≥ 65536 − 2⁻³⁷): either way its coordinate
+                // moves exactly one cell per step for fewer than 2¹⁵ steps, and only the other
+                // axis's carry varies.
+                let (major, minor, d_minor) = if dx.abs() >= dy.abs() {
+                    (dx.signum(), 1i64 << self.shift, dy)
+                } else {
+                    (dy.signum() << self.shift, 1, dx)
+                };
+                let minor_inc = (d_minor as f64 * inv) as i64;
+                if minor == 1 {
+                    let inc = (major << 16).wrapping_add(minor_inc) as u64;
+                    trace_steps_fixed(&mut self.cells, self.mask, start, n, inc);
+                } else {
+                    let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
+                    let fraction = (minor_inc & 0xFFFF) as u32;
+                    trace_steps(
+                        &mut self.cells,
+                        self.mask,
+                        start,
+                        n,
+                        step,
+                        minor.trailing_zeros(),
+                        fraction,
+                    );
+                }
             } else {
-                (dy.signum() << self.shift, 1, ix, iy)
-            };
-            if major_inc.abs() >= 0xFFFF && n < 0x8000 {
-                let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
-                let fraction = (minor_inc & 0xFFFF) as u16;
-                trace_steps(
-                    &mut self.cells,
-                    self.mask,
-                    start,
-                    n,
-                    step,
-                    minor as usize,
-                    fraction,
-                );
-            } else {
+                let (ix, iy) = ((dx as f64 * inv) as i64, (dy as f64 * inv) as i64);
                 self.trace_dda(x0, y0, n, ix, iy);
             }
         }
@@ -407,9 +449,12 @@ impl LocalGrid {
 }
 
 /// `n` free passes along a DDA from torus index `start`: each step moves `step` (the longer
-/// axis's cell, plus the shorter axis's whole cells per step) and `minor` more when the shorter
-/// axis's 16-bit fraction (from the cell's centre, growing by `fraction`) carries over. The
-/// same cells as the 16.16 DDA with one index update per cell instead of two coordinates.
+/// axis's cell, plus the shorter axis's whole cells per step), and the shorter axis's cell
+/// (`1 << minor_shift` in the index) once more each time its 16-bit fraction, from the cell's
+/// centre and growing by `fraction`, carries over. The same cells as the 16.16 DDA with one
+/// index per cell instead of two coordinates. Step k's index is computed from k alone (the
+/// carries so far are the high half of 0x8000 + k·fraction, which fits 32 bits for k < 2¹⁵), not
+/// from step k − 1's index: the steps do not wait on each other's carry.
 #[inline(always)]
 fn trace_steps(
     cells: &mut [u8],
@@ -417,18 +462,34 @@ fn trace_steps(
     start: usize,
     n: i64,
     step: usize,
-    minor: usize,
-    fraction: u16,
+    minor_shift: u32,
+    fraction: u32,
 ) {
     // Exactly side² cells: indices masked by side² − 1 need no bounds check.
     let cells = &mut cells[..=mask];
-    let (mut i, mut frac) = (start, 0x8000u16);
-    let step_carry = step.wrapping_add(minor);
+    let (mut whole, mut frac) = (start, 0x8000u32);
     for _ in 0..n {
+        let i = whole.wrapping_add(((frac >> 16) as usize) << minor_shift) & mask;
         cells[i] = FREE_NEXT[cells[i] as usize];
-        let (f, carry) = frac.overflowing_add(fraction);
-        frac = f;
-        i = i.wrapping_add(if carry { step_carry } else { step }) & mask;
+        whole = whole.wrapping_add(step);
+        frac += fraction;
+    }
+}
+
+/// `n` free passes along a DDA from torus index `start` whose shorter axis is x (one index per
+/// cell): the index in fixed point, 16 bits of fraction from the cell's centre, grows by `inc`
+/// (the longer axis's index step · 2¹⁶ plus the shorter axis's 16.16 increment), and its whole
+/// part is the cell. The same cells as `trace_steps` with one add per step (wrapping: the
+/// whole part is taken modulo the torus).
+#[inline(always)]
+fn trace_steps_fixed(cells: &mut [u8], mask: usize, start: usize, n: i64, inc: u64) {
+    // Exactly side² cells: indices masked by side² − 1 need no bounds check.
+    let cells = &mut cells[..=mask];
+    let mut at = ((start as u64) << 16) | 0x8000;
+    for _ in 0..n {
+        let i = (at >> 16) as usize & mask;
+        cells[i] = FREE_NEXT[cells[i] as usize];
+        at = at.wrapping_add(inc);
     }
 }
 
@@ -446,6 +507,134 @@ pub struct Density {
 mod tests {
     use super::*;
     use crate::recognizer::density::CELL_OCCUPIED_FROM;
+
+    /// `integrate` as it was written before its per-beam shortcuts (cells by division, the hit
+    /// test of `Scan::is_hit`, the start by trailing zeros): the reference for exactness.
+    fn integrate_plain(grid: &mut LocalGrid, odom: &OdomPose, scan: &Scan) {
+        let robot = odom.0;
+        let (rcx, rcy) = grid.cell_of(robot.x, robot.y);
+        grid.recenter(rcx, rcy);
+        let mount = &scan.layout.mount;
+        let sensor: Pose2 = robot.compose(mount);
+        let reach = (grid.radius_m - mount.x.hypot(mount.y)).max(0.0);
+        let (sx, sy) = grid.cell_of(sensor.x, sensor.y);
+        if !grid.inside(sx, sy) {
+            return;
+        }
+        let step = scan.layout.step_rad.abs();
+        let (mut s, mut c) = (sensor.theta + scan.layout.start_angle_rad).sin_cos();
+        let (ds, dc) = scan.layout.step_rad.sin_cos();
+        for i in 0..scan.layout.count.min(scan.ranges_m.len()) {
+            let r = scan.ranges_m[i];
+            let (bs, bc) = (s, c);
+            (s, c) = (s * dc + c * ds, c * dc - s * ds);
+            if r.is_nan() || r <= 0.0 {
+                continue;
+            }
+            let (len, hit) = if scan.is_hit(i) && r <= reach {
+                (r, true)
+            } else {
+                (r.min(reach), false)
+            };
+            let t = if i == 0 { 31 } else { i.trailing_zeros() };
+            let start = if t >= 4 || step <= 0.0 {
+                0.0
+            } else {
+                0.5 * grid.cell_m / (step * (1u32 << (t + 1)) as f64)
+            };
+            let (ex, ey) = grid.cell_of(sensor.x + bc * len, sensor.y + bs * len);
+            if start >= len {
+                if hit {
+                    grid.mark(ex, ey, true);
+                }
+                continue;
+            }
+            let (bx, by) = if start > 0.0 {
+                grid.cell_of(sensor.x + bc * start, sensor.y + bs * start)
+            } else {
+                (sx, sy)
+            };
+            grid.trace(bx, by, ex, ey, hit);
+        }
+    }
+
+    /// `integrate` leaves every cell as the plain per-beam code does: random poses (far from
+    /// the origin too, where the product floor is not used), ranges with misses, no-returns,
+    /// NaN and non-positive readings.
+    #[test]
+    fn integrate_equals_the_plain_per_beam_code() {
+        use crate::scan::BeamLayout;
+        let mut seed = 3u64;
+        let mut unit = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let layout =
+            BeamLayout::centered(181, std::f64::consts::PI, 8.0, Pose2::new(0.021, 0.0, 0.0));
+        let mut fast = LocalGrid::with_memory(0.05, 3.0, 6.4, 7.5);
+        let mut plain = fast.clone();
+        let (mut x, mut y) = (0.0, 0.0);
+        for k in 0..3000 {
+            if k % 1000 == 0 {
+                // Jump: near the origin, far away, beyond the product floor's range.
+                (x, y) = [(0.3, -0.7), (1.0e5, -2.5e4), (3.0e7, 1.0)][k / 1000];
+            }
+            x += unit() * 0.2 - 0.05;
+            y += unit() * 0.2 - 0.1;
+            let odom = OdomPose(Pose2::new(x, y, unit() * 7.0 - 3.5));
+            let ranges_m = (0..181)
+                .map(|_| match (unit() * 20.0) as u32 {
+                    0 => f64::NAN,
+                    1 => 0.0,
+                    2 => 8.0,
+                    3 => f64::INFINITY,
+                    _ => unit() * 5.0,
+                })
+                .collect();
+            let scan = Scan {
+                layout: layout.clone(),
+                ranges_m,
+                time_s: 0.0,
+            };
+            fast.integrate(&odom, &scan);
+            integrate_plain(&mut plain, &odom, &scan);
+            assert_eq!(fast.cells, plain.cells, "scan {k}");
+        }
+        assert!(fast.cells.iter().any(|&v| v >= CELL_OCCUPIED_FROM));
+    }
+
+    /// The product floor is the division's floor, also for quotients within an ulp of an
+    /// integer (where the product alone may round to the other side), at several cell sizes.
+    #[test]
+    fn floor_div_equals_the_division() {
+        let mut seed = 11u64;
+        let mut next = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            seed >> 11
+        };
+        for cell_m in [0.05, 0.1, 0.03, 0.07, 0.2, 1.0 / 3.0] {
+            let inv = 1.0 / cell_m;
+            for _ in 0..200_000 {
+                let k = (next() % 2_000_000) as f64 - 1_000_000.0;
+                // On a cell border, a few ulps either side, or anywhere in the cell.
+                let v = match next() % 4 {
+                    0 => k * cell_m,
+                    1 => f64::from_bits((k * cell_m).to_bits() + next() % 5),
+                    2 => f64::from_bits((k * cell_m).to_bits().saturating_sub(next() % 5)),
+                    _ => (k + (next() % 1000) as f64 / 1000.0) * cell_m,
+                };
+                assert_eq!(
+                    floor_div(v, cell_m, inv),
+                    floor_i32(v / cell_m),
+                    "{v} / {cell_m}"
+                );
+            }
+        }
+    }
 
     /// The one-index trace updates exactly the cells of the plain 16.16 DDA, in the same order
     /// (a counter passed twice by one beam moves twice), across the torus's edges too.
