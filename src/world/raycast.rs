@@ -460,21 +460,16 @@ impl RelSegment {
 /// hit something within `dmin` are skipped.
 fn hit_beams(s: &Sensor, g: &RelSegment, i0: usize, i1: usize, dmin: f64, out: &mut [f64]) {
     let beams = i0..i1 + 1;
+    // Without branches: whether a beam hits depends on the quotients, and mispredicted
+    // branches waiting on two divisions cost more than dividing for every beam.
     for (o, &[bx, by]) in out[beams.clone()].iter_mut().zip(&s.dirs[beams]) {
-        if *o <= dmin {
-            continue;
-        }
         let denom = bx * g.ey - by * g.ex;
         // A parallel beam (denom 0) needs no test of its own: pe ≠ 0, so t is ±∞ and is
-        // rejected below like any hit behind the sensor or beyond the beam's range.
+        // rejected like any hit behind the sensor or beyond the beam's range.
         let t = g.pe / denom;
-        if t <= 0.0 || t >= *o {
-            continue;
-        }
         let u = (g.px * by - g.py * bx) / denom;
-        if (0.0..=1.0).contains(&u) {
-            *o = t;
-        }
+        let miss = (*o <= dmin) | (t <= 0.0) | (t >= *o) | !(0.0..=1.0).contains(&u);
+        *o = if miss { *o } else { t };
     }
 }
 
@@ -644,17 +639,14 @@ pub fn fast_atan2(y: f64, x: f64) -> f64 {
     let a = mn / mx;
     let s = a * a;
     // Odd minimax polynomial for atan on [0, 1] (max error about 1e-5 rad).
-    let mut r = a
+    let r = a
         * (0.999_977_26
             + s * (-0.332_623_47
                 + s * (0.193_543_46
                     + s * (-0.116_432_87 + s * (0.052_653_32 - 0.011_721_20 * s)))));
-    if ay > ax {
-        r = PI / 2.0 - r;
-    }
-    if x < 0.0 {
-        r = PI - r;
-    }
+    // Selects rather than branches (the octant is unpredictable).
+    let r = if ay > ax { PI / 2.0 - r } else { r };
+    let r = if x < 0.0 { PI - r } else { r };
     if y < 0.0 { -r } else { r }
 }
 
