@@ -1,5 +1,6 @@
 //! Simulator benchmarks: one 181-beam scan on an institute-floor-sized world at both laser
-//! presets, one simulation step (physics, controller, odometry, and a scan every other step),
+//! presets (and the `lms200` scan again timed by the thread's CPU clock, `_cpu`: on a shared
+//! machine wall clock counts the waits for a core), one simulation step (physics, controller, odometry, and a scan every other step),
 //! and one full lap; writing and reading one lap as a lap cache entry (`io::lap_file`). Setup
 //! stays outside the timed part.
 //!
@@ -15,6 +16,7 @@ use placewords::world::DoorStates;
 use placewords::world::raycast::SweepCaster;
 use std::hint::black_box;
 use std::path::Path;
+use std::time::Duration;
 
 /// Scenario B on `worlds/institute-floor.toml` (the shipped floor: 180 m lap, 77 doors).
 fn scenario() -> Scenario {
@@ -44,22 +46,33 @@ fn bench_scan(c: &mut Criterion) {
             poses.push(Pose2::new(p.x, p.y, th));
         }
     }
-    for (name, preset) in [
-        ("scan_181_lms200", LaserPreset::Lms200),
-        ("scan_181_lms200_mm", LaserPreset::Lms200Mm),
+    for (name, preset, cpu) in [
+        ("scan_181_lms200", LaserPreset::Lms200, false),
+        ("scan_181_lms200_mm", LaserPreset::Lms200Mm, false),
+        ("scan_181_lms200_cpu", LaserPreset::Lms200, true),
     ] {
         let mut rng = stream(1, 0, 0, Purpose::LaserAngles);
         let laser = Laser::new(LaserConfig::preset(preset), &mut rng);
         let mut noise = stream(1, 0, 0, Purpose::LaserNoise);
         let mut ranges = Vec::with_capacity(181);
         let mut i = 0;
+        let mut scan = || {
+            i = (i + 1) % poses.len();
+            laser.exact_ranges(&caster, poses[i], &[], &mut ranges);
+            laser.add_noise(&mut ranges, &mut noise);
+            black_box(&ranges);
+        };
         c.bench_function(name, |b| {
-            b.iter(|| {
-                i = (i + 1) % poses.len();
-                laser.exact_ranges(&caster, poses[i], &[], &mut ranges);
-                laser.add_noise(&mut ranges, &mut noise);
-                black_box(&ranges);
-            })
+            if cpu {
+                // Not under valgrind: rustix's vDSO lookup for the CPU clock crashes there.
+                b.iter_custom(|n| {
+                    let t0 = placewords::clock::thread_cpu_s();
+                    (0..n).for_each(|_| scan());
+                    Duration::from_secs_f64(placewords::clock::thread_cpu_s() - t0)
+                })
+            } else {
+                b.iter(&mut scan)
+            }
         });
     }
 }

@@ -194,7 +194,7 @@ impl Laser {
                 } else {
                     *r
                 };
-                *r = ((noisy * 1000.0).round() / 1000.0).clamp(0.0, max);
+                *r = (round_half_away(noisy * 1000.0) / 1000.0).clamp(0.0, max);
             }
         }
     }
@@ -216,5 +216,65 @@ impl Laser {
             ranges_m: ranges,
             time_s,
         }
+    }
+}
+
+/// `x.round()` (halves away from zero, the sign of zero kept) without the software `round`
+/// the baseline x86-64 target calls for it. Below 2⁵², adding and taking away 2⁵² rounds the
+/// magnitude to the nearest whole number with ties to even, exactly; the remainder, also exact,
+/// is ½ only for the ties that went down, which `round` takes up. From 2⁵² on every f64 is whole.
+#[inline]
+fn round_half_away(x: f64) -> f64 {
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    let a = x.abs();
+    if a >= TWO_52 || a.is_nan() {
+        return x; // already whole, or not finite
+    }
+    let mut y = (a + TWO_52) - TWO_52;
+    if a - y == 0.5 {
+        y += 1.0;
+    }
+    y.copysign(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_half_away_is_round() {
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            2.5,
+            -2.5,
+            0.499_999_999_999_999_94,
+            -0.499_999_999_999_999_94,
+            4_503_599_627_370_495.5,
+            4_503_599_627_370_497.0,
+            -4_503_599_627_370_495.5,
+            1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+        ];
+        // Every millimetre half-way point and its neighbours over the laser's ranges.
+        for k in -40_000i64..=40_000 {
+            let h = k as f64 + 0.5;
+            xs.extend([
+                h,
+                f64::from_bits(h.to_bits() + 1),
+                f64::from_bits(h.to_bits() - 1),
+            ]);
+            xs.push(k as f64 * 0.001_3 * 1000.0);
+        }
+        for x in xs {
+            assert_eq!(round_half_away(x).to_bits(), x.round().to_bits(), "{x}");
+        }
+        assert!(round_half_away(f64::NAN).is_nan());
     }
 }

@@ -31,6 +31,9 @@ pub struct Disc {
 pub struct Beams {
     start_rad: f64,
     step_rad: f64,
+    /// 1 / `step_rad`: index ranges are widened by `margin_beams`, far more than the rounding
+    /// of a product instead of a quotient.
+    per_step: f64,
     /// cos and sin of each beam's true angle in the sensor frame.
     dirs: Vec<(f64, f64)>,
     /// How many beams to widen each covered index range by (angle errors, rounding).
@@ -63,6 +66,7 @@ impl Beams {
         Beams {
             start_rad,
             step_rad,
+            per_step: 1.0 / step_rad,
             dirs,
             margin_beams,
             front_only,
@@ -83,23 +87,24 @@ impl Beams {
         if self.step_rad <= 0.0 {
             return Some((0, n - 1));
         }
-        let x0 = (lo - self.start_rad) / self.step_rad - self.margin_beams;
-        let x1 = (hi - self.start_rad) / self.step_rad + self.margin_beams;
+        let x0 = (lo - self.start_rad) * self.per_step - self.margin_beams;
+        let x1 = (hi - self.start_rad) * self.per_step + self.margin_beams;
         let last = (n - 1) as f64;
-        if x1 < 0.0 || x0 > last || x0 > x1 {
+        if !(x1 >= 0.0 && x0 <= last && x0 <= x1) {
             return None;
         }
-        // ceil and floor by truncation (both are within [0, n-1] after clamping; avoids libm).
-        let x0 = x0.max(0.0);
-        let mut i0 = x0 as usize;
+        // ceil and floor by truncation (both are within [0, n-1] after clamping; avoids libm;
+        // i64 converts in fewer instructions than usize).
+        let x0 = if x0 > 0.0 { x0 } else { 0.0 };
+        let mut i0 = x0 as i64;
         if (i0 as f64) < x0 {
             i0 += 1;
         }
-        let i1 = (x1.min(last) as usize).min(n - 1);
+        let i1 = (if x1 < last { x1 } else { last }) as i64;
         if i0 > i1 {
             return None;
         }
-        Some((i0, i1))
+        Some((i0 as usize, i1 as usize))
     }
 }
 
@@ -161,8 +166,8 @@ struct Sensor<'a> {
     hs: f64,
     max_range_m: f64,
     beams: &'a Beams,
-    dx: &'a [f64],
-    dy: &'a [f64],
+    /// World-frame direction `[x, y]` of each beam.
+    dirs: &'a [[f64; 2]],
 }
 
 impl Sensor<'_> {
@@ -300,20 +305,13 @@ impl SweepCaster {
         out.clear();
         out.resize(n, max_range_m);
         let (hs, hc) = heading_rad.sin_cos();
-        // World-frame beam directions.
-        let mut dx = [0.0f64; 512];
-        let mut dy = [0.0f64; 512];
-        let mut heap;
-        let (dx, dy): (&mut [f64], &mut [f64]) = if n <= 512 {
-            (&mut dx[..n], &mut dy[..n])
-        } else {
-            heap = (vec![0.0; n], vec![0.0; n]);
-            (&mut heap.0[..], &mut heap.1[..])
-        };
-        for (i, &(c, s)) in beams.dirs.iter().enumerate() {
-            dx[i] = hc * c - hs * s;
-            dy[i] = hs * c + hc * s;
-        }
+        // World-frame beam directions, collected rather than written into a zeroed buffer (the
+        // zeroing cost more than the allocation).
+        let dirs: Vec<[f64; 2]> = beams
+            .dirs
+            .iter()
+            .map(|&(c, s)| [hc * c - hs * s, hs * c + hc * s])
+            .collect();
         let sensor = Sensor {
             ox: origin.x,
             oy: origin.y,
@@ -321,8 +319,7 @@ impl SweepCaster {
             hs,
             max_range_m,
             beams,
-            dx,
-            dy,
+            dirs: &dirs,
         };
         self.sweep_cells(&sensor, out);
         for d in discs {
@@ -339,11 +336,20 @@ impl SweepCaster {
         }
         let mut swept = vec![0u64; self.segs.len().div_ceil(64)];
         let (ci, cj) = g.cell_of(s.ox, s.oy);
+        // Beams before `open` hit something within an earlier ring's bound; ranges only shrink
+        // and the bound only grows, so they never need looking at again.
+        let mut open = 0;
         for k in 0..=g.last_ring(ci, cj) {
             // Every point of ring k is at least this far from the sensor.
             let ring_min = (k - 1) as f64 * g.cell_m() - CELL_SLACK_M;
-            if ring_min >= s.max_range_m || (k >= 2 && out.iter().all(|&o| o <= ring_min)) {
+            if ring_min >= s.max_range_m {
                 break;
+            }
+            if k >= 2 {
+                open += out[open..].iter().take_while(|&&o| o <= ring_min).count();
+                if open == out.len() {
+                    break;
+                }
             }
             for strip in g.ring(ci, cj, k).into_iter().flatten() {
                 if in_view(s, g.cells_rect(strip)).is_some() {
@@ -398,7 +404,10 @@ impl SweepCaster {
     fn relative(&self, s: &Sensor, k: usize) -> Option<(RelSegment, f64)> {
         let seg = &self.segs[k];
         let (px, py, qx, qy) = (seg[0] - s.ox, seg[1] - s.oy, seg[2] - s.ox, seg[3] - s.oy);
-        let d2 = box_distance_sq(px.min(qx), py.min(qy), px.max(qx), py.max(qy));
+        // Ordered by comparison rather than f64::min/max (no NaN handling needed: finite).
+        let (x0, x1) = if px <= qx { (px, qx) } else { (qx, px) };
+        let (y0, y1) = if py <= qy { (py, qy) } else { (qy, py) };
+        let d2 = box_distance_sq(x0, y0, x1, y1);
         if d2 >= s.max_range_m * s.max_range_m {
             return None;
         }
@@ -449,26 +458,18 @@ impl RelSegment {
 
 /// Intersects a segment with beams `i0..=i1`, keeping each beam's nearest hit; beams that already
 /// hit something within `dmin` are skipped.
-// Beams are indexed into three parallel arrays (dx, dy, out): an index loop reads clearest.
-#[allow(clippy::needless_range_loop)]
 fn hit_beams(s: &Sensor, g: &RelSegment, i0: usize, i1: usize, dmin: f64, out: &mut [f64]) {
-    for i in i0..=i1 {
-        if out[i] <= dmin {
-            continue;
-        }
-        let (bx, by) = (s.dx[i], s.dy[i]);
+    let beams = i0..i1 + 1;
+    // Without branches: whether a beam hits depends on the quotients, and mispredicted
+    // branches waiting on two divisions cost more than dividing for every beam.
+    for (o, &[bx, by]) in out[beams.clone()].iter_mut().zip(&s.dirs[beams]) {
         let denom = bx * g.ey - by * g.ex;
-        if denom == 0.0 {
-            continue;
-        }
+        // A parallel beam (denom 0) needs no test of its own: pe ≠ 0, so t is ±∞ and is
+        // rejected like any hit behind the sensor or beyond the beam's range.
         let t = g.pe / denom;
-        if t <= 0.0 || t >= out[i] {
-            continue;
-        }
         let u = (g.px * by - g.py * bx) / denom;
-        if (0.0..=1.0).contains(&u) {
-            out[i] = t;
-        }
+        let miss = (*o <= dmin) | (t <= 0.0) | (t >= *o) | !(0.0..=1.0).contains(&u);
+        *o = if miss { *o } else { t };
     }
 }
 
@@ -563,9 +564,11 @@ fn cell_span(s: &Sensor, rect: [f64; 4], out: &[f64]) -> Option<BeamSpan> {
     };
     let lo = ap - ATAN2_TOL_RAD;
     for_each_range(s.beams, lo, lo + span + 2.0 * ATAN2_TOL_RAD, |i0, i1| {
-        let open = |i: &usize| out[*i] > dmin;
-        if let Some(a) = (i0..=i1).find(open) {
-            let b = (a..=i1).rev().find(open).unwrap_or(a);
+        let beams = &out[i0..i1 + 1];
+        let open = |o: &f64| *o > dmin;
+        if let Some(a) = beams.iter().position(open) {
+            let b = beams.iter().rposition(open).unwrap_or(a);
+            let (a, b) = (i0 + a, i0 + b);
             bs.ranges[bs.len] = (a, b);
             bs.len += 1;
             bs.beams += b - a + 1;
@@ -575,7 +578,7 @@ fn cell_span(s: &Sensor, rect: [f64; 4], out: &[f64]) -> Option<BeamSpan> {
 }
 
 /// Intersects a disc with the beams it covers.
-// Beams are indexed into parallel arrays (dx, dy, out): an index loop reads clearest.
+// Beams are indexed into parallel arrays (dirs, out): an index loop reads clearest.
 #[allow(clippy::needless_range_loop)]
 fn sweep_disc(s: &Sensor, d: &Disc, out: &mut [f64]) {
     let (cx, cy) = (d.centre.x - s.ox, d.centre.y - s.oy);
@@ -596,7 +599,8 @@ fn sweep_disc(s: &Sensor, d: &Disc, out: &mut [f64]) {
     let half = (d.radius_m / dist).asin() + ATAN2_TOL_RAD;
     let mut hit = |i0: usize, i1: usize| {
         for i in i0..=i1 {
-            let b = s.dx[i] * cx + s.dy[i] * cy;
+            let [bx, by] = s.dirs[i];
+            let b = bx * cx + by * cy;
             let disc = b * b - (c2 - r2);
             if disc < 0.0 || b <= 0.0 {
                 continue;
@@ -627,24 +631,22 @@ fn sweep_disc(s: &Sensor, d: &Disc, out: &mut [f64]) {
 pub fn fast_atan2(y: f64, x: f64) -> f64 {
     let ax = x.abs();
     let ay = y.abs();
-    let mx = ax.max(ay);
+    // By comparison rather than f64::max/min, which also order NaNs.
+    let (mn, mx) = if ay > ax { (ax, ay) } else { (ay, ax) };
     if mx == 0.0 {
         return 0.0;
     }
-    let a = ax.min(ay) / mx;
+    let a = mn / mx;
     let s = a * a;
     // Odd minimax polynomial for atan on [0, 1] (max error about 1e-5 rad).
-    let mut r = a
+    let r = a
         * (0.999_977_26
             + s * (-0.332_623_47
                 + s * (0.193_543_46
                     + s * (-0.116_432_87 + s * (0.052_653_32 - 0.011_721_20 * s)))));
-    if ay > ax {
-        r = PI / 2.0 - r;
-    }
-    if x < 0.0 {
-        r = PI - r;
-    }
+    // Selects rather than branches (the octant is unpredictable).
+    let r = if ay > ax { PI / 2.0 - r } else { r };
+    let r = if x < 0.0 { PI - r } else { r };
     if y < 0.0 { -r } else { r }
 }
 
