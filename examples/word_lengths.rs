@@ -3,7 +3,7 @@
 //!
 //! ```text
 //! cargo run --release --example word_lengths -- scenarios/hall.toml --seed 1
-//! cargo run --release --example word_lengths -- ../shared/data/carmen/intel.gfs.log.gz
+//! cargo run --release --example word_lengths -- ../shared/data/carmen/intel-corrected.log.gz --wide-radius-m 0
 //! ```
 
 use anyhow::{Result, bail};
@@ -27,6 +27,9 @@ struct Args {
     /// Print every word of the first run (else only the summary).
     #[arg(long)]
     list: bool,
+    /// `[recognizer.density] wide_radius_m` instead of the settings' (0: no wide window).
+    #[arg(long)]
+    wide_radius_m: Option<f64>,
 }
 
 fn main() -> ExitCode {
@@ -62,7 +65,10 @@ fn load(args: &Args) -> Result<(Vec<RunLog>, RecognizerConfig)> {
 }
 
 fn run(args: &Args) -> Result<()> {
-    let (runs, cfg) = load(args)?;
+    let (runs, mut cfg) = load(args)?;
+    if let Some(r) = args.wide_radius_m {
+        cfg.density.wide_radius_m = r;
+    }
     let truth = GroundTruth::from_runs(&runs);
     let mut rec = Recognizer::new(cfg)?;
     let mut frame = 0;
