@@ -5,6 +5,7 @@
 //! millions of laps to pass it).
 
 use foldhash::HashMap;
+use std::cell::Cell;
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// `a` in the high half, `b` in the low half.
@@ -93,6 +94,9 @@ impl PairSet {
     }
 }
 
+/// A line `(step, key)`, an interval of `q` along it, and whether the interval is held.
+type Lookup = (i8, i64, [usize; 2], bool);
+
 /// A set of index pairs `(q, p)` kept as intervals of `q` along the lines `p = key + step·q`
 /// of the runs that made them (a match's aligned run of step `step` lies on one such line), so
 /// a run of pairs costs one interval, not an entry per pair, and a pair is looked up in a small
@@ -108,6 +112,9 @@ pub struct RunSet {
     steps: Vec<i8>,
     /// The interval being extended by consecutive inserts, not yet in `lines`.
     open: Option<(i8, i64, [usize; 2])>,
+    /// The last lookup in `lines`: a line, an interval of it held or a gap between two, and
+    /// which (the pairs of a run are looked up one after the other along one line).
+    last: Cell<Option<Lookup>>,
 }
 
 impl RunSet {
@@ -121,10 +128,27 @@ impl RunSet {
             {
                 return true;
             }
-            self.lines.get(&(t, key)).is_some_and(|iv| {
-                let i = iv.partition_point(|v| v[1] <= q);
-                iv.get(i).is_some_and(|v| v[0] <= q)
-            })
+            if let Some((s, k, [a, b], held)) = self.last.get()
+                && (s, k) == (t, key)
+                && (a..b).contains(&q)
+            {
+                return held;
+            }
+            let (range, held) = match self.lines.get(&(t, key)) {
+                None => ([0, usize::MAX], false),
+                Some(iv) => {
+                    let i = iv.partition_point(|v| v[1] <= q);
+                    match iv.get(i) {
+                        Some(&v) if v[0] <= q => (v, true),
+                        next => {
+                            let from = i.checked_sub(1).map_or(0, |j| iv[j][1]);
+                            ([from, next.map_or(usize::MAX, |v| v[0])], false)
+                        }
+                    }
+                }
+            };
+            self.last.set(Some((t, key, range, held)));
+            held
         })
     }
 
@@ -151,6 +175,7 @@ impl RunSet {
         let Some((s, k, [a, b])) = self.open.take() else {
             return;
         };
+        self.last.set(None);
         let iv = self.lines.entry((s, k)).or_default();
         // The intervals that overlap or touch [a, b) are iv[i..j].
         let i = iv.partition_point(|v| v[1] < a);
@@ -178,6 +203,7 @@ impl RunSet {
     /// when given (unsorted; a pair held along two lines is appended once per line).
     pub fn remove_below(&mut self, h: usize, mut gone: Option<&mut Vec<u64>>) {
         self.settle();
+        self.last.set(None);
         self.lines.retain(|&(t, key), iv| {
             let cut = iv.partition_point(|v| v[1] <= h);
             if let Some(gone) = gone.as_deref_mut() {
@@ -274,6 +300,15 @@ mod tests {
         let check = |set: &RunSet, want: &BTreeSet<(usize, usize)>| {
             for q in 0..45 {
                 for p in 0..40 {
+                    assert_eq!(set.contains(q, p), want.contains(&(q, p)), "({q}, {p})");
+                }
+            }
+            // Along lines, as a run is looked up.
+            for key in -12..12i64 {
+                for q in 0..45usize {
+                    let Ok(p) = usize::try_from(q as i64 + key) else {
+                        continue;
+                    };
                     assert_eq!(set.contains(q, p), want.contains(&(q, p)), "({q}, {p})");
                 }
             }

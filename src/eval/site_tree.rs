@@ -429,7 +429,13 @@ pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cov
     let Some(inside) = position_cover(x, y, s, q.r2) else {
         return Cover::None;
     };
-    match (inside, heading_cover(s.theta, theta, q.facing, q.tol_rad)) {
+    joined_cover(inside, heading_cover(s.theta, theta, q.facing, q.tol_rad))
+}
+
+/// How much of a box a query takes, from whether its positions are all `inside` the radius
+/// (none outside) and how many of its headings agree.
+pub(super) fn joined_cover(inside: bool, heading: Cover) -> Cover {
+    match (inside, heading) {
         (_, Cover::None) => Cover::None,
         (true, Cover::All) => Cover::All,
         _ => Cover::Part,
@@ -439,7 +445,7 @@ pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cov
 /// Whether a box of sites (position bounds `x`, `y`) lies within `r2` (squared) of `s`:
 /// `None` when wholly outside, `Some(true)` wholly inside, `Some(false)` in part. The distance
 /// bounds use the site test's own operations (see the module doc).
-fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
+pub(super) fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
     let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
     let near = |v: f64, b: [f64; 2]| {
         let (lo, hi) = (v - b[1], v - b[0]);
@@ -476,7 +482,7 @@ fn boxes_cover(a: &Node, b: &Node, r2: f64) -> Option<bool> {
 }
 
 /// How many headings in the wrapped range `range` agree with `theta` as `facing` says.
-fn heading_cover(theta: f64, range: [f64; 2], facing: Facing, tol_rad: f64) -> Cover {
+pub(super) fn heading_cover(theta: f64, range: [f64; 2], facing: Facing, tol_rad: f64) -> Cover {
     let half = (range[1] - range[0]) / 2.0;
     let mid = range[0] + half;
     let one = |offset: f64| {
