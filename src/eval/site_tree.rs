@@ -357,7 +357,9 @@ impl<'s> SiteTree<'s> {
     }
 
     /// [`Self::count_pairs_facings`] in two leaves (the same leaf when `same`), site by site,
-    /// for the facings `open` leaves undecided.
+    /// for the facings `open` leaves undecided. Each site of the first leaf is first tested
+    /// against the second's box, as a query is ([`position_cover`], [`heading_cover`]): the
+    /// facings it decides for the whole box need no test per pair.
     fn count_leaf_pairs<const N: usize>(
         &self,
         (na, nb, same): (&Node, &Node, bool),
@@ -371,17 +373,43 @@ impl<'s> SiteTree<'s> {
         let (b0, b1) = (nb.start as usize, nb.end as usize);
         for i in a0..a1 {
             let from = if same { i + 1 } else { b0 };
+            if from >= b1 {
+                continue;
+            }
+            let a = &self.placed[i];
+            let Some(inside) = position_cover(nb.x, nb.y, a, r2) else {
+                continue;
+            };
+            let mut undecided = open;
+            for (f, &facing) in facings.iter().enumerate() {
+                if open & (1 << f) == 0 {
+                    continue;
+                }
+                match heading_cover(a.theta, nb.theta, facing, tol_rad) {
+                    Cover::None => undecided &= !(1 << f),
+                    Cover::All if inside => {
+                        total[f] += (b1 - from) as u64;
+                        undecided &= !(1 << f);
+                    }
+                    _ => {}
+                }
+            }
+            if undecided == 0 {
+                continue;
+            }
             for j in from..b1 {
                 let (later, earlier) = if self.order[i] > self.order[j] {
-                    (&self.placed[i], &self.placed[j])
+                    (a, &self.placed[j])
                 } else {
-                    (&self.placed[j], &self.placed[i])
+                    (&self.placed[j], a)
                 };
                 if (later.x - earlier.x).powi(2) + (later.y - earlier.y).powi(2) > r2 {
                     continue;
                 }
                 for (f, &facing) in facings.iter().enumerate() {
-                    if open & (1 << f) != 0 && facing.agrees(later.theta, earlier.theta, tol_rad) {
+                    if undecided & (1 << f) != 0
+                        && facing.agrees(later.theta, earlier.theta, tol_rad)
+                    {
                         total[f] += 1;
                     }
                 }
