@@ -41,8 +41,9 @@ impl Site {
     }
 }
 
-/// Sites in a leaf at most.
+/// Sites in a leaf at most (at most 32: a leaf's sites are flagged in a `u32`).
 const LEAF: usize = 16;
+const _: () = assert!(LEAF <= 32);
 /// Headings are classified per node only this far from the tolerance, radians.
 const HEADING_MARGIN_RAD: f64 = 1e-9;
 /// Marks a leaf in `Node::children`.
@@ -380,35 +381,49 @@ impl<'s> SiteTree<'s> {
             let Some(inside) = position_cover(nb.x, nb.y, a, r2) else {
                 continue;
             };
-            let mut undecided = open;
+            // Per facing still open: whether every heading of the box agrees (only the
+            // positions are left to test), or only some do.
+            let (mut by_position, mut by_pair) = (0u8, 0u8);
             for (f, &facing) in facings.iter().enumerate() {
                 if open & (1 << f) == 0 {
                     continue;
                 }
                 match heading_cover(a.theta, nb.theta, facing, tol_rad) {
-                    Cover::None => undecided &= !(1 << f),
-                    Cover::All if inside => {
-                        total[f] += (b1 - from) as u64;
-                        undecided &= !(1 << f);
-                    }
-                    _ => {}
+                    Cover::None => {}
+                    Cover::All if inside => total[f] += (b1 - from) as u64,
+                    Cover::All => by_position |= 1 << f,
+                    Cover::Part => by_pair |= 1 << f,
                 }
             }
-            if undecided == 0 {
+            if by_position | by_pair == 0 {
                 continue;
             }
-            for j in from..b1 {
+            // The sites within the radius, without a branch per site (the squared distance is
+            // the pair test's: a difference's square does not depend on its sign).
+            let mut within = 0u32;
+            for (k, b) in self.placed[from..b1].iter().enumerate() {
+                let d2 = (a.x - b.x).powi(2) + (a.y - b.y).powi(2);
+                within |= u32::from(d2 <= r2) << k;
+            }
+            for (f, n) in total.iter_mut().enumerate() {
+                if by_position & (1 << f) != 0 {
+                    *n += u64::from(within.count_ones());
+                }
+            }
+            if by_pair == 0 {
+                continue;
+            }
+            let mut bits = within;
+            while bits != 0 {
+                let j = from + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
                 let (later, earlier) = if self.order[i] > self.order[j] {
                     (a, &self.placed[j])
                 } else {
                     (&self.placed[j], a)
                 };
-                if (later.x - earlier.x).powi(2) + (later.y - earlier.y).powi(2) > r2 {
-                    continue;
-                }
                 for (f, &facing) in facings.iter().enumerate() {
-                    if undecided & (1 << f) != 0
-                        && facing.agrees(later.theta, earlier.theta, tol_rad)
+                    if by_pair & (1 << f) != 0 && facing.agrees(later.theta, earlier.theta, tol_rad)
                     {
                         total[f] += 1;
                     }
