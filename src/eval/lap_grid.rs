@@ -24,7 +24,7 @@
 //! are decided as the k-d tree decides a node's (the same operations, [`super::site_tree`]).
 
 use super::pair_recall::Facing;
-use super::site_tree::{Cover, Query, Site, cover};
+use super::site_tree::{Cover, Query, Site, cover, heading_cover, joined_cover, position_cover};
 use crate::geom::wrap_angle;
 use foldhash::HashMap;
 use std::f64::consts::PI;
@@ -161,16 +161,15 @@ impl Bounds {
         self.turned = join(self.turned, b.turned);
     }
 
-    /// How much of the box `q` takes, its headings bounded by the narrower of the two ranges
-    /// (the turned range, turned back, holds the same headings within rounding, far below the
-    /// margin the heading test keeps: [`super::site_tree`]).
-    fn cover(&self, q: &Query) -> Cover {
-        let theta = if self.turned[1] - self.turned[0] < self.theta[1] - self.theta[0] {
+    /// The headings' bounds: the narrower of the two ranges (the turned range, turned back,
+    /// holds the same headings within rounding, far below the margin the heading test keeps:
+    /// [`super::site_tree`]).
+    fn headings(&self) -> [f64; 2] {
+        if self.turned[1] - self.turned[0] < self.theta[1] - self.theta[0] {
             [self.turned[0] + PI, self.turned[1] + PI]
         } else {
             self.theta
-        };
-        cover(self.x, self.y, theta, q)
+        }
     }
 }
 
@@ -213,6 +212,8 @@ struct LapGrid<const N: usize> {
     /// Per facing asked about, per lap: a copy of the site that last agreed with a query (kept
     /// beside each other, so testing the witnesses of many laps reads few cache lines).
     witness: [Vec<Option<Site>>; N],
+    /// Scratch of [`Self::laps`]: the (cell, sub-cell, facing) taken in part.
+    part: Vec<(u8, u32, u8)>,
 }
 
 impl<const N: usize> LapGrid<N> {
@@ -222,6 +223,7 @@ impl<const N: usize> LapGrid<N> {
             inv_sub_m: SUBS as f64 / (r_m * 1.01),
             cells: HashMap::default(),
             witness: std::array::from_fn(|_| Vec::new()),
+            part: Vec::new(),
         }
     }
 
@@ -284,28 +286,48 @@ impl<const N: usize> LapGrid<N> {
     /// Adds to `laps[f]` the lap of every active site `qs[f]` takes (the queries ask about one
     /// site, each facing its own way). First the sub-cells wholly taken give all their laps at
     /// once; then, in those taken in part, the runs of laps not yet found are looked at one by
-    /// one (skipped whole when every lap of the sub-cell is found).
+    /// one. A sub-cell whose laps are all found already is not looked at (for that facing), so
+    /// the query's own cell comes first: its sub-cells are the likeliest to be taken whole. A
+    /// sub-cell's position bounds are tested once for every facing.
     fn laps(&mut self, sites: &[Site], qs: &[Query; N], laps: &mut [Laps; N]) {
-        let ((cx, cy), _) = self.cell_of(qs[0].site);
+        let s = qs[0].site;
+        let ((cx, cy), _) = self.cell_of(s);
         let cells: [Option<&Cell>; 9] = std::array::from_fn(|i| {
-            self.cells
-                .get(&(cx + i as i64 / 3 - 1, cy + i as i64 % 3 - 1))
+            let i = (i + 4) as i64 % 9;
+            self.cells.get(&(cx + i / 3 - 1, cy + i % 3 - 1))
         });
-        for sub in cells.iter().flatten().flat_map(|c| &c.subs) {
-            for (q, laps) in qs.iter().zip(laps.iter_mut()) {
-                if sub.bounds.cover(q) == Cover::All {
-                    laps.add_all(&sub.laps);
+        let mut part = std::mem::take(&mut self.part);
+        part.clear();
+        for (c, cell) in cells.iter().enumerate() {
+            for (k, sub) in cell.iter().flat_map(|c| &c.subs).enumerate() {
+                let mut inside = None;
+                for (f, (q, laps)) in qs.iter().zip(laps.iter_mut()).enumerate() {
+                    if laps.holds_all(&sub.laps) {
+                        continue;
+                    }
+                    let b = &sub.bounds;
+                    let Some(inside) =
+                        *inside.get_or_insert_with(|| position_cover(b.x, b.y, s, q.r2))
+                    else {
+                        break;
+                    };
+                    let headings = heading_cover(s.theta, b.headings(), q.facing, q.tol_rad);
+                    match joined_cover(inside, headings) {
+                        Cover::All => laps.add_all(&sub.laps),
+                        Cover::Part => part.push((c as u8, k as u32, f as u8)),
+                        Cover::None => {}
+                    }
                 }
             }
         }
-        for sub in cells.iter().flatten().flat_map(|c| &c.subs) {
-            for ((q, laps), witness) in qs.iter().zip(laps.iter_mut()).zip(&mut self.witness) {
-                if laps.holds_all(&sub.laps) || sub.bounds.cover(q) != Cover::Part {
-                    continue;
-                }
-                part_laps(sites, sub, q, laps, witness);
+        for &(c, k, f) in &part {
+            let sub = &cells[c as usize].expect("a cell held").subs[k as usize];
+            let f = f as usize;
+            if !laps[f].holds_all(&sub.laps) {
+                part_laps(sites, sub, &qs[f], &mut laps[f], &mut self.witness[f]);
             }
         }
+        self.part = part;
     }
 }
 

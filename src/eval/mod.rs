@@ -486,13 +486,12 @@ impl Recording {
     /// Keeps (or scores) matches `found`, after the frames and observations they name.
     fn take(&mut self, rec: &dyn PlaceRecognizer, truth: &GroundTruth, found: Vec<Match>) {
         match &mut self.tally {
-            Some((spec, tally)) => {
+            Some((_, tally)) => {
                 if !found.is_empty() {
                     let w = Stopwatch::start();
                     tally.sync(rec.observations(), truth);
                     for m in &found {
-                        tally.add(m);
-                        self.ranking.add(m, tally.scorer(), spec);
+                        tally.add_ranked(m, Some(&mut self.ranking));
                     }
                     self.score_seconds += w.cpu_s();
                 }

@@ -41,8 +41,9 @@ impl Site {
     }
 }
 
-/// Sites in a leaf at most.
+/// Sites in a leaf at most (at most 32: a leaf's sites are flagged in a `u32`).
 const LEAF: usize = 16;
+const _: () = assert!(LEAF <= 32);
 /// Headings are classified per node only this far from the tolerance, radians.
 const HEADING_MARGIN_RAD: f64 = 1e-9;
 /// Marks a leaf in `Node::children`.
@@ -357,7 +358,9 @@ impl<'s> SiteTree<'s> {
     }
 
     /// [`Self::count_pairs_facings`] in two leaves (the same leaf when `same`), site by site,
-    /// for the facings `open` leaves undecided.
+    /// for the facings `open` leaves undecided. Each site of the first leaf is first tested
+    /// against the second's box, as a query is ([`position_cover`], [`heading_cover`]): the
+    /// facings it decides for the whole box need no test per pair.
     fn count_leaf_pairs<const N: usize>(
         &self,
         (na, nb, same): (&Node, &Node, bool),
@@ -371,17 +374,57 @@ impl<'s> SiteTree<'s> {
         let (b0, b1) = (nb.start as usize, nb.end as usize);
         for i in a0..a1 {
             let from = if same { i + 1 } else { b0 };
-            for j in from..b1 {
-                let (later, earlier) = if self.order[i] > self.order[j] {
-                    (&self.placed[i], &self.placed[j])
-                } else {
-                    (&self.placed[j], &self.placed[i])
-                };
-                if (later.x - earlier.x).powi(2) + (later.y - earlier.y).powi(2) > r2 {
+            if from >= b1 {
+                continue;
+            }
+            let a = &self.placed[i];
+            let Some(inside) = position_cover(nb.x, nb.y, a, r2) else {
+                continue;
+            };
+            // Per facing still open: whether every heading of the box agrees (only the
+            // positions are left to test), or only some do.
+            let (mut by_position, mut by_pair) = (0u8, 0u8);
+            for (f, &facing) in facings.iter().enumerate() {
+                if open & (1 << f) == 0 {
                     continue;
                 }
+                match heading_cover(a.theta, nb.theta, facing, tol_rad) {
+                    Cover::None => {}
+                    Cover::All if inside => total[f] += (b1 - from) as u64,
+                    Cover::All => by_position |= 1 << f,
+                    Cover::Part => by_pair |= 1 << f,
+                }
+            }
+            if by_position | by_pair == 0 {
+                continue;
+            }
+            // The sites within the radius, without a branch per site (the squared distance is
+            // the pair test's: a difference's square does not depend on its sign).
+            let mut within = 0u32;
+            for (k, b) in self.placed[from..b1].iter().enumerate() {
+                let d2 = (a.x - b.x).powi(2) + (a.y - b.y).powi(2);
+                within |= u32::from(d2 <= r2) << k;
+            }
+            for (f, n) in total.iter_mut().enumerate() {
+                if by_position & (1 << f) != 0 {
+                    *n += u64::from(within.count_ones());
+                }
+            }
+            if by_pair == 0 {
+                continue;
+            }
+            let mut bits = within;
+            while bits != 0 {
+                let j = from + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let (later, earlier) = if self.order[i] > self.order[j] {
+                    (a, &self.placed[j])
+                } else {
+                    (&self.placed[j], a)
+                };
                 for (f, &facing) in facings.iter().enumerate() {
-                    if open & (1 << f) != 0 && facing.agrees(later.theta, earlier.theta, tol_rad) {
+                    if by_pair & (1 << f) != 0 && facing.agrees(later.theta, earlier.theta, tol_rad)
+                    {
                         total[f] += 1;
                     }
                 }
@@ -429,7 +472,13 @@ pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cov
     let Some(inside) = position_cover(x, y, s, q.r2) else {
         return Cover::None;
     };
-    match (inside, heading_cover(s.theta, theta, q.facing, q.tol_rad)) {
+    joined_cover(inside, heading_cover(s.theta, theta, q.facing, q.tol_rad))
+}
+
+/// How much of a box a query takes, from whether its positions are all `inside` the radius
+/// (none outside) and how many of its headings agree.
+pub(super) fn joined_cover(inside: bool, heading: Cover) -> Cover {
+    match (inside, heading) {
         (_, Cover::None) => Cover::None,
         (true, Cover::All) => Cover::All,
         _ => Cover::Part,
@@ -439,7 +488,7 @@ pub(super) fn cover(x: [f64; 2], y: [f64; 2], theta: [f64; 2], q: &Query) -> Cov
 /// Whether a box of sites (position bounds `x`, `y`) lies within `r2` (squared) of `s`:
 /// `None` when wholly outside, `Some(true)` wholly inside, `Some(false)` in part. The distance
 /// bounds use the site test's own operations (see the module doc).
-fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
+pub(super) fn position_cover(x: [f64; 2], y: [f64; 2], s: &Site, r2: f64) -> Option<bool> {
     let far = |v: f64, b: [f64; 2]| (v - b[0]).powi(2).max((v - b[1]).powi(2));
     let near = |v: f64, b: [f64; 2]| {
         let (lo, hi) = (v - b[1], v - b[0]);
@@ -476,7 +525,7 @@ fn boxes_cover(a: &Node, b: &Node, r2: f64) -> Option<bool> {
 }
 
 /// How many headings in the wrapped range `range` agree with `theta` as `facing` says.
-fn heading_cover(theta: f64, range: [f64; 2], facing: Facing, tol_rad: f64) -> Cover {
+pub(super) fn heading_cover(theta: f64, range: [f64; 2], facing: Facing, tol_rad: f64) -> Cover {
     let half = (range[1] - range[0]) / 2.0;
     let mid = range[0] + half;
     let one = |offset: f64| {

@@ -37,13 +37,13 @@ use super::lap_grid::{LapSweep, Laps};
 use super::metrics::{Counts, DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, Scorer};
 use super::pair_recall::{Facing, PairRecall, count_possible, count_possible_facings};
 use super::pair_set::pack;
+use super::ranking::Ranking;
 use super::site_tree::{Site, SiteTree};
-use crate::place::{Match, ObsId, Observation};
+use crate::place::{Direction, Match, ObsId, Observation};
 use crate::spec::evaluation::EvaluationSpec;
 // foldhash: the keys are packed indices, not adversarial input, and SipHash stood high in the
-// profile of scoring as matches arrive (BENCHMARKS.md, issue 30). The maps keyed by packed
-// pairs hash them so that a run of pairs lands in neighbouring buckets (`pair_set::PairMap`).
-use super::pair_set::PairMap;
+// profile of scoring as matches arrive (BENCHMARKS.md, issue 30).
+use super::pair_set::RunSet;
 use foldhash::{HashMap, HashSet};
 
 /// What a tally counts.
@@ -112,10 +112,13 @@ pub struct Tally {
     spec: EvaluationSpec,
     scorer: Scorer,
     slots: Vec<Slot>,
-    /// Distinct resolved pairs at or after the horizon, packed `(query, past)` observation
-    /// indices → bits: seen by facing (0 either, 1 same, 2 opposite), found for pair recall by
-    /// facing (3 + the same).
-    window: PairMap<u8>,
+    /// Distinct resolved pairs `(query, past)` (observation indices) at or after the horizon,
+    /// claimed the same way (0) and the opposite way (1), as runs along the lines of the
+    /// matches' runs (`pair_set::RunSet`: a chain's matches repeat each other's pairs along
+    /// one line, so a lookup reads a small map of lines, not a table of every pair, which was
+    /// scoring's main cost in a `check`: BENCHMARKS.md, session 5). Whether a pair was found
+    /// for pair recall follows from the claims it was seen with ([`could_be_found`]).
+    window: [RunSet; 2],
     /// Pairs naming an unknown observation (by ids) → seen by facing; never forgotten (a
     /// recognizer that names unknown observations is broken, not long-running).
     unresolved: HashMap<u64, u8>,
@@ -201,7 +204,7 @@ impl Tally {
             spec: spec.clone(),
             scorer,
             slots,
-            window: PairMap::default(),
+            window: Default::default(),
             unresolved: HashMap::default(),
             visits: Vec::new(),
             visits_compact: 0,
@@ -249,11 +252,13 @@ impl Tally {
 
     /// Counts match `m` (its observations must be synced).
     pub fn add(&mut self, m: &Match) {
+        self.add_ranked(m, None);
+    }
+
+    /// [`Self::add`], and each resolved pair's answer given to `ranking` (as
+    /// [`Ranking::add`] would give it, in the same order) in the same pass over the pairs.
+    pub fn add_ranked(&mut self, m: &Match, mut ranking: Option<&mut Ranking>) {
         let claim = Facing::of(m.direction);
-        let claim_bit = facing_bit(claim);
-        let tol = self.scorer.heading_tol_rad();
-        let r_main = self.spec.tp_radius_m;
-        let counts = |s: &Slot| s.facing.counts(m.direction);
         for s in &mut self.slots {
             (s.n, s.ok, s.cfg) = (0, 0, None);
         }
@@ -261,79 +266,20 @@ impl Tally {
         // Pairs repeat within a match only where its runs' queries overlap (a run's queries are
         // distinct), so the set of the match's pairs is kept only then.
         let may_repeat = !queries_disjoint(m);
-        for (query, past) in m.pairs() {
-            let resolved = self.scorer.resolve(query, past);
-            let Some((qi, pi, q, pa)) = resolved else {
-                let flags = self.unresolved.entry(pack(query, past)).or_insert(0);
-                let before = *flags;
-                for s in self.slots.iter_mut().filter(|s| counts(s)) {
-                    if before & (1 << facing_bit(s.facing)) == 0 {
-                        s.counts.unresolved += 1;
-                    }
+        for run in &m.runs {
+            for (query, past) in run.pairs() {
+                let Some(pair) = self.scorer.resolve(query, past) else {
+                    self.add_unresolved(query, past, m.direction);
+                    continue;
+                };
+                let new_in_match = !may_repeat || self.in_match.insert((query, past));
+                let right = self.add_pair(pair, run.past_step, claim, new_in_match);
+                if let Some(r) = ranking.as_deref_mut() {
+                    r.answer(pair.0, m.score, right);
                 }
-                *flags |= 1 | (1 << claim_bit);
-                continue;
-            };
-            if qi < self.evicted_below {
-                self.late_pairs += 1;
-            }
-            let d2 = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2);
-            let agrees = claim.agrees(q.theta, pa.theta, tol);
-            let new_in_match = !may_repeat || self.in_match.insert((query, past));
-            let entry = self.window.entry(pack(qi, pi)).or_insert(0);
-            let before = *entry;
-            let cfg = self.scorer.config(qi);
-            if before & (1 << claim_bit) != 0 {
-                // Seen with this claim: every figure counting it has counted it, its pair
-                // recall and visit were recorded then (the same test of the same pair), so
-                // only the match's own tally is left.
-                if new_in_match {
-                    for s in self.slots.iter_mut().filter(|s| counts(s)) {
-                        s.n += 1;
-                        s.ok += usize::from(d2 <= s.radius_m * s.radius_m && agrees);
-                        s.cfg.get_or_insert(cfg);
-                    }
-                }
-                continue;
-            }
-            let mut recalls = false;
-            for s in self.slots.iter_mut().filter(|s| counts(s)) {
-                let correct = d2 <= s.radius_m * s.radius_m && agrees;
-                recalls |= s.recalls;
-                if new_in_match {
-                    s.n += 1;
-                    s.ok += usize::from(correct);
-                    s.cfg.get_or_insert(cfg);
-                }
-                if before & (1 << facing_bit(s.facing)) == 0 {
-                    s.counts.pairs += 1;
-                    s.counts.correct += usize::from(correct);
-                    if s.breakdown {
-                        s.per_cfg[cfg].pairs += 1;
-                        s.per_cfg[cfg].correct += usize::from(correct);
-                    }
-                    if correct {
-                        s.recalled_query.set(qi);
-                        s.recalled_any.set(qi);
-                        s.recalled_any.set(pi);
-                    }
-                }
-            }
-            let mut after = before | 1 | (1 << claim_bit);
-            if recalls && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim) {
-                for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
-                    let bit = 1 << (3 + facing_bit(s.facing));
-                    if before & bit == 0 {
-                        s.found += 1;
-                        after |= bit;
-                    }
-                }
-            }
-            *entry = after;
-            if recalls && d2 <= r_main * r_main && agrees {
-                self.push_visit(qi, pa.lap, if claim == Facing::Same { 1 } else { 2 });
             }
         }
+        let counts = |s: &Slot| s.facing.counts(m.direction);
         for s in self.slots.iter_mut().filter(|s| counts(s) && s.n > 0) {
             let good = 2 * s.ok > s.n;
             s.counts.matches += 1;
@@ -343,6 +289,104 @@ impl Tally {
                 s.per_cfg[c].correct_matches += usize::from(good);
             }
         }
+    }
+
+    /// Counts a pair naming an unknown observation, claimed as `direction` says.
+    fn add_unresolved(&mut self, query: ObsId, past: ObsId, direction: Direction) {
+        let claim_bit = facing_bit(Facing::of(direction));
+        let flags = self.unresolved.entry(pack(query, past)).or_insert(0);
+        let before = *flags;
+        for s in self.slots.iter_mut().filter(|s| s.facing.counts(direction)) {
+            if before & (1 << facing_bit(s.facing)) == 0 {
+                s.counts.unresolved += 1;
+            }
+        }
+        *flags |= 1 | (1 << claim_bit);
+    }
+
+    /// Counts resolved pair `(qi, pi, q, pa)` (positions and sites) of a run of step `step` of
+    /// a match claiming `claim` (`new_in_match`: not yet counted in this match). Returns
+    /// whether the pair is a right answer by the ranking's rule ([`Ranking::add`]).
+    fn add_pair(
+        &mut self,
+        (qi, pi, q, pa): (usize, usize, Site, Site),
+        step: i8,
+        claim: Facing,
+        new_in_match: bool,
+    ) -> bool {
+        let tol = self.scorer.heading_tol_rad();
+        let r_main = self.spec.tp_radius_m;
+        if qi < self.evicted_below {
+            self.late_pairs += 1;
+        }
+        let d2 = (q.x - pa.x).powi(2) + (q.y - pa.y).powi(2);
+        let agrees = claim.agrees(q.theta, pa.theta, tol);
+        let right =
+            d2 <= r_main * r_main && agrees && q.travel_m - pa.travel_m >= self.spec.min_gap_m;
+        let counts = |s: &Slot| s.facing == Facing::Either || s.facing == claim;
+        let cfg = self.scorer.config(qi);
+        let (own, other) = claim_sets(&mut self.window, claim);
+        if own.contains(qi, pi) {
+            // Seen with this claim: every figure counting it has counted it, its pair recall
+            // and visit were recorded then (the same test of the same pair), so only the
+            // match's own tally is left.
+            if new_in_match {
+                for s in self.slots.iter_mut().filter(|s| counts(s)) {
+                    s.n += 1;
+                    s.ok += usize::from(d2 <= s.radius_m * s.radius_m && agrees);
+                    s.cfg.get_or_insert(cfg);
+                }
+            }
+            return right;
+        }
+        own.insert(qi, pi, step);
+        // What was recorded when the pair came with the other claim: seen (either facing and
+        // that one) and, where it could have been found so, found.
+        let mut before = 0u8;
+        if !other.is_empty() && other.contains(qi, pi) {
+            let other_claim = match claim {
+                Facing::Same => Facing::Opposite,
+                _ => Facing::Same,
+            };
+            before = 1 | 1 << facing_bit(other_claim);
+            if self.slots.iter().any(|s| s.recalls)
+                && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), other_claim)
+            {
+                before |= 1 << 3 | 1 << (3 + facing_bit(other_claim));
+            }
+        }
+        let mut recalls = false;
+        for s in self.slots.iter_mut().filter(|s| counts(s)) {
+            let correct = d2 <= s.radius_m * s.radius_m && agrees;
+            recalls |= s.recalls;
+            if new_in_match {
+                s.n += 1;
+                s.ok += usize::from(correct);
+                s.cfg.get_or_insert(cfg);
+            }
+            if before & (1 << facing_bit(s.facing)) == 0 {
+                s.counts.pairs += 1;
+                s.counts.correct += usize::from(correct);
+                if s.breakdown {
+                    s.per_cfg[cfg].pairs += 1;
+                    s.per_cfg[cfg].correct += usize::from(correct);
+                }
+                if correct {
+                    s.recalled_query.set(qi);
+                    s.recalled_any.set(qi);
+                    s.recalled_any.set(pi);
+                }
+            }
+        }
+        if recalls && could_be_found(&self.scorer, &self.spec, (qi, &q), (pi, &pa), claim) {
+            for s in self.slots.iter_mut().filter(|s| s.recalls && counts(s)) {
+                s.found += u64::from(before & 1 << (3 + facing_bit(s.facing)) == 0);
+            }
+        }
+        if recalls && d2 <= r_main * r_main && agrees {
+            self.push_visit(qi, pa.lap, if claim == Facing::Same { 1 } else { 2 });
+        }
+        right
     }
 
     /// Records that query `qi` was correctly paired with lap `lap` by a match claiming
@@ -363,20 +407,20 @@ impl Tally {
         if h <= self.evicted_below {
             return;
         }
-        let behind = |k: u64| ((k >> 32) as usize) < h;
-        match &mut self.forgotten {
+        let gone = self.forgotten.as_mut();
+        match gone {
             Some(gone) => {
                 let from = gone.len();
-                self.window.retain(|&k, _| {
-                    let keep = !behind(k);
-                    if !keep {
-                        gone.push(k);
-                    }
-                    keep
-                });
-                gone[from..].sort_unstable();
+                self.window
+                    .iter_mut()
+                    .for_each(|w| w.remove_below(h, Some(&mut *gone)));
+                // Sorted within the eviction; a pair claimed both ways is listed once.
+                let mut tail = gone.split_off(from);
+                tail.sort_unstable();
+                tail.dedup();
+                gone.append(&mut tail);
             }
-            None => self.window.retain(|&k, _| !behind(k)),
+            None => self.window.iter_mut().for_each(|w| w.remove_below(h, None)),
         }
         self.evicted_below = h;
         self.count_visits_below(h);
@@ -426,19 +470,15 @@ impl Tally {
         self.scorer.within(q, p, self.spec.tp_radius_m)
     }
 
-    /// Distinct pairs held to deduplicate (those at or after the horizon).
+    /// Pairs held to deduplicate (those at or after the horizon; a pair claimed both ways, or
+    /// along two lines, counts twice).
     pub fn pairs_held(&self) -> usize {
-        self.window.len()
+        self.window.iter().map(RunSet::len).sum()
     }
 
     /// Pairs that arrived behind the horizon so far (see [`Metrics::late_pairs`]).
     pub fn late_pairs(&self) -> usize {
         self.late_pairs
-    }
-
-    /// The observations joined with their truth (what `eval::ranking` judges pairs by).
-    pub(super) fn scorer(&self) -> &Scorer {
-        &self.scorer
     }
 
     /// Observations synced so far.
@@ -828,6 +868,15 @@ impl Slot {
             ..total.metrics(self.radius_m)
         };
         (metrics, configs)
+    }
+}
+
+/// The pairs seen with `claim` (same or opposite) and those seen with the other claim.
+fn claim_sets(window: &mut [RunSet; 2], claim: Facing) -> (&mut RunSet, &RunSet) {
+    let [same, opposite] = window;
+    match claim {
+        Facing::Opposite => (opposite, same),
+        _ => (same, opposite),
     }
 }
 
