@@ -17,16 +17,17 @@
 //! Work is quadratic in the observations (brute force, on purpose: nothing is missed); CSAIL
 //! takes about a second, a scenario of 14,000 observations about a minute.
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Parser;
 use placewords::eval::GroundTruth;
-use placewords::experiment::{ExperimentOptions, load_scenario, real, simulate};
 use placewords::geom::{Pose2, wrap_angle};
-use placewords::io::real_log::TruthSource;
 use placewords::log::RunLog;
-use placewords::recognizer::{Recognizer, RecognizerConfig};
+use placewords::recognizer::RecognizerConfig;
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+#[path = "support/input.rs"]
+mod input;
 
 #[derive(Parser)]
 #[command(about = "Nearest earlier Ψ windows, with the truth's verdict")]
@@ -77,17 +78,11 @@ struct Pick {
 }
 
 fn main() -> ExitCode {
-    match run(&Args::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
+    input::exit_code(run(&Args::parse()))
 }
 
 fn run(args: &Args) -> Result<()> {
-    let (runs, cfg) = load(args)?;
+    let (runs, cfg) = input::load(&args.input, args.seed)?;
     let obs = observe(&runs, cfg)?;
     let window =
         (args.window_m / RecognizerConfig::default().front_end.observation_spacing_m).round();
@@ -126,44 +121,10 @@ fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// The runs of a log (one run, `recognize`'s default noise) or of a simulated scenario, and the
-/// recognizer settings to observe them with.
-fn load(args: &Args) -> Result<(Vec<RunLog>, RecognizerConfig)> {
-    let path = &args.input;
-    if path.extension().is_some_and(|e| e == "toml") {
-        // Its errors name the file, line and column.
-        let mut scn = load_scenario(path)?;
-        scn.sim.seed = args.seed;
-        let (runs, _, _) = simulate(&scn, &ExperimentOptions::default())?;
-        return Ok((runs, scn.recognizer.clone()));
-    }
-    let Some(noise) = real::parse_noise_model("proportional").map_err(anyhow::Error::msg)? else {
-        bail!("the default noise model has no parameters");
-    };
-    let (run, _) = real::load_real_run(
-        path,
-        false,
-        TruthSource::Corrected,
-        Some(&noise),
-        args.seed,
-        &Default::default(),
-    )?;
-    Ok((vec![run], RecognizerConfig::default()))
-}
-
 /// Every observation the recognizer makes of `runs`, with its truth.
 fn observe(runs: &[RunLog], cfg: RecognizerConfig) -> Result<Vec<Obs>> {
     let truth = GroundTruth::from_runs(runs);
-    let mut rec = Recognizer::new(cfg)?;
-    let mut frame = 0;
-    for run in runs {
-        rec.start_run();
-        for f in run.frames() {
-            rec.push_frame(frame, f.odom, &f.scan);
-            frame += 1;
-        }
-    }
-    rec.finish();
+    let rec = input::recognize(runs, cfg)?;
     let words = rec.words();
     Ok(rec
         .observations()

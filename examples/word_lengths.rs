@@ -6,15 +6,14 @@
 //! cargo run --release --example word_lengths -- ../shared/data/carmen/intel-corrected.log.gz --wide-radius-m 0
 //! ```
 
-use anyhow::{Result, bail};
+use anyhow::Result;
 use clap::Parser;
 use placewords::eval::GroundTruth;
-use placewords::experiment::{ExperimentOptions, load_scenario, real, simulate};
-use placewords::io::real_log::TruthSource;
-use placewords::log::RunLog;
-use placewords::recognizer::{Recognizer, RecognizerConfig};
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+#[path = "support/input.rs"]
+mod input;
 
 #[derive(Parser)]
 #[command(about = "Level-0 words of a log or scenario, with their lengths")]
@@ -33,53 +32,16 @@ struct Args {
 }
 
 fn main() -> ExitCode {
-    match run(&Args::parse()) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e:#}");
-            ExitCode::from(2)
-        }
-    }
-}
-
-fn load(args: &Args) -> Result<(Vec<RunLog>, RecognizerConfig)> {
-    let path = &args.input;
-    if path.extension().is_some_and(|e| e == "toml") {
-        let mut scn = load_scenario(path)?;
-        scn.sim.seed = args.seed;
-        let (runs, _, _) = simulate(&scn, &ExperimentOptions::default())?;
-        return Ok((runs, scn.recognizer.clone()));
-    }
-    let Some(noise) = real::parse_noise_model("proportional").map_err(anyhow::Error::msg)? else {
-        bail!("the default noise model has no parameters");
-    };
-    let (run, _) = real::load_real_run(
-        path,
-        false,
-        TruthSource::Corrected,
-        Some(&noise),
-        args.seed,
-        &Default::default(),
-    )?;
-    Ok((vec![run], RecognizerConfig::default()))
+    input::exit_code(run(&Args::parse()))
 }
 
 fn run(args: &Args) -> Result<()> {
-    let (runs, mut cfg) = load(args)?;
+    let (runs, mut cfg) = input::load(&args.input, args.seed)?;
     if let Some(r) = args.wide_radius_m {
         cfg.density.wide_radius_m = r;
     }
     let truth = GroundTruth::from_runs(&runs);
-    let mut rec = Recognizer::new(cfg)?;
-    let mut frame = 0;
-    for run in &runs {
-        rec.start_run();
-        for f in run.frames() {
-            rec.push_frame(frame, f.odom, &f.scan);
-            frame += 1;
-        }
-    }
-    rec.finish();
+    let rec = input::recognize(&runs, cfg)?;
     let words = rec.words();
     let obs = rec.observations();
     let mut lengths: Vec<f64> = Vec::new();
