@@ -246,9 +246,8 @@ impl<'s> SiteTree<'s> {
         facings: [Facing; N],
         tol_rad: f64,
     ) -> [u64; N] {
-        assert!(N <= 8, "at most 8 facings at once");
+        let all = facings_mask::<N>();
         let mut total = [0u64; N];
-        let all: u8 = ((1u16 << N) - 1) as u8;
         // (node, the facings whose heading test the node's ancestors left undecided)
         let mut stack = vec![(0u32, all)];
         while let Some((id, mut open)) = stack.pop() {
@@ -304,12 +303,11 @@ impl<'s> SiteTree<'s> {
         facings: [Facing; N],
         tol_rad: f64,
     ) -> [u64; N] {
-        assert!(N <= 8, "at most 8 facings at once");
+        let all = facings_mask::<N>();
         let mut total = [0u64; N];
         if self.nodes.is_empty() {
             return total;
         }
-        let all: u8 = ((1u16 << N) - 1) as u8;
         let mut stack = vec![(0u32, 0u32, all)];
         while let Some((a, b, mut open)) = stack.pop() {
             let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
@@ -601,6 +599,12 @@ pub fn sweep_tree(tree: &mut SiteTree, min_gap_m: f64, mut visit: impl FnMut(usi
         tree.activate_to(ready);
         visit(k, &*tree);
     }
+}
+
+/// A bit per facing of `N` queried at once (at most 8, the width of the masks the walks carry).
+fn facings_mask<const N: usize>() -> u8 {
+    assert!(N <= 8, "at most 8 facings at once");
+    ((1u16 << N) - 1) as u8
 }
 
 #[cfg(test)]

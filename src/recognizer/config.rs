@@ -204,6 +204,17 @@ impl RecognizerConfig {
         self
     }
 
+    /// The open-space classes above the top density class that these settings use:
+    /// `[recognizer.words] wide_classes` when the wide window is on (`[recognizer.density]
+    /// wide_radius_m` > 0), else none.
+    pub fn wide_classes_in_use(&self) -> usize {
+        if self.density.wide_radius_m > 0.0 {
+            self.words.wide_classes
+        } else {
+            0
+        }
+    }
+
     /// Kernel radius in grid cells (rounded).
     pub fn kernel_radius_cells(&self) -> usize {
         (self.density.kernel_radius_m / self.grid.grid_cell_m).round() as usize

@@ -26,6 +26,7 @@ use super::density::{DensityKernel, RayDeltas};
 use super::grid::LocalGrid;
 use super::types::{DensityObservation, FrameId, Observation};
 use super::wide::WideWindow;
+use super::words::density_class;
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
@@ -141,19 +142,18 @@ impl ObservationClock {
     }
 }
 
-/// The word settings the wide window depends on: Φ is measured where Ψ reaches the top class.
+/// The word settings the wide window depends on (Φ is read where Ψ is in the top class), when
+/// the settings use it.
 fn wide_window_settings(config: &RecognizerConfig) -> Option<(usize, usize)> {
-    (config.density.wide_radius_m > 0.0 && config.words.wide_classes > 0)
-        .then_some((config.words.classes, config.words.wide_classes))
+    let wide_classes = config.wide_classes_in_use();
+    (wide_classes > 0).then_some((config.words.classes, wide_classes))
 }
 
-/// The wide window of `config` and the Ψ at which Φ is read (the top class's lower bound),
-/// when the settings use it.
-fn wide_window(config: &RecognizerConfig) -> Option<(WideWindow, f64)> {
+/// The wide window of `config` and the density classes whose top one reads Φ, when the
+/// settings use it.
+fn wide_window(config: &RecognizerConfig) -> Option<(WideWindow, usize)> {
     let (classes, _) = wide_window_settings(config)?;
-    // A hair below the bound, so rounding never leaves a top-class observation without Φ.
-    let from_psi = (classes - 1) as f64 / classes as f64 - 1e-9;
-    Some((WideWindow::new(config.density.wide_radius_m), from_psi))
+    Some((WideWindow::new(config.density.wide_radius_m), classes))
 }
 
 /// Local grid + density: makes observations from odometry and scans.
@@ -165,9 +165,9 @@ pub struct DensityFrontEnd {
     grid: LocalGrid,
     kernel: DensityKernel,
     deltas: RayDeltas,
-    /// The wide window (`wide_radius_m` > 0 and `wide_classes` > 0), and the Ψ from which the
-    /// word builder reads Φ (its top class): Φ is measured there only.
-    wide: Option<(WideWindow, f64)>,
+    /// The wide window (`wide_radius_m` > 0 and `wide_classes` > 0), and the number of density
+    /// classes: the word builder reads Φ in the top one, so Φ is measured there only.
+    wide: Option<(WideWindow, usize)>,
     /// Whether the newest observation's Ψ was in the top class (Φ read there).
     open: bool,
     run: usize,
@@ -284,7 +284,9 @@ impl DensityFrontEnd {
                     .grid
                     .density_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
                 let wide_density = match &self.wide {
-                    Some((w, from_psi)) if density.psi >= *from_psi => {
+                    Some((w, classes))
+                        if usize::from(density_class(density.psi, *classes)) + 1 == *classes =>
+                    {
                         self.open = true;
                         w.density_at(pose.0.x, pose.0.y)
                     }

@@ -98,6 +98,13 @@ impl WordMatcher {
             *t = config.matcher.min_ngram[k].max(1);
         }
         let words = &config.words;
+        let word_levels = WordLevels::with_rule(
+            words.classes,
+            words.min_word_size,
+            config.levels,
+            words.multi_level,
+        )
+        .with_wide_classes(config.wide_classes_in_use());
         Ok(WordMatcher {
             levels: config.levels,
             tau,
@@ -106,18 +113,8 @@ impl WordMatcher {
             verify_opts: config.verify.clone(),
             spacing_m: config.front_end.observation_spacing_m,
             rejections: VerificationCounts::default(),
-            words: WordLevels::with_rule(
-                words.classes,
-                words.min_word_size,
-                config.levels,
-                words.multi_level,
-            )
-            .with_wide_classes(if config.density.wide_radius_m > 0.0 {
-                words.wide_classes
-            } else {
-                0
-            }),
-            occurrences: vec![Vec::new(); words.classes + words.wide_classes],
+            occurrences: vec![Vec::new(); word_levels.class_count()],
+            words: word_levels,
             memo: Default::default(),
             successors: Vec::new(),
             memo_forgotten: 0,

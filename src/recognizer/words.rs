@@ -31,6 +31,14 @@ use super::options::MultiLevelRule;
 use super::types::{DensityObservation, Observation, WordRef};
 use crate::geom::wrap_angle;
 
+/// Density class of Ψ among `classes` uniform classes: min(floor(classes·Ψ), classes − 1) (NaN
+/// gives class 0). The one rule, for the word builder and for the front end (which reads the
+/// wide density only in the top class).
+pub fn density_class(psi: f64, classes: usize) -> u8 {
+    let c = (psi * classes as f64).floor();
+    (c.max(0.0) as usize).min(classes.max(1) - 1) as u8
+}
+
 /// Arena index of a word (across levels).
 pub type WordId = u32;
 
@@ -205,8 +213,7 @@ impl WordLevels {
 
     /// Density class of Ψ: min(floor(classes·Ψ), classes − 1) (NaN gives class 0).
     pub fn class_of(&self, psi: f64) -> u8 {
-        let c = (psi * self.classes as f64).floor();
-        (c.max(0.0) as usize).min(self.classes - 1) as u8
+        density_class(psi, self.classes)
     }
 
     /// Class of an observation: [`Self::class_of`] its Ψ; in the top class, open space (at
