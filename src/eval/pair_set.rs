@@ -102,8 +102,8 @@ type Lookup = (i8, i64, [usize; 2], bool);
 /// a run of pairs costs one interval, not an entry per pair, and a pair is looked up in a small
 /// map of lines that stays in cache. Scoring as matches arrive keeps the distinct pairs it has
 /// counted this way (`eval::tally`): later matches of a chain repeat most of the earlier ones'
-/// pairs, along the same lines. A pair inserted along several lines is held once per line;
-/// [`RunSet::remove_below`] lists the pairs it drops without repeats.
+/// pairs, along the same lines. A pair inserted along several lines is held once per line, and
+/// [`RunSet::remove_below`] lists it once per line (its caller removes the repeats).
 #[derive(Clone, Debug, Default)]
 pub struct RunSet {
     /// `(step, key)` → sorted, disjoint, non-touching half-open intervals of `q`.
