@@ -213,6 +213,9 @@ impl ExternalRecognizer {
         if let Some(dir) = &spec.dir {
             command.current_dir(dir);
         }
+        // Its own process group, so stopping it stops what `sh -c` started too (a program run by
+        // the shell outlived a kill of the shell alone, spinning on after the run).
+        std::os::unix::process::CommandExt::process_group(&mut command, 0);
         let mut child = command
             .arg("-c")
             .arg(&spec.command)
@@ -316,7 +319,7 @@ impl ExternalRecognizer {
                 Err(self.closed(request, written.is_ok()))
             }
             Err(RecvTimeoutError::Timeout) => {
-                let _ = self.child.kill();
+                self.stop();
                 Err(self.error(format!(
                     "no answer within {} s to `{}` (after {} line(s)); it was stopped",
                     self.spec.timeout_s,
@@ -325,6 +328,14 @@ impl ExternalRecognizer {
                 )))
             }
         }
+    }
+
+    /// Stops the program and everything it started: the process group `start` gave it
+    /// (the `sh -c` and what it runs), then the shell itself if the group is already gone.
+    fn stop(&mut self) {
+        let group = rustix::process::Pid::from_child(&self.child);
+        let _ = rustix::process::kill_process_group(group, rustix::process::Signal::KILL);
+        let _ = self.child.kill();
     }
 
     /// The error for a recognizer that closed its output while `request` (`read`: written to
@@ -358,7 +369,7 @@ impl ExternalRecognizer {
         match self.try_exchange(request, frame) {
             Ok(m) => m,
             Err(e) => {
-                let _ = self.child.kill();
+                self.stop();
                 self.failure = Some(e);
                 Vec::new()
             }
@@ -517,7 +528,7 @@ impl Drop for ExternalRecognizer {
             }
             std::thread::sleep(Duration::from_millis(10));
         }
-        let _ = self.child.kill();
+        self.stop();
         let _ = self.child.wait();
     }
 }

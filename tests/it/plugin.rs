@@ -341,10 +341,35 @@ fn a_crash_is_named_with_its_exit_status_and_last_stderr_lines() {
     assert!(err.contains("after printing 32 line(s)"), "{err}");
 }
 
+/// A program that stops answering is stopped, and so is what the shell started for it: the
+/// Python process, not only `sh -c`, is gone once the run has ended (it used to spin on).
 #[test]
 fn a_hang_is_stopped_after_the_timeout() {
-    let err = failing_run("--hang-at 30", "1");
+    // A tag only this test's program carries on its command line.
+    let tag = format!("--hang-tag-{}", std::process::id());
+    let err = failing_run(&format!("--hang-at 30 {tag}"), "1");
     assert!(err.contains("no answer within 1 s"), "{err}");
+    let mut left = Vec::new();
+    for _ in 0..50 {
+        left = processes_with(&tag);
+        if left.is_empty() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    assert!(left.is_empty(), "still running after the run: {left:?}");
+}
+
+/// The command lines of the running processes that contain `tag` (from `/proc`; zombies, which
+/// have an empty command line, are not running).
+fn processes_with(tag: &str) -> Vec<String> {
+    let Ok(dir) = std::fs::read_dir("/proc") else {
+        return Vec::new();
+    };
+    dir.filter_map(|e| std::fs::read(e.ok()?.path().join("cmdline")).ok())
+        .map(|c| String::from_utf8_lossy(&c).replace('\0', " "))
+        .filter(|c| c.contains(tag))
+        .collect()
 }
 
 #[test]
