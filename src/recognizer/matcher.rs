@@ -317,6 +317,12 @@ impl WordMatcher {
         let (from, placed_from) = (scr.chain.len(), scr.placed.len());
         let extends_reported = self.push_chain((c, idx), k, dir, scr)?;
         let pairs = from..scr.chain.len();
+        let chain_len = self.memo[dir as usize][c as usize][idx].len[k] as usize;
+        if !extends_reported && self.too_few_classes(&scr.word_pairs[pairs.clone()], dir, chain_len)
+        {
+            scr.truncate(from, placed_from);
+            return None;
+        }
         if !self.beyond_candidate_gap(&scr.word_pairs[pairs.clone()]) {
             self.within_gap += 1;
             scr.truncate(from, placed_from);

@@ -18,6 +18,11 @@
 //! help (there are none). So an n-gram read backwards must turn: the current side's heading must
 //! change by at least `reverse_min_turn_deg` from its first word. Within a stretch whose ends
 //! both turn, reading backwards negates the turns and breaks such false chains at the corners.
+//! Before any of that, an n-gram driven the same way whose current words take two density
+//! classes only waits for `two_class_extra_ngram` more words of chain
+//! ([`WordMatcher::too_few_classes`]): its classes alternate, so they add nothing after its
+//! first word, and what is left (sizes, turns) repeats along a corridor of regularly spaced
+//! doors and between corners that turn alike (scenario A with weaving laps: every false chain).
 //! The first 10,000 candidates verification turns down are kept as one observation pair each
 //! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
 //! the checks turned down look-alikes or true revisits.
@@ -100,6 +105,33 @@ impl WordMatcher {
         } else {
             None
         }
+    }
+
+    /// Whether the n-gram of `word_pairs` (oldest first), whose chain is `chain_len` words
+    /// long, is not yet a candidate: driven the same way, its current words (the classes the
+    /// matching compared, whatever their level) take fewer than three density classes, and its
+    /// chain is shorter than the n-gram plus `two_class_extra_ngram` words.
+    pub(super) fn too_few_classes(
+        &self,
+        word_pairs: &[(WordId, WordId)],
+        dir: Direction,
+        chain_len: usize,
+    ) -> bool {
+        let extra = self.matcher_opts.two_class_extra_ngram;
+        if extra == 0 || dir == Direction::Opposite || chain_len >= word_pairs.len() + extra {
+            return false;
+        }
+        let mut seen: [Option<u8>; 2] = [None; 2];
+        for &(c, _) in word_pairs {
+            let class = self.word(c).class;
+            match seen {
+                [Some(a), Some(b)] if class != a && class != b => return false,
+                [None, _] => seen[0] = Some(class),
+                [Some(a), None] if class != a => seen[1] = Some(class),
+                _ => {}
+            }
+        }
+        true
     }
 
     /// Σ over the pairs of placement `w` of the squared difference of the observations'

@@ -75,6 +75,14 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ("alignment.chain_alignment_tie", "0.05", "", Input::Dense),
     ("matcher.reverse", "false", "", Input::Dense),
     ("matcher.reverse_extra_ngram", "0", "", Input::Dense),
+    // Smoke's chains of τ words take three classes or more: with n-grams of two words, some
+    // take two.
+    (
+        "matcher.two_class_extra_ngram",
+        "0",
+        "matcher.min_ngram = [2, 3, 4, 5]",
+        Input::Dense,
+    ),
     ("matcher.substitutions", "false", "", Input::Dense),
     ("matcher.substitution_size_ratio", "1.0", "", Input::Dense),
     ("matcher.ngram_travel_m", "5", "", Input::Dense),
