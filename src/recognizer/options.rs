@@ -418,15 +418,17 @@ pub struct MatcherOptions {
     pub reverse_extra_ngram: usize,
     /// Extra words a chain needs, driven the same way, when its n-gram's current words take
     /// only two density classes. Neighbouring words differ in class, so such an n-gram's
-    /// classes alternate and, after its first word, say nothing; its evidence is the words' sizes and turns alone, which a corridor of regularly
-    /// spaced doors repeats, and two corners that turn alike share. The n-gram is verified and
-    /// reported once its chain is this many words longer (it stays the last τ words); 0 = off.
-    /// Read backwards this does not apply (those chains must turn, and need
-    /// `reverse_extra_ngram` more words already). Default 1: tuned on scenario A with weaving
-    /// laps (`lap_variation = "real-weave"`), seeds 1–5, whose false chains were all two-class
-    /// n-grams of exactly τ words (3-level precision worst 0.916 → 0.960, recall 0.426 → 0.381
-    /// mean; 2 gave 0.966 and 0.373, refusing every two-class n-gram 0.962 and 0.333); Intel
-    /// unchanged (RESULTS.md, 2026-12-05).
+    /// classes alternate and, after its first word, say nothing; its evidence is the words'
+    /// sizes and turns alone, which a corridor of regularly spaced doors repeats and two
+    /// corners that turn alike share. The n-gram is verified and reported once its chain is
+    /// this many words longer (it stays the last τ words); 0 = off. Read backwards this does
+    /// not apply (those chains must turn, and need `reverse_extra_ngram` more words already).
+    /// Default 1: tuned on scenario A with weaving laps (`lap_variation = "real-weave"`),
+    /// seeds 1–5, where 7 of the 8 false chains were two-class n-grams of exactly τ words
+    /// (3-level precision worst 0.916 → 0.960, recall mean 0.397 → 0.382; 2 gave 0.966 and
+    /// 0.373, refusing every two-class n-gram 0.962 and 0.319), and Intel (unchanged);
+    /// confirmed on A, B, C and `reverse`, smooth and weaving, seeds 1–10, and the five logs
+    /// (RESULTS.md, 2026-12-05).
     pub two_class_extra_ngram: usize,
     /// Chains may bridge one substituted word: (c, p) may extend a chain ending one level-0 word
     /// further back on both sides, when the two skipped words have the same class and sizes

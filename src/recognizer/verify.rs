@@ -22,7 +22,8 @@
 //! classes only waits for `two_class_extra_ngram` more words of chain
 //! ([`WordMatcher::too_few_classes`]): its classes alternate, so they add nothing after its
 //! first word, and what is left (sizes, turns) repeats along a corridor of regularly spaced
-//! doors and between corners that turn alike (scenario A with weaving laps: every false chain).
+//! doors and between corners that turn alike (scenario A with weaving laps: 7 of 8 false
+//! chains, seeds 1–5).
 //! The first 10,000 candidates verification turns down are kept as one observation pair each
 //! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
 //! the checks turned down look-alikes or true revisits.

@@ -1953,10 +1953,10 @@ fn the_wide_window_splits_a_hall_crossing_into_words() {
     );
 }
 
-/// Scenario A with weaving laps (`lap_variation = "real-weave"`), seed 2 (issue 28): its false
-/// chains were same-direction n-grams of exactly τ words whose words take two density classes
-/// only (the north corridor at the west one's place, a corner at another corner that turns the
-/// same way), so their classes said nothing after the first word. Such an n-gram now waits for
+/// Scenario A with weaving laps (`lap_variation = "real-weave"`), seed 2 (issue 28): most of
+/// its false pairs came from same-direction n-grams of exactly τ words whose words take two
+/// density classes only (the south corridor at the north one's place, a corner at another
+/// corner that turns the same way), so their classes said nothing after the first word. Such an n-gram now waits for
 /// one more word of chain (`two_class_extra_ngram`): 3-level precision reaches 0.95, which it
 /// misses with the rule off, and the recall stays within a few hundredths.
 #[test]
