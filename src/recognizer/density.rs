@@ -772,6 +772,26 @@ mod tests {
         }
     }
 
+    /// A kernel walking every 4th ray reads an all-free window as Ψ = 1 and a half-plane
+    /// (free on one side of a wall through the centre) as about half, as every ray does.
+    #[test]
+    fn a_ray_stride_keeps_psi_of_free_and_half_free_windows() {
+        let (full, sparse) = (
+            DensityKernel::new(50, 1.0),
+            DensityKernel::with_ray_stride(50, 1.0, 4),
+        );
+        assert!(sparse.node_count() * 3 < full.node_count());
+        let free = DenseGrid::new(121, 121, CellState::Free);
+        assert_eq!(free.psi(&sparse, 60, 60), 1.0);
+        let mut half = free.clone();
+        for y in 0..121 {
+            half.set(60 + 1, y, CellState::Occupied);
+        }
+        let (a, b) = (half.psi(&full, 60, 60), half.psi(&sparse, 60, 60));
+        assert!((a - b).abs() < 0.02, "{a} {b}");
+        assert!((0.4..0.65).contains(&a), "{a}");
+    }
+
     #[test]
     fn unknown_cells_do_not_count_nor_stop() {
         let k = DensityKernel::new(10, 1.0);
