@@ -157,3 +157,26 @@ fn the_approximate_front_end_keeps_psi_within_the_bound_of_the_exact_one() {
         assert!(!gap.within(), "{name}: 4° rays pass the bound: {gap:?}");
     }
 }
+
+/// A stride out of range is refused with where it is and what is allowed.
+#[test]
+fn strides_out_of_range_are_refused_where_they_are_written() {
+    use placewords::experiment::parse_recognizer_config;
+    use std::path::Path;
+    for (table, key, value) in [
+        ("grid", "beam_stride", "0"),
+        ("grid", "beam_stride", "9"),
+        ("density", "ray_stride", "0"),
+        ("density", "ray_stride", "20"),
+    ] {
+        let src = format!("[recognizer.{table}]\n{key} = {value}\n");
+        let e = parse_recognizer_config(&src, Path::new("t.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("[recognizer.{table}] {key}")) && e.contains("[1, 8]"),
+            "{key} = {value}: {e}"
+        );
+        assert!(e.starts_with("t.toml:"), "{e}");
+    }
+}
