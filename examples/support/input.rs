@@ -35,6 +35,7 @@ pub fn load(path: &Path, seed: u64) -> Result<(Vec<RunLog>, RecognizerConfig)> {
 }
 
 /// The recognizer with `cfg` after every frame of `runs` (each run a run of its own).
+#[allow(dead_code)] // not every example recognizes (`psi_bound` runs front ends only)
 pub fn recognize(runs: &[RunLog], cfg: RecognizerConfig) -> Result<Recognizer> {
     let mut rec = Recognizer::new(cfg)?;
     let mut frame = 0;

@@ -10,7 +10,7 @@
 //! recognizer sees, up to the small differences of a grid turned with the odometry frame.
 
 use crate::geom::Vec2;
-use crate::recognizer::density::{CellState, DensityKernel, Visited, cell_value};
+use crate::recognizer::density::{CellState, Visited, cell_value};
 use crate::recognizer::{RecognizerConfig, WordLevels};
 use crate::world::geometry::ThickSegment;
 use crate::world::raster::Raster;
@@ -114,7 +114,7 @@ pub fn density_map(
     sample_m: f64,
 ) -> DensityMap {
     let cell_m = cfg.grid.grid_cell_m;
-    let kernel = DensityKernel::new(cfg.kernel_radius_cells(), cfg.density.ray_step_deg);
+    let kernel = cfg.density_kernel();
     // Half a cell of dilation keeps thin diagonal walls closed for the kernel's rays.
     let raster = Raster::new(&obstacles(world, doors), &[], cell_m, 1.0, cell_m * 0.5);
     let pad = kernel.radius_cells() + 1;

@@ -215,6 +215,16 @@ impl RecognizerConfig {
         }
     }
 
+    /// The density kernel of these settings: `kernel_radius_m` in cells, a ray every
+    /// `ray_step_deg`, every `ray_stride`-th of them walked.
+    pub fn density_kernel(&self) -> super::density::DensityKernel {
+        super::density::DensityKernel::with_ray_stride(
+            self.kernel_radius_cells(),
+            self.density.ray_step_deg,
+            self.density.ray_stride,
+        )
+    }
+
     /// Kernel radius in grid cells (rounded).
     pub fn kernel_radius_cells(&self) -> usize {
         (self.density.kernel_radius_m / self.grid.grid_cell_m).round() as usize

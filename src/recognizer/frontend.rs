@@ -184,13 +184,14 @@ impl DensityFrontEnd {
     /// [`Self::same_settings`]).
     pub fn new(config: &RecognizerConfig) -> Result<Self, RecognizerError> {
         config.validate()?;
-        let grid = LocalGrid::with_memory(
+        let mut grid = LocalGrid::with_memory(
             config.grid.grid_cell_m,
             config.grid.grid_radius_m,
             config.grid.grid_memory_m,
             config.front_end.max_interpolation_m + config.density.kernel_radius_m,
         );
-        let kernel = DensityKernel::new(config.kernel_radius_cells(), config.density.ray_step_deg);
+        grid.set_beam_stride(config.grid.beam_stride);
+        let kernel = config.density_kernel();
         Ok(DensityFrontEnd {
             clock: ObservationClock::new(
                 config.front_end.observation_spacing_m,

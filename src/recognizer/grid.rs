@@ -18,7 +18,10 @@
 //! other coordinate in 16.16 fixed point), only up to the grid radius. Near the sensor, where
 //! neighbouring beams cross the same cells, beams are thinned (see [`LocalGrid::integrate`]):
 //! the cells there are still crossed by the sparser beams, and about a quarter of the cell
-//! visits are saved.
+//! visits are saved. With a beam stride (`[recognizer.grid] beam_stride`, default 1) a scan
+//! traces only every n-th beam, the next scan the next ones, each traced beam lowering the
+//! counters it passes n times; returns are marked for every beam. An approximation: Ψ stays
+//! within the bound `tests/it/frontend_bound.rs` checks against the exact update (stride 1).
 
 use super::density::{CellState, DensityKernel, FreeCells, RayDeltas, Visited, cell_state};
 use crate::geom::{OdomPose, Pose2};
@@ -62,6 +65,31 @@ const fn hit_next() -> [u8; 256] {
 
 /// Counter after a beam passes the cell.
 const FREE_NEXT: [u8; 256] = free_next();
+
+/// Largest beam stride (`LocalGrid::set_beam_stride`).
+pub const MAX_BEAM_STRIDE: usize = 8;
+
+/// Per stride n ≤ [`MAX_BEAM_STRIDE`], the counter after n beams pass the cell (`FREE_NEXT`
+/// applied n times; entry 0 is unused).
+const FREE_NEXT_TIMES: [[u8; 256]; MAX_BEAM_STRIDE + 1] = {
+    let mut t = [[0u8; 256]; MAX_BEAM_STRIDE + 1];
+    let mut n = 1;
+    while n <= MAX_BEAM_STRIDE {
+        let mut i = 0;
+        while i < 256 {
+            let mut v = i as u8;
+            let mut k = 0;
+            while k < n {
+                v = FREE_NEXT[v as usize];
+                k += 1;
+            }
+            t[n][i] = v;
+            i += 1;
+        }
+        n += 1;
+    }
+    t
+};
 /// Counter after a beam ends in the cell.
 const HIT_NEXT: [u8; 256] = hit_next();
 
@@ -96,6 +124,13 @@ fn floor_div(v: f64, cell_m: f64, inv_cell: f64) -> i32 {
     }
 }
 
+/// Longest step from the last scan integrated after which a scan may skip beams, metres: the
+/// scans of an observation step (0.10 m) may, those of a sparse log (0.7 m apart) may not.
+pub const STRIDE_MAX_STEP_M: f64 = 0.15;
+/// Largest turn since the last scan integrated after which a scan may skip beams, radians
+/// (2°): turning, the view changes and every beam is traced.
+pub const STRIDE_MAX_TURN_RAD: f64 = 0.035;
+
 /// The rolling local grid.
 #[derive(Clone, Debug)]
 pub struct LocalGrid {
@@ -115,6 +150,15 @@ pub struct LocalGrid {
     visited: Visited,
     /// `65536 / n` for trace lengths n of up to a window's side (a division per beam saved).
     inv_steps: Vec<f64>,
+    /// Beams traced per scan: every `beam_stride`-th (1: all), see [`LocalGrid::set_beam_stride`].
+    beam_stride: usize,
+    /// Scans integrated so far: which beams of the stride the next scan traces.
+    phase: usize,
+    /// The sensor pose of the last scan integrated (`None` after `clear`).
+    last_sensor: Option<Pose2>,
+    /// What a beam passing a cell does to its counter in the scan being integrated: one pass,
+    /// or as many as the scan's stride (each traced beam stands for that many).
+    free_next: &'static [u8; 256],
 }
 
 impl LocalGrid {
@@ -159,7 +203,20 @@ impl LocalGrid {
             has_origin: false,
             visited: Visited::default(),
             inv_steps: (0..=side).map(|n| 65536.0 / n as f64).collect(),
+            beam_stride: 1,
+            phase: 0,
+            last_sensor: None,
+            free_next: &FREE_NEXT_TIMES[1],
         }
+    }
+
+    /// Traces only every `stride`-th beam of each scan (1, the default: every beam), the next
+    /// scan the next beams of the stride, so that `stride` consecutive scans trace each beam
+    /// once; every return within the radius still marks its cell occupied. Free space is
+    /// then seen once per `stride` integrations (a cell's counter lowers more slowly), walls
+    /// as before.
+    pub fn set_beam_stride(&mut self, stride: usize) {
+        self.beam_stride = stride.clamp(1, MAX_BEAM_STRIDE);
     }
 
     /// Side of the window, cells.
@@ -171,6 +228,7 @@ impl LocalGrid {
     pub fn clear(&mut self) {
         self.cells.fill(0);
         self.has_origin = false;
+        self.last_sensor = None;
     }
 
     /// Global cell of a point of the odometry frame.
@@ -286,6 +344,12 @@ impl LocalGrid {
         // (always, short of 2.6e7 m from the origin at 5 cm cells), cells come from a product.
         let far = (sensor.x.abs().max(sensor.y.abs()) + reach) / cell_m + 2.0;
         let small = far < SMALL_QUOTIENT;
+        let stride = self.stride_from(&sensor);
+        let phase = self.phase % stride;
+        // A traced beam stands for the `stride` beams around it: the counters it passes fall
+        // as fast per scan as with every beam (a passer-by's returns fade as quickly).
+        self.free_next = &FREE_NEXT_TIMES[stride];
+        self.phase = self.phase.wrapping_add(1);
         let cell = |x: f64, y: f64| {
             if small {
                 (
@@ -310,7 +374,9 @@ impl LocalGrid {
             // cell apart, so the cells there are still crossed by the sparser beams.
             let start = starts[i & 15];
             let (ex, ey) = cell(sensor.x + bc * len, sensor.y + bs * len);
-            if start >= len {
+            // Beams traced from the sensor (every 16th) are traced on every scan: they lower the
+            // counters of the cells around the robot, which a passer-by's returns raised.
+            if start >= len || (stride > 1 && i % stride != phase && i & 15 != 0) {
                 if hit {
                     self.mark(ex, ey, true);
                 }
@@ -325,12 +391,23 @@ impl LocalGrid {
         }
     }
 
+    /// The stride of the scan taken at `sensor`: `beam_stride` when the last scan integrated
+    /// was taken near it (so that the beams skipped now were traced from about here), else 1.
+    fn stride_from(&mut self, sensor: &Pose2) -> usize {
+        let near = self.last_sensor.is_some_and(|last| {
+            last.distance(sensor) <= STRIDE_MAX_STEP_M
+                && crate::geom::wrap_angle(sensor.theta - last.theta).abs() <= STRIDE_MAX_TURN_RAD
+        });
+        self.last_sensor = Some(*sensor);
+        if near { self.beam_stride } else { 1 }
+    }
+
     /// Updates one cell: a beam ended in it (`hit`) or passed it.
     #[inline]
     fn mark(&mut self, x: i32, y: i32, hit: bool) {
         let i = self.index(x, y);
         let v = self.cells[i] as usize;
-        self.cells[i] = if hit { HIT_NEXT[v] } else { FREE_NEXT[v] };
+        self.cells[i] = if hit { HIT_NEXT[v] } else { self.free_next[v] };
     }
 
     /// Marks the cells from (x0, y0) to (x1, y1) free, the last one occupied when `hit`: n steps
@@ -358,12 +435,12 @@ impl LocalGrid {
                 let minor_inc = (d_minor as f64 * inv) as i64;
                 if minor == 1 {
                     let inc = (major << 16).wrapping_add(minor_inc) as u64;
-                    trace_steps_fixed(&mut self.cells, self.mask, start, n, inc);
+                    trace_steps_fixed(&mut self.cells, self.free_next, self.mask, start, n, inc);
                 } else {
                     let step = major.wrapping_add((minor_inc >> 16).wrapping_mul(minor)) as usize;
                     let fraction = (minor_inc & 0xFFFF) as u32;
                     trace_steps(
-                        &mut self.cells,
+                        (&mut self.cells, self.free_next),
                         self.mask,
                         start,
                         n,
@@ -384,12 +461,12 @@ impl LocalGrid {
     fn trace_dda(&mut self, x0: i32, y0: i32, n: i64, ix: i64, iy: i64) {
         let mut xf = ((x0 as i64) << 16) + 0x8000;
         let mut yf = ((y0 as i64) << 16) + 0x8000;
-        let (shift, mask) = (self.shift, self.mask);
+        let (shift, mask, free_next) = (self.shift, self.mask, self.free_next);
         // Exactly side² cells: indices masked by side² − 1 need no bounds check.
         let cells = &mut self.cells[..=mask];
         for _ in 0..n {
             let i = (((yf >> 16) << shift) + (xf >> 16)) as usize & mask;
-            cells[i] = FREE_NEXT[cells[i] as usize];
+            cells[i] = free_next[cells[i] as usize];
             xf += ix;
             yf += iy;
         }
@@ -454,10 +531,11 @@ impl LocalGrid {
 /// centre and growing by `fraction`, carries over. The same cells as the 16.16 DDA with one
 /// index per cell instead of two coordinates. Step k's index is computed from k alone (the
 /// carries so far are the high half of 0x8000 + k·fraction, which fits 32 bits for k < 2¹⁵), not
-/// from step k − 1's index: the steps do not wait on each other's carry.
+/// from step k − 1's index: the steps do not wait on each other's carry. `free_next` is what
+/// a pass does to a counter.
 #[inline(always)]
 fn trace_steps(
-    cells: &mut [u8],
+    (cells, free_next): (&mut [u8], &[u8; 256]),
     mask: usize,
     start: usize,
     n: i64,
@@ -470,7 +548,7 @@ fn trace_steps(
     let (mut whole, mut frac) = (start, 0x8000u32);
     for _ in 0..n {
         let i = whole.wrapping_add(((frac >> 16) as usize) << minor_shift) & mask;
-        cells[i] = FREE_NEXT[cells[i] as usize];
+        cells[i] = free_next[cells[i] as usize];
         whole = whole.wrapping_add(step);
         frac += fraction;
     }
@@ -482,13 +560,20 @@ fn trace_steps(
 /// part is the cell. The same cells as `trace_steps` with one add per step (wrapping: the
 /// whole part is taken modulo the torus).
 #[inline(always)]
-fn trace_steps_fixed(cells: &mut [u8], mask: usize, start: usize, n: i64, inc: u64) {
+fn trace_steps_fixed(
+    cells: &mut [u8],
+    free_next: &[u8; 256],
+    mask: usize,
+    start: usize,
+    n: i64,
+    inc: u64,
+) {
     // Exactly side² cells: indices masked by side² − 1 need no bounds check.
     let cells = &mut cells[..=mask];
     let mut at = ((start as u64) << 16) | 0x8000;
     for _ in 0..n {
         let i = (at >> 16) as usize & mask;
-        cells[i] = FREE_NEXT[cells[i] as usize];
+        cells[i] = free_next[cells[i] as usize];
         at = at.wrapping_add(inc);
     }
 }

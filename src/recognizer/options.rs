@@ -15,6 +15,11 @@ pub const MIN_OBSERVATION_SPACING_M: f64 = 0.01;
 /// Largest `max_alignment_offset` and `chain_alignment_offset`, observations: each shift is
 /// tried for every matched pair (1e9 never finishes).
 pub const MAX_ALIGNMENT_OFFSET: usize = 1000;
+/// Largest `ray_stride`: weights of bins that wider strides leave with a cell or none say
+/// little.
+pub const MAX_RAY_STRIDE: usize = 8;
+/// Largest `beam_stride`: a wider stride leaves free space unseen for as many integrations.
+pub use super::grid::MAX_BEAM_STRIDE;
 /// Largest local grid the recognizer accepts, cells from the centre to the edge.
 pub const MAX_GRID_HALF_CELLS: f64 = 1000.0;
 
@@ -143,6 +148,17 @@ pub struct GridOptions {
     /// it was a setting; 12.8 m, which remembers a corridor the robot turned out of, cost fhw
     /// every pair).
     pub grid_memory_m: f64,
+    /// Beams of a scan traced into the grid: every `beam_stride`-th, the next scan the next
+    /// ones, so that `beam_stride` consecutive integrations trace each beam once, and each
+    /// traced beam lowers the counters it passes as `beam_stride` beams would; every return
+    /// within `grid_radius_m` still marks its cell occupied, and the beams traced from the
+    /// sensor (every 16th) are traced on every scan. A scan more than 0.15 m or 2° from the
+    /// last one integrated (a sparse log, a turn) traces every beam. 1 traces every beam on
+    /// every scan (the exact front end). Default 1: 2 costs the grid update about a third less
+    /// with Ψ within the bound `tests/it/frontend_bound.rs` checks against the exact front end,
+    /// but with `ray_stride = 4` it cost A's worst 3-level precision 0.956 → 0.932 and reverse's
+    /// same-direction precision 0.968 → 0.948 (docs/design.md, "The front end's approximation").
+    pub beam_stride: usize,
 }
 
 impl Default for GridOptions {
@@ -151,6 +167,7 @@ impl Default for GridOptions {
             grid_cell_m: 0.05,
             grid_radius_m: 3.0,
             grid_memory_m: 6.4,
+            beam_stride: 1,
         }
     }
 }
@@ -170,6 +187,14 @@ impl GridOptions {
         }
         self.radius_problems(&mut p);
         self.memory_problems(&mut p);
+        let b = self.beam_stride;
+        p.within(
+            "beam_stride",
+            b as f64,
+            (1..=MAX_BEAM_STRIDE).contains(&b),
+            &format!("[1, {MAX_BEAM_STRIDE}]"),
+            "1",
+        );
         p.out
     }
 
@@ -241,6 +266,14 @@ pub struct DensityOptions {
     /// free lately, the wide density Φ, splits Ψ's top class in open space, where Ψ saturates
     /// (`wide_classes` in `[recognizer.words]`; `recognizer::wide`). 0 turns it off. Default 20.
     pub wide_radius_m: f64,
+    /// Rays walked: every `ray_stride`-th of those `ray_step_deg` apart, each cell counted with
+    /// a weight (the cells every ray reaches in its bin, a ring and a sector, over those the
+    /// walked rays reach; `DensityKernel::with_ray_stride`), so that an all-free window still
+    /// gives Ψ = 1 and Ψ stays that of every ray within the bound `tests/it/frontend_bound.rs`
+    /// checks. 1 walks every ray (the exact kernel). Default 1: 4 costs a density about half,
+    /// and with `beam_stride = 2` the front end 15 ms a lap instead of 25 (BENCHMARKS.md), but
+    /// moved the figures past their gates (see `beam_stride` in `[recognizer.grid]`).
+    pub ray_stride: usize,
 }
 
 impl Default for DensityOptions {
@@ -249,6 +282,7 @@ impl Default for DensityOptions {
             kernel_radius_m: 2.5,
             ray_step_deg: 1.0,
             wide_radius_m: 20.0,
+            ray_stride: 1,
         }
     }
 }
@@ -281,6 +315,14 @@ impl DensityOptions {
             w.is_finite() && (w == 0.0 || (1.0..=100.0).contains(&w)),
             "0 (off) or [1, 100]",
             "20",
+        );
+        let k = self.ray_stride;
+        p.within(
+            "ray_stride",
+            k as f64,
+            (1..=MAX_RAY_STRIDE).contains(&k),
+            &format!("[1, {MAX_RAY_STRIDE}]"),
+            "1",
         );
         p.out
     }

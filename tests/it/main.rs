@@ -12,6 +12,7 @@ mod cli;
 mod common;
 mod compare;
 mod eval;
+mod frontend_bound;
 mod fuzz;
 mod io;
 mod longterm;

@@ -27,8 +27,10 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ("front_end.integrate_every_scan", "true", "", Input::Dense),
     ("grid.grid_cell_m", "0.1", "", Input::Dense),
     ("grid.grid_radius_m", "2.5", "", Input::Dense),
+    ("grid.beam_stride", "2", "", Input::Dense),
     ("density.kernel_radius_m", "1.5", "", Input::Dense),
     ("density.ray_step_deg", "5.0", "", Input::Dense),
+    ("density.ray_stride", "4", "", Input::Dense),
     ("words.classes", "5", "", Input::Dense),
     // Smoke has no open space: with two classes, its junctions reach the top class, and a
     // 3 m window sees half of it free there.

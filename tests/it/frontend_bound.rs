@@ -1,0 +1,182 @@
+//! The approximate front end (`[recognizer.grid] beam_stride = 2`, `[recognizer.density]
+//! ray_stride = 4`) keeps Ψ within a bound of the exact one (both 1, the defaults: the authors'
+//! grid update and kernel): over the first run of every shipped scenario and the start of every
+//! CARMEN log, Ψ of each observation is compared (docs/design.md, "The front end's
+//! approximation"; `examples/psi_bound.rs` prints the same figures for whole runs).
+
+use super::common::root;
+use placewords::experiment::{ExperimentOptions, load_scenario, real, simulate};
+use placewords::io::real_log::TruthSource;
+use placewords::log::RunLog;
+use placewords::recognizer::{DensityFrontEnd, DensityObservation, RecognizerConfig, WordLevels};
+
+/// The bound, per dataset: |ΔΨ| at the 99th percentile and on average, the share of
+/// observations farther apart than [`FAR`], and the share whose class (Φ included) changes.
+const P99: f64 = 0.04;
+const MEAN: f64 = 0.008;
+/// A passer-by's trace fades at another pace in places (|ΔΨ| up to 0.46 in the long-term run):
+/// rare, so the share beyond this is bounded rather than the largest.
+const FAR: f64 = 0.1;
+const FAR_SHARE: f64 = 0.005;
+const CLASS_SHARE: f64 = 0.08;
+/// Scans of a log read: its first ones (all of a log with fewer).
+const LOG_SCANS: usize = 1500;
+
+/// Figures of one dataset.
+#[derive(Debug)]
+struct Gap {
+    p99: f64,
+    mean: f64,
+    far_share: f64,
+    class_share: f64,
+}
+
+impl Gap {
+    fn of(cfg: &RecognizerConfig, a: &[DensityObservation], b: &[DensityObservation]) -> Self {
+        assert_eq!(
+            a.len(),
+            b.len(),
+            "both front ends observe at the same travel"
+        );
+        assert!(a.len() > 300, "{} observations", a.len());
+        let levels = WordLevels::new(cfg.words.classes, cfg.words.min_word_size, 1)
+            .with_wide_classes(cfg.wide_classes_in_use());
+        let class = |o: &DensityObservation| levels.class_of_observation(o.psi, o.wide_density);
+        let mut d: Vec<f64> = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x.psi - y.psi).abs())
+            .collect();
+        d.sort_by(f64::total_cmp);
+        let n = d.len() as f64;
+        Gap {
+            p99: d[((d.len() - 1) as f64 * 0.99) as usize],
+            mean: d.iter().sum::<f64>() / n,
+            far_share: d.iter().filter(|&&v| v > FAR).count() as f64 / n,
+            class_share: a
+                .iter()
+                .zip(b)
+                .filter(|(x, y)| class(x) != class(y))
+                .count() as f64
+                / n,
+        }
+    }
+
+    fn within(&self) -> bool {
+        self.p99 <= P99
+            && self.mean <= MEAN
+            && self.far_share <= FAR_SHARE
+            && self.class_share <= CLASS_SHARE
+    }
+}
+
+fn observe(runs: &[RunLog], cfg: &RecognizerConfig, scans: usize) -> Vec<DensityObservation> {
+    let mut fe = DensityFrontEnd::new(cfg).unwrap();
+    let mut out = Vec::new();
+    let mut frame = 0;
+    for run in runs {
+        fe.start_run();
+        for f in run.frames().take(scans) {
+            out.extend(fe.push_frame(frame, f.odom, &f.scan));
+            frame += 1;
+        }
+    }
+    out
+}
+
+fn exact(cfg: &RecognizerConfig) -> RecognizerConfig {
+    let mut exact = cfg.clone();
+    exact.grid.beam_stride = 1;
+    exact.density.ray_stride = 1;
+    exact
+}
+
+/// The approximation the bound is for: every 2nd beam a scan, every 4th density ray.
+fn approximate(cfg: &RecognizerConfig) -> RecognizerConfig {
+    let mut approx = cfg.clone();
+    approx.grid.beam_stride = 2;
+    approx.density.ray_stride = 4;
+    approx
+}
+
+/// Per dataset (the first run of every scenario, the first scans of every log): its name, the
+/// inputs, the settings and how many scans of each run to read.
+fn datasets() -> Vec<(String, Vec<RunLog>, RecognizerConfig, usize)> {
+    let mut out = Vec::new();
+    let mut scenarios: Vec<_> = std::fs::read_dir(root().join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenarios.sort();
+    for path in scenarios {
+        let mut scn = load_scenario(&path).unwrap();
+        scn.sim.runs.truncate(1);
+        let (runs, _, _) = simulate(&scn, &ExperimentOptions::default()).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        out.push((name, runs, scn.recognizer.clone(), usize::MAX));
+    }
+    let logs = root().join("../shared/data/carmen");
+    let noise = real::parse_noise_model("proportional").unwrap();
+    for log in ["csail", "fhw", "freiburg-079", "intel", "seattle"] {
+        let path = logs.join(format!("{log}-corrected.log.gz"));
+        let (run, _) = real::load_real_run(
+            &path,
+            false,
+            TruthSource::Corrected,
+            noise.as_ref(),
+            1,
+            &Default::default(),
+        )
+        .unwrap();
+        let cfg = RecognizerConfig::default();
+        out.push((log.to_string(), vec![run], cfg, LOG_SCANS));
+    }
+    out
+}
+
+/// The approximate front end is within the bound of the exact one on every shipped scenario
+/// and log; a coarser kernel (rays every 4°, every ray walked) is not, so the bound tells a
+/// worse approximation. The defaults are the exact front end.
+#[test]
+fn the_approximate_front_end_keeps_psi_within_the_bound_of_the_exact_one() {
+    let default = RecognizerConfig::default();
+    assert_eq!(
+        (default.grid.beam_stride, default.density.ray_stride),
+        (1, 1)
+    );
+    for (name, runs, cfg, scans) in datasets() {
+        let a = observe(&runs, &exact(&cfg), scans);
+        let gap = Gap::of(&cfg, &a, &observe(&runs, &approximate(&cfg), scans));
+        eprintln!("{name}: {} observations, approximate {gap:?}", a.len());
+        assert!(gap.within(), "{name}: {gap:?}");
+        let mut coarse = exact(&cfg);
+        coarse.density.ray_step_deg = 4.0;
+        let gap = Gap::of(&cfg, &a, &observe(&runs, &coarse, scans));
+        eprintln!("{name}: 4° rays {gap:?}");
+        assert!(!gap.within(), "{name}: 4° rays pass the bound: {gap:?}");
+    }
+}
+
+/// A stride out of range is refused with where it is and what is allowed.
+#[test]
+fn strides_out_of_range_are_refused_where_they_are_written() {
+    use placewords::experiment::parse_recognizer_config;
+    use std::path::Path;
+    for (table, key, value) in [
+        ("grid", "beam_stride", "0"),
+        ("grid", "beam_stride", "9"),
+        ("density", "ray_stride", "0"),
+        ("density", "ray_stride", "20"),
+    ] {
+        let src = format!("[recognizer.{table}]\n{key} = {value}\n");
+        let e = parse_recognizer_config(&src, Path::new("t.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("[recognizer.{table}] {key}")) && e.contains("[1, 8]"),
+            "{key} = {value}: {e}"
+        );
+        assert!(e.starts_with("t.toml:"), "{e}");
+    }
+}
