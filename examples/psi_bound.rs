@@ -17,7 +17,9 @@
 use anyhow::Result;
 use clap::Parser;
 use placewords::log::RunLog;
-use placewords::recognizer::{DensityFrontEnd, DensityObservation, RecognizerConfig, WordLevels};
+use placewords::recognizer::{
+    DensityFrontEnd, DensityObservation, PsiGap, RecognizerConfig, WordLevels,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -222,31 +224,19 @@ fn report(
         );
         return;
     }
-    let levels = WordLevels::new(cfg.words.classes, cfg.words.min_word_size, 1)
-        .with_wide_classes(cfg.wide_classes_in_use());
-    let class = |o: &DensityObservation| levels.class_of_observation(o.psi, o.wide_density);
-    let mut d: Vec<f64> = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x.psi - y.psi).abs())
-        .collect();
-    let changed = a
-        .iter()
-        .zip(b)
-        .filter(|(x, y)| class(x) != class(y))
-        .count();
-    d.sort_by(f64::total_cmp);
-    let n = d.len().max(1);
-    let q = |p: f64| d.get(((n - 1) as f64 * p) as usize).copied().unwrap_or(0.0);
+    let Some(gap) = PsiGap::between(cfg, a, b) else {
+        println!("{name:<28} no observations");
+        return;
+    };
     let (wa, la) = words(cfg, a);
     let (wb, lb) = words(cfg, b);
     println!(
         "{name:<28} {:>6} {:>7.4} {:>7.4} {:>8.5} {:>6.2}% {:>6} {:>5.2}m {:>6} {:>5.2}m {:>6.2}s {:>6.2}s",
-        d.len(),
-        q(1.0),
-        q(0.99),
-        d.iter().sum::<f64>() / n as f64,
-        100.0 * changed as f64 / n as f64,
+        gap.observations,
+        gap.max,
+        gap.p99,
+        gap.mean,
+        100.0 * gap.class_share,
         wa,
         la,
         wb,

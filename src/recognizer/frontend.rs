@@ -26,7 +26,7 @@ use super::density::{DensityKernel, RayDeltas};
 use super::grid::LocalGrid;
 use super::types::{DensityObservation, FrameId, Observation};
 use super::wide::WideWindow;
-use super::words::density_class;
+use super::words::{WordLevels, density_class};
 use crate::geom::OdomPose;
 use crate::scan::Scan;
 
@@ -349,5 +349,66 @@ impl DensityFrontEnd {
     /// Index of the current run (0 for the first).
     pub fn run(&self) -> usize {
         self.run
+    }
+}
+
+/// How far one front end's Ψ is from another's over the same observations (the fast front end
+/// against the exact one, `[recognizer.grid] beam_stride`, `[recognizer.density] ray_stride`):
+/// the one measure `tests/it/frontend_bound.rs` bounds and `examples/psi_bound.rs` prints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PsiGap {
+    /// Observations compared.
+    pub observations: usize,
+    /// Largest |ΔΨ|.
+    pub max: f64,
+    /// |ΔΨ| at the 99th percentile.
+    pub p99: f64,
+    /// Mean |ΔΨ|.
+    pub mean: f64,
+    /// Share of the observations with |ΔΨ| above [`PsiGap::FAR`].
+    pub far_share: f64,
+    /// Share of the observations whose density class (the word builder's, the wide density Φ
+    /// included) differs.
+    pub class_share: f64,
+}
+
+impl PsiGap {
+    /// |ΔΨ| beyond which an observation counts in `far_share`.
+    pub const FAR: f64 = 0.1;
+
+    /// The gap between `a` and `b`, observations of the same inputs in the same order, classed
+    /// by `cfg`'s words; `None` when their counts differ (the front ends did not observe at the
+    /// same travel) or there is none.
+    pub fn between(
+        cfg: &RecognizerConfig,
+        a: &[DensityObservation],
+        b: &[DensityObservation],
+    ) -> Option<PsiGap> {
+        if a.len() != b.len() || a.is_empty() {
+            return None;
+        }
+        let levels = WordLevels::new(cfg.words.classes, cfg.words.min_word_size, 1)
+            .with_wide_classes(cfg.wide_classes_in_use());
+        let class = |o: &DensityObservation| levels.class_of_observation(o.psi, o.wide_density);
+        let mut d: Vec<f64> = a
+            .iter()
+            .zip(b)
+            .map(|(x, y)| (x.psi - y.psi).abs())
+            .collect();
+        d.sort_by(f64::total_cmp);
+        let n = d.len() as f64;
+        let changed = a
+            .iter()
+            .zip(b)
+            .filter(|(x, y)| class(x) != class(y))
+            .count();
+        Some(PsiGap {
+            observations: d.len(),
+            max: d[d.len() - 1],
+            p99: d[((d.len() - 1) as f64 * 0.99) as usize],
+            mean: d.iter().sum::<f64>() / n,
+            far_share: d.iter().filter(|&&v| v > Self::FAR).count() as f64 / n,
+            class_share: changed as f64 / n,
+        })
     }
 }

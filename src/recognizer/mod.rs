@@ -33,7 +33,7 @@ pub use config::{
 };
 pub use density::{CellState, DenseGrid, DensityKernel, FreeCells, RayDeltas, Visited, density};
 pub use diagnostics::{MatchDiagnostics, Rejection, VerificationCounts, long_steps_sentence};
-pub use frontend::{DensityFrontEnd, Due, ObservationClock};
+pub use frontend::{DensityFrontEnd, Due, ObservationClock, PsiGap};
 pub use grid::{Density, LocalGrid};
 pub use matcher::WordMatcher;
 pub use options::{
