@@ -46,8 +46,14 @@ impl WordMatcher {
                 ],
             }
         }));
-        offsets.sort_by(f64::total_cmp);
-        let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
+        // The middle element of the sorted offsets, found by selection: `total_cmp` is a total
+        // order, so it is the same value a full sort puts there.
+        let mid = offsets.len() / 2;
+        let offset_m = if offsets.is_empty() {
+            0.0
+        } else {
+            *offsets.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
         anchors.extend(word_pairs.iter().map(|&(c, p)| {
             let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
             ((start_gap_m - offset_m) / self.spacing_m).round() as i64

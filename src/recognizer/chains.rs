@@ -30,7 +30,7 @@
 //! (the laser looks ahead), so opposite chains are runs of a few long words.
 //!
 
-use super::index::recent_candidates;
+use super::index::{Occurrence, recent_candidates};
 use super::matcher::{Scratch, WordMatcher};
 use super::types::Direction;
 use super::words::{MAX_LEVELS, Word, WordId};
@@ -50,9 +50,10 @@ pub(super) struct Entry {
 }
 
 impl WordMatcher {
-    /// Whether current word `a` matches past word `b` read in direction `dir` (backwards, b's
-    /// angle syllable is negated; class and size do not change).
-    pub(super) fn syllables_match(&self, a: &Word, b: &Word, dir: Direction) -> bool {
+    /// Whether current word `a` matches past word `b` (an entry of its class's occurrence list)
+    /// read in direction `dir` (backwards, b's angle syllable is negated; class and size do not
+    /// change).
+    pub(super) fn syllables_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
         let (sa, sb) = (a.size as f64, b.size as f64);
         if (sa - sb).abs() > self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9 {
             return false;
@@ -61,7 +62,11 @@ impl WordMatcher {
             Direction::Same => b.angle_deg,
             Direction::Opposite => -b.angle_deg,
         };
-        let mut d = (a.angle_deg - b_angle).abs() % 360.0;
+        // `%` is a software fmod; below 360 it returns its operand unchanged.
+        let mut d = (a.angle_deg - b_angle).abs();
+        if d >= 360.0 {
+            d %= 360.0;
+        }
         if d > 180.0 {
             d = 360.0 - d;
         }
@@ -99,15 +104,20 @@ impl WordMatcher {
         let cw = self.word(c).clone();
         let limit = cw.start_travel_m - self.matcher_opts.candidate_gap_m;
         let occ = &self.occurrences[cw.class as usize];
-        let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
+        let end = occ.partition_point(|p| p.end_travel_m <= limit + 1e-9);
         let c_preds = cw.pred_ids();
 
         let levels = self.levels;
-        let candidates = recent_candidates(&occ[..end], self.matcher_opts.max_candidates, |p| {
-            self.syllables_match(&cw, self.word(p), dir)
-        });
+        let mut candidates = std::mem::take(&mut self.candidates);
+        candidates.clear();
+        recent_candidates(
+            &occ[..end],
+            self.matcher_opts.max_candidates,
+            |p| self.syllables_match(&cw, p, dir),
+            &mut candidates,
+        );
         let mut entries = Vec::with_capacity(candidates.len());
-        for p in candidates {
+        for &p in &candidates {
             let pw = self.word(p);
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
@@ -153,6 +163,7 @@ impl WordMatcher {
             });
         }
         self.memo[d].push(entries);
+        self.candidates = candidates;
     }
 
     /// Fills the lookup tables for word `c` in direction `d` under a new stamp (returned): slot i

@@ -26,12 +26,15 @@ use super::align::{Placement, PlacementKey, PsiResidual};
 use super::chains::Entry;
 use super::config::{RecognizerConfig, RecognizerError};
 use super::diagnostics::{MAX_REJECTED_SAMPLES, VerificationCounts};
+use super::index::Occurrence;
 use super::options::{AlignmentOptions, MatcherOptions, VerifyOptions};
 use super::types::{AlignedRun, DensityObservation, Direction, Observation, WordMatch};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::place::RejectedCandidate;
 use std::cell::RefCell;
-use std::collections::HashMap;
+// foldhash: the keys are word ids and shifts, not adversarial input; SipHash was ~5 % of the
+// back end's instructions (a placement is looked up ~100k times per lap at 40 laps).
+use foldhash::HashMap;
 
 /// Words, multi-level words, matching and alignment over a stream of observations.
 #[derive(Clone, Debug)]
@@ -48,7 +51,9 @@ pub struct WordMatcher {
     pub(super) spacing_m: f64,
     pub(super) words: WordLevels,
     /// Per class, the words of that class in creation order (so by end travel).
-    pub(super) occurrences: Vec<Vec<WordId>>,
+    pub(super) occurrences: Vec<Vec<Occurrence>>,
+    /// Working space of `memoise`: the candidates of the word being matched.
+    pub(super) candidates: Vec<WordId>,
     /// Per direction (`Same`, `Opposite`), per word, an entry per matching past word, sorted by
     /// past word.
     pub(super) memo: [Vec<Vec<Entry>>; 2],
@@ -114,6 +119,7 @@ impl WordMatcher {
             spacing_m: config.front_end.observation_spacing_m,
             rejections: VerificationCounts::default(),
             occurrences: vec![Vec::new(); word_levels.class_count()],
+            candidates: Vec::new(),
             words: word_levels,
             memo: Default::default(),
             successors: Vec::new(),
@@ -275,7 +281,8 @@ impl WordMatcher {
                 self.level0_travel_m += size as f64 * self.spacing_m;
             }
             let class = self.word(c).class as usize;
-            self.occurrences[class].push(c);
+            let occurrence = Occurrence::of(c, self.word(c));
+            self.occurrences[class].push(occurrence);
         }
         self.forget_behind_horizon();
         out
