@@ -54,10 +54,17 @@ impl WordMatcher {
     /// read in direction `dir` (backwards, b's angle syllable is negated; class and size do not
     /// change).
     pub(super) fn syllables_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
+        self.sizes_match(a, b) && self.angles_match(a, b, dir)
+    }
+
+    /// The size syllables of [`syllables_match`](Self::syllables_match) (the same either way).
+    fn sizes_match(&self, a: &Word, b: &Occurrence) -> bool {
         let (sa, sb) = (a.size as f64, b.size as f64);
-        if (sa - sb).abs() > self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9 {
-            return false;
-        }
+        (sa - sb).abs() <= self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9
+    }
+
+    /// The angle syllables of [`syllables_match`](Self::syllables_match), read in direction `dir`.
+    fn angles_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
         let b_angle = match dir {
             Direction::Same => b.angle_deg,
             Direction::Opposite => -b.angle_deg,
@@ -96,26 +103,53 @@ impl WordMatcher {
         }
     }
 
-    /// Fills the memo of word `c` in direction `dir`: one entry per matching past word.
+    /// Lists the candidates of word `c` (`index.rs`) in `candidates`, per direction (read
+    /// backwards only with `reverse`): the words of its class that end `candidate_gap_m` before
+    /// it begins and match it. When every match is a candidate, one walk over the class serves
+    /// both directions (the size test is the same both ways).
+    pub(super) fn find_candidates(&mut self, c: WordId) {
+        let mut found = std::mem::take(&mut self.candidates);
+        found.iter_mut().for_each(Vec::clear);
+        let cw = self.word(c);
+        let limit = cw.start_travel_m - self.matcher_opts.candidate_gap_m;
+        let occ = &self.occurrences[cw.class as usize];
+        let occ = &occ[..occ.partition_point(|p| p.end_travel_m <= limit + 1e-9)];
+        let max = self.matcher_opts.max_candidates;
+        if max == 0 && self.matcher_opts.reverse {
+            let [same, opposite] = &mut found;
+            for p in occ.iter().filter(|p| self.sizes_match(cw, p)) {
+                if self.angles_match(cw, p, Direction::Same) {
+                    same.push(p.id);
+                }
+                if self.angles_match(cw, p, Direction::Opposite) {
+                    opposite.push(p.id);
+                }
+            }
+        } else {
+            let dirs = if self.matcher_opts.reverse {
+                &Direction::BOTH[..]
+            } else {
+                &[Direction::Same]
+            };
+            for &dir in dirs {
+                let matches = |p: &Occurrence| self.syllables_match(cw, p, dir);
+                recent_candidates(occ, max, matches, &mut found[dir as usize]);
+            }
+        }
+        self.candidates = found;
+    }
+
+    /// Fills the memo of word `c` in direction `dir`: one entry per matching past word (its
+    /// candidates, listed by [`find_candidates`](Self::find_candidates)).
     pub(super) fn memoise(&mut self, c: WordId, dir: Direction) {
         let d = dir as usize;
         debug_assert_eq!(self.memo[d].len(), c as usize);
         let stamp = self.fill_lookups(c, d);
         let cw = self.word(c).clone();
-        let limit = cw.start_travel_m - self.matcher_opts.candidate_gap_m;
-        let occ = &self.occurrences[cw.class as usize];
-        let end = occ.partition_point(|p| p.end_travel_m <= limit + 1e-9);
         let c_preds = cw.pred_ids();
 
         let levels = self.levels;
-        let mut candidates = std::mem::take(&mut self.candidates);
-        candidates.clear();
-        recent_candidates(
-            &occ[..end],
-            self.matcher_opts.max_candidates,
-            |p| self.syllables_match(&cw, p, dir),
-            &mut candidates,
-        );
+        let candidates = std::mem::take(&mut self.candidates[d]);
         let mut entries = Vec::with_capacity(candidates.len());
         for &p in &candidates {
             let pw = self.word(p);
@@ -163,7 +197,7 @@ impl WordMatcher {
             });
         }
         self.memo[d].push(entries);
-        self.candidates = candidates;
+        self.candidates[d] = candidates;
     }
 
     /// Fills the lookup tables for word `c` in direction `d` under a new stamp (returned): slot i

@@ -52,8 +52,9 @@ pub struct WordMatcher {
     pub(super) words: WordLevels,
     /// Per class, the words of that class in creation order (so by end travel).
     pub(super) occurrences: Vec<Vec<Occurrence>>,
-    /// Working space of `memoise`: the candidates of the word being matched.
-    pub(super) candidates: Vec<WordId>,
+    /// Working space of `memoise`: per direction, the candidates of the word being matched
+    /// (`find_candidates`).
+    pub(super) candidates: [Vec<WordId>; 2],
     /// Per direction (`Same`, `Opposite`), per word, an entry per matching past word, sorted by
     /// past word.
     pub(super) memo: [Vec<Vec<Entry>>; 2],
@@ -119,7 +120,7 @@ impl WordMatcher {
             spacing_m: config.front_end.observation_spacing_m,
             rejections: VerificationCounts::default(),
             occurrences: vec![Vec::new(); word_levels.class_count()],
-            candidates: Vec::new(),
+            candidates: Default::default(),
             words: word_levels,
             memo: Default::default(),
             successors: Vec::new(),
@@ -161,11 +162,11 @@ impl WordMatcher {
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
-            out = self.match_words(&closed);
+            self.match_words(&closed, &mut out);
             self.forget_finished_runs();
         }
         let closed = self.words.push(density);
-        out.extend(self.match_words(&closed));
+        self.match_words(&closed, &mut out);
         out
     }
 
@@ -173,7 +174,8 @@ impl WordMatcher {
     /// while the current run has no observation.
     pub fn start_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.start_run();
-        let out = self.match_words(&closed);
+        let mut out = Vec::new();
+        self.match_words(&closed, &mut out);
         self.forget_finished_runs();
         out
     }
@@ -217,7 +219,9 @@ impl WordMatcher {
     /// the end of the input).
     pub fn finish_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.finish_run();
-        self.match_words(&closed)
+        let mut out = Vec::new();
+        self.match_words(&closed, &mut out);
+        out
     }
 
     pub fn words(&self) -> &WordLevels {
@@ -261,20 +265,22 @@ impl WordMatcher {
         self.words.word(id)
     }
 
-    pub(super) fn match_words(&mut self, closed: &[WordId]) -> Vec<WordMatch> {
-        let mut out = Vec::new();
+    /// Matches the words just closed, in order; their matches are appended to `out` (one vector
+    /// for all of an observation's, not one per call to copy over).
+    pub(super) fn match_words(&mut self, closed: &[WordId], out: &mut Vec<WordMatch>) {
         for &c in closed {
             debug_assert_eq!(self.reading_starts.len(), c as usize);
             let starts = Direction::BOTH.map(|dir| self.measure_reading_start(c, dir));
             self.reading_starts.push(starts);
             self.link_successors(c);
+            self.find_candidates(c);
             self.memoise(c, Direction::Same);
             if self.matcher_opts.reverse {
                 self.memoise(c, Direction::Opposite);
             } else {
                 self.memo[Direction::Opposite as usize].push(Vec::new());
             }
-            self.report(c, &mut out);
+            self.report(c, out);
             let (level, size) = (self.word(c).level, self.word(c).size);
             if level == 0 {
                 self.level0_words += 1;
@@ -285,7 +291,6 @@ impl WordMatcher {
             self.occurrences[class].push(occurrence);
         }
         self.forget_behind_horizon();
-        out
     }
 
     pub(super) fn report(&mut self, c: WordId, out: &mut Vec<WordMatch>) {
@@ -436,8 +441,8 @@ pub(super) struct Scratch {
     pub(super) word_pairs: Vec<(WordId, WordId)>,
     pub(super) anchors: Vec<i64>,
     pub(super) placed: Vec<Option<Placement>>,
-    /// Working space of `chain_anchors` and of `emit`.
-    pub(super) offsets: Vec<f64>,
+    /// Working space of `chain_anchors` (offsets as `total_order_key`s) and of `emit`.
+    pub(super) offsets: Vec<i64>,
     pub(super) runs: Vec<AlignedRun>,
 }
 
