@@ -324,6 +324,30 @@ impl WordMatcher {
         Some((entry.back_word[k], entry.back_idx[k] as usize))
     }
 
+    /// The shortest chain (in word pairs) configuration k reports in direction `dir`: τ, or
+    /// with the travel rule (`ngram_travel_m`, `reverse_ngram_travel_m`) its minimum words if
+    /// fewer. [`tau_chain`](Self::tau_chain) finds nothing for a shorter chain.
+    pub(super) fn min_chain_len(&self, k: usize, dir: Direction) -> usize {
+        let (tau, min_words) = self.tau_and_min_words(k, dir);
+        if self.matcher_opts.travel_rule_m(dir) > 0.0 {
+            tau.min(min_words)
+        } else {
+            tau
+        }
+    }
+
+    /// τ of configuration k read in direction `dir`, and the travel rule's minimum words.
+    fn tau_and_min_words(&self, k: usize, dir: Direction) -> (usize, usize) {
+        let extra = match dir {
+            Direction::Same => 0,
+            Direction::Opposite => self.matcher_opts.reverse_extra_ngram,
+        };
+        (
+            self.tau[k] + extra,
+            self.matcher_opts.ngram_travel_min_words.max(1) + extra,
+        )
+    }
+
     /// Appends to `chain` the τ-gram of configuration k ending at memo entry `idx` of `c`,
     /// newest pair first; false (nothing appended) when the chain is shorter than τ (and not
     /// long enough in travel).
@@ -335,18 +359,10 @@ impl WordMatcher {
         chain: &mut Vec<(WordId, usize)>,
     ) -> bool {
         let memo = &self.memo[dir as usize];
-        let tau = match dir {
-            Direction::Same => self.tau[k],
-            Direction::Opposite => self.tau[k] + self.matcher_opts.reverse_extra_ngram,
-        };
+        let (tau, min_words) = self.tau_and_min_words(k, dir);
         let e = memo[c as usize][idx];
         let travel_m = self.matcher_opts.travel_rule_m(dir);
         let by_travel = travel_m > 0.0;
-        let min_words = self.matcher_opts.ngram_travel_min_words.max(1)
-            + match dir {
-                Direction::Same => 0,
-                Direction::Opposite => self.matcher_opts.reverse_extra_ngram,
-            };
         let len = e.len[k] as usize;
         if len < tau && !(by_travel && len >= min_words) {
             return false;

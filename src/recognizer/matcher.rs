@@ -301,7 +301,12 @@ impl WordMatcher {
             // it is reported (see `emit`).
             scratch.clear();
             for dir in Direction::BOTH {
+                let min_len = self.min_chain_len(k, dir);
                 for idx in 0..self.memo[dir as usize][c as usize].len() {
+                    // A chain too short for k has no τ-gram (`tau_chain`): skipped here at once.
+                    if (self.memo[dir as usize][c as usize][idx].len[k] as usize) < min_len {
+                        continue;
+                    }
                     if let Some(cand) = self.candidate(c, idx, k, dir, &mut scratch) {
                         scratch.found.push(cand);
                     }
