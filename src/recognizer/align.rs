@@ -27,7 +27,7 @@ impl WordMatcher {
         &self,
         word_pairs: &[(WordId, WordId)],
         dir: Direction,
-        offsets: &mut Vec<f64>,
+        offsets: &mut Vec<i64>,
         anchors: &mut Vec<i64>,
     ) {
         // Both boundaries of every word pair, as read: a word of flat Ψ whose boundaries moved
@@ -45,9 +45,14 @@ impl WordMatcher {
                     cw.end_travel_m + pw.start_travel_m,
                 ],
             }
+            .map(total_order_key)
         }));
-        offsets.sort_by(f64::total_cmp);
-        let offset_m = offsets.get(offsets.len() / 2).copied().unwrap_or(0.0);
+        // The middle offset in `f64::total_cmp`'s order, sorted as integers (see
+        // `total_order_key`): the same value a sort of the offsets puts there.
+        offsets.sort_unstable();
+        let offset_m = offsets
+            .get(offsets.len() / 2)
+            .map_or(0.0, |&k| from_total_order_key(k));
         anchors.extend(word_pairs.iter().map(|&(c, p)| {
             let start_gap_m = self.word(c).start_travel_m - self.reading_start(p, dir).0;
             ((start_gap_m - offset_m) / self.spacing_m).round() as i64
@@ -196,6 +201,18 @@ impl WordMatcher {
     }
 }
 
+/// `f64::total_cmp`'s order as an integer (the map it compares by): keys sort as their values
+/// do under `total_cmp`, and [`from_total_order_key`] gives the value back bit for bit.
+fn total_order_key(x: f64) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ (((bits >> 63) as u64) >> 1) as i64
+}
+
+/// The value of a [`total_order_key`] (the map keeps the sign bit, so it is its own inverse).
+fn from_total_order_key(key: i64) -> f64 {
+    f64::from_bits((key ^ (((key >> 63) as u64) >> 1) as i64) as u64)
+}
+
 /// What a placement is a function of while a word is reported: (current word, past word,
 /// direction, anchor).
 pub(super) type PlacementKey = (WordId, WordId, Direction, i64);
@@ -316,6 +333,35 @@ impl PsiResidual {
             f64::INFINITY
         } else {
             (self.sum / self.count as f64).sqrt()
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn any_f64() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            -1e3f64..1e3,
+            any::<u64>().prop_map(f64::from_bits),
+            Just(0.0),
+            Just(-0.0),
+        ]
+    }
+
+    proptest! {
+        /// Keys sort as `f64::total_cmp` sorts their values (NaNs and signed zeros included),
+        /// and give them back bit for bit: the median offset is the plain sort's.
+        #[test]
+        fn total_order_keys_sort_as_total_cmp(xs in proptest::collection::vec(any_f64(), 0..40)) {
+            let mut plain = xs.clone();
+            plain.sort_by(f64::total_cmp);
+            let mut keys: Vec<i64> = xs.iter().copied().map(total_order_key).collect();
+            keys.sort_unstable();
+            let back: Vec<u64> = keys.into_iter().map(|k| from_total_order_key(k).to_bits()).collect();
+            prop_assert_eq!(back, plain.iter().map(|x| x.to_bits()).collect::<Vec<_>>());
         }
     }
 }

@@ -30,7 +30,7 @@
 //! (the laser looks ahead), so opposite chains are runs of a few long words.
 //!
 
-use super::index::recent_candidates;
+use super::index::{Occurrence, recent_candidates};
 use super::matcher::{Scratch, WordMatcher};
 use super::types::Direction;
 use super::words::{MAX_LEVELS, Word, WordId};
@@ -50,18 +50,30 @@ pub(super) struct Entry {
 }
 
 impl WordMatcher {
-    /// Whether current word `a` matches past word `b` read in direction `dir` (backwards, b's
-    /// angle syllable is negated; class and size do not change).
-    pub(super) fn syllables_match(&self, a: &Word, b: &Word, dir: Direction) -> bool {
+    /// Whether current word `a` matches past word `b` (an entry of its class's occurrence list)
+    /// read in direction `dir` (backwards, b's angle syllable is negated; class and size do not
+    /// change).
+    pub(super) fn syllables_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
+        self.sizes_match(a, b) && self.angles_match(a, b, dir)
+    }
+
+    /// The size syllables of [`syllables_match`](Self::syllables_match) (the same either way).
+    fn sizes_match(&self, a: &Word, b: &Occurrence) -> bool {
         let (sa, sb) = (a.size as f64, b.size as f64);
-        if (sa - sb).abs() > self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9 {
-            return false;
-        }
+        (sa - sb).abs() <= self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9
+    }
+
+    /// The angle syllables of [`syllables_match`](Self::syllables_match), read in direction `dir`.
+    fn angles_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
         let b_angle = match dir {
             Direction::Same => b.angle_deg,
             Direction::Opposite => -b.angle_deg,
         };
-        let mut d = (a.angle_deg - b_angle).abs() % 360.0;
+        // `%` is a software fmod; below 360 it returns its operand unchanged.
+        let mut d = (a.angle_deg - b_angle).abs();
+        if d >= 360.0 {
+            d %= 360.0;
+        }
         if d > 180.0 {
             d = 360.0 - d;
         }
@@ -91,23 +103,55 @@ impl WordMatcher {
         }
     }
 
-    /// Fills the memo of word `c` in direction `dir`: one entry per matching past word.
+    /// Lists the candidates of word `c` (`index.rs`) in `candidates`, per direction (read
+    /// backwards only with `reverse`): the words of its class that end `candidate_gap_m` before
+    /// it begins and match it. When every match is a candidate, one walk over the class serves
+    /// both directions (the size test is the same both ways).
+    pub(super) fn find_candidates(&mut self, c: WordId) {
+        let mut found = std::mem::take(&mut self.candidates);
+        found.iter_mut().for_each(Vec::clear);
+        let cw = self.word(c);
+        let limit = cw.start_travel_m - self.matcher_opts.candidate_gap_m;
+        let occ = &self.occurrences[cw.class as usize];
+        let occ = &occ[..occ.partition_point(|p| p.end_travel_m <= limit + 1e-9)];
+        let max = self.matcher_opts.max_candidates;
+        if max == 0 && self.matcher_opts.reverse {
+            let [same, opposite] = &mut found;
+            for p in occ.iter().filter(|p| self.sizes_match(cw, p)) {
+                if self.angles_match(cw, p, Direction::Same) {
+                    same.push(p.id);
+                }
+                if self.angles_match(cw, p, Direction::Opposite) {
+                    opposite.push(p.id);
+                }
+            }
+        } else {
+            let dirs = if self.matcher_opts.reverse {
+                &Direction::BOTH[..]
+            } else {
+                &[Direction::Same]
+            };
+            for &dir in dirs {
+                let matches = |p: &Occurrence| self.syllables_match(cw, p, dir);
+                recent_candidates(occ, max, matches, &mut found[dir as usize]);
+            }
+        }
+        self.candidates = found;
+    }
+
+    /// Fills the memo of word `c` in direction `dir`: one entry per matching past word (its
+    /// candidates, listed by [`find_candidates`](Self::find_candidates)).
     pub(super) fn memoise(&mut self, c: WordId, dir: Direction) {
         let d = dir as usize;
         debug_assert_eq!(self.memo[d].len(), c as usize);
         let stamp = self.fill_lookups(c, d);
         let cw = self.word(c).clone();
-        let limit = cw.start_travel_m - self.matcher_opts.candidate_gap_m;
-        let occ = &self.occurrences[cw.class as usize];
-        let end = occ.partition_point(|&p| self.word(p).end_travel_m <= limit + 1e-9);
         let c_preds = cw.pred_ids();
 
         let levels = self.levels;
-        let candidates = recent_candidates(&occ[..end], self.matcher_opts.max_candidates, |p| {
-            self.syllables_match(&cw, self.word(p), dir)
-        });
+        let candidates = std::mem::take(&mut self.candidates[d]);
         let mut entries = Vec::with_capacity(candidates.len());
-        for p in candidates {
+        for &p in &candidates {
             let pw = self.word(p);
             let top = cw.level.max(pw.level);
             let mut len = [0u16; MAX_LEVELS];
@@ -153,6 +197,7 @@ impl WordMatcher {
             });
         }
         self.memo[d].push(entries);
+        self.candidates[d] = candidates;
     }
 
     /// Fills the lookup tables for word `c` in direction `d` under a new stamp (returned): slot i
@@ -279,6 +324,30 @@ impl WordMatcher {
         Some((entry.back_word[k], entry.back_idx[k] as usize))
     }
 
+    /// The shortest chain (in word pairs) configuration k reports in direction `dir`: τ, or
+    /// with the travel rule (`ngram_travel_m`, `reverse_ngram_travel_m`) its minimum words if
+    /// fewer. [`tau_chain`](Self::tau_chain) finds nothing for a shorter chain.
+    pub(super) fn min_chain_len(&self, k: usize, dir: Direction) -> usize {
+        let (tau, min_words) = self.tau_and_min_words(k, dir);
+        if self.matcher_opts.travel_rule_m(dir) > 0.0 {
+            tau.min(min_words)
+        } else {
+            tau
+        }
+    }
+
+    /// τ of configuration k read in direction `dir`, and the travel rule's minimum words.
+    fn tau_and_min_words(&self, k: usize, dir: Direction) -> (usize, usize) {
+        let extra = match dir {
+            Direction::Same => 0,
+            Direction::Opposite => self.matcher_opts.reverse_extra_ngram,
+        };
+        (
+            self.tau[k] + extra,
+            self.matcher_opts.ngram_travel_min_words.max(1) + extra,
+        )
+    }
+
     /// Appends to `chain` the τ-gram of configuration k ending at memo entry `idx` of `c`,
     /// newest pair first; false (nothing appended) when the chain is shorter than τ (and not
     /// long enough in travel).
@@ -290,18 +359,10 @@ impl WordMatcher {
         chain: &mut Vec<(WordId, usize)>,
     ) -> bool {
         let memo = &self.memo[dir as usize];
-        let tau = match dir {
-            Direction::Same => self.tau[k],
-            Direction::Opposite => self.tau[k] + self.matcher_opts.reverse_extra_ngram,
-        };
+        let (tau, min_words) = self.tau_and_min_words(k, dir);
         let e = memo[c as usize][idx];
         let travel_m = self.matcher_opts.travel_rule_m(dir);
         let by_travel = travel_m > 0.0;
-        let min_words = self.matcher_opts.ngram_travel_min_words.max(1)
-            + match dir {
-                Direction::Same => 0,
-                Direction::Opposite => self.matcher_opts.reverse_extra_ngram,
-            };
         let len = e.len[k] as usize;
         if len < tau && !(by_travel && len >= min_words) {
             return false;

@@ -11,43 +11,111 @@
 //! were bounded the same way, so they hold the same recent laps. With k = 0 every earlier
 //! matching word is a candidate (the paper's search).
 
-use super::words::WordId;
+use super::words::{Word, WordId};
 
-/// The candidates among `occurrences` (oldest first): the last `limit` words that satisfy
-/// `matches`, oldest first, or every such word when `limit` is 0.
-pub(super) fn recent_candidates(
-    occurrences: &[WordId],
-    limit: usize,
-    mut matches: impl FnMut(WordId) -> bool,
-) -> Vec<WordId> {
-    if limit == 0 {
-        return occurrences
-            .iter()
-            .copied()
-            .filter(|&p| matches(p))
-            .collect();
+/// A word in its class's occurrence list: what the candidate search reads of it (the
+/// syllables `syllables_match` compares and where it ends), kept beside its id so that walking
+/// a class's occurrences over many laps reads a few bytes per word, not each whole [`Word`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Occurrence {
+    pub(super) id: WordId,
+    /// S, observations.
+    pub(super) size: usize,
+    /// A, degrees.
+    pub(super) angle_deg: f64,
+    /// A's slack, degrees ([`Word::angle_slack_deg`]).
+    pub(super) angle_slack_deg: f64,
+    /// Travel at its last observation, metres.
+    pub(super) end_travel_m: f64,
+}
+
+impl Occurrence {
+    pub(super) fn of(id: WordId, w: &Word) -> Self {
+        Occurrence {
+            id,
+            size: w.size,
+            angle_deg: w.angle_deg,
+            angle_slack_deg: w.angle_slack_deg,
+            end_travel_m: w.end_travel_m,
+        }
     }
-    let mut out: Vec<WordId> = occurrences
-        .iter()
-        .rev()
-        .copied()
-        .filter(|&p| matches(p))
-        .take(limit)
-        .collect();
-    out.reverse();
-    out
+}
+
+/// Appends to `out` the candidates among `occurrences` (oldest first): the ids of the last
+/// `limit` that satisfy `matches`, oldest first, or of every such one when `limit` is 0. The
+/// caller keeps `out` between words, so the search allocates nothing once it is large enough.
+pub(super) fn recent_candidates(
+    occurrences: &[Occurrence],
+    limit: usize,
+    mut matches: impl FnMut(&Occurrence) -> bool,
+    out: &mut Vec<WordId>,
+) {
+    let from = out.len();
+    if limit == 0 {
+        out.extend(occurrences.iter().filter(|o| matches(o)).map(|o| o.id));
+        return;
+    }
+    out.extend(
+        occurrences
+            .iter()
+            .rev()
+            .filter(|o| matches(o))
+            .take(limit)
+            .map(|o| o.id),
+    );
+    out[from..].reverse();
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    use proptest::prelude::*;
+
+    fn occurrence(id: WordId) -> Occurrence {
+        Occurrence {
+            id,
+            size: 5,
+            angle_deg: 0.0,
+            angle_slack_deg: 0.0,
+            end_travel_m: id as f64,
+        }
+    }
+
+    fn candidates(occ: &[Occurrence], limit: usize, f: impl Fn(WordId) -> bool) -> Vec<WordId> {
+        let mut out = vec![99];
+        recent_candidates(occ, limit, |o| f(o.id), &mut out);
+        assert_eq!(out.remove(0), 99, "what `out` held stays");
+        out
+    }
+
     #[test]
     fn keeps_the_most_recent_matching_words_in_order() {
-        let occ: Vec<WordId> = (0..10).collect();
+        let occ: Vec<Occurrence> = (0..10).map(occurrence).collect();
         let even = |p: WordId| p.is_multiple_of(2);
-        assert_eq!(recent_candidates(&occ, 0, even), vec![0, 2, 4, 6, 8]);
-        assert_eq!(recent_candidates(&occ, 2, even), vec![6, 8]);
-        assert_eq!(recent_candidates(&occ, 9, even), vec![0, 2, 4, 6, 8]);
+        assert_eq!(candidates(&occ, 0, even), vec![0, 2, 4, 6, 8]);
+        assert_eq!(candidates(&occ, 2, even), vec![6, 8]);
+        assert_eq!(candidates(&occ, 9, even), vec![0, 2, 4, 6, 8]);
+    }
+
+    proptest! {
+        /// The search appends exactly what the plain rule lists: every matching word in order,
+        /// or the last `limit` of them in order.
+        #[test]
+        fn appends_what_the_plain_rule_lists(
+            ids in proptest::collection::vec(0u32..1000, 0..60),
+            modulus in 1u32..5,
+            limit in 0usize..8,
+        ) {
+            let occ: Vec<Occurrence> = ids.iter().map(|&i| occurrence(i)).collect();
+            let matches = |p: WordId| p.is_multiple_of(modulus);
+            let all: Vec<WordId> = ids.iter().copied().filter(|&p| matches(p)).collect();
+            let plain = if limit == 0 {
+                all
+            } else {
+                all[all.len().saturating_sub(limit)..].to_vec()
+            };
+            prop_assert_eq!(candidates(&occ, limit, matches), plain);
+        }
     }
 }

@@ -26,12 +26,15 @@ use super::align::{Placement, PlacementKey, PsiResidual};
 use super::chains::Entry;
 use super::config::{RecognizerConfig, RecognizerError};
 use super::diagnostics::{MAX_REJECTED_SAMPLES, VerificationCounts};
+use super::index::Occurrence;
 use super::options::{AlignmentOptions, MatcherOptions, VerifyOptions};
 use super::types::{AlignedRun, DensityObservation, Direction, Observation, WordMatch};
 use super::words::{MAX_LEVELS, Word, WordId, WordLevels};
 use crate::place::RejectedCandidate;
 use std::cell::RefCell;
-use std::collections::HashMap;
+// foldhash: the keys are word ids and shifts, not adversarial input; SipHash was ~5 % of the
+// back end's instructions (a placement is looked up ~100k times per lap at 40 laps).
+use foldhash::HashMap;
 
 /// Words, multi-level words, matching and alignment over a stream of observations.
 #[derive(Clone, Debug)]
@@ -48,7 +51,10 @@ pub struct WordMatcher {
     pub(super) spacing_m: f64,
     pub(super) words: WordLevels,
     /// Per class, the words of that class in creation order (so by end travel).
-    pub(super) occurrences: Vec<Vec<WordId>>,
+    pub(super) occurrences: Vec<Vec<Occurrence>>,
+    /// Working space of `memoise`: per direction, the candidates of the word being matched
+    /// (`find_candidates`).
+    pub(super) candidates: [Vec<WordId>; 2],
     /// Per direction (`Same`, `Opposite`), per word, an entry per matching past word, sorted by
     /// past word.
     pub(super) memo: [Vec<Vec<Entry>>; 2],
@@ -114,6 +120,7 @@ impl WordMatcher {
             spacing_m: config.front_end.observation_spacing_m,
             rejections: VerificationCounts::default(),
             occurrences: vec![Vec::new(); word_levels.class_count()],
+            candidates: Default::default(),
             words: word_levels,
             memo: Default::default(),
             successors: Vec::new(),
@@ -155,11 +162,11 @@ impl WordMatcher {
         let mut out = Vec::new();
         if obs.run > self.words.run() {
             let closed = self.words.begin_run(obs.run);
-            out = self.match_words(&closed);
+            self.match_words(&closed, &mut out);
             self.forget_finished_runs();
         }
         let closed = self.words.push(density);
-        out.extend(self.match_words(&closed));
+        self.match_words(&closed, &mut out);
         out
     }
 
@@ -167,7 +174,8 @@ impl WordMatcher {
     /// while the current run has no observation.
     pub fn start_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.start_run();
-        let out = self.match_words(&closed);
+        let mut out = Vec::new();
+        self.match_words(&closed, &mut out);
         self.forget_finished_runs();
         out
     }
@@ -211,7 +219,9 @@ impl WordMatcher {
     /// the end of the input).
     pub fn finish_run(&mut self) -> Vec<WordMatch> {
         let closed = self.words.finish_run();
-        self.match_words(&closed)
+        let mut out = Vec::new();
+        self.match_words(&closed, &mut out);
+        out
     }
 
     pub fn words(&self) -> &WordLevels {
@@ -255,30 +265,32 @@ impl WordMatcher {
         self.words.word(id)
     }
 
-    pub(super) fn match_words(&mut self, closed: &[WordId]) -> Vec<WordMatch> {
-        let mut out = Vec::new();
+    /// Matches the words just closed, in order; their matches are appended to `out` (one vector
+    /// for all of an observation's, not one per call to copy over).
+    pub(super) fn match_words(&mut self, closed: &[WordId], out: &mut Vec<WordMatch>) {
         for &c in closed {
             debug_assert_eq!(self.reading_starts.len(), c as usize);
             let starts = Direction::BOTH.map(|dir| self.measure_reading_start(c, dir));
             self.reading_starts.push(starts);
             self.link_successors(c);
+            self.find_candidates(c);
             self.memoise(c, Direction::Same);
             if self.matcher_opts.reverse {
                 self.memoise(c, Direction::Opposite);
             } else {
                 self.memo[Direction::Opposite as usize].push(Vec::new());
             }
-            self.report(c, &mut out);
+            self.report(c, out);
             let (level, size) = (self.word(c).level, self.word(c).size);
             if level == 0 {
                 self.level0_words += 1;
                 self.level0_travel_m += size as f64 * self.spacing_m;
             }
             let class = self.word(c).class as usize;
-            self.occurrences[class].push(c);
+            let occurrence = Occurrence::of(c, self.word(c));
+            self.occurrences[class].push(occurrence);
         }
         self.forget_behind_horizon();
-        out
     }
 
     pub(super) fn report(&mut self, c: WordId, out: &mut Vec<WordMatch>) {
@@ -289,7 +301,12 @@ impl WordMatcher {
             // it is reported (see `emit`).
             scratch.clear();
             for dir in Direction::BOTH {
+                let min_len = self.min_chain_len(k, dir);
                 for idx in 0..self.memo[dir as usize][c as usize].len() {
+                    // A chain too short for k has no τ-gram (`tau_chain`): skipped here at once.
+                    if (self.memo[dir as usize][c as usize][idx].len[k] as usize) < min_len {
+                        continue;
+                    }
                     if let Some(cand) = self.candidate(c, idx, k, dir, &mut scratch) {
                         scratch.found.push(cand);
                     }
@@ -435,8 +452,8 @@ pub(super) struct Scratch {
     pub(super) word_pairs: Vec<(WordId, WordId)>,
     pub(super) anchors: Vec<i64>,
     pub(super) placed: Vec<Option<Placement>>,
-    /// Working space of `chain_anchors` and of `emit`.
-    pub(super) offsets: Vec<f64>,
+    /// Working space of `chain_anchors` (offsets as `total_order_key`s) and of `emit`.
+    pub(super) offsets: Vec<i64>,
     pub(super) runs: Vec<AlignedRun>,
 }
 

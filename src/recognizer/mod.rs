@@ -139,7 +139,13 @@ impl Recognizer {
     fn match_observations(&mut self, observations: &[DensityObservation]) -> Vec<WordMatch> {
         let mut out = Vec::new();
         for obs in observations {
-            out.extend(self.back.push_observation(obs));
+            let matches = self.back.push_observation(obs);
+            // Usually one observation per scan: its matches are the scan's, not copied over.
+            if out.is_empty() {
+                out = matches;
+            } else {
+                out.extend(matches);
+            }
         }
         out
     }

@@ -148,13 +148,25 @@ impl WordMatcher {
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);
         let sign = past.step as f64;
-        w.r.clone()
-            .map(|i| {
-                let q = lateral[(s2 + w.a + i) as usize];
-                let d = q - sign * lateral[past.index(w.b + i)];
-                d * d
-            })
-            .sum()
+        let sq = |(q, p): (&f64, &f64)| {
+            let d = q - sign * p;
+            d * d
+        };
+        if w.count() == 0 {
+            return std::iter::empty::<f64>().sum();
+        }
+        // Both sides as slices (no index arithmetic per pair), summed in the same order.
+        let cur = &lateral[(s2 + w.a + w.r.start) as usize..(s2 + w.a + w.r.end) as usize];
+        let first = past.index(w.b + w.r.start);
+        if past.step > 0 {
+            cur.iter()
+                .zip(&lateral[first..first + cur.len()])
+                .map(sq)
+                .sum()
+        } else {
+            let back = lateral[first + 1 - cur.len()..=first].iter().rev();
+            cur.iter().zip(back).map(sq).sum()
+        }
     }
 
     /// Where word `w` begins when read in direction `dir`: (travel, odometric heading) of its
