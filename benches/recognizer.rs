@@ -106,57 +106,70 @@ fn whole_recognizer(c: &mut Criterion) {
     let mut g = c.benchmark_group("recognizer_per_lap");
     g.sample_size(10);
     g.measurement_time(Duration::from_secs(5));
-    let cfg = RecognizerConfig::default();
     let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
-    let mut rec = Recognizer::new(cfg).unwrap();
-    let mut done = 0usize;
-    let histories: &[usize] = if full_run() { &[1, 40] } else { &[1, 2] };
-    for &history in histories {
-        while done < history {
-            for (o, s) in &laps[done % laps.len()] {
-                rec.push(*o, s);
+    // The default (exact) front end, and the fast one of docs/design.md, "The front end's
+    // approximation" (every 2nd beam a scan, every 4th density ray).
+    let mut fast = RecognizerConfig::default();
+    fast.grid.beam_stride = 2;
+    fast.density.ray_stride = 4;
+    for (name, cfg) in [
+        ("3_levels", RecognizerConfig::default()),
+        ("3_levels_fast_front_end", fast),
+    ] {
+        let mut rec = Recognizer::new(cfg).unwrap();
+        let mut done = 0usize;
+        let histories: &[usize] = if full_run() { &[1, 40] } else { &[1, 2] };
+        for &history in histories {
+            while done < history {
+                for (o, s) in &laps[done % laps.len()] {
+                    rec.push(*o, s);
+                }
+                done += 1;
             }
-            done += 1;
-        }
-        // Lap inputs restart at the same odometry: the loop is closed in odometry too.
-        let next = &laps[history % laps.len()];
-        // One lap's thread CPU (clock_gettime, sub-microsecond), five times on clones of the
-        // recognizer: criterion's figures below are wall clock.
-        let mut lap_ms = Vec::new();
-        let mut pairs = 0usize;
-        for _ in 0..if full_run() { 5 } else { 1 } {
-            let mut r = rec.clone();
-            let c1 = placewords::clock::thread_cpu_s();
-            pairs = next
-                .iter()
-                .flat_map(|(o, s)| r.push(*o, s))
-                .map(|m| m.pair_count())
-                .sum();
-            lap_ms.push((placewords::clock::thread_cpu_s() - c1) * 1e3);
-        }
-        let mean_ms = lap_ms.iter().sum::<f64>() / lap_ms.len() as f64;
-        let min_ms = lap_ms.iter().copied().fold(f64::INFINITY, f64::min);
-        eprintln!(
-            "recognizer_per_lap/3_levels/{history}_laps_history: thread CPU per lap {mean_ms:.1} ms mean, {min_ms:.1} ms least of {} ({pairs} aligned pairs)",
-            lap_ms.len()
-        );
-        g.bench_function(format!("3_levels/{history}_laps_history"), |b| {
-            b.iter_batched(
-                || rec.clone(),
-                |mut r| {
-                    let mut pairs = 0;
-                    for (o, s) in next {
-                        for mt in r.push(*o, s) {
-                            pairs += mt.pair_count();
+            // Lap inputs restart at the same odometry: the loop is closed in odometry too.
+            let next = &laps[history % laps.len()];
+            one_lap_cpu(&rec, next, &format!("{name}/{history}_laps_history"));
+            g.bench_function(format!("{name}/{history}_laps_history"), |b| {
+                b.iter_batched(
+                    || rec.clone(),
+                    |mut r| {
+                        let mut pairs = 0;
+                        for (o, s) in next {
+                            for mt in r.push(*o, s) {
+                                pairs += mt.pair_count();
+                            }
                         }
-                    }
-                    (r, pairs)
-                },
-                BatchSize::LargeInput,
-            )
-        });
+                        (r, pairs)
+                    },
+                    BatchSize::LargeInput,
+                )
+            });
+        }
     }
     g.finish();
+}
+
+/// Prints one lap's thread CPU (clock_gettime, sub-microsecond), five times on clones of the
+/// recognizer: criterion's figures are wall clock.
+fn one_lap_cpu(rec: &Recognizer, next: &[(OdomPose, Scan)], name: &str) {
+    let mut lap_ms = Vec::new();
+    let mut pairs = 0usize;
+    for _ in 0..if full_run() { 5 } else { 1 } {
+        let mut r = rec.clone();
+        let c1 = placewords::clock::thread_cpu_s();
+        pairs = next
+            .iter()
+            .flat_map(|(o, s)| r.push(*o, s))
+            .map(|m| m.pair_count())
+            .sum();
+        lap_ms.push((placewords::clock::thread_cpu_s() - c1) * 1e3);
+    }
+    let mean_ms = lap_ms.iter().sum::<f64>() / lap_ms.len() as f64;
+    let min_ms = lap_ms.iter().copied().fold(f64::INFINITY, f64::min);
+    eprintln!(
+        "recognizer_per_lap/{name}: thread CPU per lap {mean_ms:.1} ms mean, {min_ms:.1} ms least of {} ({pairs} aligned pairs)",
+        lap_ms.len()
+    );
 }
 
 criterion_group!(benches, word_building, matching, whole_recognizer);
