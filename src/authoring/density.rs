@@ -4,7 +4,7 @@
 //! The world is drawn into cells of the recognizer's grid size (walls and door panels in their
 //! given state occupied, the free space the route and home reach free, everything else unknown),
 //! and Ψ of a sample of cells is computed by the recognizer's own kernel
-//! ([`DensityKernel::free_cells_at`]) and quantized by its own rule ([`WordLevels::class_of`]).
+//! ([`crate::recognizer::DensityKernel::free_cells_at`]) and quantized by its own rule ([`WordLevels::class_of`]).
 //! The robot's local grid holds what its laser saw within a few metres, which for a robot in
 //! open view of its surroundings is this map's free space; so the classes here are those the
 //! recognizer sees, up to the small differences of a grid turned with the odometry frame.

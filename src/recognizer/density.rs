@@ -275,7 +275,7 @@ impl DensityKernel {
     ///
     /// The sparser rays reach fewer of the cells, more so far from the centre, so a plain count
     /// would weigh the inner part more (Ψ rose by about 0.05 with every 2nd ray). Each cell is
-    /// counted instead with the weight of its bin (see [`ring_weights`]): the cells all the rays
+    /// counted instead with the weight of its bin (see `ring_weights`): the cells all the rays
     /// reach in the bin over those the walked rays reach, so that an all-free bin counts as it
     /// did. Ψ is the weighted count over the weighted count of an all-free window.
     pub fn with_ray_stride(radius_cells: usize, ray_step_deg: f64, ray_stride: usize) -> Self {
