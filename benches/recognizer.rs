@@ -109,9 +109,7 @@ fn whole_recognizer(c: &mut Criterion) {
     let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
     // The default (exact) front end, and the fast one of docs/design.md, "The front end's
     // approximation" (every 2nd beam a scan, every 4th density ray).
-    let mut fast = RecognizerConfig::default();
-    fast.grid.beam_stride = 2;
-    fast.density.ray_stride = 4;
+    let fast = RecognizerConfig::default().with_fast_front_end();
     for (name, cfg) in [
         ("3_levels", RecognizerConfig::default()),
         ("3_levels_fast_front_end", fast),

@@ -145,10 +145,8 @@ fn run(args: &Args) -> Result<()> {
 
 /// The exact settings and the candidate's, both from a dataset's settings.
 fn configs(base: &RecognizerConfig, args: &Args) -> (RecognizerConfig, RecognizerConfig) {
-    let mut exact = base.clone();
+    let mut exact = base.clone().with_exact_front_end();
     exact.density.ray_step_deg = 1.0;
-    exact.density.ray_stride = 1;
-    exact.grid.beam_stride = 1;
     let mut cand = base.clone();
     if let Some(v) = args.ray_step_deg {
         cand.density.ray_step_deg = v;

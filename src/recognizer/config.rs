@@ -215,6 +215,24 @@ impl RecognizerConfig {
         }
     }
 
+    /// These settings with the fast front end of docs/design.md, "The front end's
+    /// approximation": every 2nd beam of a scan traced (`beam_stride = 2`), every 4th density
+    /// ray walked, cells weighted (`ray_stride = 4`); Ψ within the bound `tests/it/frontend_bound.rs`
+    /// checks.
+    pub fn with_fast_front_end(mut self) -> Self {
+        self.grid.beam_stride = 2;
+        self.density.ray_stride = 4;
+        self
+    }
+
+    /// These settings with the exact front end (the authors' grid update and kernel): every beam
+    /// traced and every ray walked (`beam_stride = 1`, `ray_stride = 1`, the defaults).
+    pub fn with_exact_front_end(mut self) -> Self {
+        self.grid.beam_stride = 1;
+        self.density.ray_stride = 1;
+        self
+    }
+
     /// The density kernel of these settings: `kernel_radius_m` in cells, a ray every
     /// `ray_step_deg`, every `ray_stride`-th of them walked.
     pub fn density_kernel(&self) -> super::density::DensityKernel {

@@ -50,18 +50,12 @@ fn observe(runs: &[RunLog], cfg: &RecognizerConfig, scans: usize) -> Vec<Density
 }
 
 fn exact(cfg: &RecognizerConfig) -> RecognizerConfig {
-    let mut exact = cfg.clone();
-    exact.grid.beam_stride = 1;
-    exact.density.ray_stride = 1;
-    exact
+    cfg.clone().with_exact_front_end()
 }
 
 /// The approximation the bound is for: every 2nd beam a scan, every 4th density ray.
 fn approximate(cfg: &RecognizerConfig) -> RecognizerConfig {
-    let mut approx = cfg.clone();
-    approx.grid.beam_stride = 2;
-    approx.density.ray_stride = 4;
-    approx
+    cfg.clone().with_fast_front_end()
 }
 
 /// Per dataset (the first run of every scenario, the first scans of every log): its name, the
