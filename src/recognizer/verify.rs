@@ -30,7 +30,9 @@
 //! while the next agrees again. So each word start's heading offset between the two sides must
 //! lie within `verify_turn_deg` of the offsets' median, except at a few word starts inside the
 //! n-gram; at its first and newest word starts the offset must agree (one side turning there
-//! alone is where two paths meet, or where the robot left the revisit).
+//! alone is where two paths meet, or where the robot left the revisit). The travel can be
+//! judged likewise (`verify_travel_outliers`, off by default): a word start that moved on one
+//! pass is passed over, and the next one is measured from the last that agreed.
 //! The first 10,000 candidates verification turns down are kept as one observation pair each
 //! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
 //! the checks turned down look-alikes or true revisits.
@@ -50,7 +52,7 @@ const TURN_OFFSETS: usize = 32;
 impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
-    /// both sides; the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
+    /// both sides (but for `verify_travel_outliers` and `verify_turn_outliers` word starts); the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
     /// the n-gram extends a verified one) must be small. The placements it makes (of the pairs
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
@@ -77,6 +79,9 @@ impl WordMatcher {
         // whole (`verify_turn_outliers`); longer n-grams than the buffer use the per-word limit.
         let mut offsets = [0.0; TURN_OFFSETS];
         let robust = self.verify_opts.verify_turn_outliers > 0 && word_pairs.len() <= TURN_OFFSETS;
+        // Travel at the last word start that agreed (current, past), and the interior word
+        // starts passed over so far (`verify_travel_outliers`).
+        let (mut agreed, mut passed_over) = ((0.0, 0.0), 0);
         for (i, w) in word_pairs.windows(2).enumerate() {
             let (c0, c1) = (start(w[0].0), start(w[1].0));
             let (p0, p1) = (past_start(w[0].1), past_start(w[1].1));
@@ -84,7 +89,12 @@ impl WordMatcher {
             let dp = (p1.0 - p0.0, wrap_angle(p1.1 - p0.1));
             cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
             cum_p = (cum_p.0 + dp.0, cum_p.1 + dp.1);
-            if !ok_travel(dc.0, dp.0) || !ok_travel(cum_c.0, cum_p.0) {
+            let interior = i + 2 < word_pairs.len();
+            if ok_travel(cum_c.0 - agreed.0, cum_p.0 - agreed.1) && ok_travel(cum_c.0, cum_p.0) {
+                agreed = (cum_c.0, cum_p.0);
+            } else if interior && passed_over < self.verify_opts.verify_travel_outliers {
+                passed_over += 1;
+            } else {
                 return Some(Rejection::Travel);
             }
             if robust {
