@@ -24,6 +24,15 @@
 //! first word, and what is left (sizes, turns) repeats along a corridor of regularly spaced
 //! doors and between corners that turn alike (scenario A with weaving laps: 7 of 8 false
 //! chains, seeds 1–5).
+//! The turn is judged over the n-gram as a whole (`verify_turn_outliers`, not in the paper): a
+//! real robot cuts corners and turns on the spot, so a word boundary falls inside a corner on
+//! one visit and after it on the other, and that one word start's heading is off by the corner
+//! while the next agrees again. So each word start's heading offset between the two sides must
+//! lie within `verify_turn_deg` of the offsets' median, except at a few word starts inside the
+//! n-gram; at its first and newest word starts the offset must agree (one side turning there
+//! alone is where two paths meet, or where the robot left the revisit). The travel can be
+//! judged likewise (`verify_travel_outliers`, off by default): a word start that moved on one
+//! pass is passed over, and the next one is measured from the last that agreed.
 //! The first 10,000 candidates verification turns down are kept as one observation pair each
 //! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
 //! the checks turned down look-alikes or true revisits.
@@ -36,10 +45,14 @@ use super::types::Direction;
 use super::words::WordId;
 use crate::geom::wrap_angle;
 
+/// Word starts whose heading offsets `verify_turn_outliers` judges together at most (τ at four
+/// levels is 15, read backwards 2 more).
+const TURN_OFFSETS: usize = 32;
+
 impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
-    /// both sides; the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
+    /// both sides (but for `verify_travel_outliers` and `verify_turn_outliers` word starts); the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
     /// the n-gram extends a verified one) must be small. The placements it makes (of the pairs
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
@@ -62,20 +75,39 @@ impl WordMatcher {
         let turn_tol = self.verify_opts.verify_turn_deg.to_radians();
         let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
         let mut turned: f64 = 0.0;
-        for w in word_pairs.windows(2) {
+        // The heading offsets per word start, when the turn is judged over the n-gram as a
+        // whole (`verify_turn_outliers`); longer n-grams than the buffer use the per-word limit.
+        let mut offsets = [0.0; TURN_OFFSETS];
+        let robust = self.verify_opts.verify_turn_outliers > 0 && word_pairs.len() <= TURN_OFFSETS;
+        // Travel at the last word start that agreed (current, past), and the interior word
+        // starts passed over so far (`verify_travel_outliers`).
+        let (mut agreed, mut passed_over) = ((0.0, 0.0), 0);
+        for (i, w) in word_pairs.windows(2).enumerate() {
             let (c0, c1) = (start(w[0].0), start(w[1].0));
             let (p0, p1) = (past_start(w[0].1), past_start(w[1].1));
             let dc = (c1.0 - c0.0, wrap_angle(c1.1 - c0.1));
             let dp = (p1.0 - p0.0, wrap_angle(p1.1 - p0.1));
             cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
             cum_p = (cum_p.0 + dp.0, cum_p.1 + dp.1);
-            if !ok_travel(dc.0, dp.0) || !ok_travel(cum_c.0, cum_p.0) {
+            let interior = i + 2 < word_pairs.len();
+            if ok_travel(cum_c.0 - agreed.0, cum_p.0 - agreed.1) && ok_travel(cum_c.0, cum_p.0) {
+                agreed = (cum_c.0, cum_p.0);
+            } else if interior && passed_over < self.verify_opts.verify_travel_outliers {
+                passed_over += 1;
+            } else {
                 return Some(Rejection::Travel);
             }
-            if wrap_angle(dc.1 - dp.1).abs() > turn_tol || (cum_c.1 - cum_p.1).abs() > turn_tol {
+            if robust {
+                offsets[i + 1] = cum_c.1 - cum_p.1;
+            } else if wrap_angle(dc.1 - dp.1).abs() > turn_tol
+                || (cum_c.1 - cum_p.1).abs() > turn_tol
+            {
                 return Some(Rejection::Turn);
             }
             turned = turned.max(cum_c.1.abs());
+        }
+        if robust && self.turn_offsets_disagree(&mut offsets[..word_pairs.len()], turn_tol) {
+            return Some(Rejection::Turn);
         }
         if dir == Direction::Opposite && turned < self.verify_opts.reverse_min_turn_deg.to_radians()
         {
@@ -106,6 +138,21 @@ impl WordMatcher {
         } else {
             None
         }
+    }
+
+    /// Whether the heading offsets between the two sides at an n-gram's word starts (`offsets`,
+    /// oldest first, the first 0; reordered here) disagree: the newest, or more than
+    /// `verify_turn_outliers` of the others, lie over `tol` (radians) from their median.
+    pub(super) fn turn_offsets_disagree(&self, offsets: &mut [f64], tol: f64) -> bool {
+        let (Some(&oldest), Some(&newest)) = (offsets.first(), offsets.last()) else {
+            return false;
+        };
+        offsets.sort_unstable_by(f64::total_cmp);
+        let n = offsets.len();
+        let median = (offsets[(n - 1) / 2] + offsets[n / 2]) / 2.0;
+        let off = |e: f64| (e - median).abs() > tol;
+        let interior = offsets.iter().filter(|&&e| off(e)).count();
+        off(oldest) || off(newest) || interior > self.verify_opts.verify_turn_outliers
     }
 
     /// Whether the n-gram of `word_pairs` (oldest first), whose chain is `chain_len` words

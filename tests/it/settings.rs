@@ -118,6 +118,21 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("verify.reverse_min_turn_deg", "0", LOOSE, Input::Dense),
+    (
+        "verify.verify_travel_outliers",
+        "1",
+        "matcher.min_ngram = [2, 3, 4, 5]\nmatcher.reverse_extra_ngram = 0\n\
+         verify.verify_max_psi_rms = 1.0\nverify.verify_travel_ratio = 0.01\n\
+         verify.verify_travel_slack_m = 0.05",
+        Input::Dense,
+    ),
+    (
+        "verify.verify_turn_outliers",
+        "0",
+        "matcher.min_ngram = [2, 3, 4, 5]\nmatcher.reverse_extra_ngram = 0\n\
+         verify.verify_max_psi_rms = 1.0\nverify.verify_turn_deg = 5",
+        Input::Dense,
+    ),
 ];
 
 /// Short chains, read backwards as readily, with a loose density check: candidates reach the
