@@ -506,6 +506,23 @@ pub struct MatcherOptions {
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
     pub ngram_travel_min_words: usize,
+    /// A shorter n-gram read backwards (not in the paper): when a chain read backwards has no
+    /// n-gram by τ or by `reverse_ngram_travel_m`, its last `reverse_short_ngram_words` or more
+    /// word pairs, fewer than `ngram_travel_min_words` + `reverse_extra_ngram`, are a candidate
+    /// when they span at least `reverse_short_ngram_travel_m`; verification then holds them to
+    /// `reverse_short_max_lateral_rms` in `[recognizer.verify]`. 0 = off.
+    /// Read backwards a place's words disagree more than driven the same way (on fhw, words of
+    /// one class at an opposite revisit differ in size by 0.27–0.36 of the larger, median over
+    /// noise seeds 1–5, against 0.17–0.23 driven the same way; `examples/opposite_revisits.rs`),
+    /// so opposite chains stop at 4–5 words where same-direction ones go on; seattle's one
+    /// opposite stretch long enough makes a chain of 4 words over 22–25 m. Default 4 (tuned
+    /// on seattle and `reverse`, smooth and weaving, seeds 1–10; confirmed on A, B, C, Intel
+    /// and fhw: RESULTS.md, session 7).
+    pub reverse_short_ngram_words: usize,
+    /// Travel the current side of such a short n-gram read backwards must span, metres. Default
+    /// 22 (seattle's chains span 22–25 m: 25 lost seeds 1, 3 and 5; 20 let `reverse` fall to
+    /// 0.937 worst precision).
+    pub reverse_short_ngram_travel_m: f64,
 }
 
 impl Default for MatcherOptions {
@@ -525,6 +542,8 @@ impl Default for MatcherOptions {
             ngram_travel_m: 0.0,
             reverse_ngram_travel_m: 30.0,
             ngram_travel_min_words: 4,
+            reverse_short_ngram_words: 4,
+            reverse_short_ngram_travel_m: 22.0,
         }
     }
 }
@@ -555,6 +574,10 @@ impl MatcherOptions {
         );
         p.non_negative("ngram_travel_m", self.ngram_travel_m);
         p.non_negative("reverse_ngram_travel_m", self.reverse_ngram_travel_m);
+        p.non_negative(
+            "reverse_short_ngram_travel_m",
+            self.reverse_short_ngram_travel_m,
+        );
         p.out
     }
 
@@ -585,6 +608,23 @@ impl MatcherOptions {
         } else {
             0
         }
+    }
+
+    /// The short rule for n-grams read backwards (`reverse_short_ngram_words`): its words and
+    /// travel, metres, when it is on.
+    pub(crate) fn short_opposite_rule(&self) -> Option<(usize, f64)> {
+        (self.reverse && self.reverse_short_ngram_words > 0).then_some((
+            self.reverse_short_ngram_words,
+            self.reverse_short_ngram_travel_m,
+        ))
+    }
+
+    /// Whether an n-gram of `words` word pairs read backwards is one the short rule let through:
+    /// fewer words than the travel rule asks for
+    /// ([`short_opposite_rule`](Self::short_opposite_rule)).
+    pub(crate) fn is_short_opposite(&self, words: usize) -> bool {
+        self.short_opposite_rule().is_some()
+            && words < self.ngram_travel_min_words.max(1) + self.opposite_extra_ngram()
     }
 
     /// The travel rule's span in direction `dir`: `ngram_travel_m` or `reverse_ngram_travel_m`.
@@ -737,6 +777,11 @@ pub struct VerifyOptions {
     /// pairs per seed, 3-level precision 0.940 and 0.918 without it); Intel's opposite-direction
     /// recall hardly changes (noise seeds 1–3: 0.331–0.465 with 45 or 80).
     pub reverse_min_turn_deg: f64,
+    /// The sides bound for a short n-gram read backwards (`reverse_short_ngram_words` in
+    /// `[recognizer.matcher]`). Default 0.04: four words say little, and the side of the free
+    /// space is what tells a place from its mirror image (`reverse` at 0.06: worst precision
+    /// 0.946; at 0.04 its opposite recall is unchanged and seattle keeps its pairs).
+    pub reverse_short_max_lateral_rms: f64,
 }
 
 impl Default for VerifyOptions {
@@ -750,6 +795,7 @@ impl Default for VerifyOptions {
             verify_max_lateral_rms: 0.08,
             reverse_verify_max_lateral_rms: 0.06,
             reverse_min_turn_deg: 45.0,
+            reverse_short_max_lateral_rms: 0.035,
         }
     }
 }
@@ -769,6 +815,10 @@ impl VerifyOptions {
                 self.reverse_verify_max_lateral_rms,
             ),
             ("reverse_min_turn_deg", self.reverse_min_turn_deg),
+            (
+                "reverse_short_max_lateral_rms",
+                self.reverse_short_max_lateral_rms,
+            ),
         ] {
             p.non_negative(field, v);
         }

@@ -101,10 +101,20 @@ impl WordMatcher {
         };
         if mean(sum) > self.verify_opts.verify_max_psi_rms {
             Some(Rejection::Density)
-        } else if mean(lateral) > self.verify_opts.max_lateral_rms(dir) {
+        } else if mean(lateral) > self.lateral_bound(word_pairs.len(), dir) {
             Some(Rejection::Sides)
         } else {
             None
+        }
+    }
+
+    /// The sides bound for an n-gram of `words` word pairs read in direction `dir`: tighter for
+    /// a short n-gram read backwards (`reverse_short_max_lateral_rms`).
+    fn lateral_bound(&self, words: usize, dir: Direction) -> f64 {
+        if dir == Direction::Opposite && self.matcher_opts.is_short_opposite(words) {
+            self.verify_opts.reverse_short_max_lateral_rms
+        } else {
+            self.verify_opts.max_lateral_rms(dir)
         }
     }
 

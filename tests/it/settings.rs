@@ -95,6 +95,13 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("matcher.reverse_ngram_travel_m", "5", "", Input::Dense),
+    ("matcher.reverse_short_ngram_words", "2", "", Input::Dense),
+    (
+        "matcher.reverse_short_ngram_travel_m",
+        "5",
+        "",
+        Input::Dense,
+    ),
     ("verify.enabled", "false", "", Input::Dense),
     ("verify.verify_travel_ratio", "0.01", "", Input::Dense),
     (
@@ -118,6 +125,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("verify.reverse_min_turn_deg", "0", LOOSE, Input::Dense),
+    (
+        "verify.reverse_short_max_lateral_rms",
+        "0.001",
+        "matcher.reverse_short_ngram_travel_m = 5",
+        Input::Dense,
+    ),
 ];
 
 /// Short chains, read backwards as readily, with a loose density check: candidates reach the
