@@ -515,13 +515,14 @@ pub struct MatcherOptions {
     /// one class at an opposite revisit differ in size by 0.27–0.36 of the larger, median over
     /// noise seeds 1–5, against 0.17–0.23 driven the same way; `examples/opposite_revisits.rs`),
     /// so opposite chains stop at 4–5 words where same-direction ones go on; seattle's one
-    /// opposite stretch long enough makes a chain of 4 words over 22–25 m. Default 4 (tuned
-    /// on seattle and `reverse`, smooth and weaving, seeds 1–10; confirmed on A, B, C, Intel
-    /// and fhw: RESULTS.md, session 7).
+    /// opposite stretch long enough makes a chain of 4 words over 22–25 m. Default 4: seattle
+    /// gets pairs on noise seeds 1–4 instead of 4 only (5 words: seed 4 only); tuned on seattle
+    /// and `reverse` seeds 1–10, confirmed on A, B, C and `reverse`, smooth and weaving, Intel
+    /// (every scan and every 3rd) and fhw (RESULTS.md, session 7).
     pub reverse_short_ngram_words: usize,
     /// Travel the current side of such a short n-gram read backwards must span, metres. Default
-    /// 22 (seattle's chains span 22–25 m: 25 lost seeds 1, 3 and 5; 20 let `reverse` fall to
-    /// 0.937 worst precision).
+    /// 22: seattle's short chains span 22–25 m (25 keeps seed 4 only); 20 gives `reverse` the
+    /// same precision (3 levels 0.984 mean, 0.969 worst seed).
     pub reverse_short_ngram_travel_m: f64,
 }
 
@@ -778,9 +779,9 @@ pub struct VerifyOptions {
     /// recall hardly changes (noise seeds 1–3: 0.331–0.465 with 45 or 80).
     pub reverse_min_turn_deg: f64,
     /// The sides bound for a short n-gram read backwards (`reverse_short_ngram_words` in
-    /// `[recognizer.matcher]`). Default 0.04: four words say little, and the side of the free
-    /// space is what tells a place from its mirror image (`reverse` at 0.06: worst precision
-    /// 0.946; at 0.04 its opposite recall is unchanged and seattle keeps its pairs).
+    /// `[recognizer.matcher]`). Default 0.035: four words say little, and the side of the free
+    /// space is what tells a place from its mirror image (`reverse`, 3 levels, worst seed: 0.956
+    /// at 0.04, 0.968 at 0.035, as without the rule; 0.03 costs seattle seed 2 its pairs).
     pub reverse_short_max_lateral_rms: f64,
 }
 
