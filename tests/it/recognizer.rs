@@ -1390,7 +1390,7 @@ fn too_long_steps_are_named_when_nothing_matches() {
 }
 
 /// A run without pairs says whether its revisits could hold a chain of τ words at all: with τ
-/// far above Intel's chains, the reason compares the longest stretch of revisits in each
+/// far above Intel's chains (and no rule for chains shorter than τ), the reason compares the longest stretch of revisits in each
 /// direction (`longest_revisit_m`) with τ words of the run's mean word length, and says "too
 /// short" exactly when both directions fall short.
 #[test]
@@ -1400,6 +1400,7 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
             c.matcher.min_ngram = vec![tau; 4];
             c.matcher.ngram_travel_m = 0.0;
             c.matcher.reverse_ngram_travel_m = 0.0;
+            c.matcher.reverse_short_ngram_words = 0;
         });
         let Some(scores) = real_log_scores_with("intel", 1, 1, &cfg) else {
             return;
