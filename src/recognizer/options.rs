@@ -507,10 +507,10 @@ pub struct MatcherOptions {
     /// `reverse_extra_ngram` read backwards). Default 4.
     pub ngram_travel_min_words: usize,
     /// A shorter n-gram read backwards (not in the paper): when a chain read backwards has no
-    /// n-gram by τ or by `reverse_ngram_travel_m`, its last `reverse_short_ngram_words` or more
-    /// word pairs, fewer than `ngram_travel_min_words` + `reverse_extra_ngram`, are a candidate
-    /// when they span at least `reverse_short_ngram_travel_m`; verification then holds them to
-    /// `reverse_short_max_lateral_rms` in `[recognizer.verify]`. 0 = off.
+    /// n-gram by τ or by `reverse_ngram_travel_m`, its last word pairs, as few as span
+    /// `reverse_short_ngram_travel_m` but at least `reverse_short_ngram_words` and fewer than τ,
+    /// are a candidate; verification holds such an n-gram to `reverse_short_max_lateral_rms` in
+    /// `[recognizer.verify]`. 0 = off.
     /// Read backwards a place's words disagree more than driven the same way (on fhw, words of
     /// one class at an opposite revisit differ in size by 0.27–0.36 of the larger, median over
     /// noise seeds 1–5, against 0.17–0.23 driven the same way; `examples/opposite_revisits.rs`),
@@ -521,8 +521,8 @@ pub struct MatcherOptions {
     /// (every scan and every 3rd) and fhw (RESULTS.md, session 7).
     pub reverse_short_ngram_words: usize,
     /// Travel the current side of such a short n-gram read backwards must span, metres. Default
-    /// 22: seattle's short chains span 22–25 m (25 keeps seed 4 only); 20 gives `reverse` the
-    /// same precision (3 levels 0.984 mean, 0.969 worst seed).
+    /// 22: seattle's short chains span 22–25 m (25 keeps seed 4 only); 20 gives `reverse` about
+    /// the same precision (3 levels 0.984 mean, 0.969 worst seed).
     pub reverse_short_ngram_travel_m: f64,
 }
 
@@ -618,14 +618,6 @@ impl MatcherOptions {
             self.reverse_short_ngram_words,
             self.reverse_short_ngram_travel_m,
         ))
-    }
-
-    /// Whether an n-gram of `words` word pairs read backwards is one the short rule let through:
-    /// fewer words than the travel rule asks for
-    /// ([`short_opposite_rule`](Self::short_opposite_rule)).
-    pub(crate) fn is_short_opposite(&self, words: usize) -> bool {
-        self.short_opposite_rule().is_some()
-            && words < self.ngram_travel_min_words.max(1) + self.opposite_extra_ngram()
     }
 
     /// The travel rule's span in direction `dir`: `ngram_travel_m` or `reverse_ngram_travel_m`.
@@ -780,8 +772,8 @@ pub struct VerifyOptions {
     pub reverse_min_turn_deg: f64,
     /// The sides bound for a short n-gram read backwards (`reverse_short_ngram_words` in
     /// `[recognizer.matcher]`). Default 0.035: four words say little, and the side of the free
-    /// space is what tells a place from its mirror image (`reverse`, 3 levels, worst seed: 0.956
-    /// at 0.04, 0.968 at 0.035, as without the rule; 0.03 costs seattle seed 2 its pairs).
+    /// space is what tells a place from its mirror image (`reverse`, 3 levels, worst seed: 0.957
+    /// at 0.04, 0.969 at 0.035, 0.967 without the rule; 0.03 costs seattle seed 2 its pairs).
     pub reverse_short_max_lateral_rms: f64,
 }
 

@@ -44,12 +44,14 @@ impl WordMatcher {
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
+    /// An n-gram the short rule made (`short`, `reverse_short_ngram_words`) is held to
+    /// `reverse_short_max_lateral_rms`.
     pub(super) fn verify(
         &self,
         word_pairs: &[(WordId, WordId)],
         dir: Direction,
         anchors: &[i64],
-        newest_only: bool,
+        (newest_only, short): (bool, bool),
         placed: &mut Vec<Option<Placement>>,
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
@@ -101,17 +103,17 @@ impl WordMatcher {
         };
         if mean(sum) > self.verify_opts.verify_max_psi_rms {
             Some(Rejection::Density)
-        } else if mean(lateral) > self.lateral_bound(word_pairs.len(), dir) {
+        } else if mean(lateral) > self.lateral_bound(short, dir) {
             Some(Rejection::Sides)
         } else {
             None
         }
     }
 
-    /// The sides bound for an n-gram of `words` word pairs read in direction `dir`: tighter for
-    /// a short n-gram read backwards (`reverse_short_max_lateral_rms`).
-    fn lateral_bound(&self, words: usize, dir: Direction) -> f64 {
-        if dir == Direction::Opposite && self.matcher_opts.is_short_opposite(words) {
+    /// The sides bound for an n-gram read in direction `dir`: tighter for one the short rule
+    /// made (`reverse_short_max_lateral_rms`).
+    fn lateral_bound(&self, short: bool, dir: Direction) -> f64 {
+        if short {
             self.verify_opts.reverse_short_max_lateral_rms
         } else {
             self.verify_opts.max_lateral_rms(dir)

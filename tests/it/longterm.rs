@@ -35,7 +35,7 @@ fn without_timings(v: &mut serde_json::Value) {
 /// 21,167 pairs, recall 0.663 → 0.604, precision 0.9994 → 0.9992; 3 levels 311,897 → 306,729
 /// pairs, precision 0.9985 and recall 0.951 both), and for short chains read backwards
 /// (`reverse_short_ngram_words`, session 7: only verification's rejection counts rose, e.g. 3
-/// levels turn 1,250 → 2,283, `rejected_candidates.sampled` 3,028 → 4,118; every pair, match
+/// levels turn 1,250 → 2,325, `rejected_candidates.sampled` 3,028 → 4,160; every pair, match
 /// and figure identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.

@@ -1750,7 +1750,7 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
 /// A corridor of long words of Ψ `psis`, `size` observations each, driven twice (the second
 /// time backwards when `back`), turning by `turn_deg` and back again in alternate words: the
 /// first pass's length, every observation, and a 1-level configuration with a 5 m candidate gap
-/// and no n-gram accepted by travel.
+/// and no n-gram accepted by travel (nor by the short rule for chains read backwards).
 fn corridor_of_long_words(
     psis: &[f64],
     size: usize,
@@ -1776,6 +1776,7 @@ fn corridor_of_long_words(
         c.matcher.candidate_gap_m = 5.0;
         c.matcher.ngram_travel_m = 0.0;
         c.matcher.reverse_ngram_travel_m = 0.0;
+        c.matcher.reverse_short_ngram_words = 0;
     });
     (first.len(), all, base)
 }
