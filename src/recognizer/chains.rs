@@ -326,14 +326,21 @@ impl WordMatcher {
 
     /// The shortest chain (in word pairs) configuration k reports in direction `dir`: τ, or
     /// with the travel rule (`ngram_travel_m`, `reverse_ngram_travel_m`) its minimum words if
-    /// fewer. [`tau_chain`](Self::tau_chain) finds nothing for a shorter chain.
+    /// fewer, or read backwards the short rule's (`reverse_short_ngram_words`) if fewer still.
+    /// [`tau_chain`](Self::tau_chain) finds nothing for a shorter chain.
     pub(super) fn min_chain_len(&self, k: usize, dir: Direction) -> usize {
         let (tau, min_words) = self.tau_and_min_words(k, dir);
-        if self.matcher_opts.travel_rule_m(dir) > 0.0 {
+        let mut len = if self.matcher_opts.travel_rule_m(dir) > 0.0 {
             tau.min(min_words)
         } else {
             tau
+        };
+        if let (Direction::Opposite, Some((words, _))) =
+            (dir, self.matcher_opts.short_opposite_rule())
+        {
+            len = len.min(words.max(1));
         }
+        len
     }
 
     /// τ of configuration k read in direction `dir`, and the travel rule's minimum words.
@@ -349,19 +356,53 @@ impl WordMatcher {
     }
 
     /// Appends to `chain` the τ-gram of configuration k ending at memo entry `idx` of `c`,
-    /// newest pair first; false (nothing appended) when the chain is shorter than τ (and not
-    /// long enough in travel).
+    /// newest pair first, and says whether the short rule made it; `None` (nothing appended)
+    /// when the chain is shorter than τ (and not long enough in travel). Read backwards, a chain
+    /// with neither falls back on the short rule (`reverse_short_ngram_words` words or more,
+    /// fewer than τ, over `reverse_short_ngram_travel_m`).
     pub(super) fn tau_chain(
         &self,
         (c, idx): (WordId, usize),
         k: usize,
         dir: Direction,
         chain: &mut Vec<(WordId, usize)>,
+    ) -> Option<bool> {
+        let (tau, min_words) = self.tau_and_min_words(k, dir);
+        let travel_m = self.matcher_opts.travel_rule_m(dir);
+        if self.walk_chain((c, idx), k, dir, (tau, min_words, travel_m), chain) {
+            return Some(false);
+        }
+        // The short rule: as few words as span `reverse_short_ngram_travel_m`, at least
+        // `reverse_short_ngram_words` and fewer than τ.
+        let (words, short_m) = self.matcher_opts.short_opposite_rule()?;
+        let (words, most) = (words.max(1), tau.saturating_sub(1));
+        if dir == Direction::Same || words > most {
+            return None;
+        }
+        let start = chain.len();
+        if !self.walk_chain((c, idx), k, dir, (most, words, short_m), chain) {
+            return None;
+        }
+        let oldest = chain[chain.len() - 1].0;
+        if self.word(c).end_travel_m - self.word(oldest).start_travel_m < short_m {
+            chain.truncate(start);
+            return None;
+        }
+        Some(true)
+    }
+
+    /// [`tau_chain`](Self::tau_chain) by one rule: τ words, or at least `min_words` whose
+    /// current side spans `travel_m` (> 0).
+    fn walk_chain(
+        &self,
+        (c, idx): (WordId, usize),
+        k: usize,
+        dir: Direction,
+        (tau, min_words, travel_m): (usize, usize, f64),
+        chain: &mut Vec<(WordId, usize)>,
     ) -> bool {
         let memo = &self.memo[dir as usize];
-        let (tau, min_words) = self.tau_and_min_words(k, dir);
         let e = memo[c as usize][idx];
-        let travel_m = self.matcher_opts.travel_rule_m(dir);
         let by_travel = travel_m > 0.0;
         let len = e.len[k] as usize;
         if len < tau && !(by_travel && len >= min_words) {
@@ -373,7 +414,7 @@ impl WordMatcher {
         let end_m = self.word(c).end_travel_m;
         while chain.len() - start < tau {
             // An n-gram long in travel but short in words (`ngram_travel_m`,
-            // `reverse_ngram_travel_m`).
+            // `reverse_ngram_travel_m`, `reverse_short_ngram_travel_m`).
             if by_travel
                 && chain.len() - start >= min_words
                 && end_m - self.word(wc).start_travel_m >= travel_m
@@ -397,19 +438,18 @@ impl WordMatcher {
 
     /// Appends to `scr` the τ-gram of configuration k ending at memo entry `idx` of `c`, oldest
     /// pair first (its chain and word pairs); whether it extends a chain reported in
-    /// configuration k, or `None` (nothing appended) when there is no τ-gram.
+    /// configuration k and whether the short rule made it (`tau_chain`), or `None` (nothing
+    /// appended) when there is no τ-gram.
     pub(super) fn push_chain(
         &self,
         (c, idx): (WordId, usize),
         k: usize,
         dir: Direction,
         scr: &mut Scratch,
-    ) -> Option<bool> {
+    ) -> Option<(bool, bool)> {
         let memo = &self.memo[dir as usize];
         let from = scr.chain.len();
-        if !self.tau_chain((c, idx), k, dir, &mut scr.chain) {
-            return None;
-        }
+        let short = self.tau_chain((c, idx), k, dir, &mut scr.chain)?;
         // The chain extends one whose n-gram was verified and reported: only its new pair's
         // densities need checking (the travel and turn checks are cheap and run in full).
         let extends_reported = scr
@@ -423,7 +463,7 @@ impl WordMatcher {
                 .iter()
                 .map(|&(wc, widx)| (wc, memo[wc as usize][widx].past)),
         );
-        Some(extends_reported)
+        Some((extends_reported, short))
     }
 
     /// Whether the n-gram's first current word begins at least `candidate_gap_m` after its

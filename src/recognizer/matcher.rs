@@ -332,7 +332,7 @@ impl WordMatcher {
         scr: &mut Scratch,
     ) -> Option<Candidate> {
         let (from, placed_from) = (scr.chain.len(), scr.placed.len());
-        let extends_reported = self.push_chain((c, idx), k, dir, scr)?;
+        let (extends_reported, short) = self.push_chain((c, idx), k, dir, scr)?;
         let pairs = from..scr.chain.len();
         let chain_len = self.memo[dir as usize][c as usize][idx].len[k] as usize;
         if !extends_reported && self.too_few_classes(&scr.word_pairs[pairs.clone()], dir, chain_len)
@@ -356,7 +356,7 @@ impl WordMatcher {
                 &scr.word_pairs[pairs.clone()],
                 dir,
                 &scr.anchors[pairs.clone()],
-                extends_reported,
+                (extends_reported, short),
                 &mut scr.placed,
             )
         {

@@ -506,6 +506,24 @@ pub struct MatcherOptions {
     /// Fewest word pairs an n-gram accepted by `ngram_travel_m` needs (plus
     /// `reverse_extra_ngram` read backwards). Default 4.
     pub ngram_travel_min_words: usize,
+    /// A shorter n-gram read backwards (not in the paper): when a chain read backwards has no
+    /// n-gram by τ or by `reverse_ngram_travel_m`, its last word pairs, as few as span
+    /// `reverse_short_ngram_travel_m` but at least `reverse_short_ngram_words` and fewer than τ,
+    /// are a candidate; verification holds such an n-gram to `reverse_short_max_lateral_rms` in
+    /// `[recognizer.verify]`. 0 = off.
+    /// Read backwards a place's words disagree more than driven the same way (on fhw, words of
+    /// one class at an opposite revisit differ in size by 0.27–0.36 of the larger, median over
+    /// noise seeds 1–5, against 0.17–0.23 driven the same way; `examples/opposite_revisits.rs`),
+    /// so opposite chains stop at 4–5 words where same-direction ones go on; seattle's one
+    /// opposite stretch long enough makes a chain of 4 words over 22–25 m. Default 4: seattle
+    /// gets pairs on noise seeds 1–4 instead of 4 only (5 words: seed 4 only); tuned on seattle
+    /// and `reverse` seeds 1–10, confirmed on A, B, C and `reverse`, smooth and weaving, Intel
+    /// (every scan and every 3rd) and fhw (RESULTS.md, session 7).
+    pub reverse_short_ngram_words: usize,
+    /// Travel the current side of such a short n-gram read backwards must span, metres. Default
+    /// 22: seattle's short chains span 22–25 m (25 keeps seed 4 only); 20 gives `reverse` about
+    /// the same precision (3 levels 0.984 mean, 0.969 worst seed).
+    pub reverse_short_ngram_travel_m: f64,
 }
 
 impl Default for MatcherOptions {
@@ -525,6 +543,8 @@ impl Default for MatcherOptions {
             ngram_travel_m: 0.0,
             reverse_ngram_travel_m: 30.0,
             ngram_travel_min_words: 4,
+            reverse_short_ngram_words: 4,
+            reverse_short_ngram_travel_m: 22.0,
         }
     }
 }
@@ -555,6 +575,10 @@ impl MatcherOptions {
         );
         p.non_negative("ngram_travel_m", self.ngram_travel_m);
         p.non_negative("reverse_ngram_travel_m", self.reverse_ngram_travel_m);
+        p.non_negative(
+            "reverse_short_ngram_travel_m",
+            self.reverse_short_ngram_travel_m,
+        );
         p.out
     }
 
@@ -585,6 +609,15 @@ impl MatcherOptions {
         } else {
             0
         }
+    }
+
+    /// The short rule for n-grams read backwards (`reverse_short_ngram_words`): its words and
+    /// travel, metres, when it is on.
+    pub(crate) fn short_opposite_rule(&self) -> Option<(usize, f64)> {
+        (self.reverse && self.reverse_short_ngram_words > 0).then_some((
+            self.reverse_short_ngram_words,
+            self.reverse_short_ngram_travel_m,
+        ))
     }
 
     /// The travel rule's span in direction `dir`: `ngram_travel_m` or `reverse_ngram_travel_m`.
@@ -765,6 +798,11 @@ pub struct VerifyOptions {
     /// misses its per-direction bounds (3 levels same-direction worst 0.932 → 0.910, opposite
     /// 0.980 → 0.953), so it is not the default (RESULTS.md, session 7).
     pub verify_travel_outliers: usize,
+    /// The sides bound for a short n-gram read backwards (`reverse_short_ngram_words` in
+    /// `[recognizer.matcher]`). Default 0.035: four words say little, and the side of the free
+    /// space is what tells a place from its mirror image (`reverse`, 3 levels, worst seed: 0.957
+    /// at 0.04, 0.969 at 0.035, 0.967 without the rule; 0.03 costs seattle seed 2 its pairs).
+    pub reverse_short_max_lateral_rms: f64,
 }
 
 impl Default for VerifyOptions {
@@ -780,6 +818,7 @@ impl Default for VerifyOptions {
             reverse_min_turn_deg: 45.0,
             verify_turn_outliers: 1,
             verify_travel_outliers: 0,
+            reverse_short_max_lateral_rms: 0.035,
         }
     }
 }
@@ -799,6 +838,10 @@ impl VerifyOptions {
                 self.reverse_verify_max_lateral_rms,
             ),
             ("reverse_min_turn_deg", self.reverse_min_turn_deg),
+            (
+                "reverse_short_max_lateral_rms",
+                self.reverse_short_max_lateral_rms,
+            ),
         ] {
             p.non_negative(field, v);
         }

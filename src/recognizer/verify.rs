@@ -57,12 +57,14 @@ impl WordMatcher {
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
+    /// An n-gram the short rule made (`short`, `reverse_short_ngram_words`) is held to
+    /// `reverse_short_max_lateral_rms`.
     pub(super) fn verify(
         &self,
         word_pairs: &[(WordId, WordId)],
         dir: Direction,
         anchors: &[i64],
-        newest_only: bool,
+        (newest_only, short): (bool, bool),
         placed: &mut Vec<Option<Placement>>,
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
@@ -133,7 +135,7 @@ impl WordMatcher {
         };
         if mean(sum) > self.verify_opts.verify_max_psi_rms {
             Some(Rejection::Density)
-        } else if mean(lateral) > self.verify_opts.max_lateral_rms(dir) {
+        } else if mean(lateral) > self.lateral_bound(short, dir) {
             Some(Rejection::Sides)
         } else {
             None
@@ -153,6 +155,16 @@ impl WordMatcher {
         let off = |e: f64| (e - median).abs() > tol;
         let interior = offsets.iter().filter(|&&e| off(e)).count();
         off(oldest) || off(newest) || interior > self.verify_opts.verify_turn_outliers
+    }
+
+    /// The sides bound for an n-gram read in direction `dir`: tighter for one the short rule
+    /// made (`reverse_short_max_lateral_rms`).
+    fn lateral_bound(&self, short: bool, dir: Direction) -> f64 {
+        if short {
+            self.verify_opts.reverse_short_max_lateral_rms
+        } else {
+            self.verify_opts.max_lateral_rms(dir)
+        }
     }
 
     /// Whether the n-gram of `word_pairs` (oldest first), whose chain is `chain_len` words

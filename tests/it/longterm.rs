@@ -33,9 +33,11 @@ fn without_timings(v: &mut serde_json::Value) {
 /// `correct` counts fell, 2,175 → 2,150 at 3 levels; every other value identical), and for
 /// two-class n-grams waiting for one more word (`two_class_extra_ngram`: 1 level 26,758 →
 /// 21,167 pairs, recall 0.663 → 0.604, precision 0.9994 → 0.9992; 3 levels 311,897 → 306,729
-/// pairs, precision 0.9985 and recall 0.951 both), and for the turn judged over the n-gram
+/// pairs, precision 0.9985 and recall 0.951 both), for the turn judged over the n-gram
 /// (`verify_turn_outliers` = 1, session 7: 3 levels 306,729 → 306,787 pairs and 5,869 → 5,872
-/// matches, precision 0.9985 and recall 0.951 both; 1 level identical).
+/// matches, precision 0.9985 and recall 0.951 both; 1 level identical), and for short chains
+/// read backwards (`reverse_short_ngram_words`, session 7: only verification's rejection counts
+/// rose; every pair, match and figure identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]

@@ -543,6 +543,72 @@ fn a_mirror_image_driven_back_is_not_a_revisit() {
     }
 }
 
+/// A stretch driven back along five long words over 27 m (about seattle's one opposite revisit
+/// long enough): fewer words than τ or the travel rule (six words over 30 m) ask for read
+/// backwards, and its neighbours differ on each pass, so the chain stops at its five words.
+/// The short rule for chains read backwards (`reverse_short_ngram_words`: four words or more
+/// over 22 m, sides held tighter) recognizes it, each query paired with the place it revisits;
+/// without the rule nothing is found.
+#[test]
+fn a_short_stretch_driven_back_is_recognized() {
+    let place = [
+        Stretch::new(class_psi(2, 8), 60, 0.0),
+        Stretch::new(class_psi(4, 8), 45, 0.0),
+        Stretch::new(class_psi(1, 8), 55, 90.0),
+        Stretch::new(class_psi(5, 8), 50, 0.0),
+        Stretch::new(class_psi(3, 8), 60, 0.0),
+    ];
+    // Other places around it on each pass, and a separator of one class whose size differs
+    // between the passes, so that no chain reaches past the stretch.
+    let around = |before: &[(usize, usize)], place: &[Stretch], after: &[(usize, usize)]| {
+        let stretch =
+            |&(class, size): &(usize, usize)| Stretch::new(class_psi(class, 8), size, 0.0);
+        let mut lap: Vec<Stretch> = before.iter().map(stretch).collect();
+        lap.extend_from_slice(place);
+        lap.extend(after.iter().map(stretch));
+        lap
+    };
+    let first_lap = around(
+        &[(6, 30), (0, 40), (7, 20)],
+        &place,
+        &[(7, 20), (0, 35), (6, 45)],
+    );
+    let first = with_noise(synth::observations(&first_lap, 0.1, 0, None), 1);
+    let second_lap = around(
+        &[(5, 25), (6, 50), (7, 80)],
+        &reversed(&place),
+        &[(7, 80), (5, 30)],
+    );
+    let second = with_noise(synth::observations(&second_lap, 0.1, 0, first.last()), 2);
+    let start = |lap: &[Stretch]| -> usize { lap[..3].iter().map(|s| s.size).sum() };
+    let place_len: usize = place.iter().map(|s| s.size).sum();
+    let (p0, q0) = (start(&first_lap), first.len() + start(&second_lap));
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
+
+    let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    let opposite: Vec<&WordMatch> = (matches.iter())
+        .filter(|m| m.direction == Direction::Opposite)
+        .collect();
+    assert!(
+        !opposite.is_empty(),
+        "the stretch driven back is recognized"
+    );
+    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
+        // Query q0 + j is at the place of observation p0 + place_len − 1 − j.
+        let mirror = (p0 + place_len - 1 + q0).checked_sub(query);
+        assert!(
+            mirror.is_some_and(|m| m.abs_diff(past) <= 2),
+            "query {query} paired with {past}, its place is {mirror:?}"
+        );
+    }
+    let without = config(|c| c.matcher.reverse_short_ngram_words = 0);
+    let (_, matches) = run_matcher(&without, &all);
+    assert!(
+        matches.iter().all(|m| m.direction == Direction::Same),
+        "without the short rule the stretch is too short to be recognized"
+    );
+}
+
 /// Driven the same way, a place whose free space lies on the other side of the path is not the
 /// place: verification rejects it (`rejected_sides`); the same pass with the same sides matches.
 #[test]
@@ -1324,7 +1390,7 @@ fn too_long_steps_are_named_when_nothing_matches() {
 }
 
 /// A run without pairs says whether its revisits could hold a chain of τ words at all: with τ
-/// far above Intel's chains, the reason compares the longest stretch of revisits in each
+/// far above Intel's chains (and no rule for chains shorter than τ), the reason compares the longest stretch of revisits in each
 /// direction (`longest_revisit_m`) with τ words of the run's mean word length, and says "too
 /// short" exactly when both directions fall short.
 #[test]
@@ -1334,6 +1400,7 @@ fn no_pairs_reason_weighs_revisit_length_against_tau_words() {
             c.matcher.min_ngram = vec![tau; 4];
             c.matcher.ngram_travel_m = 0.0;
             c.matcher.reverse_ngram_travel_m = 0.0;
+            c.matcher.reverse_short_ngram_words = 0;
         });
         let Some(scores) = real_log_scores_with("intel", 1, 1, &cfg) else {
             return;
@@ -1683,7 +1750,7 @@ fn a_substitution_bridges_only_words_of_about_the_same_size() {
 /// A corridor of long words of Ψ `psis`, `size` observations each, driven twice (the second
 /// time backwards when `back`), turning by `turn_deg` and back again in alternate words: the
 /// first pass's length, every observation, and a 1-level configuration with a 5 m candidate gap
-/// and no n-gram accepted by travel.
+/// and no n-gram accepted by travel (nor by the short rule for chains read backwards).
 fn corridor_of_long_words(
     psis: &[f64],
     size: usize,
@@ -1709,6 +1776,7 @@ fn corridor_of_long_words(
         c.matcher.candidate_gap_m = 5.0;
         c.matcher.ngram_travel_m = 0.0;
         c.matcher.reverse_ngram_travel_m = 0.0;
+        c.matcher.reverse_short_ngram_words = 0;
     });
     (first.len(), all, base)
 }

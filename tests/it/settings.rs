@@ -95,6 +95,13 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("matcher.reverse_ngram_travel_m", "5", "", Input::Dense),
+    ("matcher.reverse_short_ngram_words", "2", "", Input::Dense),
+    (
+        "matcher.reverse_short_ngram_travel_m",
+        "5",
+        "",
+        Input::Dense,
+    ),
     ("verify.enabled", "false", "", Input::Dense),
     ("verify.verify_travel_ratio", "0.01", "", Input::Dense),
     (
@@ -131,6 +138,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         "0",
         "matcher.min_ngram = [2, 3, 4, 5]\nmatcher.reverse_extra_ngram = 0\n\
          verify.verify_max_psi_rms = 1.0\nverify.verify_turn_deg = 5",
+        Input::Dense,
+    ),
+    (
+        "verify.reverse_short_max_lateral_rms",
+        "0.001",
+        "matcher.reverse_short_ngram_travel_m = 5",
         Input::Dense,
     ),
 ];
