@@ -783,6 +783,7 @@ pub struct VerifyOptions {
     /// (allowing it cost Intel 0.02 precision), and one whose newest word turns on one side only
     /// waits until a later word agrees again. Tuned on Intel and scenario A with smooth and
     /// weaving laps (with 1: weaving A recall 0.414 → 0.515, worst precision 0.960 → 0.963).
+    /// A short n-gram read backwards (`reverse_short_ngram_words`) keeps the per-word limit.
     pub verify_turn_outliers: usize,
     /// Travel, judged over the n-gram as a whole: up to this many of its word starts, never
     /// the first or the newest, may disagree and are passed over; the travel to the next word

@@ -58,7 +58,9 @@ impl WordMatcher {
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
     /// An n-gram the short rule made (`short`, `reverse_short_ngram_words`) is held to
-    /// `reverse_short_max_lateral_rms`.
+    /// `reverse_short_max_lateral_rms` and to the per-word turn limit (with four words, one
+    /// word start passed over is half of its interior: weaving A seed 2 got a false chain read
+    /// backwards that way).
     pub(super) fn verify(
         &self,
         word_pairs: &[(WordId, WordId)],
@@ -80,7 +82,8 @@ impl WordMatcher {
         // The heading offsets per word start, when the turn is judged over the n-gram as a
         // whole (`verify_turn_outliers`); longer n-grams than the buffer use the per-word limit.
         let mut offsets = [0.0; TURN_OFFSETS];
-        let robust = self.verify_opts.verify_turn_outliers > 0 && word_pairs.len() <= TURN_OFFSETS;
+        let robust =
+            self.verify_opts.verify_turn_outliers > 0 && !short && word_pairs.len() <= TURN_OFFSETS;
         // Travel at the last word start that agreed (current, past), and the interior word
         // starts passed over so far (`verify_travel_outliers`).
         let (mut agreed, mut passed_over) = ((0.0, 0.0), 0);

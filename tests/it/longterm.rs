@@ -37,7 +37,8 @@ fn without_timings(v: &mut serde_json::Value) {
 /// (`verify_turn_outliers` = 1, session 7: 3 levels 306,729 → 306,787 pairs and 5,869 → 5,872
 /// matches, precision 0.9985 and recall 0.951 both; 1 level identical), and for short chains
 /// read backwards (`reverse_short_ngram_words`, session 7: only verification's rejection counts
-/// rose; every pair, match and figure identical).
+/// rose, again when such chains kept the per-word turn limit; every pair, match and figure
+/// identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]

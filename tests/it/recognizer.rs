@@ -2150,7 +2150,10 @@ fn weaving_laps_keep_revisits_with_one_moved_word_start() {
 /// a true revisit's n-gram is off by the corner. Judged over the n-gram as a whole
 /// (`verify_turn_outliers`: one word start inside the n-gram may disagree), the turn check
 /// lets those revisits through: recall rises by more than a tenth of what it was, the turn
-/// check turns down fewer true revisits, and precision stays at 0.95 or more.
+/// check turns down fewer true revisits, and precision stays at 0.95 or more. Scenario A is
+/// driven one way, so every pair read backwards would be false: a short chain read backwards
+/// (`reverse_short_ngram_words`, four words) keeps the per-word turn limit, and none is reported
+/// (with one of its two interior word starts passed over, 208 false pairs were).
 #[test]
 fn weaving_laps_keep_revisits_whose_corner_falls_between_words() {
     let (scn, runs) = weaving_a(2);
@@ -2188,5 +2191,9 @@ fn weaving_laps_keep_revisits_whose_corner_falls_between_words() {
         "precision {:.3} (per-word limit {:.3})",
         with.precision,
         without.precision
+    );
+    assert_eq!(
+        with.directions.opposite.pairs, 0,
+        "pairs read backwards in a scenario driven one way"
     );
 }
