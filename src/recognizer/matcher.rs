@@ -110,7 +110,8 @@ impl WordMatcher {
             config.levels,
             words.multi_level,
         )
-        .with_wide_classes(config.wide_classes_in_use());
+        .with_wide_classes(config.wide_classes_in_use())
+        .with_psi_window(words.psi_window, words.psi_window_statistic);
         Ok(WordMatcher {
             levels: config.levels,
             tau,

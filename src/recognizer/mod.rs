@@ -38,7 +38,7 @@ pub use grid::{Density, LocalGrid};
 pub use matcher::WordMatcher;
 pub use options::{
     AlignmentMode, AlignmentOptions, DensityOptions, FrontEndOptions, GridOptions, MatcherOptions,
-    MultiLevelRule, VerifyOptions, WordOptions,
+    MultiLevelRule, PsiWindowStatistic, VerifyOptions, WordOptions,
 };
 pub use types::{
     AlignedRun, DensityObservation, Direction, FrameId, ObsId, Observation, WordMatch, WordRef,

@@ -352,6 +352,25 @@ pub struct WordOptions {
     /// `classes + min(floor(wide_classes·(2Φ − 1)), wide_classes − 1)`. 0 (or a wide window
     /// turned off) keeps the top class whole. Default 4.
     pub wide_classes: usize,
+    /// Observations of a centred window over which Ψ is summarized before it is quantized (an
+    /// experiment, issue 28): an odd count; each observation's class is that of the window's
+    /// `psi_window_statistic`, the window cut at the ends of a run. Centred, so a place driven
+    /// either way gets the same classes; words then close `psi_window / 2` observations later.
+    /// 1 (off) classifies each observation by its own Ψ. Default 1.
+    pub psi_window: usize,
+    /// How the `psi_window` is summarized: `median` or `mean`. Default `median`.
+    pub psi_window_statistic: PsiWindowStatistic,
+}
+
+/// How a window of Ψ is summarized before quantization (`psi_window_statistic`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+#[non_exhaustive]
+pub enum PsiWindowStatistic {
+    /// The median (the mean of the two middle values of an even count).
+    Median,
+    /// The arithmetic mean.
+    Mean,
 }
 
 impl Default for WordOptions {
@@ -361,6 +380,8 @@ impl Default for WordOptions {
             min_word_size: 5,
             multi_level: MultiLevelRule::Boundaries,
             wide_classes: 4,
+            psi_window: 1,
+            psi_window_statistic: PsiWindowStatistic::Median,
         }
     }
 }
@@ -391,6 +412,16 @@ impl WordOptions {
                     "classes + wide_classes must be at most 256, got {} + {}; the default is 4 \
                      (0: no open-space classes)",
                     self.classes, self.wide_classes
+                ),
+            );
+        }
+        if self.psi_window.is_multiple_of(2) {
+            p.bad(
+                "psi_window",
+                format!(
+                    "must be an odd count of observations (centred), got {}; the default is 1 \
+                     (off)",
+                    self.psi_window
                 ),
             );
         }

@@ -27,7 +27,7 @@
 //! the boundaries crossed puts `A B A` at level 1, `A B C B A` at level 2 and `A B C D C B A` at
 //! level 3, so each level adds the words of deeper bumps that lower levels cannot correct.
 
-use super::options::MultiLevelRule;
+use super::options::{MultiLevelRule, PsiWindowStatistic};
 use super::types::{DensityObservation, Observation, WordRef};
 use crate::geom::wrap_angle;
 
@@ -142,6 +142,12 @@ pub struct WordLevels {
     min_word_size: usize,
     levels: usize,
     rule: MultiLevelRule,
+    /// Half the centred Ψ window (`WordOptions::psi_window`): 0 classifies each observation as
+    /// it comes.
+    psi_half_window: usize,
+    psi_statistic: PsiWindowStatistic,
+    /// Wide density Φ of each observation, kept for classes decided a half window later.
+    wide_density: Vec<f64>,
     observations: Vec<Observation>,
     /// Ψ of each observation, contiguous for the alignment.
     psi: Vec<f64>,
@@ -183,6 +189,9 @@ impl WordLevels {
             min_word_size: min_word_size.max(1),
             levels: levels.clamp(1, MAX_LEVELS),
             rule,
+            psi_half_window: 0,
+            psi_statistic: PsiWindowStatistic::Median,
+            wide_density: Vec::new(),
             observations: Vec::new(),
             psi: Vec::new(),
             lateral_moments: Vec::new(),
@@ -204,6 +213,53 @@ impl WordLevels {
     pub fn with_wide_classes(mut self, wide_classes: usize) -> Self {
         self.wide_classes = wide_classes.min(256 - self.classes);
         self
+    }
+
+    /// This builder classifying each observation by the `statistic` of Ψ over a centred window
+    /// of `window` observations (`WordOptions::psi_window`, odd; 1: off), cut at the ends of a
+    /// run; an observation's class is known, and words close, `window / 2` observations later.
+    pub fn with_psi_window(mut self, window: usize, statistic: PsiWindowStatistic) -> Self {
+        self.psi_half_window = window / 2;
+        self.psi_statistic = statistic;
+        self
+    }
+
+    /// Class of observation `j` from the Ψ window around it, cut at the run's start and at the
+    /// last observation so far (the same rule at both ends, so reversing a run reverses its
+    /// classes).
+    fn windowed_class(&self, j: usize) -> u8 {
+        let k = self.psi_half_window;
+        let run_start = self.run_starts[self.run];
+        let lo = j.saturating_sub(k).max(run_start);
+        let hi = (j + k + 1).min(self.psi.len());
+        let psi = match self.psi_statistic {
+            PsiWindowStatistic::Mean => self.psi[lo..hi].iter().sum::<f64>() / (hi - lo) as f64,
+            PsiWindowStatistic::Median => {
+                let mut w = self.psi[lo..hi].to_vec();
+                w.sort_by(f64::total_cmp);
+                let n = w.len();
+                (w[(n - 1) / 2] + w[n / 2]) / 2.0
+            }
+        };
+        self.class_of_observation(psi, self.wide_density[j])
+    }
+
+    /// Classifies every observation whose window is complete (all of them when `flush`, at the
+    /// end of a run) and feeds them to the word builder; returns the words they closed.
+    fn classify_due(&mut self, flush: bool) -> Vec<WordId> {
+        let mut closed = Vec::new();
+        let lag = if flush { 0 } else { self.psi_half_window };
+        while self.obs_class.len() + lag < self.observations.len() {
+            let j = self.obs_class.len();
+            let q = if self.psi_half_window == 0 {
+                self.class_of_observation(self.psi[j], self.wide_density[j])
+            } else {
+                self.windowed_class(j)
+            };
+            self.obs_class.push(q);
+            closed.extend(self.step(j, q));
+        }
+        closed
     }
 
     /// How many classes an observation may have: the density classes and the wide ones.
@@ -235,13 +291,16 @@ impl WordLevels {
 
     /// Adds one observation; returns the ids of the words it closed (level 0 first).
     pub fn push(&mut self, obs: &DensityObservation) -> Vec<WordId> {
-        let i = self.observations.len();
-        let q = self.class_of_observation(obs.psi, obs.wide_density);
         self.observations.push(obs.observation);
         self.psi.push(obs.psi);
+        self.wide_density.push(obs.wide_density);
         self.lateral_moments.push(obs.lateral_moment);
         self.position_slack_m.push(obs.position_slack_m);
-        self.obs_class.push(q);
+        self.classify_due(false)
+    }
+
+    /// Algorithm 1's step for observation `i` of class `q`; returns the words it closed.
+    fn step(&mut self, i: usize, q: u8) -> Vec<WordId> {
         let Some(mut open) = self.open else {
             self.open = Some(Run {
                 class: q,
@@ -295,13 +354,15 @@ impl WordLevels {
 
     /// Closes the open word of the run (however short); returns the words it closed.
     pub fn finish_run(&mut self) -> Vec<WordId> {
+        let mut closed = self.classify_due(true);
         let Some(mut open) = self.open.take() else {
-            return Vec::new();
+            return closed;
         };
         if let Some(p) = self.pending.take() {
             open.len += p.len;
         }
-        self.close_word(open)
+        closed.extend(self.close_word(open));
+        closed
     }
 
     /// Closes the current run and starts the next one: no word will have a predecessor across.
@@ -547,6 +608,62 @@ mod tests {
         assert_eq!(w.class_of_observation(1.0, 1.0), 11);
         let plain = WordLevels::new(8, 5, 1);
         assert_eq!(plain.class_of_observation(1.0, 1.0), 7);
+    }
+
+    /// Classes of `psi` read through a builder with a centred Ψ window, and its level-0 word
+    /// sizes.
+    fn windowed(psi: &[f64], window: usize, stat: PsiWindowStatistic) -> (Vec<u8>, Vec<usize>) {
+        let mut w = WordLevels::new(8, 3, 1).with_psi_window(window, stat);
+        let mut closed = 0;
+        for (i, &p) in psi.iter().enumerate() {
+            let observation =
+                Observation::new(i, 0, i, OdomPose(Pose2::new(i as f64, 0.0, 0.0)), i as f64);
+            closed += w
+                .push(&DensityObservation {
+                    observation,
+                    psi: p,
+                    lateral_moment: 0.0,
+                    position_slack_m: 0.0,
+                    wide_density: f64::NAN,
+                })
+                .len();
+        }
+        closed += w.finish_run().len();
+        let sizes: Vec<usize> = w.level(0).map(|x| x.size).collect();
+        assert_eq!(closed, sizes.len());
+        assert_eq!(
+            sizes.iter().sum::<usize>(),
+            psi.len(),
+            "words cover every observation"
+        );
+        (w.observation_classes().to_vec(), sizes)
+    }
+
+    /// A centred Ψ window is the same driven either way: the reversed Ψ sequence gives the
+    /// reversed classes (window cut at both ends of the run alike); it removes a flicker across
+    /// a class threshold, and a window of one observation is today's per-observation rule.
+    #[test]
+    fn a_centred_psi_window_gives_reversed_classes_for_reversed_psi() {
+        let psi: Vec<f64> = (0..60)
+            .map(|i| 0.3 + 0.15 * (i as f64 / 9.0).sin() + if i % 3 == 0 { 0.06 } else { -0.02 })
+            .collect();
+        let reversed: Vec<f64> = psi.iter().rev().copied().collect();
+        for stat in [PsiWindowStatistic::Median, PsiWindowStatistic::Mean] {
+            for window in [3, 5, 7] {
+                let (fwd, _) = windowed(&psi, window, stat);
+                let (mut back, _) = windowed(&reversed, window, stat);
+                back.reverse();
+                assert_eq!(fwd, back, "{stat:?} over {window}");
+            }
+        }
+        let own: Vec<u8> = psi.iter().map(|&p| density_class(p, 8)).collect();
+        assert_eq!(windowed(&psi, 1, PsiWindowStatistic::Median).0, own);
+        let flicker = [
+            0.49, 0.49, 0.51, 0.49, 0.49, 0.51, 0.49, 0.49, 0.51, 0.49, 0.49,
+        ];
+        let (classes, sizes) = windowed(&flicker, 3, PsiWindowStatistic::Median);
+        assert!(classes.iter().all(|&c| c == 3), "{classes:?}");
+        assert_eq!(sizes, vec![flicker.len()]);
     }
 
     fn along(points: &[(f64, f64)]) -> Vec<Observation> {

@@ -47,6 +47,13 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("words.min_word_size", "3", "", Input::Dense),
+    ("words.psi_window", "5", "", Input::Dense),
+    (
+        "words.psi_window_statistic",
+        "\"mean\"",
+        "words.psi_window = 5",
+        Input::Dense,
+    ),
     ("matcher.size_tolerance_ratio", "0.6", "", Input::Dense),
     ("matcher.angle_tolerance_deg", "90", "", Input::Dense),
     (
