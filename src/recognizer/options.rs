@@ -356,11 +356,16 @@ pub struct WordOptions {
     /// experiment, issue 28): an odd count; each observation's class is that of the window's
     /// `psi_window_statistic`, the window cut at the ends of a run. Centred, so a place driven
     /// either way gets the same classes; words then close `psi_window / 2` observations later.
-    /// 1 (off) classifies each observation by its own Ψ. Default 1.
+    /// 1 (off) classifies each observation by its own Ψ. Default 1; at most
+    /// [`MAX_PSI_WINDOW`].
     pub psi_window: usize,
     /// How the `psi_window` is summarized: `median` or `mean`. Default `median`.
     pub psi_window_statistic: PsiWindowStatistic,
 }
+
+/// The widest `psi_window`, observations (10 m at the default spacing): each observation sorts
+/// its window, so a window as long as a run would make the word builder quadratic.
+pub const MAX_PSI_WINDOW: usize = 101;
 
 /// How a window of Ψ is summarized before quantization (`psi_window_statistic`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -415,12 +420,12 @@ impl WordOptions {
                 ),
             );
         }
-        if self.psi_window.is_multiple_of(2) {
+        if self.psi_window.is_multiple_of(2) || self.psi_window > MAX_PSI_WINDOW {
             p.bad(
                 "psi_window",
                 format!(
-                    "must be an odd count of observations (centred), got {}; the default is 1 \
-                     (off)",
+                    "must be an odd count of observations (centred) of at most {MAX_PSI_WINDOW}, \
+                     got {}; the default is 1 (off)",
                     self.psi_window
                 ),
             );

@@ -400,6 +400,17 @@ fn settings_from_a_toml_file() {
         e.contains("my.toml:3:1: [recognizer.words] classes: must be between 1 and 255"),
         "{e}"
     );
+    // A Ψ window as long as a run would make the word builder quadratic: refused, located.
+    for window in ["4", "1001"] {
+        let text = format!("[recognizer.words]\npsi_window = {window}\n");
+        let e = parse_recognizer_config(&text, path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("my.toml:2:1: [recognizer.words] psi_window: must be an odd count"),
+            "{e}"
+        );
+    }
 }
 
 /// A file written before the subtables: each flat key of `[recognizer]` is refused at its
