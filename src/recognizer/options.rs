@@ -356,8 +356,8 @@ pub struct WordOptions {
     /// experiment, issue 28): an odd count; each observation's class is that of the window's
     /// `psi_window_statistic`, the window cut at the ends of a run. Centred, so a place driven
     /// either way gets the same classes; words then close `psi_window / 2` observations later.
-    /// 1 (off) classifies each observation by its own Ψ. Default 1; at most
-    /// [`MAX_PSI_WINDOW`].
+    /// 1 (off) classifies each observation by its own Ψ. Default 1; at most 101
+    /// (`MAX_PSI_WINDOW`).
     pub psi_window: usize,
     /// How the `psi_window` is summarized: `median` or `mean`. Default `median`.
     pub psi_window_statistic: PsiWindowStatistic,
