@@ -146,8 +146,9 @@ pub struct WordLevels {
     /// it comes.
     psi_half_window: usize,
     psi_statistic: PsiWindowStatistic,
-    /// Wide density Φ of each observation, kept for classes decided a half window later.
-    wide_density: Vec<f64>,
+    /// Wide density Φ of the observations not classified yet (at most a half window of them),
+    /// oldest first: only the class needs it.
+    pending_wide: std::collections::VecDeque<f64>,
     observations: Vec<Observation>,
     /// Ψ of each observation, contiguous for the alignment.
     psi: Vec<f64>,
@@ -191,7 +192,7 @@ impl WordLevels {
             rule,
             psi_half_window: 0,
             psi_statistic: PsiWindowStatistic::Median,
-            wide_density: Vec::new(),
+            pending_wide: std::collections::VecDeque::new(),
             observations: Vec::new(),
             psi: Vec::new(),
             lateral_moments: Vec::new(),
@@ -224,10 +225,10 @@ impl WordLevels {
         self
     }
 
-    /// Class of observation `j` from the Ψ window around it, cut at the run's start and at the
-    /// last observation so far (the same rule at both ends, so reversing a run reverses its
-    /// classes).
-    fn windowed_class(&self, j: usize) -> u8 {
+    /// Class of observation `j` (of wide density `wide_density`) from the Ψ window around it,
+    /// cut at the run's start and at the last observation so far (the same rule at both ends,
+    /// so reversing a run reverses its classes).
+    fn windowed_class(&self, j: usize, wide_density: f64) -> u8 {
         let k = self.psi_half_window;
         let run_start = self.run_starts[self.run];
         let lo = j.saturating_sub(k).max(run_start);
@@ -241,7 +242,7 @@ impl WordLevels {
                 (w[(n - 1) / 2] + w[n / 2]) / 2.0
             }
         };
-        self.class_of_observation(psi, self.wide_density[j])
+        self.class_of_observation(psi, wide_density)
     }
 
     /// Classifies every observation whose window is complete (all of them when `flush`, at the
@@ -251,10 +252,12 @@ impl WordLevels {
         let lag = if flush { 0 } else { self.psi_half_window };
         while self.obs_class.len() + lag < self.observations.len() {
             let j = self.obs_class.len();
+            // One Φ is queued per observation pushed and not yet classified (this loop's bound).
+            let wide = self.pending_wide.pop_front().unwrap_or(f64::NAN);
             let q = if self.psi_half_window == 0 {
-                self.class_of_observation(self.psi[j], self.wide_density[j])
+                self.class_of_observation(self.psi[j], wide)
             } else {
-                self.windowed_class(j)
+                self.windowed_class(j, wide)
             };
             self.obs_class.push(q);
             closed.extend(self.step(j, q));
@@ -293,7 +296,7 @@ impl WordLevels {
     pub fn push(&mut self, obs: &DensityObservation) -> Vec<WordId> {
         self.observations.push(obs.observation);
         self.psi.push(obs.psi);
-        self.wide_density.push(obs.wide_density);
+        self.pending_wide.push_back(obs.wide_density);
         self.lateral_moments.push(obs.lateral_moment);
         self.position_slack_m.push(obs.position_slack_m);
         self.classify_due(false)
