@@ -169,6 +169,32 @@ fn run(args: &Args) -> Result<()> {
         println!("{class:<16} {same:>6} {opp:>6} {n:>6}  {:.3}", share(n));
     }
     let short = classes.get("short").map_or(0, |c| c[0] + c[1]);
+    let right = |q: usize, p: usize, dir: Direction| {
+        let turn = wrap_angle(t[q].theta - t[p].theta).abs();
+        let tol = HEADING_TOL_DEG.to_radians();
+        dist(&t[q], &t[p]) <= RADIUS_M
+            && match dir {
+                Direction::Same => turn <= tol,
+                Direction::Opposite => turn >= std::f64::consts::PI - tol,
+            }
+    };
+    let rejected = rec.diagnostics().rejected;
+    let (mut lookalike, mut delayed, mut lost) = (0, 0, 0);
+    for r in &rejected {
+        let ok = right(r.query, r.past, r.direction)
+            && r.oldest.is_none_or(|(q, p)| right(q, p, r.direction));
+        if !ok {
+            lookalike += 1;
+        } else if base.contains(&r.query) {
+            delayed += 1;
+        } else {
+            lost += 1;
+        }
+    }
+    println!(
+        "rejected candidates {}: look-alikes {lookalike}, true revisits recognized anyway {delayed}, true revisits lost {lost}",
+        rejected.len()
+    );
     println!(
         "ceiling without the short stretches: recall {:.3}; without verification: {:.3}",
         1.0 - share(short),
