@@ -117,19 +117,27 @@ fn front_end(c: &mut Criterion<ThreadCpu>) {
     });
 
     g.sample_size(10);
-    g.bench_function("front_end_per_lap_5000_scans", |b| {
-        b.iter_batched(
-            || DensityFrontEnd::new(&cfg).unwrap(),
-            |mut fe| {
-                let mut n = 0;
-                for (o, s) in &inputs {
-                    n += fe.push(*o, s).len();
-                }
-                n
-            },
-            BatchSize::LargeInput,
-        )
-    });
+    // The exact front end (the default) and the fast one of docs/design.md, "The front end's
+    // approximation" (every 4th beam a scan, every 2nd density ray).
+    let fast = cfg.clone().with_fast_front_end();
+    for (name, cfg) in [
+        ("front_end_per_lap_5000_scans", &cfg),
+        ("fast_front_end_per_lap_5000_scans", &fast),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter_batched(
+                || DensityFrontEnd::new(cfg).unwrap(),
+                |mut fe| {
+                    let mut n = 0;
+                    for (o, s) in &inputs {
+                        n += fe.push(*o, s).len();
+                    }
+                    n
+                },
+                BatchSize::LargeInput,
+            )
+        });
+    }
     g.finish();
 }
 

@@ -108,7 +108,7 @@ fn whole_recognizer(c: &mut Criterion) {
     g.measurement_time(Duration::from_secs(5));
     let laps: Vec<Vec<(OdomPose, Scan)>> = (0..4).map(|s| lap_inputs(100 + s)).collect();
     // The default (exact) front end, and the fast one of docs/design.md, "The front end's
-    // approximation" (every 2nd beam a scan, every 4th density ray).
+    // approximation" (every 4th beam a scan, every 2nd density ray).
     let fast = RecognizerConfig::default().with_fast_front_end();
     for (name, cfg) in [
         ("3_levels", RecognizerConfig::default()),

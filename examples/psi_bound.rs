@@ -8,9 +8,9 @@
 //!
 //! ```text
 //! # the approximate front end, every scenario (first 4 runs) and log
-//! cargo run --release --example psi_bound -- --runs 4 --beam-stride 2 --ray-stride 4
+//! cargo run --release --example psi_bound -- --runs 4 --beam-stride 4 --ray-stride 2
 //! cargo run --release --example psi_bound -- --ray-step-deg 2 scenarios/A.toml
-//! cargo run --release --example psi_bound -- --floor-laps 5 --beam-stride 2 --ray-stride 4
+//! cargo run --release --example psi_bound -- --floor-laps 5 --beam-stride 4 --ray-stride 2
 //! cargo run --release --example psi_bound -- --scan-step 3 ../shared/data/carmen/intel-corrected.log.gz
 //! ```
 

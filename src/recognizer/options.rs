@@ -153,11 +153,14 @@ pub struct GridOptions {
     /// traced beam lowers the counters it passes as `beam_stride` beams would; every return
     /// within `grid_radius_m` still marks its cell occupied, and the beams traced from the
     /// sensor (every 16th) are traced on every scan. A scan more than 0.15 m or 2° from the
-    /// last one integrated (a sparse log, a turn) traces every beam. 1 traces every beam on
-    /// every scan (the exact front end). Default 1: 2 costs the grid update about a third less
-    /// with Ψ within the bound `tests/it/frontend_bound.rs` checks against the exact front end,
-    /// but with `ray_stride = 4` it cost A's worst 3-level precision 0.956 → 0.932 and reverse's
-    /// same-direction precision 0.968 → 0.948 (docs/design.md, "The front end's approximation").
+    /// last one integrated (a sparse log, a turn) traces every beam, so on the real logs, whose
+    /// scans are farther apart, a stride changes nothing. 1 traces every beam on every scan (the
+    /// exact front end). Default 1. The fast front end (`beam_stride = 4`, `ray_stride = 2`;
+    /// `RecognizerConfig::with_fast_front_end`) costs about 14 ms a lap of the loop floor
+    /// against 24, with Ψ within the bound `tests/it/frontend_bound.rs` checks, but misses two
+    /// of `scenarios/reverse.toml`'s bounds (opposite precision, worst seed: 3 levels 0.956 <
+    /// 0.96, 1 level 0.951 < 0.97), so it is not the default (docs/design.md, "The front end's
+    /// approximation").
     pub beam_stride: usize,
 }
 
@@ -270,9 +273,9 @@ pub struct DensityOptions {
     /// a weight (the cells every ray reaches in its bin, a ring and a sector, over those the
     /// walked rays reach; `DensityKernel::with_ray_stride`), so that an all-free window still
     /// gives Ψ = 1 and Ψ stays that of every ray within the bound `tests/it/frontend_bound.rs`
-    /// checks. 1 walks every ray (the exact kernel). Default 1: 4 costs a density about half,
-    /// and with `beam_stride = 2` the front end 15 ms a lap instead of 25 (BENCHMARKS.md), but
-    /// moved the figures past their gates (see `beam_stride` in `[recognizer.grid]`).
+    /// checks. 1 walks every ray (the exact kernel). Default 1: 2 costs a density about 40 %
+    /// less, and with `beam_stride = 4` is the fast front end (see `beam_stride` in
+    /// `[recognizer.grid]`); 3 or 4 cost seattle its pairs on 3 noise seeds of its 4.
     pub ray_stride: usize,
 }
 

@@ -1,5 +1,5 @@
-//! The approximate front end (`[recognizer.grid] beam_stride = 2`, `[recognizer.density]
-//! ray_stride = 4`) keeps Ψ within a bound of the exact one (both 1, the defaults: the authors'
+//! The approximate front end (`[recognizer.grid] beam_stride = 4`, `[recognizer.density]
+//! ray_stride = 2`) keeps Ψ within a bound of the exact one (both 1, the defaults: the authors'
 //! grid update and kernel): over the first run of every shipped scenario and the start of every
 //! CARMEN log, Ψ of each observation is compared (docs/design.md, "The front end's
 //! approximation"; `examples/psi_bound.rs` prints the same figures for whole runs).
@@ -53,7 +53,7 @@ fn exact(cfg: &RecognizerConfig) -> RecognizerConfig {
     cfg.clone().with_exact_front_end()
 }
 
-/// The approximation the bound is for: every 2nd beam a scan, every 4th density ray.
+/// The approximation the bound is for: every 4th beam a scan, every 2nd density ray.
 fn approximate(cfg: &RecognizerConfig) -> RecognizerConfig {
     cfg.clone().with_fast_front_end()
 }

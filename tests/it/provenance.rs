@@ -20,6 +20,18 @@ fn ok(args: &[&str]) {
     );
 }
 
+/// Runs a gated command (`check`, `merge`): whether the smoke scenario's bounds hold on two
+/// seeds is not what is tested here, only that it ran and wrote its report (exit 0 or 1, not 2).
+fn gated(args: &[&str]) {
+    let o = placewords(args);
+    assert!(
+        matches!(o.status.code(), Some(0 | 1)),
+        "{args:?}: {:?} {}",
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 /// The provenance of the report at `path`, checked for what every report must say; returns it
 /// with the roles of its inputs.
 fn provenance(path: &Path, command: &str) -> (Value, Vec<String>) {
@@ -89,7 +101,7 @@ fn every_report_names_its_version_commit_seeds_and_input_hashes() {
     has(&roles, &SCENARIO, "run");
     assert_eq!(p["seeds"], serde_json::json!([42]));
 
-    ok(&["check", smoke, "--seeds", "1..2", "-q", "-o", &d("check")]);
+    gated(&["check", smoke, "--seeds", "1..2", "-q", "-o", &d("check")]);
     let (p, roles) = provenance(&dir.path().join("check/report.json"), "check");
     has(&roles, &SCENARIO[..4], "check");
     assert_eq!(p["seeds"], serde_json::json!([1, 2]));
@@ -121,14 +133,14 @@ fn every_report_names_its_version_commit_seeds_and_input_hashes() {
     for k in 1..=2 {
         let shard = format!("{k}/2");
         let part = d(&format!("part{k}.json"));
-        ok(&[
+        gated(&[
             "check", smoke, "--seeds", "1..2", "-q", "--shard", &shard, "--report", &part,
         ]);
         let (p, roles) = provenance(Path::new(&part), "check");
         has(&roles, &SCENARIO[..4], "part");
         assert_eq!(p["seeds"], serde_json::json!([k]));
     }
-    ok(&[
+    gated(&[
         "merge",
         &d("part1.json"),
         &d("part2.json"),

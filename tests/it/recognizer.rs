@@ -1899,13 +1899,15 @@ impl RayByRay {
     }
 }
 
-/// Feeds `frames` (odometry, scan) to a front end and checks every observation's Ψ, and the
-/// free cells and first moment behind it, against [`RayByRay`]; returns the observations checked.
+/// Feeds `frames` (odometry, scan) to the exact front end (every ray walked, so that each free
+/// cell counts 1 as the reference counts it; a `ray_stride` above 1 weighs the cells,
+/// `tests/it/frontend_bound.rs`) and checks every observation's Ψ, and the free cells
+/// and first moment behind it, against [`RayByRay`]; returns the observations checked.
 fn check_density_against_reference<'a>(
     what: &str,
     frames: impl Iterator<Item = (OdomPose, &'a placewords::scan::Scan)>,
 ) -> usize {
-    let cfg = RecognizerConfig::default();
+    let cfg = RecognizerConfig::default().with_exact_front_end();
     let mut fe = DensityFrontEnd::new(&cfg).unwrap();
     let kernel = fe.kernel().clone();
     let reference = RayByRay::new(&kernel);

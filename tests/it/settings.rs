@@ -80,7 +80,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("alignment.mode", "\"paper\"", "", Input::Dense),
-    ("alignment.chain_alignment_offset", "0", "", Input::Dense),
+    (
+        "alignment.chain_alignment_offset",
+        "0",
+        "matcher.min_ngram = [2, 3, 4, 5]",
+        Input::Dense,
+    ),
     ("alignment.chain_alignment_tie", "0.05", "", Input::Dense),
     ("matcher.reverse", "false", "", Input::Dense),
     ("matcher.reverse_extra_ngram", "0", "", Input::Dense),
@@ -92,7 +97,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         "matcher.min_ngram = [2, 3, 4, 5]",
         Input::Dense,
     ),
-    ("matcher.substitutions", "false", "", Input::Dense),
+    (
+        "matcher.substitutions",
+        "false",
+        "matcher.min_ngram = [4, 6, 8, 10]",
+        Input::Dense,
+    ),
     ("matcher.substitution_size_ratio", "1.0", "", Input::Dense),
     ("matcher.ngram_travel_m", "5", "", Input::Dense),
     (
