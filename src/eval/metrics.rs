@@ -166,6 +166,12 @@ pub struct Evaluation {
     pub door_configs: Vec<DoorConfigMetrics>,
     /// At `tp_radius_m`, per direction.
     pub directions: DirectionMetrics,
+    /// Per observation (scoring order): whether it is the newer side of a correct pair at
+    /// `tp_radius_m`, either direction (recall's numerator). Not written: it tells which of the
+    /// true revisits verification turned down were recognized later
+    /// ([`super::scores::RejectedScores::correct_recognized`]).
+    #[serde(skip)]
+    pub recognized: Vec<bool>,
 }
 
 /// Scores of the matches of one direction against the revisits of that direction.

@@ -237,6 +237,8 @@ pub struct Recognition {
 /// oldest end when it spans a stretch.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RejectedTruth {
+    /// The query observation's position among the recognition's observations (scoring order).
+    pub query_index: usize,
     pub query: TruePose,
     pub past: TruePose,
     pub direction: Direction,
@@ -275,14 +277,18 @@ fn rejected_truth(
 ) -> Vec<RejectedTruth> {
     // The recognizer's own ids are the observations' indices; anything else is looked up.
     let by_index = observations.iter().enumerate().all(|(i, o)| o.id == i);
-    let map: std::collections::HashMap<ObsId, &Observation> = if by_index {
+    let map: std::collections::HashMap<ObsId, usize> = if by_index {
         Default::default()
     } else {
-        observations.iter().map(|o| (o.id, o)).collect()
+        observations
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (o.id, i))
+            .collect()
     };
-    let find = |id: ObsId| {
+    let index = |id: ObsId| {
         if by_index {
-            observations.get(id)
+            (id < observations.len()).then_some(id)
         } else {
             map.get(&id).copied()
         }
@@ -290,12 +296,13 @@ fn rejected_truth(
     rejected
         .iter()
         .filter_map(|r| {
-            let pose = |id: ObsId| truth.observation_pose(find(id)?);
+            let pose = |id: ObsId| truth.observation_pose(&observations[index(id)?]);
             let oldest = match r.oldest {
                 Some((q, p)) => Some((pose(q)?, pose(p)?)),
                 None => None,
             };
             Some(RejectedTruth {
+                query_index: index(r.query)?,
                 query: pose(r.query)?,
                 past: pose(r.past)?,
                 direction: r.direction,
@@ -731,6 +738,7 @@ mod tests {
         let spec = EvaluationSpec::default();
         let at = |x: f64, y: f64| TruePose(Pose2::new(x, y, 0.0));
         let newest_right = RejectedTruth {
+            query_index: 0,
             query: at(0.0, 0.0),
             past: at(0.2, 0.0),
             direction: Direction::Same,

@@ -14,8 +14,10 @@
 //!                 "matches": 812, "correct_matches": 771, "revisits": 61234,
 //!                 "recall_either_side": 0.45, "visit_recall": 0.3, "pair_recall": 0.1,
 //!                 "longest_revisit_m": 62.5,
-//!                 "rejected_candidates": { "sampled": 25, "correct": 22, "correct_travel": 10,
-//!                                          "correct_turn": 8, ... } | absent,
+//!                 "rejected_candidates": { "sampled": 25, "correct": 22,
+//!                                          "correct_recognized": 19, "correct_by_check":
+//!                                          [ { "check": "travel", "count": 10 }, ... ] }
+//!                                        | absent,
 //!                 "recognize_seconds_per_lap": 0.8, "recognize_seconds_by_lap": [0.7, 0.8, ...],
 //!                 "only_here": { "than_levels": 2, "pairs": 812, "correct_pairs": 790 } | null,
 //!                 "sensitivity": [ { "radius_m": 0.5, "precision": ..., "recall": ..., ... } ],
@@ -176,7 +178,8 @@ impl Scores {
         let w = crate::clock::Stopwatch::start();
         let e = super::evaluate(rec, spec);
         let d = rec.diagnostics.as_deref();
-        let rejected = d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec));
+        let rejected =
+            d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec, &e.recognized));
         let ranking = super::ranking::of_recognition(rec, e.main.revisits, spec);
         let causes = no_pairs_causes(&e, d, rejected.as_ref());
         let scores = Scores {
@@ -266,6 +269,12 @@ pub struct RejectedScores {
     /// `correct` per check that turned them down, in the recognizer's order of checks (every
     /// check named, 0 included).
     pub correct_by_check: Vec<CheckCount>,
+    /// Of `correct`, those whose query observation is the newer side of a correct pair by the
+    /// end of the run: verification made the revisit wait (a later, longer n-gram through it
+    /// was accepted, or another match found it), it did not lose it. `correct` minus this is
+    /// what the checks cost the recall at the sampled candidates.
+    #[serde(default)]
+    pub correct_recognized: usize,
 }
 
 /// A count for one of a recognizer's checks.
@@ -289,11 +298,13 @@ impl CheckCount {
 
 impl RejectedScores {
     /// The scores of `rejected` (turned down by the named `checks`) with `spec`'s radius and
-    /// heading tolerance; `None` when empty.
+    /// heading tolerance, `recognized` saying per observation whether it is the newer side of
+    /// a correct pair ([`super::Evaluation::recognized`]); `None` when empty.
     pub fn of(
         rejected: &[super::RejectedTruth],
         checks: &[String],
         spec: &EvaluationSpec,
+        recognized: &[bool],
     ) -> Option<Self> {
         if rejected.is_empty() {
             return None;
@@ -302,9 +313,11 @@ impl RejectedScores {
             sampled: rejected.len(),
             correct: 0,
             correct_by_check: checks.iter().map(|c| CheckCount::new(c, 0)).collect(),
+            correct_recognized: 0,
         };
         for r in rejected.iter().filter(|r| r.is_right(spec)) {
             s.correct += 1;
+            s.correct_recognized += usize::from(recognized.get(r.query_index) == Some(&true));
             if let Some(c) = s.correct_by_check.get_mut(r.check) {
                 c.count += 1;
             }

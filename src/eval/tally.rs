@@ -602,11 +602,22 @@ impl Tally {
         // A chain follows one direction: the stretch the figure promises is the longer of the
         // two directions', not one that turns from same-direction revisits to opposite ones.
         main.longest_revisit_m = super::metrics::longest_of_directions(&main, &same, &opposite);
+        let recognized = self.recognized(n);
         Evaluation {
             main,
             sensitivity,
             door_configs,
             directions: DirectionMetrics { same, opposite },
+            recognized,
+        }
+    }
+
+    /// Per observation of the `n`: the newer side of a correct pair at `tp_radius_m` (the first
+    /// figure's, either direction).
+    fn recognized(&self, n: usize) -> Vec<bool> {
+        match self.slots.first() {
+            Some(s) => (0..n).map(|i| s.recalled_query.get(i)).collect(),
+            None => Vec::new(),
         }
     }
 

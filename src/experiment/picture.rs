@@ -738,6 +738,7 @@ mod tests {
         use crate::recognizer::Rejection;
         let at = |x: f64| TruePose(Pose2::new(x, 1.0, 0.0));
         let r = |q: f64, p: f64, reason: Rejection| RejectedTruth {
+            query_index: 0,
             query: at(q),
             past: at(p),
             direction: Direction::Same,

@@ -87,9 +87,17 @@ fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
         .iter()
         .map(|c| format!("{} {}", c.check, c.count))
         .collect();
+    let later = if r.correct_recognized > 0 {
+        format!(
+            " ({} of them recognized later all the same)",
+            r.correct_recognized
+        )
+    } else {
+        String::new()
+    };
     format!(
         "by the ground truth {} of the {} rejected candidates sampled paired the same place \
-         (within {} m, at both ends of a chain; {}): verification turned down true revisits",
+         (within {} m, at both ends of a chain; {}): verification turned down true revisits{later}",
         r.correct,
         r.sampled,
         spec.tp_radius_m,
@@ -263,6 +271,7 @@ mod tests {
         let spec = EvaluationSpec::default();
         let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
         let r = |q, p, direction, reason: Rejection| RejectedTruth {
+            query_index: 0,
             query: q,
             past: p,
             direction,
@@ -300,8 +309,12 @@ mod tests {
                 Rejection::Travel,
             ),
         ];
-        let s = RejectedScores::of(&rejected, &checks, &spec).expect("four sampled");
-        assert_eq!((s.sampled, s.correct), (4, 2));
+        // Every candidate's query observation (index 0) recognized by the end of the run: the
+        // two true revisits were recognized later, the look-alikes do not count.
+        let later = RejectedScores::of(&rejected, &checks, &spec, &[true]).expect("four sampled");
+        assert_eq!((later.correct, later.correct_recognized), (2, 2));
+        let s = RejectedScores::of(&rejected, &checks, &spec, &[false]).expect("four sampled");
+        assert_eq!((s.sampled, s.correct, s.correct_recognized), (4, 2, 0));
         assert_eq!(
             (
                 s.correct_by("turn"),
@@ -310,7 +323,7 @@ mod tests {
             ),
             (1, 1, 0)
         );
-        assert_eq!(RejectedScores::of(&[], &checks, &spec), None);
+        assert_eq!(RejectedScores::of(&[], &checks, &spec, &[]), None);
         let mut e = Evaluation::default();
         e.main.revisits = 10;
         let d = MatchDiagnostics {
@@ -334,7 +347,7 @@ mod tests {
             "{why}"
         );
         assert!(why.contains("turned down true revisits"), "{why}");
-        let none_right = RejectedScores::of(&rejected[3..], &checks, &spec).unwrap();
+        let none_right = RejectedScores::of(&rejected[3..], &checks, &spec, &[]).unwrap();
         let why = reason(&e, Some(&d as &dyn Diagnostics), Some(&none_right), &spec).unwrap();
         assert!(why.contains("turned down look-alikes"), "{why}");
     }

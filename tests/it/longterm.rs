@@ -38,7 +38,8 @@ fn without_timings(v: &mut serde_json::Value) {
 /// matches, precision 0.9985 and recall 0.951 both; 1 level identical), and for short chains
 /// read backwards (`reverse_short_ngram_words`, session 7: only verification's rejection counts
 /// rose, again when such chains kept the per-word turn limit; every pair, match and figure
-/// identical).
+/// identical), and for `rejected_candidates.correct_recognized` (session 8: a key added; every
+/// other value identical).
 /// Re-mint only for an intended change
 /// to the recognizer or the scoring: `PLACEWORDS_REMINT=1 cargo test --release smoke_40_laps`.
 #[test]
