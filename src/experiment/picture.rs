@@ -267,7 +267,18 @@ pub fn matches_svg(
                 }),
         );
     }
-    let right_rejected = rec.rejected.iter().filter(|r| r.is_right(&spec)).count();
+    let right: Vec<_> = rec.rejected.iter().filter(|r| r.is_right(&spec)).collect();
+    // Recognized later: the query observation is the newer side of a correct pair all the same.
+    let later = right
+        .iter()
+        .filter(|r| {
+            status
+                .pair_counts
+                .get(r.query_index)
+                .is_some_and(|c| c.0 > 0)
+        })
+        .count();
+    let right_rejected = (right.len(), later);
     let checks = rec
         .diagnostics
         .as_ref()
@@ -336,8 +347,13 @@ fn status_legend(status: &ObservationStatus, clusters: usize, shown: usize) -> V
 }
 
 /// The matches picture's notes: the pairs, and what verification turned down (`rejected`
-/// candidates sampled, `right_rejected` of them true revisits).
-fn pair_notes(status: &ObservationStatus, rejected: usize, right_rejected: usize) -> Vec<String> {
+/// candidates sampled; `right_rejected`: how many of them were true revisits, and how many of
+/// those were recognized later all the same).
+fn pair_notes(
+    status: &ObservationStatus,
+    rejected: usize,
+    (right_rejected, later): (usize, usize),
+) -> Vec<String> {
     let mut notes = vec![format!(
         "pairs: {} correct, {} wrong",
         status.correct_pairs,
@@ -346,8 +362,8 @@ fn pair_notes(status: &ObservationStatus, rejected: usize, right_rejected: usize
     if rejected > 0 {
         let look_alikes = rejected - right_rejected;
         notes.push(format!(
-            "verification turned down {right_rejected} true revisit{}, {look_alikes} \
-             look-alike{} (candidates sampled)",
+            "verification turned down {right_rejected} true revisit{} ({later} recognized \
+             later all the same), {look_alikes} look-alike{} (candidates sampled)",
             plural(right_rejected),
             plural(look_alikes)
         ));
@@ -727,6 +743,30 @@ mod tests {
         assert!(texts.contains(&"pairs: 0 correct, 0 wrong".to_string()));
         assert_eq!(plural(1), "");
         assert_eq!(plural(2), "s");
+    }
+
+    /// The notes say how many of the true revisits turned down were recognized later all the
+    /// same, beside the look-alikes turned down.
+    #[test]
+    fn turned_down_notes_count_the_revisits_recognized_later() {
+        let status = crate::eval::observation_status::ObservationStatus {
+            kinds: Vec::new(),
+            positions: Vec::new(),
+            lap_slots: Vec::new(),
+            revisits: Vec::new(),
+            pair_counts: Vec::new(),
+            correct_pairs: 3,
+            wrong_pairs: Vec::new(),
+        };
+        let notes = pair_notes(&status, 5, (2, 1));
+        assert!(
+            notes.contains(
+                &"verification turned down 2 true revisits (1 recognized later all the same), \
+                  3 look-alikes (candidates sampled)"
+                    .to_string()
+            ),
+            "{notes:?}"
+        );
     }
 
     /// True revisits that verification turned down are marked per 5 m cell with their count
