@@ -9,6 +9,7 @@ use crate::eval::Recognition;
 use crate::eval::observation_status::{
     CLUSTER_CELL_M, ObservationKind, ObservationStatus, observation_status, worst_wrong_clusters,
 };
+use crate::eval::scores::RejectedScores;
 use crate::log::RunLog;
 use crate::report::lap_strip::{LapPoint, lap_strip};
 use crate::report::world_render::{
@@ -267,23 +268,16 @@ pub fn matches_svg(
                 }),
         );
     }
-    let right: Vec<_> = rec.rejected.iter().filter(|r| r.is_right(&spec)).collect();
-    // Recognized later: the query observation is the newer side of a correct pair all the same.
-    let later = right
-        .iter()
-        .filter(|r| {
-            status
-                .pair_counts
-                .get(r.query_index)
-                .is_some_and(|c| c.0 > 0)
-        })
-        .count();
-    let right_rejected = (right.len(), later);
     let checks = rec
         .diagnostics
         .as_ref()
         .map(|d| d.checks())
         .unwrap_or_default();
+    // The true revisits turned down, and those recognized later all the same (the query
+    // observation the newer side of a correct pair), counted as the report counts them.
+    let recognized: Vec<bool> = status.pair_counts.iter().map(|c| c.0 > 0).collect();
+    let right_rejected = RejectedScores::of(&rec.rejected, &checks, &spec, &recognized)
+        .map_or((0, 0), |s| (s.correct, s.correct_recognized));
     opts.marks.extend(turned_down_marks(
         &rec.rejected,
         &checks,

@@ -338,7 +338,7 @@ impl WordMatcher {
         if let (Direction::Opposite, Some((words, _))) =
             (dir, self.matcher_opts.short_opposite_rule())
         {
-            len = len.min(words.max(1));
+            len = len.min(words);
         }
         len
     }
@@ -375,7 +375,7 @@ impl WordMatcher {
         // The short rule: as few words as span `reverse_short_ngram_travel_m`, at least
         // `reverse_short_ngram_words` and fewer than τ.
         let (words, short_m) = self.matcher_opts.short_opposite_rule()?;
-        let (words, most) = (words.max(1), tau.saturating_sub(1));
+        let most = tau.saturating_sub(1);
         if dir == Direction::Same || words > most {
             return None;
         }

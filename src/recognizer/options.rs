@@ -650,8 +650,8 @@ impl MatcherOptions {
         }
     }
 
-    /// The short rule for n-grams read backwards (`reverse_short_ngram_words`): its words and
-    /// travel, metres, when it is on.
+    /// The short rule for n-grams read backwards (`reverse_short_ngram_words`): its words (at
+    /// least 1) and travel, metres, when it is on.
     pub(crate) fn short_opposite_rule(&self) -> Option<(usize, f64)> {
         (self.reverse && self.reverse_short_ngram_words > 0).then_some((
             self.reverse_short_ngram_words,

@@ -52,8 +52,9 @@ const TURN_OFFSETS: usize = 32;
 impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
-    /// both sides (but for `verify_travel_outliers` and `verify_turn_outliers` word starts); the Ψ residual of its aligned pairs (with `newest_only`, of its newest pair:
-    /// the n-gram extends a verified one) must be small. The placements it makes (of the pairs
+    /// both sides (but for `verify_travel_outliers` and `verify_turn_outliers` word starts); the
+    /// Ψ residual of its aligned pairs (with `newest_only`, of its newest pair: the n-gram
+    /// extends a verified one) must be small. The placements it makes (of the pairs
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.

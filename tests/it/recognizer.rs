@@ -2110,6 +2110,19 @@ fn weaving_laps_report_no_two_class_look_alikes() {
     );
 }
 
+/// The true revisits that `check` turned down in the scores `s` (the check must be named).
+fn true_revisits_turned_down(s: &placewords::eval::scores::Scores, check: &str) -> usize {
+    let rejected = s
+        .rejected_candidates
+        .as_ref()
+        .expect("rejections are scored");
+    assert!(
+        rejected.correct_by_check.iter().any(|c| c.check == check),
+        "the {check} check is named"
+    );
+    rejected.correct_by(check)
+}
+
 /// Scenario A with weaving laps, seed 3 (issue 28): where a word boundary falls at another
 /// place on one pass, one word start of a true revisit's n-gram moves, and the travel steps
 /// before and after it disagree while the n-gram's travel agrees. With that word start passed
@@ -2130,17 +2143,7 @@ fn weaving_laps_keep_revisits_with_one_moved_word_start() {
         with.recall,
         without.recall
     );
-    let travel = |s: &placewords::eval::scores::Scores| {
-        let rejected = s
-            .rejected_candidates
-            .as_ref()
-            .expect("rejections are scored");
-        let travel = rejected
-            .correct_by_check
-            .iter()
-            .find(|c| c.check == "travel");
-        travel.expect("the travel check is named").count
-    };
+    let travel = |s: &placewords::eval::scores::Scores| true_revisits_turned_down(s, "travel");
     assert!(
         2 * travel(&with) < travel(&without),
         "true revisits the travel check turned down: {} (every word start checked {})",
@@ -2182,14 +2185,7 @@ fn weaving_laps_keep_revisits_whose_corner_falls_between_words() {
         without.recall
     );
     // True revisits the turn check turned down.
-    let turn = |s: &placewords::eval::scores::Scores| {
-        let rejected = s
-            .rejected_candidates
-            .as_ref()
-            .expect("rejections are scored");
-        let turn = rejected.correct_by_check.iter().find(|c| c.check == "turn");
-        turn.expect("the turn check is named").count
-    };
+    let turn = |s: &placewords::eval::scores::Scores| true_revisits_turned_down(s, "turn");
     assert!(
         turn(&with) < turn(&without),
         "true revisits the turn check turned down: {} (per-word limit {})",
