@@ -98,17 +98,26 @@ impl Visited {
     /// Walks the prefix tree over the copied square, marking the cells reached; returns the
     /// summed moments of the subtrees occupied cells cut off.
     fn walk(&mut self, deltas: &RayDeltas) -> (i32, i32) {
-        fn sized<const N: usize>(cells: &mut [u8], deltas: &RayDeltas) -> (i32, i32) {
+        fn sized<const N: usize, I: NodeIndex>(
+            cells: &mut [u8],
+            at: &[I],
+            deltas: &RayDeltas,
+        ) -> (i32, i32) {
             let square: &mut [u8; N] = cells.try_into().expect("a scratch of N cells");
-            walk_tree(square, N - 1, deltas)
+            walk_tree(square, N - 1, at, deltas)
         }
         let cells = &mut self.cells[..];
+        let at = &deltas.at[..];
         match cells.len() {
-            n if n == SQUARE_SIZES[0] => sized::<{ SQUARE_SIZES[0] }>(cells, deltas),
-            n if n == SQUARE_SIZES[1] => sized::<{ SQUARE_SIZES[1] }>(cells, deltas),
-            n if n == SQUARE_SIZES[2] => sized::<{ SQUARE_SIZES[2] }>(cells, deltas),
-            n if n == SQUARE_SIZES[3] => sized::<{ SQUARE_SIZES[3] }>(cells, deltas),
-            _ => walk_tree(cells, usize::MAX, deltas),
+            // Node indices of the smallest square fit 16 bits: half the bytes to read a node.
+            n if n == SQUARE_SIZES[0] && deltas.at16.len() == at.len() => {
+                sized::<{ SQUARE_SIZES[0] }, u16>(cells, &deltas.at16, deltas)
+            }
+            n if n == SQUARE_SIZES[0] => sized::<{ SQUARE_SIZES[0] }, u32>(cells, at, deltas),
+            n if n == SQUARE_SIZES[1] => sized::<{ SQUARE_SIZES[1] }, u32>(cells, at, deltas),
+            n if n == SQUARE_SIZES[2] => sized::<{ SQUARE_SIZES[2] }, u32>(cells, at, deltas),
+            n if n == SQUARE_SIZES[3] => sized::<{ SQUARE_SIZES[3] }, u32>(cells, at, deltas),
+            _ => walk_tree(cells, usize::MAX, at, deltas),
         }
     }
 
@@ -166,14 +175,19 @@ const CHUNK: usize = 4;
 /// occupied cells cut off. Exactly the walk node by node: a node is reached when no ancestor is
 /// occupied, and a run of nodes none of which is occupied is reached in depth-first order.
 #[inline(always)]
-fn walk_tree(square: &mut [u8], mask: usize, deltas: &RayDeltas) -> (i32, i32) {
-    let (at, skip) = (&deltas.at[..], &deltas.skip[..]);
+fn walk_tree<I: NodeIndex>(
+    square: &mut [u8],
+    mask: usize,
+    at: &[I],
+    deltas: &RayDeltas,
+) -> (i32, i32) {
+    let skip = &deltas.skip[..];
     let mut blocked = (0i32, 0i32);
     let mut k = 0;
     while let Some(chunk) = at.get(k..k + CHUNK) {
-        let chunk: &[u32; CHUNK] = chunk.try_into().expect("CHUNK nodes");
+        let chunk: &[I; CHUNK] = chunk.try_into().expect("CHUNK nodes");
         // All reads before any mark: a mark keeps the occupied bit, so the tests hold.
-        let v: [u8; CHUNK] = std::array::from_fn(|j| square[chunk[j] as usize & mask]);
+        let v: [u8; CHUNK] = std::array::from_fn(|j| square[chunk[j].index() & mask]);
         let run = if v.iter().fold(0, |a, &b| a | b) & CELL_OCCUPIED_FROM == 0 {
             CHUNK
         } else {
@@ -184,11 +198,11 @@ fn walk_tree(square: &mut [u8], mask: usize, deltas: &RayDeltas) -> (i32, i32) {
         if run == CHUNK {
             // A constant count: unrolled, no branch per node.
             for j in 0..CHUNK {
-                square[chunk[j] as usize & mask] = v[j] | REACHED;
+                square[chunk[j].index() & mask] = v[j] | REACHED;
             }
         } else {
             for j in 0..run {
-                square[chunk[j] as usize & mask] = v[j] | REACHED;
+                square[chunk[j].index() & mask] = v[j] | REACHED;
             }
         }
         k += run;
@@ -200,7 +214,7 @@ fn walk_tree(square: &mut [u8], mask: usize, deltas: &RayDeltas) -> (i32, i32) {
         }
     }
     while let Some(&node) = at.get(k) {
-        let i = node as usize & mask;
+        let i = node.index() & mask;
         let v = square[i];
         if v & CELL_OCCUPIED_FROM != 0 {
             let m = deltas.moments[k];
@@ -212,6 +226,26 @@ fn walk_tree(square: &mut [u8], mask: usize, deltas: &RayDeltas) -> (i32, i32) {
         }
     }
     blocked
+}
+
+/// A prefix-tree node's index in the kernel's square, as stored: 16 bits when the square's
+/// scratch is 2¹⁶ cells, else 32.
+trait NodeIndex: Copy {
+    fn index(self) -> usize;
+}
+
+impl NodeIndex for u16 {
+    #[inline(always)]
+    fn index(self) -> usize {
+        usize::from(self)
+    }
+}
+
+impl NodeIndex for u32 {
+    #[inline(always)]
+    fn index(self) -> usize {
+        self as usize
+    }
 }
 
 /// Precomputed rays of a density kernel.
@@ -246,6 +280,8 @@ pub struct RayDeltas {
     side: usize,
     /// Per prefix-tree node, in depth-first order: its index in the square.
     at: Vec<u32>,
+    /// `at` in 16 bits, when every index fits (empty otherwise).
+    at16: Vec<u16>,
     /// Per node, the index just past its subtree (read only where an occupied cell stops it).
     skip: Vec<u32>,
     /// Per node, the sum of the offsets of its subtree (read only when moments are wanted).
@@ -372,17 +408,23 @@ impl DensityKernel {
             .max()
             .unwrap_or(0);
         let side = 2 * half + 1;
+        let at: Vec<u32> = self
+            .tree_offsets
+            .iter()
+            .map(|&(ox, oy)| {
+                let (x, y) = (ox as isize + half as isize, oy as isize + half as isize);
+                (y as usize * side + x as usize) as u32
+            })
+            .collect();
+        let at16 = at
+            .iter()
+            .map(|&i| u16::try_from(i).ok())
+            .collect::<Option<_>>();
         RayDeltas {
             stride,
             side,
-            at: self
-                .tree_offsets
-                .iter()
-                .map(|&(ox, oy)| {
-                    let (x, y) = (ox as isize + half as isize, oy as isize + half as isize);
-                    (y as usize * side + x as usize) as u32
-                })
-                .collect(),
+            at16: at16.unwrap_or_default(),
+            at,
             skip: self.tree_skip.clone(),
             moments: self.tree_moments.clone(),
             reach_all: self.reach_all(),

@@ -295,12 +295,19 @@ impl LocalGrid {
             ny + side..oy + side
         };
         for y in leaving_rows {
-            for x in ox..ox + side {
-                let i = self.index(x, y);
-                self.cells[i] = 0;
-            }
+            self.clear_run(ox, y, side as usize);
         }
         self.origin = new_origin;
+    }
+
+    /// Clears the `len` cells of row `y` from global column `x` on: consecutive indices of the
+    /// torus (global cell (x, y) is at (y·2ⁿ + x) mod 4ⁿ), which may wrap to the array's start.
+    /// Row by row rather than column by column, the cells cleared lie next to each other.
+    fn clear_run(&mut self, x: i32, y: i32, len: usize) {
+        let first = self.index(x, y);
+        let head = len.min(self.cells.len() - first);
+        self.cells[first..first + head].fill(0);
+        self.cells[..len - head].fill(0);
     }
 
     /// Integrates one scan taken at `odom` (the robot pose; the sensor sits at the layout's
@@ -360,9 +367,18 @@ impl LocalGrid {
                 (floor_i32(x / cell_m), floor_i32(y / cell_m))
             }
         };
+        // i mod stride, counted rather than divided (a division per beam cost more than the
+        // beam's skip saved).
+        let mut beam_in_stride = 0;
         for (i, &r) in ranges.iter().enumerate() {
             let (bs, bc) = (s, c);
             (s, c) = (s * dc + c * ds, c * dc - s * ds);
+            let in_phase = beam_in_stride == phase;
+            beam_in_stride = if beam_in_stride + 1 == stride {
+                0
+            } else {
+                beam_in_stride + 1
+            };
             if r.is_nan() || r <= 0.0 {
                 continue;
             }
@@ -373,15 +389,17 @@ impl LocalGrid {
             // where beams 2^(t+1) steps apart (t: trailing zeros of i) get more than half a
             // cell apart, so the cells there are still crossed by the sparser beams.
             let start = starts[i & 15];
-            let (ex, ey) = cell(sensor.x + bc * len, sensor.y + bs * len);
+            let end = || cell(sensor.x + bc * len, sensor.y + bs * len);
             // Beams traced from the sensor (every 16th) are traced on every scan: they lower the
             // counters of the cells around the robot, which a passer-by's returns raised.
-            if start >= len || (stride > 1 && i % stride != phase && i & 15 != 0) {
+            if start >= len || (!in_phase && i & 15 != 0) {
                 if hit {
+                    let (ex, ey) = end();
                     self.mark(ex, ey, true);
                 }
                 continue;
             }
+            let (ex, ey) = end();
             let (bx, by) = if start > 0.0 {
                 cell(sensor.x + bc * start, sensor.y + bs * start)
             } else {
