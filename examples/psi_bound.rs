@@ -3,12 +3,12 @@
 //! (the word builder's, Φ included) changes, the level-0 words each makes (count, mean length)
 //! and each front end's thread CPU. The exact front end is the default settings with every ray
 //! to the rim (`ray_step_deg` 1, `ray_stride` 1) and every beam
-//! traced (`beam_stride` 1); the candidate is the default settings (the exact front end) with
-//! the options given.
+//! traced (`beam_stride` 1); the candidate is the default settings (the fast front end:
+//! `beam_stride` 4, `ray_stride` 2) with the options given.
 //!
 //! ```text
-//! # the approximate front end, every scenario (first 4 runs) and log
-//! cargo run --release --example psi_bound -- --runs 4 --beam-stride 4 --ray-stride 2
+//! # the approximate front end (the default), every scenario (first 4 runs) and log
+//! cargo run --release --example psi_bound -- --runs 4
 //! cargo run --release --example psi_bound -- --ray-step-deg 2 scenarios/A.toml
 //! cargo run --release --example psi_bound -- --floor-laps 5 --beam-stride 4 --ray-stride 2
 //! cargo run --release --example psi_bound -- --scan-step 3 ../shared/data/carmen/intel-corrected.log.gz

@@ -216,9 +216,10 @@ impl RecognizerConfig {
     }
 
     /// These settings with the fast front end of docs/design.md, "The front end's
-    /// approximation": every 4th beam of a scan traced (`beam_stride = 4`), every 2nd density
-    /// ray walked, cells weighted (`ray_stride = 2`); Ψ within the bound `tests/it/frontend_bound.rs`
-    /// checks. About 14 ms a lap of the loop floor against 24 exact (BENCHMARKS.md, session 8).
+    /// approximation" (the defaults): every 4th beam of a scan traced (`beam_stride = 4`), every
+    /// 2nd density ray walked, cells weighted (`ray_stride = 2`); Ψ within the bound
+    /// `tests/it/frontend_bound.rs` checks. About 14 ms a lap of the loop floor against 23
+    /// exact (BENCHMARKS.md, session 9).
     pub fn with_fast_front_end(mut self) -> Self {
         self.grid.beam_stride = 4;
         self.density.ray_stride = 2;
@@ -226,7 +227,7 @@ impl RecognizerConfig {
     }
 
     /// These settings with the exact front end (the authors' grid update and kernel): every beam
-    /// traced and every ray walked (`beam_stride = 1`, `ray_stride = 1`, the defaults).
+    /// traced and every ray walked (`beam_stride = 1`, `ray_stride = 1`).
     pub fn with_exact_front_end(mut self) -> Self {
         self.grid.beam_stride = 1;
         self.density.ray_stride = 1;

@@ -155,11 +155,10 @@ pub struct GridOptions {
     /// sensor (every 16th) are traced on every scan. A scan more than 0.15 m or 2° from the
     /// last one integrated (a sparse log, a turn) traces every beam, so on the real logs, whose
     /// scans are farther apart, a stride changes nothing. 1 traces every beam on every scan (the
-    /// exact front end). Default 1. The fast front end (`beam_stride = 4`, `ray_stride = 2`;
-    /// `RecognizerConfig::with_fast_front_end`) costs about 14 ms a lap of the loop floor
-    /// against 24, with Ψ within the bound `tests/it/frontend_bound.rs` checks, but misses two
-    /// of `scenarios/reverse.toml`'s bounds (opposite precision, worst seed: 3 levels 0.956 <
-    /// 0.96, 1 level 0.951 < 0.97), so it is not the default (docs/design.md, "The front end's
+    /// exact front end, `RecognizerConfig::with_exact_front_end`). Default 4: with
+    /// `ray_stride = 2` the fast front end, about 14 ms a lap of the loop floor against 23
+    /// exact, with Ψ within the bound `tests/it/frontend_bound.rs` checks and precision as
+    /// high as exact's over scenario seeds 1–30 (docs/design.md, "The front end's
     /// approximation").
     pub beam_stride: usize,
 }
@@ -170,7 +169,7 @@ impl Default for GridOptions {
             grid_cell_m: 0.05,
             grid_radius_m: 3.0,
             grid_memory_m: 6.4,
-            beam_stride: 1,
+            beam_stride: 4,
         }
     }
 }
@@ -273,9 +272,9 @@ pub struct DensityOptions {
     /// a weight (the cells every ray reaches in its bin, a ring and a sector, over those the
     /// walked rays reach; `DensityKernel::with_ray_stride`), so that an all-free window still
     /// gives Ψ = 1 and Ψ stays that of every ray within the bound `tests/it/frontend_bound.rs`
-    /// checks. 1 walks every ray (the exact kernel). Default 1: 2 costs a density about 40 %
-    /// less, and with `beam_stride = 4` is the fast front end (see `beam_stride` in
-    /// `[recognizer.grid]`); 3 or 4 cost seattle its pairs on 3 noise seeds of its 4.
+    /// checks. 1 walks every ray (the exact kernel, the authors'). Default 2: a density costs
+    /// about 40 % less, and with `beam_stride = 4` it is the fast front end (see `beam_stride`
+    /// in `[recognizer.grid]`); 3 or 4 cost seattle its pairs on 3 noise seeds of its 4.
     pub ray_stride: usize,
 }
 
@@ -285,7 +284,7 @@ impl Default for DensityOptions {
             kernel_radius_m: 2.5,
             ray_step_deg: 1.0,
             wide_radius_m: 20.0,
-            ray_stride: 1,
+            ray_stride: 2,
         }
     }
 }
@@ -836,7 +835,7 @@ pub struct VerifyOptions {
     /// everywhere (A 0.585 → 0.627, weaving A 0.515 → 0.550, `reverse` 0.668 → 0.701, Intel
     /// 0.442 → 0.448) and every seed keeps 3-level precision ≥ 0.95, but `scenarios/reverse.toml`
     /// misses its per-direction bounds (3 levels same-direction worst 0.932 → 0.910, opposite
-    /// 0.980 → 0.953), so it is not the default (RESULTS.md, session 7).
+    /// 0.980 → 0.953), so it is not the default (RESULTS.md, session 7, exact front end).
     pub verify_travel_outliers: usize,
     /// The sides bound for a short n-gram read backwards (`reverse_short_ngram_words` in
     /// `[recognizer.matcher]`). Default 0.035: four words say little, and the side of the free
