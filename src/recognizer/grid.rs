@@ -18,10 +18,11 @@
 //! other coordinate in 16.16 fixed point), only up to the grid radius. Near the sensor, where
 //! neighbouring beams cross the same cells, beams are thinned (see [`LocalGrid::integrate`]):
 //! the cells there are still crossed by the sparser beams, and about a quarter of the cell
-//! visits are saved. With a beam stride (`[recognizer.grid] beam_stride`, default 1) a scan
-//! traces only every n-th beam, the next scan the next ones, each traced beam lowering the
-//! counters it passes n times; returns are marked for every beam. An approximation: Ψ stays
-//! within the bound `tests/it/frontend_bound.rs` checks against the exact update (stride 1).
+//! visits are saved. With a beam stride (`[recognizer.grid] beam_stride`, default 4; a grid
+//! made here traces every beam until [`LocalGrid::set_beam_stride`]) a scan traces only every
+//! n-th beam, the next scan the next ones, each traced beam lowering the counters it passes n
+//! times; returns are marked for every beam. An approximation: Ψ stays within the bound
+//! `tests/it/frontend_bound.rs` checks against the exact update (stride 1).
 
 use super::density::{CellState, DensityKernel, FreeCells, RayDeltas, Visited, cell_state};
 use crate::geom::{OdomPose, Pose2};
