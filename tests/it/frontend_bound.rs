@@ -139,3 +139,13 @@ fn strides_out_of_range_are_refused_where_they_are_written() {
         assert!(e.starts_with("t.toml:"), "{e}");
     }
 }
+
+/// `docs/exact-front-end.toml`, the file the README and docs/design.md point to for the authors'
+/// front end, gives exactly the exact settings over the defaults.
+#[test]
+fn the_exact_front_end_file_gives_the_exact_settings() {
+    let path = root().join("docs/exact-front-end.toml");
+    let cfg = placewords::experiment::load_recognizer_config(&path).unwrap();
+    assert_eq!(cfg, RecognizerConfig::default().with_exact_front_end());
+    assert_ne!(cfg, RecognizerConfig::default());
+}
