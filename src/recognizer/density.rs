@@ -107,17 +107,21 @@ impl Visited {
             walk_tree(square, N - 1, at, deltas)
         }
         let cells = &mut self.cells[..];
-        let at = &deltas.at[..];
-        match cells.len() {
-            // Node indices of the smallest square fit 16 bits: half the bytes to read a node.
-            n if n == SQUARE_SIZES[0] && deltas.at16.len() == at.len() => {
-                sized::<{ SQUARE_SIZES[0] }, u16>(cells, &deltas.at16, deltas)
+        match (&deltas.at, cells.len()) {
+            (NodeIndices::Narrow(at), n) if n == SQUARE_SIZES[0] => {
+                sized::<{ SQUARE_SIZES[0] }, u16>(cells, at, deltas)
             }
-            n if n == SQUARE_SIZES[0] => sized::<{ SQUARE_SIZES[0] }, u32>(cells, at, deltas),
-            n if n == SQUARE_SIZES[1] => sized::<{ SQUARE_SIZES[1] }, u32>(cells, at, deltas),
-            n if n == SQUARE_SIZES[2] => sized::<{ SQUARE_SIZES[2] }, u32>(cells, at, deltas),
-            n if n == SQUARE_SIZES[3] => sized::<{ SQUARE_SIZES[3] }, u32>(cells, at, deltas),
-            _ => walk_tree(cells, usize::MAX, at, deltas),
+            (NodeIndices::Wide(at), n) if n == SQUARE_SIZES[1] => {
+                sized::<{ SQUARE_SIZES[1] }, u32>(cells, at, deltas)
+            }
+            (NodeIndices::Wide(at), n) if n == SQUARE_SIZES[2] => {
+                sized::<{ SQUARE_SIZES[2] }, u32>(cells, at, deltas)
+            }
+            (NodeIndices::Wide(at), n) if n == SQUARE_SIZES[3] => {
+                sized::<{ SQUARE_SIZES[3] }, u32>(cells, at, deltas)
+            }
+            (NodeIndices::Narrow(at), _) => walk_tree(cells, usize::MAX, at, deltas),
+            (NodeIndices::Wide(at), _) => walk_tree(cells, usize::MAX, at, deltas),
         }
     }
 
@@ -228,8 +232,22 @@ fn walk_tree<I: NodeIndex>(
     blocked
 }
 
-/// A prefix-tree node's index in the kernel's square, as stored: 16 bits when the square's
-/// scratch is 2¹⁶ cells, else 32.
+/// The prefix-tree nodes' indices in the kernel's square, in depth-first order: 16 bits when
+/// the square fits the smallest scratch (2¹⁶ cells; the default's 101 × 101 does), half the
+/// bytes the walk reads a node; else 32.
+#[derive(Clone, Debug)]
+enum NodeIndices {
+    Narrow(Vec<u16>),
+    Wide(Vec<u32>),
+}
+
+impl Default for NodeIndices {
+    fn default() -> Self {
+        NodeIndices::Wide(Vec::new())
+    }
+}
+
+/// A prefix-tree node's index in the kernel's square, as stored ([`NodeIndices`]).
 trait NodeIndex: Copy {
     fn index(self) -> usize;
 }
@@ -279,9 +297,7 @@ pub struct RayDeltas {
     /// Side of the kernel's square, cells (odd: the centre cell in the middle).
     side: usize,
     /// Per prefix-tree node, in depth-first order: its index in the square.
-    at: Vec<u32>,
-    /// `at` in 16 bits, when every index fits (empty otherwise).
-    at16: Vec<u16>,
+    at: NodeIndices,
     /// Per node, the index just past its subtree (read only where an occupied cell stops it).
     skip: Vec<u32>,
     /// Per node, the sum of the offsets of its subtree (read only when moments are wanted).
@@ -408,22 +424,19 @@ impl DensityKernel {
             .max()
             .unwrap_or(0);
         let side = 2 * half + 1;
-        let at: Vec<u32> = self
-            .tree_offsets
-            .iter()
-            .map(|&(ox, oy)| {
-                let (x, y) = (ox as isize + half as isize, oy as isize + half as isize);
-                (y as usize * side + x as usize) as u32
-            })
-            .collect();
-        let at16 = at
-            .iter()
-            .map(|&i| u16::try_from(i).ok())
-            .collect::<Option<_>>();
+        let at = self.tree_offsets.iter().map(|&(ox, oy)| {
+            let (x, y) = (ox as isize + half as isize, oy as isize + half as isize);
+            y as usize * side + x as usize
+        });
+        // The smallest scratch holds the square: every index fits 16 bits.
+        let at = if side * side <= SQUARE_SIZES[0] {
+            NodeIndices::Narrow(at.map(|i| i as u16).collect())
+        } else {
+            NodeIndices::Wide(at.map(|i| i as u32).collect())
+        };
         RayDeltas {
             stride,
             side,
-            at16: at16.unwrap_or_default(),
             at,
             skip: self.tree_skip.clone(),
             moments: self.tree_moments.clone(),
