@@ -15,7 +15,7 @@ use anyhow::Result;
 use clap::Parser;
 use placewords::eval::GroundTruth;
 use placewords::geom::Pose2;
-use placewords::recognizer::{RecognizerConfig, Word};
+use placewords::recognizer::{Direction, RecognizerConfig, Word};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -89,8 +89,12 @@ fn failed_syllables(c: &Word, p: &Word, cfg: &RecognizerConfig, same: bool) -> S
     if c.class != p.class {
         out.push('D');
     }
-    let (a, b) = (c.size as f64, p.size as f64);
-    if (a - b).abs() > m.size_tolerance_ratio * a.max(b) + 1e-9 {
+    let dir = if same {
+        Direction::Same
+    } else {
+        Direction::Opposite
+    };
+    if !m.sizes_match(c.size, p.size, dir) {
         out.push('S');
     }
     let d = placewords::geom::wrap_angle((c.angle_deg + sign * p.angle_deg).to_radians())

@@ -320,8 +320,7 @@ fn truth_chain(
         let (p, _) = partner[mid].filter(|&(_, d)| d == dir).ok_or("partner")?;
         let pk = word_of[p];
         let v = l0[pk];
-        let sizes = (w.size as f64 - v.size as f64).abs()
-            <= cfg.matcher.size_tolerance_ratio * w.size.max(v.size) as f64 + 1e-9;
+        let sizes = cfg.matcher.sizes_match(w.size, v.size, dir);
         let b = if dir == Direction::Opposite {
             -v.angle_deg
         } else {

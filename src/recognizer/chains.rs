@@ -52,15 +52,15 @@ pub(super) struct Entry {
 impl WordMatcher {
     /// Whether current word `a` matches past word `b` (an entry of its class's occurrence list)
     /// read in direction `dir` (backwards, b's angle syllable is negated; class and size do not
-    /// change).
+    /// change, though sizes match within `reverse_size_tolerance_observations` more).
     pub(super) fn syllables_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
-        self.sizes_match(a, b) && self.angles_match(a, b, dir)
+        self.sizes_match(a, b, dir) && self.angles_match(a, b, dir)
     }
 
-    /// The size syllables of [`syllables_match`](Self::syllables_match) (the same either way).
-    fn sizes_match(&self, a: &Word, b: &Occurrence) -> bool {
-        let (sa, sb) = (a.size as f64, b.size as f64);
-        (sa - sb).abs() <= self.matcher_opts.size_tolerance_ratio * sa.max(sb) + 1e-9
+    /// The size syllables of [`syllables_match`](Self::syllables_match)
+    /// ([`MatcherOptions::sizes_match`](super::options::MatcherOptions::sizes_match)).
+    fn sizes_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
+        self.matcher_opts.sizes_match(a.size, b.size, dir)
     }
 
     /// The angle syllables of [`syllables_match`](Self::syllables_match), read in direction `dir`.
@@ -106,7 +106,7 @@ impl WordMatcher {
     /// Lists the candidates of word `c` (`index.rs`) in `candidates`, per direction (read
     /// backwards only with `reverse`): the words of its class that end `candidate_gap_m` before
     /// it begins and match it. When every match is a candidate, one walk over the class serves
-    /// both directions (the size test is the same both ways).
+    /// both directions.
     pub(super) fn find_candidates(&mut self, c: WordId) {
         let mut found = std::mem::take(&mut self.candidates);
         found.iter_mut().for_each(Vec::clear);
@@ -117,11 +117,17 @@ impl WordMatcher {
         let max = self.matcher_opts.max_candidates;
         if max == 0 && self.matcher_opts.reverse {
             let [same, opposite] = &mut found;
-            for p in occ.iter().filter(|p| self.sizes_match(cw, p)) {
-                if self.angles_match(cw, p, Direction::Same) {
+            let m = &self.matcher_opts;
+            let (same_slack, opposite_slack) = (
+                m.size_slack(Direction::Same) + 1e-9,
+                m.size_slack(Direction::Opposite) + 1e-9,
+            );
+            for p in occ {
+                let over = m.size_excess(cw.size, p.size);
+                if over <= same_slack && self.angles_match(cw, p, Direction::Same) {
                     same.push(p.id);
                 }
-                if self.angles_match(cw, p, Direction::Opposite) {
+                if over <= opposite_slack && self.angles_match(cw, p, Direction::Opposite) {
                     opposite.push(p.id);
                 }
             }

@@ -6,6 +6,7 @@
 //! components (the kernel inside the grid, say) is checked by `RecognizerConfig::problems`.
 
 use super::config::ConfigProblem;
+use super::types::Direction;
 use crate::spec::diag::fmt_number;
 use serde::{Deserialize, Serialize};
 
@@ -450,6 +451,10 @@ pub enum MultiLevelRule {
     Boundaries,
 }
 
+/// Largest `reverse_size_tolerance_observations`: 10 m of observations at the default spacing; more would
+/// let every word of a class match every other.
+pub const MAX_SIZE_TOLERANCE_OBSERVATIONS: usize = 100;
+
 /// Word matching and n-gram chains (paper §III-C): which word pairs match, which chains of them
 /// are reported, in which directions. `[recognizer.matcher]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -460,8 +465,24 @@ pub struct MatcherOptions {
     /// k + 1. Needs at least `levels` entries; 0 and 1 both accept every matching word pair (the
     /// paper's Fig. 8 sweeps from 0). Default [6, 9, 12, 15].
     pub min_ngram: Vec<usize>,
-    /// Size syllables match when |S₁ − S₂| ≤ ratio · max(S₁, S₂). Default 0.25.
+    /// Size syllables match when |S₁ − S₂| ≤ ratio · max(S₁, S₂) (read backwards, plus
+    /// `reverse_size_tolerance_observations`). Default 0.25.
     pub size_tolerance_ratio: f64,
+    /// Read backwards, size syllables also match within this many observations more: |S₁ − S₂| ≤
+    /// `size_tolerance_ratio` · max(S₁, S₂) + this (not in the paper; 0 = the ratio alone). Why:
+    /// a level-0 word closes only once the new class has lasted `min_word_size` observations,
+    /// and a shorter flicker before that is absorbed by the word it interrupts, the word driven
+    /// first. Driven the same way the flicker goes to the same word on both passes; driven the
+    /// other way it goes to the other word, so the boundary moves by the flicker's length,
+    /// whatever the words' lengths, and the ratio alone asks a 10-observation word to agree
+    /// within 2.5. Default 0 (off): on Intel (noise seeds 1–5) 2 raised 3-level recall 0.435 →
+    /// 0.460 (worst seed 0.387 → 0.411) at precision ≥ 0.979, but 1 lowered it to 0.428 (worst
+    /// 0.370) and 3 gave 0.475: chains read backwards won and lost by seed, not a trend; and
+    /// with 1 or 2 `scenarios/reverse.toml` misses its 1-level opposite precision bound (0.944
+    /// against 0.95 at seed 7; session 9's default had 0.951 there). Applied driven the same way
+    /// too, 2 lowered scenario A's 1-level precision to 0.633 at seed 3. RESULTS.md, session 10.
+    /// At most 100.
+    pub reverse_size_tolerance_observations: usize,
     /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
     pub angle_tolerance_deg: f64,
     /// Widen the angle tolerance of two words by how far their angle syllables may be off
@@ -569,6 +590,7 @@ impl Default for MatcherOptions {
         MatcherOptions {
             min_ngram: vec![6, 9, 12, 15],
             size_tolerance_ratio: 0.25,
+            reverse_size_tolerance_observations: 0,
             angle_tolerance_deg: 30.0,
             angle_slack: true,
             candidate_gap_m: 20.0,
@@ -588,6 +610,29 @@ impl Default for MatcherOptions {
 }
 
 impl MatcherOptions {
+    /// Whether the size syllables of two words, `a` and `b` observations long, match read in
+    /// direction `dir`: they differ by at most `size_tolerance_ratio` of the larger, read
+    /// backwards `reverse_size_tolerance_observations` more. The one size rule (the matcher and
+    /// the study tools read it).
+    pub fn sizes_match(&self, a: usize, b: usize, dir: Direction) -> bool {
+        self.size_excess(a, b) <= self.size_slack(dir) + 1e-9
+    }
+
+    /// How far sizes `a` and `b` (observations) differ beyond `size_tolerance_ratio` of the
+    /// larger (≤ 0 when they match driven the same way).
+    pub(crate) fn size_excess(&self, a: usize, b: usize) -> f64 {
+        let (sa, sb) = (a as f64, b as f64);
+        (sa - sb).abs() - self.size_tolerance_ratio * sa.max(sb)
+    }
+
+    /// The observations sizes may differ by beyond the ratio, read in direction `dir`.
+    pub(crate) fn size_slack(&self, dir: Direction) -> f64 {
+        match dir {
+            Direction::Same => 0.0,
+            Direction::Opposite => self.reverse_size_tolerance_observations as f64,
+        }
+    }
+
     /// Every problem of these options for a run of `levels` level configurations, located by
     /// key; empty when they are usable.
     pub fn problems(&self, levels: usize) -> Vec<ConfigProblem> {
@@ -630,6 +675,15 @@ impl MatcherOptions {
             "[0, 1)",
             "0.25",
         );
+        if self.reverse_size_tolerance_observations > MAX_SIZE_TOLERANCE_OBSERVATIONS {
+            p.bad(
+                "reverse_size_tolerance_observations",
+                format!(
+                    "must be at most {MAX_SIZE_TOLERANCE_OBSERVATIONS} observations, got {}; the default is 0",
+                    self.reverse_size_tolerance_observations
+                ),
+            );
+        }
         let a = self.angle_tolerance_deg;
         p.within(
             "angle_tolerance_deg",

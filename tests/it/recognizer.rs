@@ -609,6 +609,61 @@ fn a_short_stretch_driven_back_is_recognized() {
     );
 }
 
+/// Driven the other way, a word boundary moves by the flicker the word driven first absorbed
+/// (a word closes only once the new class lasts `min_word_size` observations), so short words
+/// differ in size by a few observations whatever their length: a place of 10- and
+/// 14-observation words whose sizes swap on the way back is recognized read backwards, each
+/// query near its place, with `reverse_size_tolerance_observations` = 2, and not with the ratio
+/// alone (the default; 4 > 0.25 · 14).
+#[test]
+fn short_words_whose_boundaries_moved_are_recognized_driven_back() {
+    let classes = [2, 4, 1, 5, 3, 6, 2, 4, 1, 5];
+    let place = |sizes: [usize; 2]| -> Vec<Stretch> {
+        (classes.iter().enumerate())
+            .map(|(i, &class)| {
+                let turn_deg = if i == 4 { 90.0 } else { 0.0 };
+                Stretch::new(class_psi(class, 8), sizes[i % 2], turn_deg)
+            })
+            .collect()
+    };
+    let first_place = place([10, 14]);
+    // Driven back, each word has the other size: 14 where it had 10 and the other way round.
+    let back_place = reversed(&place([14, 10]));
+    let separator = |class: usize, size: usize| Stretch::new(class_psi(class, 8), size, 0.0);
+    let mut first_lap = vec![separator(7, 30), separator(0, 40)];
+    first_lap.extend_from_slice(&first_place);
+    first_lap.extend([separator(7, 25), separator(0, 60)]);
+    let first = with_noise(synth::observations(&first_lap, 0.1, 0, None), 1);
+    let mut second_lap = vec![separator(6, 70), separator(7, 90)];
+    second_lap.extend_from_slice(&back_place);
+    second_lap.extend([separator(7, 90), separator(6, 35)]);
+    let second = with_noise(synth::observations(&second_lap, 0.1, 0, first.last()), 2);
+    let place_len: usize = first_place.iter().map(|s| s.size).sum();
+    let (p0, q0) = (70, first.len() + 160);
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
+
+    let slack = config(|c| c.matcher.reverse_size_tolerance_observations = 2);
+    let (_, matches) = run_matcher(&slack, &all);
+    let opposite: Vec<&WordMatch> = (matches.iter())
+        .filter(|m| m.direction == Direction::Opposite)
+        .collect();
+    assert!(!opposite.is_empty(), "the place driven back is recognized");
+    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
+        // Query q0 + j is at the place of observation p0 + place_len − 1 − j, within the
+        // boundaries' move.
+        let mirror = (p0 + place_len - 1 + q0).checked_sub(query);
+        assert!(
+            mirror.is_some_and(|m| m.abs_diff(past) <= 6),
+            "query {query} paired with {past}, its place is {mirror:?}"
+        );
+    }
+    let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    assert!(
+        matches.iter().all(|m| m.direction == Direction::Same),
+        "with the ratio alone the words' sizes do not match read backwards"
+    );
+}
+
 /// Driven the same way, a place whose free space lies on the other side of the path is not the
 /// place: verification rejects it (`rejected_sides`); the same pass with the same sides matches.
 #[test]
@@ -1167,7 +1222,6 @@ fn brute_chain(
         return v;
     }
     let (cw, pw) = (w.word(c), w.word(p));
-    let (sa, sb) = (cw.size as f64, pw.size as f64);
     let mut da = (cw.angle_deg - pw.angle_deg).abs() % 360.0;
     if da > 180.0 {
         da = 360.0 - da;
@@ -1175,7 +1229,7 @@ fn brute_chain(
     let ok = cw.level < k
         && pw.level < k
         && cw.class == pw.class
-        && (sa - sb).abs() <= cfg.matcher.size_tolerance_ratio * sa.max(sb) + 1e-9
+        && cfg.matcher.sizes_match(cw.size, pw.size, Direction::Same)
         && da <= cfg.matcher.angle_tolerance_deg + 1e-9
         && pw.end_travel_m + cfg.matcher.candidate_gap_m <= cw.start_travel_m + 1e-9;
     let v = if !ok {

@@ -55,6 +55,12 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("matcher.size_tolerance_ratio", "0.6", "", Input::Dense),
+    (
+        "matcher.reverse_size_tolerance_observations",
+        "30",
+        "",
+        Input::Dense,
+    ),
     ("matcher.angle_tolerance_deg", "90", "", Input::Dense),
     (
         "matcher.angle_slack",
