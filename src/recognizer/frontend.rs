@@ -144,16 +144,23 @@ impl ObservationClock {
 
 /// The word settings the wide window depends on (Φ is read where Ψ is in the top class), when
 /// the settings use it.
-fn wide_window_settings(config: &RecognizerConfig) -> Option<(usize, usize)> {
+fn wide_window_settings(config: &RecognizerConfig) -> Option<(usize, usize, f64)> {
     let wide_classes = config.wide_classes_in_use();
-    (wide_classes > 0).then_some((config.words.classes, wide_classes))
+    (wide_classes > 0).then_some((
+        config.words.classes,
+        wide_classes,
+        config.words.class_offset,
+    ))
 }
 
-/// The wide window of `config` and the density classes whose top one reads Φ, when the
-/// settings use it.
-fn wide_window(config: &RecognizerConfig) -> Option<(WideWindow, usize)> {
-    let (classes, _) = wide_window_settings(config)?;
-    Some((WideWindow::new(config.density.wide_radius_m), classes))
+/// The wide window of `config` and the density classes (count, offset) whose top one reads Φ,
+/// when the settings use it.
+fn wide_window(config: &RecognizerConfig) -> Option<(WideWindow, (usize, f64))> {
+    let (classes, _, offset) = wide_window_settings(config)?;
+    Some((
+        WideWindow::new(config.density.wide_radius_m),
+        (classes, offset),
+    ))
 }
 
 /// Local grid + density: makes observations from odometry and scans.
@@ -165,9 +172,10 @@ pub struct DensityFrontEnd {
     grid: LocalGrid,
     kernel: DensityKernel,
     deltas: RayDeltas,
-    /// The wide window (`wide_radius_m` > 0 and `wide_classes` > 0), and the number of density
-    /// classes: the word builder reads Φ in the top one, so Φ is measured there only.
-    wide: Option<(WideWindow, usize)>,
+    /// The wide window (`wide_radius_m` > 0 and `wide_classes` > 0), and the density classes
+    /// (count, `class_offset`): the word builder reads Φ in the top one, so Φ is measured there
+    /// only.
+    wide: Option<(WideWindow, (usize, f64))>,
     /// Whether the newest observation's Ψ was in the top class (Φ read there).
     open: bool,
     run: usize,
@@ -285,8 +293,9 @@ impl DensityFrontEnd {
                     .grid
                     .density_at(&self.kernel, &self.deltas, pose.0.x, pose.0.y);
                 let wide_density = match &self.wide {
-                    Some((w, classes))
-                        if usize::from(density_class(density.psi, *classes)) + 1 == *classes =>
+                    Some((w, (classes, offset)))
+                        if usize::from(density_class(density.psi, *classes, *offset)) + 1
+                            == *classes =>
                     {
                         self.open = true;
                         w.density_at(pose.0.x, pose.0.y)
@@ -388,7 +397,8 @@ impl PsiGap {
             return None;
         }
         let levels = WordLevels::new(cfg.words.classes, cfg.words.min_word_size, 1)
-            .with_wide_classes(cfg.wide_classes_in_use());
+            .with_wide_classes(cfg.wide_classes_in_use())
+            .with_class_offset(cfg.words.class_offset);
         let class = |o: &DensityObservation| levels.class_of_observation(o.psi, o.wide_density);
         let mut d: Vec<f64> = a
             .iter()

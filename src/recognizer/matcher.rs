@@ -111,7 +111,8 @@ impl WordMatcher {
             words.multi_level,
         )
         .with_wide_classes(config.wide_classes_in_use())
-        .with_psi_window(words.psi_window, words.psi_window_statistic);
+        .with_psi_window(words.psi_window, words.psi_window_statistic)
+        .with_class_offset(words.class_offset);
         Ok(WordMatcher {
             levels: config.levels,
             tau,

@@ -31,11 +31,12 @@ use super::options::{MultiLevelRule, PsiWindowStatistic};
 use super::types::{DensityObservation, Observation, WordRef};
 use crate::geom::wrap_angle;
 
-/// Density class of Ψ among `classes` uniform classes: min(floor(classes·Ψ), classes − 1) (NaN
-/// gives class 0). The one rule, for the word builder and for the front end (which reads the
-/// wide density only in the top class).
-pub fn density_class(psi: f64, classes: usize) -> u8 {
-    let c = (psi * classes as f64).floor();
+/// Density class of Ψ among `classes` uniform classes whose boundaries are shifted down by
+/// `offset` of a class (`WordOptions::class_offset`, 0 by default): min(floor(classes·Ψ +
+/// offset), classes − 1) (NaN gives class 0). The one rule, for the word builder and for the
+/// front end (which reads the wide density only in the top class).
+pub fn density_class(psi: f64, classes: usize, offset: f64) -> u8 {
+    let c = (psi * classes as f64 + offset).floor();
     (c.max(0.0) as usize).min(classes.max(1) - 1) as u8
 }
 
@@ -139,6 +140,8 @@ pub struct WordLevels {
     classes: usize,
     /// Classes added above the top class for open space, by the wide density Φ (0: none).
     wide_classes: usize,
+    /// How far the class boundaries are shifted down, in classes (`WordOptions::class_offset`).
+    class_offset: f64,
     min_word_size: usize,
     levels: usize,
     rule: MultiLevelRule,
@@ -187,6 +190,7 @@ impl WordLevels {
         WordLevels {
             classes: classes.clamp(1, 255),
             wide_classes: 0,
+            class_offset: 0.0,
             min_word_size: min_word_size.max(1),
             levels: levels.clamp(1, MAX_LEVELS),
             rule,
@@ -270,9 +274,15 @@ impl WordLevels {
         self.classes + self.wide_classes
     }
 
-    /// Density class of Ψ: min(floor(classes·Ψ), classes − 1) (NaN gives class 0).
+    /// Density class of Ψ: [`density_class`] with this builder's classes and offset.
     pub fn class_of(&self, psi: f64) -> u8 {
-        density_class(psi, self.classes)
+        density_class(psi, self.classes, self.class_offset)
+    }
+
+    /// Shifts the class boundaries down by `offset` of a class (`WordOptions::class_offset`).
+    pub fn with_class_offset(mut self, offset: f64) -> Self {
+        self.class_offset = offset;
+        self
     }
 
     /// Class of an observation: [`Self::class_of`] its Ψ; in the top class, open space (at
@@ -646,6 +656,22 @@ mod tests {
     /// reversed classes (window cut at both ends of the run alike); it removes a flicker across
     /// a class threshold, and a window of one observation is today's per-observation rule.
     #[test]
+    fn a_class_offset_shifts_every_boundary_down_by_that_share_of_a_class() {
+        // 8 classes: boundaries at 0.125·k, with 0.5 at 0.125·k − 0.0625.
+        assert_eq!(density_class(0.49, 8, 0.0), 3);
+        assert_eq!(density_class(0.49, 8, 0.5), 4);
+        assert_eq!(density_class(0.43, 8, 0.5), 3);
+        assert_eq!(density_class(0.05, 8, 0.5), 0);
+        assert_eq!(density_class(0.06, 8, 0.5), 0);
+        assert_eq!(density_class(0.07, 8, 0.5), 1);
+        // The top class reaches down to 0.8125; nothing goes past it.
+        assert_eq!(density_class(0.82, 8, 0.5), 7);
+        assert_eq!(density_class(1.0, 8, 0.5), 7);
+        let w = WordLevels::new(8, 5, 1).with_class_offset(0.5);
+        assert_eq!(w.class_of(0.49), 4);
+    }
+
+    #[test]
     fn a_centred_psi_window_gives_reversed_classes_for_reversed_psi() {
         let psi: Vec<f64> = (0..60)
             .map(|i| 0.3 + 0.15 * (i as f64 / 9.0).sin() + if i % 3 == 0 { 0.06 } else { -0.02 })
@@ -659,7 +685,7 @@ mod tests {
                 assert_eq!(fwd, back, "{stat:?} over {window}");
             }
         }
-        let own: Vec<u8> = psi.iter().map(|&p| density_class(p, 8)).collect();
+        let own: Vec<u8> = psi.iter().map(|&p| density_class(p, 8, 0.0)).collect();
         assert_eq!(windowed(&psi, 1, PsiWindowStatistic::Median).0, own);
         let flicker = [
             0.49, 0.49, 0.51, 0.49, 0.49, 0.51, 0.49, 0.49, 0.51, 0.49, 0.49,

@@ -48,6 +48,7 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
     ),
     ("words.min_word_size", "3", "", Input::Dense),
     ("words.psi_window", "5", "", Input::Dense),
+    ("words.class_offset", "0.5", "", Input::Dense),
     (
         "words.psi_window_statistic",
         "\"mean\"",
