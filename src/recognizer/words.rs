@@ -274,7 +274,7 @@ impl WordLevels {
         self.classes + self.wide_classes
     }
 
-    /// Density class of Ψ: [`density_class`] with this builder's classes and offset.
+    /// Density class of Ψ: min(floor(classes·Ψ + class_offset), classes − 1) (NaN gives 0).
     pub fn class_of(&self, psi: f64) -> u8 {
         density_class(psi, self.classes, self.class_offset)
     }
