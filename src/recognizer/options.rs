@@ -470,8 +470,8 @@ pub enum MultiLevelRule {
     Boundaries,
 }
 
-/// Largest `reverse_size_tolerance_observations`: 10 m of observations at the default spacing; more would
-/// let every word of a class match every other.
+/// Largest `reverse_size_tolerance_observations`: 10 m of observations at the default spacing;
+/// more would let every word of a class match every other.
 pub const MAX_SIZE_TOLERANCE_OBSERVATIONS: usize = 100;
 
 /// Word matching and n-gram chains (paper §III-C): which word pairs match, which chains of them
@@ -488,13 +488,13 @@ pub struct MatcherOptions {
     /// `reverse_size_tolerance_observations`). Default 0.25.
     pub size_tolerance_ratio: f64,
     /// Read backwards, size syllables also match within this many observations more: |S₁ − S₂| ≤
-    /// `size_tolerance_ratio` · max(S₁, S₂) + this (not in the paper; 0 = the ratio alone). Why:
-    /// a level-0 word closes only once the new class has lasted `min_word_size` observations,
-    /// and a shorter flicker before that is absorbed by the word it interrupts, the word driven
-    /// first. Driven the same way the flicker goes to the same word on both passes; driven the
-    /// other way it goes to the other word, so the boundary moves by the flicker's length,
-    /// whatever the words' lengths, and the ratio alone asks a 10-observation word to agree
-    /// within 2.5. Default 0 (off): on Intel (noise seeds 1–5) 2 raised 3-level recall 0.435 →
+    /// `size_tolerance_ratio` · max(S₁, S₂) + this (not in the paper; 0 = the ratio alone). The
+    /// idea: a level-0 word closes only once the new class has lasted `min_word_size`
+    /// observations, and a shorter flicker before that is absorbed by the word driven first, so
+    /// driven the other way a boundary could move by a few observations whatever the words'
+    /// lengths, while the ratio alone asks a 10-observation word to agree within 2.5. (A
+    /// boundary placed the same either way changed nothing on Intel, fhw or seattle, so that is
+    /// not what splits the words read backwards.) Default 0 (off): on Intel (noise seeds 1–5) 2 raised 3-level recall 0.435 →
     /// 0.460 (worst seed 0.387 → 0.411) at precision ≥ 0.979, but 1 lowered it to 0.428 (worst
     /// 0.370) and 3 gave 0.475: chains read backwards won and lost by seed, not a trend; and
     /// with 1 or 2 `scenarios/reverse.toml` misses its 1-level opposite precision bound (0.944
