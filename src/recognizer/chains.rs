@@ -118,16 +118,16 @@ impl WordMatcher {
         if max == 0 && self.matcher_opts.reverse {
             let [same, opposite] = &mut found;
             let m = &self.matcher_opts;
-            let (same_slack, opposite_slack) = (
-                m.size_slack(Direction::Same) + 1e-9,
-                m.size_slack(Direction::Opposite) + 1e-9,
-            );
             for p in occ {
                 let over = m.size_excess(cw.size, p.size);
-                if over <= same_slack && self.angles_match(cw, p, Direction::Same) {
+                if m.size_excess_matches(over, Direction::Same)
+                    && self.angles_match(cw, p, Direction::Same)
+                {
                     same.push(p.id);
                 }
-                if over <= opposite_slack && self.angles_match(cw, p, Direction::Opposite) {
+                if m.size_excess_matches(over, Direction::Opposite)
+                    && self.angles_match(cw, p, Direction::Opposite)
+                {
                     opposite.push(p.id);
                 }
             }

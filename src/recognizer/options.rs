@@ -634,7 +634,7 @@ impl MatcherOptions {
     /// backwards `reverse_size_tolerance_observations` more. The one size rule (the matcher and
     /// the study tools read it).
     pub fn sizes_match(&self, a: usize, b: usize, dir: Direction) -> bool {
-        self.size_excess(a, b) <= self.size_slack(dir) + 1e-9
+        self.size_excess_matches(self.size_excess(a, b), dir)
     }
 
     /// How far sizes `a` and `b` (observations) differ beyond `size_tolerance_ratio` of the
@@ -644,8 +644,15 @@ impl MatcherOptions {
         (sa - sb).abs() - self.size_tolerance_ratio * sa.max(sb)
     }
 
+    /// Whether sizes differing by `excess` ([`size_excess`](Self::size_excess)) match read in
+    /// direction `dir`: the second half of [`sizes_match`](Self::sizes_match), for a caller
+    /// that tests one excess both ways.
+    pub(crate) fn size_excess_matches(&self, excess: f64, dir: Direction) -> bool {
+        excess <= self.size_slack(dir) + 1e-9
+    }
+
     /// The observations sizes may differ by beyond the ratio, read in direction `dir`.
-    pub(crate) fn size_slack(&self, dir: Direction) -> f64 {
+    fn size_slack(&self, dir: Direction) -> f64 {
         match dir {
             Direction::Same => 0.0,
             Direction::Opposite => self.reverse_size_tolerance_observations as f64,
