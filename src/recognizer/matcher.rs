@@ -353,14 +353,10 @@ impl WordMatcher {
             &mut scr.offsets,
             &mut scr.anchors,
         );
+        let mut pairs = pairs;
         if self.verify_opts.enabled
-            && let Some(reason) = self.verify(
-                &scr.word_pairs[pairs.clone()],
-                dir,
-                &scr.anchors[pairs.clone()],
-                (extends_reported, short),
-                &mut scr.placed,
-            )
+            && let Some(reason) =
+                self.verify_or_trim(&mut pairs, dir, (extends_reported, short), placed_from, scr)
         {
             self.rejections.add(reason);
             if self.rejected.len() < MAX_REJECTED_SAMPLES {

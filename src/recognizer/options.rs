@@ -922,6 +922,20 @@ pub struct VerifyOptions {
     /// space is what tells a place from its mirror image (`reverse`, 3 levels, worst seed: 0.957
     /// at 0.04, 0.969 at 0.035, 0.967 without the rule; 0.03 costs seattle seed 2 its pairs).
     pub reverse_short_max_lateral_rms: f64,
+    /// Read backwards, an n-gram that fails the travel or turn check is verified again without
+    /// its oldest word pair, and again, while what is left is still a short n-gram
+    /// (`reverse_short_ngram_words` words or more spanning `reverse_short_ngram_travel_m` in
+    /// `[recognizer.matcher]`), held to the short rule's checks; the first that passes is the
+    /// match. Default true (not in the paper). Why: a chain read backwards reaches back to where
+    /// the robot came into the revisit from another corridor, and its oldest word starts then
+    /// turn (or travel) on one side only, so the whole n-gram failed although its newer words
+    /// are the place; chains read backwards are a few long words, so the next word does not
+    /// come soon enough to leave the junction behind. On seattle it gives noise seed 3 its
+    /// opposite pairs (every seed 1–5 has pairs at precision 1.0; also with `class_offset`
+    /// 1/16, where none had any); Intel, fhw, A, B, C and weaving `reverse` are unchanged, and
+    /// `reverse` keeps its worst precision (RESULTS.md, session 11). An n-gram that extends a
+    /// reported chain is not trimmed.
+    pub reverse_trim_to_short: bool,
 }
 
 impl Default for VerifyOptions {
@@ -938,6 +952,7 @@ impl Default for VerifyOptions {
             verify_turn_outliers: 1,
             verify_travel_outliers: 0,
             reverse_short_max_lateral_rms: 0.035,
+            reverse_trim_to_short: true,
         }
     }
 }

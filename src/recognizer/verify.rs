@@ -40,7 +40,7 @@
 
 use super::align::{PastSide, Placement};
 use super::diagnostics::Rejection;
-use super::matcher::WordMatcher;
+use super::matcher::{Scratch, WordMatcher};
 use super::types::Direction;
 use super::words::WordId;
 use crate::geom::wrap_angle;
@@ -144,6 +144,73 @@ impl WordMatcher {
         } else {
             None
         }
+    }
+
+    /// [`verify`](Self::verify) of the n-gram of `scr`'s word pairs `pairs`, with its anchors;
+    /// read backwards, one that fails the travel or turn check is tried again without its
+    /// oldest word pair while what is left is still a short n-gram (`reverse_trim_to_short`),
+    /// its anchors taken anew, and `pairs` then starts at the one that passed. `None` when one
+    /// passed, else the whole n-gram's rejection; `scr.placed` holds the placements of the one
+    /// that passed (from `placed_from`).
+    pub(super) fn verify_or_trim(
+        &self,
+        pairs: &mut std::ops::Range<usize>,
+        dir: Direction,
+        (newest_only, short): (bool, bool),
+        placed_from: usize,
+        scr: &mut Scratch,
+    ) -> Option<Rejection> {
+        let whole = pairs.clone();
+        let reason = self.verify(
+            &scr.word_pairs[whole.clone()],
+            dir,
+            &scr.anchors[whole.clone()],
+            (newest_only, short),
+            &mut scr.placed,
+        )?;
+        let Some((words, short_m)) = self.matcher_opts.short_opposite_rule() else {
+            return Some(reason);
+        };
+        if !(self.verify_opts.reverse_trim_to_short
+            && dir == Direction::Opposite
+            && !newest_only
+            && matches!(reason, Rejection::Travel | Rejection::Turn))
+        {
+            return Some(reason);
+        }
+        let end_m = self.word(scr.word_pairs[whole.end - 1].0).end_travel_m;
+        let mut anchors = Vec::new();
+        for from in whole.start + 1..=whole.end.saturating_sub(words) {
+            if end_m - self.word(scr.word_pairs[from].0).start_travel_m < short_m {
+                break;
+            }
+            scr.placed.truncate(placed_from);
+            let trimmed = from..whole.end;
+            anchors.clear();
+            self.chain_anchors(
+                &scr.word_pairs[trimmed.clone()],
+                dir,
+                &mut scr.offsets,
+                &mut anchors,
+            );
+            match self.verify(
+                &scr.word_pairs[trimmed.clone()],
+                dir,
+                &anchors,
+                (false, true),
+                &mut scr.placed,
+            ) {
+                None => {
+                    scr.anchors[trimmed.clone()].copy_from_slice(&anchors);
+                    *pairs = trimmed;
+                    return None;
+                }
+                Some(Rejection::Travel | Rejection::Turn) => {}
+                Some(_) => break,
+            }
+        }
+        scr.placed.truncate(placed_from);
+        Some(reason)
     }
 
     /// Whether the heading offsets between the two sides at an n-gram's word starts (`offsets`,

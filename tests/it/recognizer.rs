@@ -609,6 +609,60 @@ fn a_short_stretch_driven_back_is_recognized() {
     );
 }
 
+/// Read backwards, a chain that reaches back to where the robot came into the revisit from
+/// another corridor turns on one side only at its oldest words, and the whole n-gram fails
+/// the turn check; without its oldest word pair it is a short n-gram that passes
+/// (`reverse_trim_to_short`). A place of six 6 m words driven back, entered at its first word
+/// turning 28° and 10° less than the first lap left it: recognized read backwards, each query
+/// near its place, with the option and not without it (the travel rule's n-gram is the six
+/// words, and the short n-gram one word earlier does not yet turn 45°).
+#[test]
+fn a_revisit_entered_from_another_corridor_is_recognized_read_backwards() {
+    let classes = [2, 5, 1, 6, 3, 7];
+    let place = |turns_deg: [f64; 6]| -> Vec<Stretch> {
+        (classes.iter().zip(turns_deg))
+            .map(|(&class, turn_deg)| Stretch::new(class_psi(class, 8), 60, turn_deg))
+            .collect()
+    };
+    // In the order the second lap drives it; the first lap drove it the other way, and its
+    // first word (the junction) and the next turned 28° and 10° more.
+    let driven_first = reversed(&place([28.0, 10.0, 0.0, 0.0, 60.0, 0.0]));
+    let driven_back = place([0.0, 0.0, 0.0, 0.0, 60.0, 0.0]);
+    let separator = |class: usize, size: usize| Stretch::new(class_psi(class, 8), size, 0.0);
+    let mut first_lap = vec![separator(4, 30), separator(0, 40)];
+    first_lap.extend_from_slice(&driven_first);
+    first_lap.extend([separator(4, 25), separator(0, 60)]);
+    let first = with_noise(synth::observations(&first_lap, 0.1, 0, None), 1);
+    let mut second_lap = vec![separator(4, 70), separator(0, 90)];
+    second_lap.extend_from_slice(&driven_back);
+    second_lap.extend([separator(0, 90), separator(4, 35)]);
+    let second = with_noise(synth::observations(&second_lap, 0.1, 0, first.last()), 2);
+    let place_len = 6 * 60;
+    let (p0, q0) = (70, first.len() + 160);
+    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
+
+    let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    let opposite: Vec<&WordMatch> = (matches.iter())
+        .filter(|m| m.direction == Direction::Opposite)
+        .collect();
+    assert!(!opposite.is_empty(), "the place driven back is recognized");
+    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
+        // Query q0 + j is at the place of observation p0 + place_len − 1 − j.
+        let mirror = (p0 + place_len - 1 + q0).checked_sub(query);
+        assert!(
+            mirror.is_some_and(|m| m.abs_diff(past) <= 6),
+            "query {query} paired with {past}, its place is {mirror:?}"
+        );
+    }
+    let untrimmed = config(|c| c.verify.reverse_trim_to_short = false);
+    let (m, matches) = run_matcher(&untrimmed, &all);
+    assert!(
+        matches.iter().all(|m| m.direction == Direction::Same),
+        "without trimming, the n-gram through the junction is turned down"
+    );
+    assert!(m.diagnostics().verification.rejected_turn > 0);
+}
+
 /// Driven the other way, a word boundary moves by the flicker the word driven first absorbed
 /// (a word closes only once the new class lasts `min_word_size` observations), so short words
 /// differ in size by a few observations whatever their length: a place of 10- and

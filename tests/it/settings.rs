@@ -170,6 +170,14 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         "matcher.reverse_short_ngram_travel_m = 5",
         Input::Dense,
     ),
+    (
+        "verify.reverse_trim_to_short",
+        "false",
+        "matcher.min_ngram = [2, 3, 4, 5]\nmatcher.reverse_extra_ngram = 0\n\
+         matcher.reverse_short_ngram_words = 2\nmatcher.reverse_short_ngram_travel_m = 1\n\
+         verify.verify_max_psi_rms = 1.0\nverify.verify_turn_deg = 5",
+        Input::Dense,
+    ),
 ];
 
 /// Short chains, read backwards as readily, with a loose density check: candidates reach the
