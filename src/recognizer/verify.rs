@@ -33,6 +33,17 @@
 //! alone is where two paths meet, or where the robot left the revisit). The travel can be
 //! judged likewise (`verify_travel_outliers`, off by default): a word start that moved on one
 //! pass is passed over, and the next one is measured from the last that agreed.
+//! Read backwards, the oldest end of a chain can lie where the robot came into the revisit
+//! from another corridor: its oldest word starts then turn (or travel) on one side only and the
+//! n-gram fails, although its newer words are the place. Chains read backwards are a few long
+//! words, so the next word comes too late to leave the junction behind (seattle, noise seeds
+//! 1, 2, 3 and 5: 6-word chains whose two oldest word starts turn on one side only; their
+//! newest 4 words, over 25 m, pass).
+//! So such an n-gram is verified again without its oldest word pair, and again, while what is
+//! left is still a short n-gram (`reverse_trim_to_short`; `reverse_short_ngram_words` words
+//! spanning `reverse_short_ngram_travel_m`), held to the short rule's checks, its anchors taken
+//! anew; the first that passes is the match, and the candidate counts as turned down (with the
+//! whole n-gram's reason) only if none does.
 //! The first 10,000 candidates verification turns down are kept as one observation pair each
 //! (`MatchDiagnostics::rejected`), so that the harness, which knows the truth, can tell whether
 //! the checks turned down look-alikes or true revisits.
