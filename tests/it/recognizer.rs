@@ -642,18 +642,7 @@ fn a_revisit_entered_from_another_corridor_is_recognized_read_backwards() {
     let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
 
     let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
-    let opposite: Vec<&WordMatch> = (matches.iter())
-        .filter(|m| m.direction == Direction::Opposite)
-        .collect();
-    assert!(!opposite.is_empty(), "the place driven back is recognized");
-    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
-        // Query q0 + j is at the place of observation p0 + place_len − 1 − j.
-        let mirror = (p0 + place_len - 1 + q0).checked_sub(query);
-        assert!(
-            mirror.is_some_and(|m| m.abs_diff(past) <= 6),
-            "query {query} paired with {past}, its place is {mirror:?}"
-        );
-    }
+    assert_recognized_read_backwards(&matches, p0 + place_len - 1 + q0);
     let untrimmed = config(|c| c.verify.reverse_trim_to_short = false);
     let (m, matches) = run_matcher(&untrimmed, &all);
     assert!(
@@ -661,6 +650,23 @@ fn a_revisit_entered_from_another_corridor_is_recognized_read_backwards() {
         "without trimming, the n-gram through the junction is turned down"
     );
     assert!(m.diagnostics().verification.rejected_turn > 0);
+}
+
+/// `matches` recognize a place driven back: some are read backwards, and each of their pairs
+/// is within 6 observations of the place of its query (query q, past p: q + p = `mirror_sum`,
+/// the first pass's last observation of the place plus the second's first).
+fn assert_recognized_read_backwards(matches: &[WordMatch], mirror_sum: usize) {
+    let opposite: Vec<&WordMatch> = (matches.iter())
+        .filter(|m| m.direction == Direction::Opposite)
+        .collect();
+    assert!(!opposite.is_empty(), "the place driven back is recognized");
+    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
+        let mirror = mirror_sum.checked_sub(query);
+        assert!(
+            mirror.is_some_and(|m| m.abs_diff(past) <= 6),
+            "query {query} paired with {past}, its place is {mirror:?}"
+        );
+    }
 }
 
 /// Driven the other way, a word boundary moves by the flicker the word driven first absorbed
@@ -698,19 +704,9 @@ fn short_words_whose_boundaries_moved_are_recognized_driven_back() {
 
     let slack = config(|c| c.matcher.reverse_size_tolerance_observations = 2);
     let (_, matches) = run_matcher(&slack, &all);
-    let opposite: Vec<&WordMatch> = (matches.iter())
-        .filter(|m| m.direction == Direction::Opposite)
-        .collect();
-    assert!(!opposite.is_empty(), "the place driven back is recognized");
-    for (query, past) in opposite.iter().flat_map(|m| m.pairs()) {
-        // Query q0 + j is at the place of observation p0 + place_len − 1 − j, within the
-        // boundaries' move.
-        let mirror = (p0 + place_len - 1 + q0).checked_sub(query);
-        assert!(
-            mirror.is_some_and(|m| m.abs_diff(past) <= 6),
-            "query {query} paired with {past}, its place is {mirror:?}"
-        );
-    }
+    // Query q0 + j is at the place of observation p0 + place_len − 1 − j, within the
+    // boundaries' move.
+    assert_recognized_read_backwards(&matches, p0 + place_len - 1 + q0);
     let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
     assert!(
         matches.iter().all(|m| m.direction == Direction::Same),
