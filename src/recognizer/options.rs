@@ -934,7 +934,7 @@ pub struct VerifyOptions {
     /// opposite pairs (every seed 1–5 has pairs at precision 1.0; also with `class_offset`
     /// 1/16, where none had any); Intel, fhw, A, B, C and weaving `reverse` are unchanged, and
     /// `reverse` keeps its worst precision (RESULTS.md, session 11). An n-gram that extends a
-    /// reported chain is not trimmed.
+    /// reported chain is trimmed likewise, its densities then checked in full.
     pub reverse_trim_to_short: bool,
 }
 

@@ -160,7 +160,9 @@ impl WordMatcher {
     /// [`verify`](Self::verify) of the n-gram of `scr`'s word pairs `pairs`, with its anchors;
     /// read backwards, one that fails the travel or turn check is tried again without its
     /// oldest word pair while what is left is still a short n-gram (`reverse_trim_to_short`),
-    /// its anchors taken anew, and `pairs` then starts at the one that passed. `None` when one
+    /// its anchors taken anew and its densities checked in full (also when it extends a
+    /// reported chain: the junction stays in the n-gram of every later word until it slides
+    /// out), and `pairs` then starts at the one that passed. `None` when one
     /// passed, else the whole n-gram's rejection; `scr.placed` holds the placements of the one
     /// that passed (from `placed_from`).
     pub(super) fn verify_or_trim(
@@ -184,7 +186,6 @@ impl WordMatcher {
         };
         if !(self.verify_opts.reverse_trim_to_short
             && dir == Direction::Opposite
-            && !newest_only
             && matches!(reason, Rejection::Travel | Rejection::Turn))
         {
             return Some(reason);
