@@ -494,9 +494,10 @@ pub struct MatcherOptions {
     /// driven the other way a boundary could move by a few observations whatever the words'
     /// lengths, while the ratio alone asks a 10-observation word to agree within 2.5. (A
     /// boundary placed the same either way changed nothing on Intel, fhw or seattle, so that is
-    /// not what splits the words read backwards.) Default 0 (off): on Intel (noise seeds 1–5) 2 raised 3-level recall 0.435 →
-    /// 0.460 (worst seed 0.387 → 0.411) at precision ≥ 0.979, but 1 lowered it to 0.428 (worst
-    /// 0.370) and 3 gave 0.475: chains read backwards won and lost by seed, not a trend; and
+    /// not what splits the words read backwards.) Default 0 (off): on Intel (noise seeds 1–5)
+    /// 2 raised 3-level recall 0.435 → 0.460 (worst seed 0.387 → 0.411) at precision ≥ 0.979,
+    /// but 1 lowered it to 0.428 (worst 0.370) and 3 gave 0.475: chains read backwards won
+    /// and lost by seed, not a trend; and
     /// with 1 or 2 `scenarios/reverse.toml` misses its 1-level opposite precision bound (0.944
     /// against 0.95 at seed 7; session 9's default had 0.951 there). Applied driven the same way
     /// too, 2 lowered scenario A's 1-level precision to 0.633 at seed 3. RESULTS.md, session 10.

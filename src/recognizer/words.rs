@@ -652,9 +652,8 @@ mod tests {
         (w.observation_classes().to_vec(), sizes)
     }
 
-    /// A centred Ψ window is the same driven either way: the reversed Ψ sequence gives the
-    /// reversed classes (window cut at both ends of the run alike); it removes a flicker across
-    /// a class threshold, and a window of one observation is today's per-observation rule.
+    /// `class_offset` moves every boundary down by that share of a class, the top class
+    /// included, and nothing past the top class; `WordLevels` reads the same rule.
     #[test]
     fn a_class_offset_shifts_every_boundary_down_by_that_share_of_a_class() {
         // 8 classes: boundaries at 0.125·k, with 0.5 at 0.125·k − 0.0625.
@@ -671,6 +670,9 @@ mod tests {
         assert_eq!(w.class_of(0.49), 4);
     }
 
+    /// A centred Ψ window is the same driven either way: the reversed Ψ sequence gives the
+    /// reversed classes (window cut at both ends of the run alike); it removes a flicker across
+    /// a class threshold, and a window of one observation is today's per-observation rule.
     #[test]
     fn a_centred_psi_window_gives_reversed_classes_for_reversed_psi() {
         let psi: Vec<f64> = (0..60)
