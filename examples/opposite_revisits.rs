@@ -94,7 +94,12 @@ fn failed_syllables(c: &Word, p: &Word, cfg: &RecognizerConfig, same: bool) -> S
     } else {
         Direction::Opposite
     };
-    if !m.sizes_match(c.size, p.size, dir) {
+    if !m.sizes_match(
+        c.size,
+        p.size,
+        c.sampling_slack_obs + p.sampling_slack_obs,
+        dir,
+    ) {
         out.push('S');
     }
     let d = placewords::geom::wrap_angle((c.angle_deg + sign * p.angle_deg).to_radians())

@@ -320,7 +320,12 @@ fn truth_chain(
         let (p, _) = partner[mid].filter(|&(_, d)| d == dir).ok_or("partner")?;
         let pk = word_of[p];
         let v = l0[pk];
-        let sizes = cfg.matcher.sizes_match(w.size, v.size, dir);
+        let sizes = cfg.matcher.sizes_match(
+            w.size,
+            v.size,
+            w.sampling_slack_obs + v.sampling_slack_obs,
+            dir,
+        );
         let b = if dir == Direction::Opposite {
             -v.angle_deg
         } else {

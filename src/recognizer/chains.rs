@@ -8,7 +8,9 @@
 //! extends (cᵢ₋₁, pⱼ₊₁) where pⱼ₊₁ is a word whose predecessor is pⱼ. This is a second memo
 //! with the same search; its matches carry `Direction::Opposite`, are verified with the past
 //! side's travel and turn measured backwards, and are aligned on the past word's Ψ read
-//! backwards (so past ids decrease as query ids increase).
+//! backwards (so past ids decrease as query ids increase). On a sparse log the sizes read
+//! backwards also match within `reverse_sampling_slack` of the words' sampling slack (the scan
+//! steps at their ends: `MatcherOptions::sizes_match`).
 //!
 //! **Substitutions** (`substitutions`, on by default). In sparse logs, and with turns between
 //! scans, a word's turn angle (and a little its size) moves between visits; the word then fails
@@ -60,7 +62,8 @@ impl WordMatcher {
     /// The size syllables of [`syllables_match`](Self::syllables_match)
     /// ([`MatcherOptions::sizes_match`](super::options::MatcherOptions::sizes_match)).
     fn sizes_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
-        self.matcher_opts.sizes_match(a.size, b.size, dir)
+        let sampling = a.sampling_slack_obs + f64::from(b.sampling_slack_obs);
+        self.matcher_opts.sizes_match(a.size, b.size, sampling, dir)
     }
 
     /// The angle syllables of [`syllables_match`](Self::syllables_match), read in direction `dir`.
@@ -120,12 +123,13 @@ impl WordMatcher {
             let m = &self.matcher_opts;
             for p in occ {
                 let over = m.size_excess(cw.size, p.size);
-                if m.size_excess_matches(over, Direction::Same)
+                let sampling = cw.sampling_slack_obs + f64::from(p.sampling_slack_obs);
+                if m.size_excess_matches(over, sampling, Direction::Same)
                     && self.angles_match(cw, p, Direction::Same)
                 {
                     same.push(p.id);
                 }
-                if m.size_excess_matches(over, Direction::Opposite)
+                if m.size_excess_matches(over, sampling, Direction::Opposite)
                     && self.angles_match(cw, p, Direction::Opposite)
                 {
                     opposite.push(p.id);

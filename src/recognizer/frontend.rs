@@ -286,6 +286,7 @@ impl DensityFrontEnd {
                 at.push((odom, travel_now, 0.0))
             }
         }
+        let scan_step_observations = u32::try_from(at.len()).unwrap_or(u32::MAX);
         at.into_iter()
             .map(|(pose, travel_m, position_slack_m)| {
                 debug_assert!(self.grid.kernel_fits(self.kernel_cells, pose.0.x, pose.0.y));
@@ -313,6 +314,7 @@ impl DensityFrontEnd {
                     lateral_moment: cos * density.moment.1 - sin * density.moment.0,
                     position_slack_m,
                     wide_density,
+                    scan_step_observations,
                 };
                 self.next_id += 1;
                 obs

@@ -25,9 +25,15 @@ pub(super) struct Occurrence {
     pub(super) angle_deg: f64,
     /// A's slack, degrees ([`Word::angle_slack_deg`]).
     pub(super) angle_slack_deg: f64,
+    /// S's slack, observations ([`Word::sampling_slack_obs`]; f32 fills the id's padding, so
+    /// an occurrence stays 40 bytes).
+    pub(super) sampling_slack_obs: f32,
     /// Travel at its last observation, metres.
     pub(super) end_travel_m: f64,
 }
+
+// The candidate walk reads a class's occurrences over many laps: keep them small.
+const _: () = assert!(std::mem::size_of::<Occurrence>() == 40);
 
 impl Occurrence {
     pub(super) fn of(id: WordId, w: &Word) -> Self {
@@ -36,6 +42,7 @@ impl Occurrence {
             size: w.size,
             angle_deg: w.angle_deg,
             angle_slack_deg: w.angle_slack_deg,
+            sampling_slack_obs: w.sampling_slack_obs as f32,
             end_travel_m: w.end_travel_m,
         }
     }
@@ -78,6 +85,7 @@ mod tests {
             size: 5,
             angle_deg: 0.0,
             angle_slack_deg: 0.0,
+            sampling_slack_obs: 0.0,
             end_travel_m: id as f64,
         }
     }

@@ -503,6 +503,21 @@ pub struct MatcherOptions {
     /// too, 2 lowered scenario A's 1-level precision to 0.633 at seed 3. RESULTS.md, session 10.
     /// At most 100.
     pub reverse_size_tolerance_observations: usize,
+    /// Read backwards, size syllables also match within this share of the two words' sampling slack
+    /// more ([`Word::sampling_slack_obs`](super::words::Word::sampling_slack_obs): how many more
+    /// observations the scan steps at their ends made), and verification's travel check widens by
+    /// the same share in metres (not in the paper; 0 = off). On a sparse log a class boundary that
+    /// a long scan step crossed is placed somewhere along the step, so a word's size is known to a
+    /// step at each end (Intel: a scan every 0.7 m, 7 observations), while the ratio alone asks a
+    /// 15-observation word to agree within 4. A word's size and the travel to the next word's start
+    /// are one measure, hence one share for both: with the sizes alone widened, the travel check
+    /// turned the chains down. With a scan per observation or denser (every simulated run) the
+    /// slack is 0 and nothing changes. Default 0.2, tuned on Intel (noise seeds 1–5; 0.1 → 3-level
+    /// recall 0.446, 0.15 → 0.471, 0.2 → 0.492, 0.25 → 0.487, 0.3 → 0.481, 0.5 → 0.473, mean
+    /// precision 0.975–0.985) and confirmed on Intel seeds 6–10, Intel every 3rd scan, fhw and
+    /// seattle. Applied driven the same way too, it cost Intel every 3rd scan its precision (0.990
+    /// → 0.904) and fhw 1.000 → 0.976. In [0, 2].
+    pub reverse_sampling_slack: f64,
     /// Angle syllables match when the wrapped difference is at most this, degrees. Default 30.
     pub angle_tolerance_deg: f64,
     /// Widen the angle tolerance of two words by how far their angle syllables may be off
@@ -611,6 +626,7 @@ impl Default for MatcherOptions {
             min_ngram: vec![6, 9, 12, 15],
             size_tolerance_ratio: 0.25,
             reverse_size_tolerance_observations: 0,
+            reverse_sampling_slack: 0.2,
             angle_tolerance_deg: 30.0,
             angle_slack: true,
             candidate_gap_m: 20.0,
@@ -630,12 +646,31 @@ impl Default for MatcherOptions {
 }
 
 impl MatcherOptions {
-    /// Whether the size syllables of two words, `a` and `b` observations long, match read in
+    /// Whether the size syllables of two words, `a` and `b` observations long with sampling
+    /// slack `sampling_obs` between them (the sum of their
+    /// [`Word::sampling_slack_obs`](super::words::Word::sampling_slack_obs)), match read in
     /// direction `dir`: they differ by at most `size_tolerance_ratio` of the larger, read
-    /// backwards `reverse_size_tolerance_observations` more. The one size rule (the matcher and
-    /// the study tools read it).
-    pub fn sizes_match(&self, a: usize, b: usize, dir: Direction) -> bool {
-        self.size_excess_matches(self.size_excess(a, b), dir)
+    /// backwards `reverse_size_tolerance_observations` and `reverse_sampling_slack` ·
+    /// `sampling_obs` more. The one size rule (the matcher and the study tools read it).
+    pub fn sizes_match(&self, a: usize, b: usize, sampling_obs: f64, dir: Direction) -> bool {
+        self.size_excess_matches(self.size_excess(a, b), sampling_obs, dir)
+    }
+
+    /// How much more verification's travel check allows between two word starts read in
+    /// direction `dir`, metres, when the words spanning the travel have sampling slack
+    /// `sampling_obs` between them ([`sizes_match`](Self::sizes_match)) and observations are
+    /// `spacing_m` apart: the same share as the size syllables get, read backwards; 0 driven
+    /// the same way.
+    pub fn travel_sampling_slack_m(
+        &self,
+        sampling_obs: f64,
+        spacing_m: f64,
+        dir: Direction,
+    ) -> f64 {
+        match dir {
+            Direction::Same => 0.0,
+            Direction::Opposite => self.reverse_sampling_slack * sampling_obs * spacing_m,
+        }
     }
 
     /// How far sizes `a` and `b` (observations) differ beyond `size_tolerance_ratio` of the
@@ -648,15 +683,24 @@ impl MatcherOptions {
     /// Whether sizes differing by `excess` ([`size_excess`](Self::size_excess)) match read in
     /// direction `dir`: the second half of [`sizes_match`](Self::sizes_match), for a caller
     /// that tests one excess both ways.
-    pub(crate) fn size_excess_matches(&self, excess: f64, dir: Direction) -> bool {
-        excess <= self.size_slack(dir) + 1e-9
+    pub(crate) fn size_excess_matches(
+        &self,
+        excess: f64,
+        sampling_obs: f64,
+        dir: Direction,
+    ) -> bool {
+        excess <= self.size_slack(sampling_obs, dir) + 1e-9
     }
 
-    /// The observations sizes may differ by beyond the ratio, read in direction `dir`.
-    fn size_slack(&self, dir: Direction) -> f64 {
+    /// The observations sizes may differ by beyond the ratio, read in direction `dir`, for
+    /// words with sampling slack `sampling_obs` between them.
+    fn size_slack(&self, sampling_obs: f64, dir: Direction) -> f64 {
         match dir {
             Direction::Same => 0.0,
-            Direction::Opposite => self.reverse_size_tolerance_observations as f64,
+            Direction::Opposite => {
+                self.reverse_size_tolerance_observations as f64
+                    + self.reverse_sampling_slack * sampling_obs
+            }
         }
     }
 
@@ -711,6 +755,14 @@ impl MatcherOptions {
                 ),
             );
         }
+        let r = self.reverse_sampling_slack;
+        p.within(
+            "reverse_sampling_slack",
+            r,
+            (0.0..=2.0).contains(&r),
+            "[0, 2]",
+            "0.2",
+        );
         let a = self.angle_tolerance_deg;
         p.within(
             "angle_tolerance_deg",

@@ -36,6 +36,13 @@ pub struct DensityObservation {
     /// It splits Ψ's top class in open space (`WordOptions::wide_classes`).
     #[serde(default)]
     pub wide_density: f64,
+    /// How many observations the scan step that made it made in all: 1 when its scan made it
+    /// alone (every simulated run: scans 4–10 cm apart), more along a long step between sparse
+    /// scans (Intel: about 7, a scan every 0.7 m), where the class boundaries the step crossed
+    /// could lie anywhere in it; 0 when unknown (read as 1). Words read it at their ends
+    /// ([`super::words::Word::sampling_slack_obs`]).
+    #[serde(default)]
+    pub scan_step_observations: u32,
 }
 
 /// A density observation reads as the neutral observation it carries (`o.travel_m`,

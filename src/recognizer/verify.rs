@@ -33,6 +33,10 @@
 //! alone is where two paths meet, or where the robot left the revisit). The travel can be
 //! judged likewise (`verify_travel_outliers`, off by default): a word start that moved on one
 //! pass is passed over, and the next one is measured from the last that agreed.
+//! Read backwards on a sparse log, the travel between two word starts may differ by
+//! `reverse_sampling_slack` of the sampling slack of the words spanning it
+//! ([`super::words::Word::sampling_slack_obs`]) more: their sizes, which that travel is, match
+//! within as much, since a class boundary a long scan step crossed lies somewhere along it.
 //! Read backwards, the oldest end of a chain can lie where the robot came into the revisit
 //! from another corridor: its oldest word starts then turn (or travel) on one side only and the
 //! n-gram fails, although its newer words are the place. Chains read backwards are a few long
@@ -83,10 +87,19 @@ impl WordMatcher {
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
         let past_start = |w: WordId| self.reading_start(w, dir);
-        let ok_travel = |a: f64, b: f64| {
+        // Read backwards on a sparse log, the travel between two word starts is known as well as
+        // the sizes of the words spanning it (`reverse_sampling_slack`).
+        let sampling = |w: (WordId, WordId)| {
+            let m = &self.matcher_opts;
+            let obs = self.word(w.0).sampling_slack_obs + self.word(w.1).sampling_slack_obs;
+            m.travel_sampling_slack_m(obs, self.spacing_m, dir)
+        };
+        let first_sampling_m = sampling(word_pairs[0]);
+        let ok_travel = |a: f64, b: f64, sampling_m: f64| {
             (a - b).abs()
                 <= self.verify_opts.verify_travel_ratio * a.abs().max(b.abs())
                     + self.verify_opts.verify_travel_slack_m
+                    + sampling_m
         };
         let turn_tol = self.verify_opts.verify_turn_deg.to_radians();
         let (mut cum_c, mut cum_p) = ((0.0, 0.0), (0.0, 0.0));
@@ -107,7 +120,10 @@ impl WordMatcher {
             cum_c = (cum_c.0 + dc.0, cum_c.1 + dc.1);
             cum_p = (cum_p.0 + dp.0, cum_p.1 + dp.1);
             let interior = i + 2 < word_pairs.len();
-            if ok_travel(cum_c.0 - agreed.0, cum_p.0 - agreed.1) && ok_travel(cum_c.0, cum_p.0) {
+            let step_sampling_m = sampling(w[0]);
+            if ok_travel(cum_c.0 - agreed.0, cum_p.0 - agreed.1, step_sampling_m)
+                && ok_travel(cum_c.0, cum_p.0, first_sampling_m + step_sampling_m)
+            {
                 agreed = (cum_c.0, cum_p.0);
             } else if interior && passed_over < self.verify_opts.verify_travel_outliers {
                 passed_over += 1;

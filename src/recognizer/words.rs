@@ -61,6 +61,11 @@ pub struct Word {
     /// How far A may be off because the positions it is measured from were interpolated
     /// between sparse scans, degrees (`word_angle_slack_deg`; 0 with dense scans).
     pub angle_slack_deg: f64,
+    /// How far S may be off because its ends fall inside long steps between sparse scans, in
+    /// observations: the mean, over its first and last observation, of the other observations
+    /// their scan step made ([`DensityObservation::scan_step_observations`] − 1); 0 with a scan
+    /// per observation or denser (`MatcherOptions::reverse_sampling_slack`).
+    pub sampling_slack_obs: f64,
     /// Index (in the back end's observation list) of the first observation; a word's observations
     /// are consecutive.
     pub first_obs: usize,
@@ -127,6 +132,12 @@ pub fn word_angle_slack_deg(obs: &[Observation], slack_m: &[f64]) -> f64 {
     (chord(i0, im) + chord(im, i1)).to_degrees()
 }
 
+/// [`Word::sampling_slack_obs`] of a word whose first and last observations were made by scan
+/// steps of `first` and `last` observations.
+pub fn word_sampling_slack_obs(first: u32, last: u32) -> f64 {
+    f64::from(first.saturating_sub(1) + last.saturating_sub(1)) / 2.0
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Run {
     class: u8,
@@ -159,6 +170,8 @@ pub struct WordLevels {
     lateral_moments: Vec<f64>,
     /// [`DensityObservation::position_slack_m`] of each observation.
     position_slack_m: Vec<f64>,
+    /// [`DensityObservation::scan_step_observations`] of each observation.
+    scan_step_observations: Vec<u32>,
     /// Index of the first observation of each run.
     run_starts: Vec<usize>,
     obs_class: Vec<u8>,
@@ -201,6 +214,7 @@ impl WordLevels {
             psi: Vec::new(),
             lateral_moments: Vec::new(),
             position_slack_m: Vec::new(),
+            scan_step_observations: Vec::new(),
             run_starts: vec![0],
             obs_class: Vec::new(),
             words: Vec::new(),
@@ -309,6 +323,7 @@ impl WordLevels {
         self.pending_wide.push_back(obs.wide_density);
         self.lateral_moments.push(obs.lateral_moment);
         self.position_slack_m.push(obs.position_slack_m);
+        self.scan_step_observations.push(obs.scan_step_observations);
         self.classify_due(false)
     }
 
@@ -420,6 +435,10 @@ impl WordLevels {
             size: len,
             angle_deg: word_angle_deg(obs),
             angle_slack_deg: word_angle_slack_deg(obs, &self.position_slack_m[start..start + len]),
+            sampling_slack_obs: word_sampling_slack_obs(
+                self.scan_step_observations[start],
+                self.scan_step_observations[start + len - 1],
+            ),
             first_obs: start,
             run: self.run,
             l0_first: l0.0,
@@ -637,6 +656,7 @@ mod tests {
                     psi: p,
                     lateral_moment: 0.0,
                     position_slack_m: 0.0,
+                    scan_step_observations: 1,
                     wide_density: f64::NAN,
                 })
                 .len();
@@ -703,6 +723,37 @@ mod tests {
                 Observation::new(i, 0, i, OdomPose(Pose2::new(x, y, 0.0)), i as f64)
             })
             .collect()
+    }
+
+    /// A word's sampling slack is the mean, over its first and last observation, of the other
+    /// observations their scan step made; 0 where each scan made one (or the count is unknown).
+    #[test]
+    fn sampling_slack_reads_the_scan_steps_at_a_words_ends() {
+        assert_eq!(word_sampling_slack_obs(1, 1), 0.0);
+        assert_eq!(word_sampling_slack_obs(0, 1), 0.0);
+        assert_eq!(word_sampling_slack_obs(7, 3), 4.0);
+        let mut w = WordLevels::new(8, 3, 1);
+        // A word of 10 observations of class 1, its first made by a 7-observation step, its
+        // middle ones by single scans, its last by a 3-observation step; then class 6.
+        let steps = |i: usize| match i {
+            0 => 7,
+            9 => 3,
+            _ => 1,
+        };
+        for i in 0..20 {
+            let pose = OdomPose(Pose2::new(i as f64 * 0.1, 0.0, 0.0));
+            let observation = Observation::new(i, 0, i, pose, i as f64 * 0.1);
+            w.push(&DensityObservation {
+                observation,
+                psi: if i < 10 { 0.2 } else { 0.8 },
+                lateral_moment: 0.0,
+                position_slack_m: 0.0,
+                scan_step_observations: steps(i),
+                wide_density: f64::NAN,
+            });
+        }
+        let first = w.level(0).next().expect("the first word closed");
+        assert_eq!((first.size, first.sampling_slack_obs), (10, 4.0));
     }
 
     /// A word's angle slack is 0 when no position was interpolated, and grows with the slack

@@ -669,14 +669,13 @@ fn assert_recognized_read_backwards(matches: &[WordMatch], mirror_sum: usize) {
     }
 }
 
-/// Driven the other way, a word boundary moves by the flicker the word driven first absorbed
-/// (a word closes only once the new class lasts `min_word_size` observations), so short words
-/// differ in size by a few observations whatever their length: a place of 10- and
-/// 14-observation words whose sizes swap on the way back is recognized read backwards, each
-/// query near its place, with `reverse_size_tolerance_observations` = 2, and not with the ratio
-/// alone (the default; 4 > 0.25 · 14).
-#[test]
-fn short_words_whose_boundaries_moved_are_recognized_driven_back() {
+/// Two laps through a place of 10- and 14-observation words, the second driving it back with
+/// each word's size swapped (14 where it had 10 and the other way round): every observation
+/// made by a scan step of `scan_step_observations`. The observations, and the sum of a query's
+/// and its place's observation index (see [`assert_recognized_read_backwards`]).
+fn place_driven_back_with_sizes_swapped(
+    scan_step_observations: u32,
+) -> (Vec<DensityObservation>, usize) {
     let classes = [2, 4, 1, 5, 3, 6, 2, 4, 1, 5];
     let place = |sizes: [usize; 2]| -> Vec<Stretch> {
         (classes.iter().enumerate())
@@ -700,17 +699,48 @@ fn short_words_whose_boundaries_moved_are_recognized_driven_back() {
     let second = with_noise(synth::observations(&second_lap, 0.1, 0, first.last()), 2);
     let place_len: usize = first_place.iter().map(|s| s.size).sum();
     let (p0, q0) = (70, first.len() + 160);
-    let all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
-
-    let slack = config(|c| c.matcher.reverse_size_tolerance_observations = 2);
-    let (_, matches) = run_matcher(&slack, &all);
+    let mut all: Vec<DensityObservation> = first.iter().chain(&second).copied().collect();
+    for o in &mut all {
+        o.scan_step_observations = scan_step_observations;
+    }
     // Query q0 + j is at the place of observation p0 + place_len − 1 − j, within the
     // boundaries' move.
-    assert_recognized_read_backwards(&matches, p0 + place_len - 1 + q0);
+    (all, p0 + place_len - 1 + q0)
+}
+
+/// Driven the other way, a word boundary moves by the flicker the word driven first absorbed
+/// (a word closes only once the new class lasts `min_word_size` observations), so short words
+/// differ in size by a few observations whatever their length: a place of 10- and
+/// 14-observation words whose sizes swap on the way back is recognized read backwards, each
+/// query near its place, with `reverse_size_tolerance_observations` = 2, and not with the ratio
+/// alone (the default with dense scans; 4 > 0.25 · 14).
+#[test]
+fn short_words_whose_boundaries_moved_are_recognized_driven_back() {
+    let (all, mirror_sum) = place_driven_back_with_sizes_swapped(1);
+    let slack = config(|c| c.matcher.reverse_size_tolerance_observations = 2);
+    let (_, matches) = run_matcher(&slack, &all);
+    assert_recognized_read_backwards(&matches, mirror_sum);
     let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
     assert!(
         matches.iter().all(|m| m.direction == Direction::Same),
         "with the ratio alone the words' sizes do not match read backwards"
+    );
+}
+
+/// On a sparse log a word's size is known to the scan steps at its ends: the same place, its
+/// sizes swapped driven back, made by scan steps of 7 observations (Intel's 0.7 m), is
+/// recognized read backwards with the defaults (`reverse_sampling_slack` 0.2 of 6 + 6
+/// observations: 2.4 ≥ 4 − 0.25 · 14), each query near its place, and not with the option off.
+#[test]
+fn words_of_sparse_scans_match_read_backwards_within_their_scan_steps() {
+    let (all, mirror_sum) = place_driven_back_with_sizes_swapped(7);
+    let (_, matches) = run_matcher(&RecognizerConfig::default(), &all);
+    assert_recognized_read_backwards(&matches, mirror_sum);
+    let off = config(|c| c.matcher.reverse_sampling_slack = 0.0);
+    let (_, matches) = run_matcher(&off, &all);
+    assert!(
+        matches.iter().all(|m| m.direction == Direction::Same),
+        "without the sampling slack the words' sizes do not match read backwards"
     );
 }
 
@@ -980,7 +1010,8 @@ fn front_end_psi(layout: &BeamLayout) -> Vec<DensityObservation> {
 }
 
 /// Sparse scans (one every 0.5 m, as in the Intel log) still give an observation every 0.10 m,
-/// at poses along the path between them.
+/// at poses along the path between them, each saying how many its scan step made (what a word's
+/// size is known to: `reverse_sampling_slack`).
 #[test]
 fn sparse_scans_are_observed_every_spacing_along_the_path() {
     let layout = synth::lms200();
@@ -995,6 +1026,18 @@ fn sparse_scans_are_observed_every_spacing_along_the_path() {
         ));
     }
     assert!(obs.len() >= 190, "{} observations over 19.5 m", obs.len());
+    for o in &obs {
+        let made = obs.iter().filter(|p| p.frame_id == o.frame_id).count();
+        assert_eq!(
+            o.scan_step_observations as usize, made,
+            "at travel {}",
+            o.travel_m
+        );
+        assert!(
+            (4..=6).contains(&made),
+            "a 0.5 m step makes 5 observations, not {made}"
+        );
+    }
     for w in obs.windows(2) {
         let dx = w[1].odom_pose.0.x - w[0].odom_pose.0.x;
         assert!(
@@ -1279,7 +1322,9 @@ fn brute_chain(
     let ok = cw.level < k
         && pw.level < k
         && cw.class == pw.class
-        && cfg.matcher.sizes_match(cw.size, pw.size, Direction::Same)
+        && cfg
+            .matcher
+            .sizes_match(cw.size, pw.size, 0.0, Direction::Same)
         && da <= cfg.matcher.angle_tolerance_deg + 1e-9
         && pw.end_travel_m + cfg.matcher.candidate_gap_m <= cw.start_travel_m + 1e-9;
     let v = if !ok {
@@ -1740,6 +1785,7 @@ fn decreasing_travel_is_refused() {
         lateral_moment: 0.0,
         position_slack_m: 0.0,
         wide_density: 0.0,
+        scan_step_observations: 1,
     };
     m.push_observation(&o);
     o.id = 1;

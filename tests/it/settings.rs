@@ -62,6 +62,7 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         "",
         Input::Dense,
     ),
+    ("matcher.reverse_sampling_slack", "2", "", Input::Sparse),
     ("matcher.angle_tolerance_deg", "90", "", Input::Dense),
     (
         "matcher.angle_slack",

@@ -95,6 +95,7 @@ pub fn observations(
                 lateral_moment: 0.0,
                 position_slack_m: 0.0,
                 wide_density: 0.0,
+                scan_step_observations: 1,
             });
             id += 1;
             input += 1;
