@@ -12,6 +12,13 @@
 //! placement inside the larger word nearest to it; placements within `chain_alignment_tie` of
 //! the least error go to the n-gram's shift. A long word of flat Ψ has no minimum of its own:
 //! inside its own ends it slid to wherever noise favoured, and when both its boundaries had
+//! moved between the visits it was paired metres off; the shift its neighbours agree on holds it.
+//!
+//! **The rest of the current word** (`fill_max_psi_diff`, not in the paper). Eq. 2 pairs n
+//! observations; a current word longer than its match (a boundary that moved) kept the others
+//! unpaired though the match places them. Outwards from the window, each further current
+//! observation is paired at the window's shift while its Ψ stays within the bound of the past
+//! observation's ([`WordMatcher::filled`]).
 
 use super::matcher::WordMatcher;
 use super::options::AlignmentMode;
@@ -171,6 +178,7 @@ impl WordMatcher {
         };
         let s2 = self.word(c).first_obs as i64;
         let past = PastSide::of(self.word(p), dir);
+        let w = self.filled(c, p, &past, w);
         if self.ids_are_indices && self.beyond_gap(s2, &past, &w) {
             let (q, pst) = ((s2 + w.a + w.r.start) as usize, past.index(w.b + w.r.start));
             push_run(out, q, pst, past.step as i8, w.count() as u32);
@@ -183,6 +191,41 @@ impl WordMatcher {
             }
             push_pair(out, q.id, pst.id, past.step as i8);
         }
+    }
+
+    /// Placement `w` of current word `c` against past word `p` (read as `past`), widened over
+    /// the rest of the current word (`fill_max_psi_diff`): outwards from the window, each further
+    /// current observation pairs with the past observation the window's shift gives, while that
+    /// one lies in the past word's run and their Ψ differ by at most the bound. Eq. 2 pairs n =
+    /// min(S₁, S₂) observations; when the current word is the longer (a class boundary moved
+    /// between the visits and the word still matched within the size tolerance), its other
+    /// observations were left unpaired although the match says where they are. The bound stops
+    /// the pairs where the two paths part.
+    pub(super) fn filled(&self, c: WordId, p: WordId, past: &PastSide, w: Placement) -> Placement {
+        let bound = self.align_opts.fill_max_psi_diff;
+        if bound <= 0.0 || w.count() == 0 {
+            return w;
+        }
+        let psi = self.words.psi();
+        let cw = self.word(c);
+        let current = cw.first_obs as i64..(cw.first_obs + cw.size) as i64;
+        let run = self.words.run_range(self.word(p).run);
+        let run = run.start as i64..run.end as i64;
+        let (q0, b) = (current.start + w.a, w.b);
+        let pairs = |i: i64| {
+            let (q, pj) = (q0 + i, past.base + past.step * (b + i));
+            current.contains(&q)
+                && run.contains(&pj)
+                && (psi[q as usize] - psi[pj as usize]).abs() <= bound
+        };
+        let (mut start, mut end) = (w.r.start, w.r.end);
+        while pairs(start - 1) {
+            start -= 1;
+        }
+        while pairs(end) {
+            end += 1;
+        }
+        Placement { r: start..end, ..w }
     }
 
     /// Whether every pair of placement `w` (current word from observation `s2`) passes the

@@ -844,6 +844,17 @@ pub struct AlignmentOptions {
     /// flat Ψ otherwise slid to whatever placement noise favoured). Ψ², default 1e-4 (an RMS
     /// difference of 0.01, a twelfth of a class of 8).
     pub chain_alignment_tie: f64,
+    /// Pairs the rest of a matched current word too (not in the paper): Eq. 2 pairs n =
+    /// min(S₁, S₂) observations, so a current word longer than its past match (a class boundary
+    /// that moved between the visits) kept observations unpaired although the match places
+    /// them. Outwards from the window, each further observation of the current word pairs with
+    /// the past observation the window's shift gives while their Ψ differ by at most this.
+    /// Ψ, default 0.03, in [0, 1]; 0 = the n pairs of Eq. 2 only. Tuned on Intel (noise seeds
+    /// 1–5: 3-level recall 0.492 → 0.502 at precision 0.978; 0.04: 0.507 but `reverse`'s
+    /// 1-level precision bound missed on one seed, 0.08: 0.510 at worst-seed precision 0.966),
+    /// confirmed on Intel seeds 6–10, Intel every 3rd scan, seattle, fhw and the scenarios
+    /// (RESULTS.md, session 13).
+    pub fill_max_psi_diff: f64,
 }
 
 impl Default for AlignmentOptions {
@@ -853,6 +864,7 @@ impl Default for AlignmentOptions {
             max_alignment_offset: 10,
             chain_alignment_offset: 5,
             chain_alignment_tie: 1e-4,
+            fill_max_psi_diff: 0.03,
         }
     }
 }
@@ -876,6 +888,14 @@ impl AlignmentOptions {
             }
         }
         p.non_negative("chain_alignment_tie", self.chain_alignment_tie);
+        let f = self.fill_max_psi_diff;
+        p.within(
+            "fill_max_psi_diff",
+            f,
+            (0.0..=1.0).contains(&f),
+            "[0, 1]",
+            "0.03",
+        );
         p.out
     }
 }

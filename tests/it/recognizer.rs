@@ -882,6 +882,88 @@ fn alignment_recovers_a_shift() {
     }
 }
 
+/// A class boundary that moved between two visits makes the current word longer than its
+/// past match; the alignment pairs the whole current word (`fill_max_psi_diff`), each moved
+/// observation with its true partner, as far as Ψ agrees: Eq. 2's n = min(S₁, S₂) pairs alone
+/// leave the moved observations out, and where their Ψ differs by more than the bound they stay
+/// out.
+#[test]
+fn the_rest_of_a_longer_current_word_is_paired_where_psi_agrees() {
+    const MOVED: usize = 4;
+    // Stretches 6 and 7 are neighbouring classes (3 and 4, boundary at Ψ = 0.5); on both visits
+    // stretch 7 begins with MOVED observations near that boundary, above it the first time and
+    // below it the second, so the second time they close word 6 instead.
+    let passes = |half_gap: f64| {
+        let mut lap = random_stretches(17, 14);
+        lap[6] = Stretch::new(class_psi(3, 8), 20, 0.0);
+        lap[7] = Stretch::new(class_psi(4, 8), 24, 90.0);
+        lap[5].psi = class_psi(6, 8);
+        lap[8].psi = class_psi(1, 8);
+        let start7: usize = lap[..7].iter().map(|s| s.size).sum();
+        let mut first = synth::observations(&lap, 0.1, 0, None);
+        let mut second = synth::observations(&lap, 0.1, 0, first.last());
+        for i in start7..start7 + MOVED {
+            first[i].psi = 0.5 + half_gap;
+            second[i].psi = 0.5 - half_gap;
+        }
+        let n = first.len();
+        let all: Vec<DensityObservation> = first.into_iter().chain(second).collect();
+        let moved: Vec<usize> = (n + start7..n + start7 + MOVED).collect();
+        (all, n, moved)
+    };
+    let paired = |cfg: &RecognizerConfig, all: &[DensityObservation], n: usize, moved: &[usize]| {
+        let (m, matches) = run_matcher(cfg, all);
+        assert!(!matches.is_empty(), "the second visit is recognized");
+        let word6 = m
+            .words()
+            .level(0)
+            .find(|w| w.obs_range().contains(&moved[0]));
+        assert_eq!(
+            word6.map(|w| w.size),
+            Some(20 + MOVED),
+            "the current word is longer"
+        );
+        let pairs: Vec<(usize, usize)> = matches.iter().flat_map(WordMatch::pairs).collect();
+        for &(q, p) in &pairs {
+            assert_eq!(q - n, p, "every pair is the true partner");
+        }
+        pairs
+            .into_iter()
+            .map(|(q, _)| q)
+            .collect::<std::collections::HashSet<_>>()
+    };
+    let cfg = config(|c| {
+        c.levels = 1;
+        c.matcher.min_ngram = vec![3];
+        c.matcher.candidate_gap_m = 5.0;
+    });
+    assert!(cfg.alignment.fill_max_psi_diff > 0.02, "on by default");
+    let off = config(|c| {
+        *c = cfg.clone();
+        c.alignment.fill_max_psi_diff = 0.0;
+    });
+    // |ΔΨ| = 0.02 over the moved observations: the same place, classed differently.
+    let (all, n, moved) = passes(0.01);
+    let on = paired(&cfg, &all, n, &moved);
+    assert!(
+        moved.iter().all(|q| on.contains(q)),
+        "the whole word is paired"
+    );
+    let without = paired(&off, &all, n, &moved);
+    assert!(
+        moved.iter().all(|q| !without.contains(q)),
+        "Eq. 2's window alone"
+    );
+    assert!(on.len() > without.len());
+    // |ΔΨ| = 0.06: more than the bound, so not the same place as far as Ψ can tell.
+    let (all, n, moved) = passes(0.03);
+    let on = paired(&cfg, &all, n, &moved);
+    assert!(
+        moved.iter().all(|q| !on.contains(q)),
+        "Ψ differs: not paired"
+    );
+}
+
 /// A grid that remembers less than its torus holds gives, at the robot, the Ψ of a grid whose
 /// torus is exactly its window, and a kernel centred far back along a step reads the cells it
 /// forgot as unknown: the torus's far side (ahead of the robot) never leaks into it.

@@ -95,6 +95,7 @@ const TRIES: &[(&str, &str, &str, Input)] = &[
         Input::Dense,
     ),
     ("alignment.chain_alignment_tie", "0.05", "", Input::Dense),
+    ("alignment.fill_max_psi_diff", "0", "", Input::Dense),
     ("matcher.reverse", "false", "", Input::Dense),
     ("matcher.reverse_extra_ngram", "0", "", Input::Dense),
     // Smoke's chains of τ words take three classes or more: with n-grams of two words, some
