@@ -21,6 +21,11 @@
 //! The classes are an estimate (the chain along the truth uses level 0 only), good enough to
 //! tell which share a change to verification can reach.
 //!
+//! Then, for the misses outside the short stretches, how far along their stretch the nearest
+//! recognized observation lies and on which side (the miss `before` a recognized run, `after`
+//! one, or `between` two): misses next to recognized runs are within reach of the pairing
+//! (`fill_max_psi_diff` came from this count), isolated ones of the words only.
+//!
 //! ```text
 //! cargo run --release --example revisit_reach -- ../shared/data/carmen/intel-corrected.log.gz --seed 1
 //! ```
@@ -59,6 +64,8 @@ struct Args {
 const RADIUS_M: f64 = 1.0;
 const MIN_GAP_M: f64 = 20.0;
 const HEADING_TOL_DEG: f64 = 45.0;
+/// How far along its stretch a miss looks for the nearest recognized observation, metres.
+const NEAREST_REACH_M: f64 = 20.0;
 /// Observations without a revisit a stretch runs on across, as travel, metres.
 const STRETCH_GAP_M: f64 = 1.0;
 
@@ -129,6 +136,7 @@ fn run(args: &Args) -> Result<()> {
     // one revisit: a stretch runs on across such gaps.
     let gap = (STRETCH_GAP_M / cfg.front_end.observation_spacing_m).round() as usize;
     let mut classes: BTreeMap<String, [usize; 2]> = BTreeMap::new();
+    let mut nearest: BTreeMap<String, [usize; 2]> = BTreeMap::new();
     let (mut with_revisit, mut hit) = (0, 0);
     for i in 0..t.len() {
         let Some((_, dir)) = partner[i] else { continue };
@@ -153,6 +161,15 @@ fn run(args: &Args) -> Result<()> {
         } else {
             "other".to_string()
         };
+        if class != "short" {
+            let spacing_m = cfg.front_end.observation_spacing_m;
+            let reach = (NEAREST_REACH_M / spacing_m).round() as usize;
+            let row = match nearest_recognized(&partner, &base, i, dir, gap, reach) {
+                Some((n, side)) => format!("{}, {side}", distance_bucket(n as f64 * spacing_m)),
+                None => format!("none within {NEAREST_REACH_M} m"),
+            };
+            nearest.entry(row).or_default()[dir as usize] += 1;
+        }
         classes.entry(class).or_default()[dir as usize] += 1;
     }
     let share = |n: usize| n as f64 / with_revisit.max(1) as f64;
@@ -167,6 +184,13 @@ fn run(args: &Args) -> Result<()> {
     for (class, [same, opp]) in &classes {
         let n = same + opp;
         println!("{class:<16} {same:>6} {opp:>6} {n:>6}  {:.3}", share(n));
+    }
+    println!(
+        "misses outside the short stretches, by the nearest recognized observation of their stretch:"
+    );
+    println!("{:<20} {:>6} {:>6}", "nearest, side", "same", "opp");
+    for (row, [same, opp]) in &nearest {
+        println!("{row:<20} {same:>6} {opp:>6}");
     }
     let short = classes.get("short").map_or(0, |c| c[0] + c[1]);
     let right = |q: usize, p: usize, dir: Direction| {
@@ -270,6 +294,58 @@ fn revisit(t: &[Truth], i: usize) -> Option<(usize, Direction)> {
         }
     }
     best.map(|(_, j, dir)| (j, dir))
+}
+
+/// How many observations along its revisit stretch (driven the way `dir` says, across gaps of
+/// at most `gap` observations without a revisit) the nearest recognized observation lies from
+/// `i`, up to `reach`, and on which side of it `i` is: `before` it, `after` it, or `between` two
+/// equally near; `None` when none is that near.
+fn nearest_recognized(
+    partner: &[Option<(usize, Direction)>],
+    recognized: &HashSet<usize>,
+    i: usize,
+    dir: Direction,
+    gap: usize,
+    reach: usize,
+) -> Option<(usize, &'static str)> {
+    let inside = |o: usize| partner[o].is_some_and(|(_, d)| d == dir);
+    // Steps from `i` one way (`by` = ±1) to the first recognized observation of the stretch.
+    let walk = |by: isize| -> Option<usize> {
+        let mut without = 0;
+        for n in 1..=reach {
+            let o = i
+                .checked_add_signed(by * n as isize)
+                .filter(|&o| o < partner.len())?;
+            if !inside(o) {
+                without += 1;
+                if without > gap {
+                    return None;
+                }
+                continue;
+            }
+            without = 0;
+            if recognized.contains(&o) {
+                return Some(n);
+            }
+        }
+        None
+    };
+    match (walk(1), walk(-1)) {
+        (Some(a), Some(b)) if a == b => Some((a, "between")),
+        (Some(a), Some(b)) if a < b => Some((a, "before")),
+        (Some(a), None) => Some((a, "before")),
+        (_, Some(b)) => Some((b, "after")),
+        (None, None) => None,
+    }
+}
+
+/// The distance class of a miss `m` metres from the nearest recognized observation.
+fn distance_bucket(m: f64) -> String {
+    let upto = [1.0, 2.0, 4.0, 8.0]
+        .into_iter()
+        .find(|&b| m <= b + 1e-9)
+        .unwrap_or(NEAREST_REACH_M);
+    format!("≤ {upto} m")
 }
 
 /// Level-0 words with at least half their observations in the revisit stretch around `i`
