@@ -62,7 +62,7 @@ impl WordMatcher {
     /// The size syllables of [`syllables_match`](Self::syllables_match)
     /// ([`MatcherOptions::sizes_match`](super::options::MatcherOptions::sizes_match)).
     fn sizes_match(&self, a: &Word, b: &Occurrence, dir: Direction) -> bool {
-        let sampling = a.sampling_slack_obs + f64::from(b.sampling_slack_obs);
+        let sampling = b.sampling_slack_with(a);
         self.matcher_opts.sizes_match(a.size, b.size, sampling, dir)
     }
 
@@ -123,7 +123,7 @@ impl WordMatcher {
             let m = &self.matcher_opts;
             for p in occ {
                 let over = m.size_excess(cw.size, p.size);
-                let sampling = cw.sampling_slack_obs + f64::from(p.sampling_slack_obs);
+                let sampling = p.sampling_slack_with(cw);
                 if m.size_excess_matches(over, sampling, Direction::Same)
                     && self.angles_match(cw, p, Direction::Same)
                 {

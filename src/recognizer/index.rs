@@ -36,6 +36,12 @@ pub(super) struct Occurrence {
 const _: () = assert!(std::mem::size_of::<Occurrence>() == 40);
 
 impl Occurrence {
+    /// The sampling slack of this word and `w` together, observations (what
+    /// [`MatcherOptions::sizes_match`](super::options::MatcherOptions::sizes_match) reads).
+    pub(super) fn sampling_slack_with(&self, w: &Word) -> f64 {
+        w.sampling_slack_obs + f64::from(self.sampling_slack_obs)
+    }
+
     pub(super) fn of(id: WordId, w: &Word) -> Self {
         Occurrence {
             id,

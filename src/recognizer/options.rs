@@ -667,9 +667,17 @@ impl MatcherOptions {
         spacing_m: f64,
         dir: Direction,
     ) -> f64 {
+        self.sampling_slack(sampling_obs, dir) * spacing_m
+    }
+
+    /// The share of `sampling_obs` (observations) that sizes, and the travel between word
+    /// starts, may differ by beyond their own tolerances, read in direction `dir`: the one
+    /// `reverse_sampling_slack` rule of [`size_slack`](Self::size_slack) and
+    /// [`travel_sampling_slack_m`](Self::travel_sampling_slack_m).
+    fn sampling_slack(&self, sampling_obs: f64, dir: Direction) -> f64 {
         match dir {
             Direction::Same => 0.0,
-            Direction::Opposite => self.reverse_sampling_slack * sampling_obs * spacing_m,
+            Direction::Opposite => self.reverse_sampling_slack * sampling_obs,
         }
     }
 
@@ -695,13 +703,11 @@ impl MatcherOptions {
     /// The observations sizes may differ by beyond the ratio, read in direction `dir`, for
     /// words with sampling slack `sampling_obs` between them.
     fn size_slack(&self, sampling_obs: f64, dir: Direction) -> f64 {
-        match dir {
+        let observations = match dir {
             Direction::Same => 0.0,
-            Direction::Opposite => {
-                self.reverse_size_tolerance_observations as f64
-                    + self.reverse_sampling_slack * sampling_obs
-            }
-        }
+            Direction::Opposite => self.reverse_size_tolerance_observations as f64,
+        };
+        observations + self.sampling_slack(sampling_obs, dir)
     }
 
     /// Every problem of these options for a run of `levels` level configurations, located by
@@ -965,8 +971,9 @@ pub struct VerifyOptions {
     /// each word start (current minus past, from the first word) must lie within
     /// `verify_turn_deg` of the offsets' median, except at up to this many word starts, never
     /// the newest, nor the first unless the n-gram extends a reported chain (then its first word
-    /// start lies inside the chain: session 13, Intel noise seed 4 recall 0.485 → 0.505). 0 = the per-word limit of `verify_turn_deg` (every step, and every
-    /// offset from the first word, within it). Default 1 (not in the paper). Why: a real robot
+    /// start lies inside the chain: session 13, Intel noise seed 4 recall 0.485 → 0.505). 0 =
+    /// the per-word limit of `verify_turn_deg` (every step, and every offset from the first
+    /// word, within it). Default 1 (not in the paper). Why: a real robot
     /// cuts corners and turns on the spot, so a word boundary can fall inside a corner on one
     /// visit and after it on the other; that one word start is then off by the corner (60–80°)
     /// and the next agrees again. On Intel (noise seeds 1–5) the per-word limit turned down 54
