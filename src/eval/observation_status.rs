@@ -49,10 +49,13 @@ pub fn observation_status(rec: &Recognition, spec: &EvaluationSpec) -> Observati
         .enumerate()
         .map(|(i, o)| (o.id, i))
         .collect();
+    // The observation's own true pose, as the evaluation places it (its frame's, moved by the
+    // odometry between them): a real log's scans are up to a metre apart, the observations
+    // 0.1 m, so the frame's pose would judge a pair against another place than the report.
     let pose = |i: usize| {
         rec.truth
-            .frame(rec.observations[i].frame_id)
-            .map(|f| f.pose.0)
+            .observation_pose(&rec.observations[i])
+            .map(|p| p.0)
     };
     let n = rec.observations.len();
     let mut pair_counts = vec![(0usize, 0usize); n];
@@ -137,6 +140,59 @@ pub fn worst_wrong_clusters(wrong: &[(Vec2, Vec2)], k: usize) -> Vec<(Vec2, Vec2
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The status judges a pair as the report does, at the observations' own true poses: on a
+    /// log whose scans are a metre apart and whose observations are 0.1 m apart, its correct
+    /// pairs and the observations it counts as the newer side of one are the evaluation's.
+    #[test]
+    fn pairs_are_judged_at_the_observations_poses_as_the_report_judges_them() {
+        use crate::eval::metrics::{evaluate, tests::recognition};
+        use crate::eval::{GroundTruth, LapInfo};
+        use crate::geom::{OdomPose, Pose2, TruePose};
+        use crate::place::{Match, Observation};
+        // Two laps of a 40 m circle; a scan (frame) every 1 m, an observation every 0.1 m.
+        let (per_lap, radius) = (400, 40.0 / std::f64::consts::TAU);
+        let on_circle = |k: usize| {
+            let a = k as f64 / per_lap as f64 * std::f64::consts::TAU;
+            Pose2::new(
+                radius * a.cos(),
+                radius * a.sin(),
+                a + std::f64::consts::FRAC_PI_2,
+            )
+        };
+        let (mut obs, mut gt) = (Vec::new(), GroundTruth::default());
+        for lap in 0..2 {
+            gt.start_lap(LapInfo {
+                run: 0,
+                lap,
+                door_config: "closed".into(),
+                open_doors: vec![],
+            });
+            for k in 0..per_lap {
+                if k % 10 == 0 {
+                    gt.push_frame(TruePose(on_circle(k)), OdomPose(on_circle(k)));
+                }
+                let i = obs.len();
+                let frame = gt.frames.len() - 1;
+                obs.push(Observation::new(
+                    i,
+                    0,
+                    frame,
+                    OdomPose(on_circle(k)),
+                    i as f64 * 0.1,
+                ));
+            }
+        }
+        // The second lap's observations paired with the first's at shifts of up to ±1.5 m.
+        let pairs = (50..350).map(|k| (per_lap + k, (k as i64 + (k as i64 % 31) - 15) as usize));
+        let rec = recognition(&obs, &gt, vec![Match::from_pairs(pairs, 1.0)]);
+        let spec = EvaluationSpec::default();
+        let (status, e) = (observation_status(&rec, &spec), evaluate(&rec, &spec));
+        assert!(e.main.correct_pairs > 0 && e.main.correct_pairs < e.main.pairs);
+        assert_eq!(status.correct_pairs, e.main.correct_pairs);
+        let newer_side: Vec<bool> = status.pair_counts.iter().map(|c| c.0 > 0).collect();
+        assert_eq!(newer_side, e.recognized);
+    }
 
     #[test]
     fn worst_clusters_are_largest_first() {
