@@ -276,8 +276,7 @@ pub fn matches_svg(
     // The true revisits turned down, and those recognized later all the same (the query
     // observation the newer side of a correct pair), counted as the report counts them.
     let recognized: Vec<bool> = status.pair_counts.iter().map(|c| c.0 > 0).collect();
-    let right_rejected = RejectedScores::of(&rec.rejected, &checks, &spec, &recognized)
-        .map_or((0, 0), |s| (s.correct, s.correct_recognized));
+    let turned_down = RejectedScores::of(&rec.rejected, &checks, &spec, &recognized);
     opts.marks.extend(turned_down_marks(
         &rec.rejected,
         &checks,
@@ -297,7 +296,7 @@ pub fn matches_svg(
         .collect();
     opts.legend
         .extend(status_legend(&status, clusters.len(), shown));
-    let mut notes = pair_notes(&status, rec.rejected.len(), right_rejected);
+    let mut notes = pair_notes(&status, turned_down.as_ref());
     notes.append(&mut opts.notes);
     opts.notes = notes;
     render_world_svg(world, &opts)
@@ -340,28 +339,17 @@ fn status_legend(status: &ObservationStatus, clusters: usize, shown: usize) -> V
     out
 }
 
-/// The matches picture's notes: the pairs, and what verification turned down (`rejected`
-/// candidates sampled; `right_rejected`: how many of them were true revisits, and how many of
-/// those were recognized later all the same).
-fn pair_notes(
-    status: &ObservationStatus,
-    rejected: usize,
-    (right_rejected, later): (usize, usize),
-) -> Vec<String> {
+/// The matches picture's notes: the pairs, and what verification turned down (`turned_down`:
+/// the candidates sampled, scored as the report scores them), in the text table's words.
+fn pair_notes(status: &ObservationStatus, turned_down: Option<&RejectedScores>) -> Vec<String> {
     let mut notes = vec![format!(
         "pairs: {} correct, {} wrong",
         status.correct_pairs,
         status.wrong_pairs.len()
     )];
-    if rejected > 0 {
-        let look_alikes = rejected - right_rejected;
-        notes.push(format!(
-            "verification turned down {right_rejected} true revisit{} ({later} recognized \
-             later all the same), {look_alikes} look-alike{} (candidates sampled)",
-            plural(right_rejected),
-            plural(look_alikes)
-        ));
-        if right_rejected > 0 {
+    if let Some(r) = turned_down {
+        notes.push(crate::report::explain::turned_down_sentence(r));
+        if r.correct > 0 {
             notes.push(
                 "purple rings: true revisits turned down per 5 m, and the check that did most \
                  (Tr travel, Tu turn, D density, S sides, St straight)"
@@ -752,14 +740,25 @@ mod tests {
             correct_pairs: 3,
             wrong_pairs: Vec::new(),
         };
-        let notes = pair_notes(&status, 5, (2, 1));
+        let turned_down = RejectedScores {
+            sampled: 5,
+            correct: 2,
+            correct_recognized: 1,
+            ..Default::default()
+        };
+        let notes = pair_notes(&status, Some(&turned_down));
         assert!(
             notes.contains(
-                &"verification turned down 2 true revisits (1 recognized later all the same), \
-                  3 look-alikes (candidates sampled)"
+                &"verification turned down 2 true revisits (1 recognized later all the same, 1 \
+                  lost) and 3 look-alikes (of 5 candidates sampled)"
                     .to_string()
             ),
             "{notes:?}"
+        );
+        assert_eq!(
+            pair_notes(&status, None).len(),
+            1,
+            "no sentence without candidates"
         );
     }
 

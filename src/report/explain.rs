@@ -3,8 +3,9 @@
 //! ([`crate::eval::scores::NoPairsCauses`]); this module words them, and so builds the
 //! [`Scores`] and the report's subjects a run writes: [`Scores::of`], [`Report::add_subject`],
 //! [`Report::add_level`] (inherent methods of `eval`'s types, defined here, above `eval`).
-//! Also the truth rule in words ([`truth_rule`]) and the lap cache's lines
-//! ([`lap_cache_lines`]); a comparison's and a gate's sentences are in `report::compare` and
+//! Also the truth rule in words ([`truth_rule`]), what verification turned down
+//! ([`turned_down_sentence`], for the text table and the matches picture) and the lap cache's
+//! lines ([`lap_cache_lines`]); a comparison's and a gate's sentences are in `report::compare` and
 //! `report::suite`. `eval` itself writes no sentence a person reads, only data and error messages.
 
 use crate::eval::Recognition;
@@ -102,6 +103,33 @@ fn rejected_sentence(r: &RejectedScores, spec: &EvaluationSpec) -> String {
         r.sampled,
         spec.tp_radius_m,
         by_check.join(", ")
+    )
+}
+
+/// What verification turned down, in one sentence for the text table and the matches picture:
+/// the true revisits, how many of them were recognized later all the same (a later n-gram
+/// through the same place passed: the check made them wait) and how many were lost, and the
+/// look-alikes, of the candidates sampled.
+pub fn turned_down_sentence(r: &RejectedScores) -> String {
+    let s = |n: usize| if n == 1 { "" } else { "s" };
+    let alike = r.sampled - r.correct;
+    let fate = if r.correct == 0 {
+        String::new()
+    } else {
+        format!(
+            " ({} recognized later all the same, {} lost)",
+            r.correct_recognized,
+            r.correct - r.correct_recognized
+        )
+    };
+    format!(
+        "verification turned down {} true revisit{}{fate} and {alike} look-alike{} (of {} \
+         candidate{} sampled)",
+        r.correct,
+        s(r.correct),
+        s(alike),
+        r.sampled,
+        s(r.sampled)
     )
 }
 

@@ -410,16 +410,9 @@ fn notes(report: &Report, out: &mut String) {
     // Where there are pairs (the reason says it otherwise): what verification turned down.
     for (label, s) in rows(report) {
         if let (None, Some(r)) = (&s.no_pairs_reason, &s.rejected_candidates) {
-            let s = |n: usize| if n == 1 { "" } else { "s" };
-            let alike = r.sampled - r.correct;
             lines.push(format!(
-                "{label}: verification turned down {} true revisit{} and {alike} look-alike{} \
-                 (of {} candidate{} sampled)",
-                r.correct,
-                s(r.correct),
-                s(alike),
-                r.sampled,
-                s(r.sampled)
+                "{label}: {}",
+                super::explain::turned_down_sentence(r)
             ));
         }
     }
@@ -740,8 +733,9 @@ mod tests {
     /// under the level row; without them, neither does.
     /// Steps too long to observe along their length are noted once when there are pairs (and
     /// are part of the reason when there are none).
-    /// With pairs, each level's line says how many true revisits and look-alikes verification
-    /// turned down; without, its reason says it and the line is not repeated.
+    /// With pairs, each level's line says how many true revisits (and how many of those were
+    /// recognized later all the same, and lost) and look-alikes verification turned down;
+    /// without, its reason says it and the line is not repeated.
     #[test]
     fn turned_down_candidates_are_told_per_level() {
         let mut rep = sample("A", [0.9; 3], [0.2; 3]);
@@ -750,14 +744,20 @@ mod tests {
             l.scores.rejected_candidates = Some(crate::eval::scores::RejectedScores {
                 sampled: 25,
                 correct: 22,
+                correct_recognized: 20,
                 ..Default::default()
             });
         }
         rep.subjects[0].scores.no_pairs_reason = Some("every candidate was rejected".into());
         let t = text_table(&rep);
         assert_eq!(t.matches("verification turned down").count(), 2, "{t}");
+        // The lines are wrapped to the table's width; the sentence is read unwrapped.
+        let unwrapped = t.replace("\n    ", " ");
         assert!(
-            t.contains("verification turned down 22 true revisits and 3 look-alikes (of 25"),
+            unwrapped.contains(
+                "verification turned down 22 true revisits (20 recognized later all the same, 2 \
+                 lost) and 3 look-alikes (of 25 candidates sampled)"
+            ),
             "{t}"
         );
     }
