@@ -138,7 +138,6 @@ impl ExperimentOutputs {
         self,
         exp: &placewords::experiment::Experiment,
         world: &placewords::world::World,
-        radius_m: f64,
         provenance: &placewords::eval::provenance::Provenance,
     ) -> anyhow::Result<()> {
         out!("{}", placewords::report::table::text_table(&exp.report))?;
@@ -163,7 +162,7 @@ impl ExperimentOutputs {
         }
         if let Some(dir) = &self.svg {
             let staging = self.set.dir(dir).expect("begun with this folder");
-            placewords::experiment::picture::write_pictures(exp, world, radius_m, staging)?;
+            placewords::experiment::picture::write_pictures(exp, world, staging)?;
         }
         let written: Vec<String> = [&self.report, &self.matches, &self.svg]
             .into_iter()

@@ -176,6 +176,6 @@ pub fn run(args: RecognizeArgs) -> anyhow::Result<ExitCode> {
         ]);
         prov
     };
-    outputs.print_and_write(&exp, &world, args.tp_radius_m, &provenance)?;
+    outputs.print_and_write(&exp, &world, &provenance)?;
     Ok(ExitCode::SUCCESS)
 }

@@ -124,12 +124,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<ExitCode> {
     let mut provenance =
         experiment::scenario_provenance(&[&scn], args.laps, super::common::command_line());
     provenance.lap_cache = cache.map(|c| c.used());
-    outputs.expect("begun for one seed").print_and_write(
-        &exp,
-        &scn.sim.world,
-        scn.evaluation.tp_radius_m,
-        &provenance,
-    )?;
+    outputs
+        .expect("begun for one seed")
+        .print_and_write(&exp, &scn.sim.world, &provenance)?;
     if args.profile {
         eprint!("{}", profile_text([&exp.report], w.wall_s()));
     }

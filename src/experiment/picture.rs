@@ -235,19 +235,16 @@ fn plural(n: usize) -> &'static str {
 }
 
 /// The world with the true path coloured where revisits were recognized, recognized wrongly
-/// and missed (see [`ObservationStatus`]), and the worst clusters of wrong pairs as lines.
+/// and missed (see [`ObservationStatus`]), and the worst clusters of wrong pairs as lines,
+/// judged by `spec`: the rule the run's report was scored with (radius, gap, headings).
 pub fn matches_svg(
     world: &World,
     runs: &[RunLog],
     rec: &Recognition,
-    radius_m: f64,
+    spec: &EvaluationSpec,
     title: &str,
 ) -> String {
-    let spec = EvaluationSpec {
-        tp_radius_m: radius_m,
-        ..EvaluationSpec::default()
-    };
-    let status = observation_status(rec, &spec);
+    let status = observation_status(rec, spec);
     let mut opts = plain(world, runs, title.to_string());
     opts.paths = true_paths(runs, "true path, no revisit");
     for p in &mut opts.paths {
@@ -276,11 +273,11 @@ pub fn matches_svg(
     // The true revisits turned down, and those recognized later all the same (the query
     // observation the newer side of a correct pair), counted as the report counts them.
     let recognized: Vec<bool> = status.pair_counts.iter().map(|c| c.0 > 0).collect();
-    let turned_down = RejectedScores::of(&rec.rejected, &checks, &spec, &recognized);
+    let turned_down = RejectedScores::of(&rec.rejected, &checks, spec, &recognized);
     opts.marks.extend(turned_down_marks(
         &rec.rejected,
         &checks,
-        &spec,
+        spec,
         2 * WORST_CLUSTERS,
     ));
     let clusters = worst_wrong_clusters(&status.wrong_pairs, WORST_CLUSTERS);
@@ -520,7 +517,6 @@ pub fn empty_world(runs: &[RunLog], name: &str) -> World {
 pub fn write_pictures(
     exp: &super::Experiment,
     world: &World,
-    radius_m: f64,
     dir: &Path,
 ) -> std::io::Result<Vec<PathBuf>> {
     let name = &exp.report.scenario;
@@ -548,7 +544,7 @@ pub fn write_pictures(
         );
     for (what, file, rec) in recognitions {
         let title = format!("{name}: matched pairs, {what}");
-        let svg = matches_svg(world, &exp.runs, rec, radius_m, &title);
+        let svg = matches_svg(world, &exp.runs, rec, &exp.report.evaluation, &title);
         pictures.push((format!("matches-{file}.svg"), svg));
         let title = format!("{name}: recall and precision per lap, {what}");
         let svg = lap_strip_svg(rec, &exp.report.evaluation, &title);
@@ -710,7 +706,11 @@ mod tests {
         let runs = [run_in(&world, 0, &[])];
         let truth = std::sync::Arc::new(GroundTruth::from_runs(&runs));
         let rec = Recognition::new("none", Vec::new(), Vec::new(), 1, truth);
-        let texts = doc_texts(&matches_svg(&world, &runs, &rec, 0.5, "t"));
+        let spec = EvaluationSpec {
+            tp_radius_m: 0.5,
+            ..EvaluationSpec::default()
+        };
+        let texts = doc_texts(&matches_svg(&world, &runs, &rec, &spec, "t"));
         for absent in [
             "most pairs wrong",
             "most pairs correct",
@@ -725,6 +725,36 @@ mod tests {
         assert!(texts.contains(&"pairs: 0 correct, 0 wrong".to_string()));
         assert_eq!(plural(1), "");
         assert_eq!(plural(2), "s");
+    }
+
+    /// The picture judges revisits by the run's whole rule, not by its radius alone: a gap the
+    /// report was scored with (`recognize --min-gap-m`) decides what it draws as missed.
+    #[test]
+    fn matches_picture_follows_the_reports_rule() {
+        let world = loop_small();
+        let runs = [run_in(&world, 0, &[])];
+        // Two laps of a 40 m circle, no match: what has a revisit depends on the gap.
+        let (obs, truth) = crate::eval::metrics::tests::circle(2, 40.0);
+        let rec = crate::eval::metrics::tests::recognition(&obs, &truth, Vec::new());
+        let missed = |min_gap_m: f64| {
+            let spec = EvaluationSpec {
+                min_gap_m,
+                ..EvaluationSpec::default()
+            };
+            let drawn = doc_texts(&matches_svg(&world, &runs, &rec, &spec, "t"))
+                .into_iter()
+                .find(|t| t.starts_with("revisit missed"));
+            let revisits = crate::eval::evaluate(&rec, &spec).main.revisits;
+            (drawn, revisits)
+        };
+        let (near, far) = (missed(20.0), missed(50.0));
+        assert!(near.1 > far.1 && far.1 > 0, "{near:?} {far:?}");
+        for (drawn, revisits) in [near, far] {
+            assert_eq!(
+                drawn,
+                Some(format!("revisit missed ({revisits} observations)"))
+            );
+        }
     }
 
     /// The notes say how many of the true revisits turned down were recognized later all the
