@@ -2,7 +2,7 @@
 //! its door configuration and each run's first lap marked: where along the experiment the
 //! recognizer found or lost places, and under which doors.
 
-use super::svg::{Svg, num};
+use super::svg::{Svg, num, text_width_px};
 
 /// One lap's figures.
 #[derive(Clone, Debug, PartialEq)]
@@ -31,7 +31,9 @@ const SHADES: [&str; 8] = [
 pub fn lap_strip(laps: &[LapPoint], title: &str) -> String {
     let col = (900.0 / laps.len().max(1) as f64).clamp(6.0, 30.0);
     let pw = col * laps.len().max(1) as f64;
-    let (w, h) = (LEFT + pw + RIGHT, TOP + PLOT_H + BOTTOM);
+    // A log of one lap makes a narrow strip; the title still fits.
+    let w = (LEFT + pw + RIGHT).max(text_width_px(title, 15.0) + 20.0);
+    let h = TOP + PLOT_H + BOTTOM;
     let x = |i: f64| LEFT + i * col;
     let y = |v: f64| TOP + (1.0 - v) * PLOT_H;
     let mut configs: Vec<&str> = Vec::new();
@@ -174,5 +176,26 @@ mod tests {
             .count();
         assert_eq!(dots, 5 + 6);
         assert!(svg.contains("a&lt;b") && svg.contains("run 1"));
+    }
+
+    /// A real log is one lap: its strip is narrow, and the document is widened to its title.
+    #[test]
+    fn a_strip_of_one_lap_is_as_wide_as_its_title() {
+        let lap = LapPoint {
+            run: 0,
+            door_config: "unknown".into(),
+            recall: Some(0.5),
+            precision: Some(0.97),
+        };
+        let title = "intel-corrected: recall and precision per lap, 3 level(s)";
+        let svg = lap_strip(&[lap], title);
+        let doc = roxmltree::Document::parse(&svg).expect("valid SVG");
+        let width: f64 = doc
+            .root_element()
+            .attribute("width")
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(width >= text_width_px(title, 15.0), "{width}");
     }
 }

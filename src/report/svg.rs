@@ -19,6 +19,13 @@ pub fn num(x: f64) -> String {
     }
 }
 
+/// About how wide `text` is drawn at `font_px` in the sans-serif the documents name (DejaVu Sans
+/// averages 0.6 em a character; a little more than most text needs), pixels: for sizing a
+/// document so that its title is not cut off.
+pub fn text_width_px(text: &str, font_px: f64) -> f64 {
+    0.6 * font_px * text.chars().count() as f64
+}
+
 /// Accumulates an SVG document.
 pub struct Svg {
     buf: String,
