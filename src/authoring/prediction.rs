@@ -231,6 +231,18 @@ impl Prediction {
     /// A few lines for people.
     pub fn summary(&self) -> String {
         let pct = |x: f64| 100.0 * x;
+        if self.false_pairs == 0 {
+            // 0 of 0 is no share: say there was nothing to place instead of "0 %, lift 0".
+            return format!(
+                "{} ({}, seeds {:?}): no false pair to place ({} pairs, all correct); the \
+                 flagged stretches cover {:.0} % of the route\n",
+                self.scenario,
+                self.subject,
+                self.seeds,
+                self.pairs,
+                pct(self.flagged_share)
+            );
+        }
         let mut s = format!(
             "{} ({}, seeds {:?}): {} of {} false pairs ({:.0} %) lie in flagged stretches, \
              which cover {:.0} % of the route (lift {:.1})\n",
@@ -252,5 +264,43 @@ impl Prediction {
             self.slip_pairs
         ));
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Without a false pair the summary says there was nothing to place, not "0 of 0 (0 %)"
+    /// and a lift of 0; with some it gives the share and the lift.
+    #[test]
+    fn a_run_without_false_pairs_is_said_to_have_none() {
+        let mut p = Prediction {
+            scenario: "smoke".into(),
+            subject: "words-3".into(),
+            seeds: vec![1, 2],
+            pairs: 3_236,
+            false_pairs: 0,
+            predicted: 0,
+            predicted_share: 0.0,
+            flagged_share: 0.57,
+            lift: 0.0,
+            predicted_look_alike: 0,
+            predicted_door_change: 0,
+            predicted_slip: 0,
+            slip_pairs: 0,
+            per_seed: vec![(1, 0, 0), (2, 0, 0)],
+            places_m: Vec::new(),
+        };
+        let none = p.summary();
+        assert!(
+            none.contains("no false pair to place (3236 pairs, all correct)"),
+            "{none}"
+        );
+        assert!(!none.contains("lift"), "{none}");
+        (p.false_pairs, p.predicted, p.predicted_share, p.lift) = (10, 8, 0.8, 0.8 / 0.57);
+        let some = p.summary();
+        assert!(some.contains("8 of 10 false pairs (80 %)"), "{some}");
+        assert!(some.contains("lift 1.4"), "{some}");
     }
 }
