@@ -183,6 +183,13 @@ fn main_table(report: &Report, out: &mut String) {
     let body: Vec<Vec<String>> = rows_with_directions(report)
         .into_iter()
         .map(|(label, s)| {
+            // A direction's row has no time of its own: one recognizer matched both ways, and
+            // its time repeated on each row would add up to more than it took.
+            let time = if label.starts_with("  ") {
+                String::new()
+            } else {
+                format!("{:.3}", s.recognize_seconds_per_lap)
+            };
             vec![
                 label,
                 fmt_p(&s),
@@ -190,7 +197,7 @@ fn main_table(report: &Report, out: &mut String) {
                 s.pairs.to_string(),
                 s.matches.to_string(),
                 s.revisits.to_string(),
-                format!("{:.3}", s.recognize_seconds_per_lap),
+                time,
             ]
         })
         .collect();
@@ -204,7 +211,9 @@ fn main_table(report: &Report, out: &mut String) {
         ),
     };
     let split = if report.subjects.iter().any(|s| s.scores.has_opposite()) {
-        " (both directions; the same/opposite rows split them)"
+        " (both directions; the same and opposite rows count each direction's revisits, and \
+         an observation with a revisit both ways is in both, so their revisits can add up to \
+         more; their pairs add up)"
     } else {
         ""
     };
@@ -520,18 +529,21 @@ fn fmt_p(s: &Scores) -> String {
 /// words-3, icp, …)
 /// (those present in any report), per scenario a "P – R" column and a "CPU s/lap" column.
 pub fn markdown_table_i(reports: &[Report]) -> String {
-    markdown_by_level(reports, &["P – R", "CPU s/lap"], |s| {
-        vec![
-            format!("{} – {:.3}", fmt_p(s), s.recall),
-            format!("{:.2}", s.recognize_seconds_per_lap),
-        ]
+    markdown_by_level(reports, &["P – R", "CPU s/lap"], |s, direction| {
+        // A direction's row has no time of its own (one recognizer matched both ways).
+        let time = if direction {
+            String::new()
+        } else {
+            format!("{:.2}", s.recognize_seconds_per_lap)
+        };
+        vec![format!("{} – {:.3}", fmt_p(s), s.recall), time]
     })
 }
 
 /// Recall at 99 % precision and max F1 over the match score per subject and scenario
 /// (`eval::ranking`), in Markdown; – where a subject has no ranking.
 pub fn markdown_ranking(reports: &[Report]) -> String {
-    markdown_by_level(reports, &["R@P99", "max F1"], |s| match &s.ranking {
+    markdown_by_level(reports, &["R@P99", "max F1"], |s, _| match &s.ranking {
         Some(r) => vec![
             format!("{:.3}", r.recall_at_99_precision),
             format!("{:.3}", r.max_f1),
@@ -543,7 +555,7 @@ pub fn markdown_ranking(reports: &[Report]) -> String {
 /// Visit recall and pair recall per level row and scenario (the companions of Table I that
 /// reward matching across door changes and count every pair that could be found), in Markdown.
 pub fn markdown_visit_recall(reports: &[Report]) -> String {
-    markdown_by_level(reports, &["visit R", "pair R"], |s| {
+    markdown_by_level(reports, &["visit R", "pair R"], |s, _| {
         vec![
             format!("{:.3}", s.visit_recall),
             format!("{:.3}", s.pair_recall),
@@ -552,11 +564,12 @@ pub fn markdown_visit_recall(reports: &[Report]) -> String {
 }
 
 /// A Markdown table with a row per subject found in any report (words subjects by levels, then
-/// the others) and, per scenario, one column per entry of `columns`, filled by `cells`.
+/// the others) and, per scenario, one column per entry of `columns`, filled by `cells` (told
+/// whether the row is one direction's of a subject).
 fn markdown_by_level(
     reports: &[Report],
     columns: &[&str],
-    cells: impl Fn(&Scores) -> Vec<String>,
+    cells: impl Fn(&Scores, bool) -> Vec<String>,
 ) -> String {
     let rows = subject_names(reports);
     let mut out = String::from("| subject |");
@@ -568,11 +581,11 @@ fn markdown_by_level(
     out.push_str("\n|---|");
     out.push_str(&"---|".repeat(reports.len() * columns.len()));
     out.push('\n');
-    let mut line = |label: String, scores: &dyn Fn(&Report) -> Option<Scores>| {
+    let mut line = |label: String, direction: bool, scores: &dyn Fn(&Report) -> Option<Scores>| {
         let _ = write!(out, "| {label} |");
         for r in reports {
             match scores(r) {
-                Some(s) => cells(&s).iter().for_each(|c| {
+                Some(s) => cells(&s, direction).iter().for_each(|c| {
                     let _ = write!(out, " {c} |");
                 }),
                 None => out.push_str(&" – |".repeat(columns.len())),
@@ -584,13 +597,13 @@ fn markdown_by_level(
         fn of<'r>(r: &'r Report, name: &str) -> Option<&'r Scores> {
             r.subject(name).map(|s| &s.scores)
         }
-        line(name.clone(), &|r| of(r, &name).cloned());
+        line(name.clone(), false, &|r| of(r, &name).cloned());
         if reports
             .iter()
             .any(|r| of(r, &name).is_some_and(Scores::has_opposite))
         {
             for d in Direction::BOTH {
-                line(format!("{name} {}", d.name()), &|r| {
+                line(format!("{name} {}", d.name()), true, &|r| {
                     of(r, &name).map(|s| s.of_direction(d))
                 });
             }
@@ -787,7 +800,7 @@ mod tests {
             "{}",
             text_table(&plain)
         );
-        assert!(!text_table(&plain).contains("same/opposite rows"));
+        assert!(!text_table(&plain).contains("same and opposite rows"));
         assert!(!markdown_table_i(std::slice::from_ref(&plain)).contains("opposite"));
         let mut both = plain.clone();
         let s = &mut both.subjects[2].scores;
@@ -798,6 +811,19 @@ mod tests {
         let t = text_table(&both);
         let opposite = t.lines().find(|l| l.starts_with("  opposite")).unwrap();
         assert!(opposite.contains("0.800"), "{t}");
+        // A direction's row repeats no time (the words-3 row has 1.500).
+        assert!(
+            t.lines()
+                .any(|l| l.starts_with("words-3") && l.ends_with("1.500")),
+            "{t}"
+        );
+        assert!(opposite.ends_with("100"), "{t}");
+        // The rows do not split the revisits: one observation can have a revisit both ways.
+        assert!(
+            t.replace("\n               ", " ")
+                .contains("a revisit both ways is in both"),
+            "{t}"
+        );
         assert!(
             t.lines()
                 .any(|l| l.starts_with("  same") && l.contains("0.970")),
@@ -806,6 +832,14 @@ mod tests {
         let md = markdown_table_i(&[both]);
         assert!(md.contains("| words-3 same | 0.970 – "), "{md}");
         assert!(md.contains("| words-3 opposite | 0.800 – "), "{md}");
+        let md_row = |label: &str| {
+            md.lines()
+                .find(|l| l.starts_with(label))
+                .unwrap()
+                .to_string()
+        };
+        assert!(md_row("| words-3 |").ends_with(" 1.50 |"), "{md}");
+        assert!(md_row("| words-3 opposite |").ends_with("|  |"), "{md}");
     }
 
     /// Each subject leads with the paper's two figures and what they count; a real log's
