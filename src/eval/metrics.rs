@@ -831,6 +831,50 @@ pub(crate) mod tests {
         (obs, gt)
     }
 
+    /// [`circle`] as a real log records it: a scan (frame) only every `obs_per_frame`
+    /// observations, so an observation's true pose is its frame's moved by the odometry
+    /// between them ([`GroundTruth::observation_pose`]), up to a metre away with 10.
+    pub(crate) fn circle_sparse_frames(
+        laps: usize,
+        perimeter: f64,
+        obs_per_frame: usize,
+    ) -> (Vec<Observation>, GroundTruth) {
+        let per_lap = (perimeter / 0.1).round() as usize;
+        let radius = perimeter / (2.0 * std::f64::consts::PI);
+        let on_circle = |k: usize| {
+            let a = k as f64 / per_lap as f64 * 2.0 * std::f64::consts::PI;
+            Pose2::new(
+                radius * a.cos(),
+                radius * a.sin(),
+                a + std::f64::consts::FRAC_PI_2,
+            )
+        };
+        let (mut obs, mut gt) = (Vec::new(), GroundTruth::default());
+        for lap in 0..laps {
+            gt.start_lap(LapInfo {
+                run: 0,
+                lap,
+                door_config: "closed".into(),
+                open_doors: vec![],
+            });
+            for k in 0..per_lap {
+                if k % obs_per_frame.max(1) == 0 {
+                    gt.push_frame(TruePose(on_circle(k)), OdomPose(on_circle(k)));
+                }
+                let (i, frame) = (obs.len(), gt.frames.len() - 1);
+                let travel_m = i as f64 * 0.1;
+                obs.push(Observation::new(
+                    i,
+                    0,
+                    frame,
+                    OdomPose(on_circle(k)),
+                    travel_m,
+                ));
+            }
+        }
+        (obs, gt)
+    }
+
     fn pair(_obs: &[Observation], q: usize, p: usize) -> AlignedPair {
         (q, p)
     }

@@ -146,43 +146,12 @@ mod tests {
     /// pairs and the observations it counts as the newer side of one are the evaluation's.
     #[test]
     fn pairs_are_judged_at_the_observations_poses_as_the_report_judges_them() {
-        use crate::eval::metrics::{evaluate, tests::recognition};
-        use crate::eval::{GroundTruth, LapInfo};
-        use crate::geom::{OdomPose, Pose2, TruePose};
-        use crate::place::{Match, Observation};
+        use crate::eval::metrics::evaluate;
+        use crate::eval::metrics::tests::{circle_sparse_frames, recognition};
+        use crate::place::Match;
         // Two laps of a 40 m circle; a scan (frame) every 1 m, an observation every 0.1 m.
-        let (per_lap, radius) = (400, 40.0 / std::f64::consts::TAU);
-        let on_circle = |k: usize| {
-            let a = k as f64 / per_lap as f64 * std::f64::consts::TAU;
-            Pose2::new(
-                radius * a.cos(),
-                radius * a.sin(),
-                a + std::f64::consts::FRAC_PI_2,
-            )
-        };
-        let (mut obs, mut gt) = (Vec::new(), GroundTruth::default());
-        for lap in 0..2 {
-            gt.start_lap(LapInfo {
-                run: 0,
-                lap,
-                door_config: "closed".into(),
-                open_doors: vec![],
-            });
-            for k in 0..per_lap {
-                if k % 10 == 0 {
-                    gt.push_frame(TruePose(on_circle(k)), OdomPose(on_circle(k)));
-                }
-                let i = obs.len();
-                let frame = gt.frames.len() - 1;
-                obs.push(Observation::new(
-                    i,
-                    0,
-                    frame,
-                    OdomPose(on_circle(k)),
-                    i as f64 * 0.1,
-                ));
-            }
-        }
+        let (obs, gt) = circle_sparse_frames(2, 40.0, 10);
+        let per_lap = 400;
         // The second lap's observations paired with the first's at shifts of up to ±1.5 m.
         let pairs = (50..350).map(|k| (per_lap + k, (k as i64 + (k as i64 % 31) - 15) as usize));
         let rec = recognition(&obs, &gt, vec![Match::from_pairs(pairs, 1.0)]);

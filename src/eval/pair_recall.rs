@@ -13,7 +13,10 @@
 //!   been found, where a pair could have been found when it joins an observation to an earlier
 //!   one, at least `min_gap_m` of true travel before it, within `tp_radius_m` and facing the
 //!   way the figure counts (same, opposite or either) and it is found when a match claiming
-//!   that pair's direction holds it. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
+//!   that pair's direction holds it. Both are judged at the true poses of the scans the
+//!   observations were made from (an observation between two scans takes its scan's; the other
+//!   figures move it along the odometry to where it was made), so on a real log, whose scans
+//!   are up to a metre apart, a pair can count as correct and not as possible, or the reverse. Unlike per-observation recall (one earlier lap suffices) and visit recall (one
 //!   observation per earlier lap suffices), it counts every observation of every earlier pass,
 //!   so it is the figure closest to the paper's "matches that could be obtained". Counted by
 //!   `eval::tally` (found, as matches arrive) and `count_possible` (the denominator).
@@ -207,6 +210,30 @@ mod tests {
         assert_eq!(some, nearest.len() as f64 / all.len() as f64);
         assert!(some < 0.1, "{some}");
         assert_eq!(pair_recall(&obs, &[], &gt, Facing::Same), 0.0);
+    }
+
+    /// Pair recall counts pairs of observations at the true poses of the scans they were made
+    /// from (an observation between two scans takes its scan's): where scans are sparser than
+    /// observations (a real log), an oracle that claims every pair possible at those poses
+    /// scores 1, the pairs found and the pairs possible judged alike.
+    #[test]
+    fn pair_recall_judges_the_pairs_at_their_scans_poses() {
+        let (obs, gt) = crate::eval::metrics::tests::circle_sparse_frames(3, 40.0, 10);
+        let spec = EvaluationSpec::default();
+        let travel = true_travel_m(&gt);
+        let scan = |i: usize| gt.frames[obs[i].frame_id].pose.0;
+        let mut all = Vec::new();
+        for q in 0..obs.len() {
+            for p in 0..q {
+                let gap = travel[obs[q].frame_id] - travel[obs[p].frame_id];
+                if gap >= spec.min_gap_m && scan(q).distance(&scan(p)) <= 1.0 {
+                    all.push((q, p));
+                }
+            }
+        }
+        assert!(all.len() > 1000, "{}", all.len());
+        let full = pair_recall(&obs, &[one_match(&obs, &all)], &gt, Facing::Same);
+        assert_eq!(full, 1.0);
     }
 
     /// A pair facing the other way is found only by a match claiming the opposite direction.
