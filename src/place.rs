@@ -283,6 +283,13 @@ pub trait Diagnostics: std::fmt::Debug + Send + Sync {
         let _ = (same_m, opposite_m);
         None
     }
+    /// For one direction whose revisits got no pair while the other direction's did: whether
+    /// its longest stretch of revisits, `longest_m` of true travel, is long enough for this
+    /// recognizer to match that way, in words; `None` when it cannot tell.
+    fn direction_length_reason(&self, direction: Direction, longest_m: f64) -> Option<String> {
+        let _ = (direction, longest_m);
+        None
+    }
     /// Notes worth showing beside the results even when there are matches (e.g. inputs the
     /// recognizer could not use in full).
     fn notes(&self) -> Vec<String> {

@@ -1094,7 +1094,7 @@ pub(crate) mod tests {
             e.directions.opposite.longest_revisit_m,
             RevisitStretch::of(0.0)
         );
-        let (scores, _) = crate::eval::scores::Scores::measure(&rec, &spec);
+        let (scores, _, _) = crate::eval::scores::Scores::measure(&rec, &spec);
         let json = serde_json::to_value(&scores).unwrap();
         assert_eq!(json["directions"]["opposite"]["longest_revisit_m"], 0.0);
         assert!(scores.has_opposite());

@@ -34,7 +34,10 @@
 //! Precision is 0 with `"no_pairs": true` when nothing was matched (never NaN); then
 //! `"no_pairs_reason"` says why when it can tell, and `"diagnostics"` (the recognizer's longest
 //! chains, verification counts and mean word length, when it tells) gives the figures behind
-//! it. `"longest_revisit_m"` (written whenever the figure has revisits, here and in each
+//! it. A subject with pairs one way whose other direction has revisits and none writes
+//! `"direction_no_pairs_reasons": [ { "direction": "opposite", "reason": "..." } ]`: that
+//! direction's longest revisit against the chain it needs, and what verification turned down
+//! that way. `"longest_revisit_m"` (written whenever the figure has revisits, here and in each
 //! direction's figures; the top-level one is the longer of the two directions') is the longest
 //! stretch of true travel along which every observation has a revisit.
 
@@ -43,7 +46,7 @@ use super::metrics::{
     DirectionMetrics, DoorConfigMetrics, Evaluation, Metrics, RevisitStretch, pairs_not_in,
 };
 use super::sweep::{PrCurve, SweepResult};
-use crate::place::Diagnostics;
+use crate::place::{Diagnostics, Direction};
 use crate::spec::evaluation::EvaluationSpec;
 use serde::{Deserialize, Serialize};
 
@@ -95,6 +98,12 @@ pub struct Scores {
     /// rejected by verification, with counts per reason).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub no_pairs_reason: Option<String>,
+    /// Per direction whose revisits got no pair while the other direction's did: why, as far
+    /// as the recognizer and the truth tell (its longest stretch of revisits against the chain
+    /// the recognizer needs that way, and the candidates of that direction verification turned
+    /// down); empty otherwise (a subject without any pair says why in `no_pairs_reason`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub direction_no_pairs_reasons: Vec<DirectionReason>,
     /// The candidates the recognizer's verification turned down (as sampled), and how many of
     /// them the truth says were right; `None` when none was turned down.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -148,6 +157,7 @@ impl Scores {
             door_configs: Vec::new(),
             directions: DirectionMetrics::default(),
             no_pairs_reason: None,
+            direction_no_pairs_reasons: Vec::new(),
             rejected_candidates: None,
             diagnostics: None,
             notes: Vec::new(),
@@ -174,7 +184,10 @@ impl Scores {
     /// Evaluates `rec` with `spec` and takes its timing (the scoring's included): the figures,
     /// with `no_pairs_reason` unset, and what made a run without pairs, when it has none.
     /// `Scores::of` (`report::explain`) puts the causes into words.
-    pub fn measure(rec: &Recognition, spec: &EvaluationSpec) -> (Self, Option<NoPairsCauses>) {
+    pub fn measure(
+        rec: &Recognition,
+        spec: &EvaluationSpec,
+    ) -> (Self, Option<NoPairsCauses>, Vec<DirectionCauses>) {
         let w = crate::clock::Stopwatch::start();
         let e = super::evaluate(rec, spec);
         let d = rec.diagnostics.as_deref();
@@ -182,6 +195,7 @@ impl Scores {
             d.and_then(|d| RejectedScores::of(&rec.rejected, &d.checks(), spec, &e.recognized));
         let ranking = super::ranking::of_recognition(rec, e.main.revisits, spec);
         let causes = no_pairs_causes(&e, d, rejected.as_ref());
+        let directions = d.map_or_else(Vec::new, |d| direction_causes(&e, d, &rec.rejected, spec));
         let scores = Scores {
             recognize_wall_seconds_per_lap: rec.wall_seconds_per_lap(),
             score_seconds: rec.score_seconds + w.cpu_s(),
@@ -191,8 +205,71 @@ impl Scores {
             ranking: Some(ranking),
             ..Scores::new(&e, rec.seconds_per_lap())
         };
-        (scores, causes)
+        (scores, causes, directions)
     }
+}
+
+/// Why one direction's revisits got no pair, in words ([`Scores::direction_no_pairs_reasons`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct DirectionReason {
+    pub direction: Direction,
+    pub reason: String,
+}
+
+impl DirectionReason {
+    pub fn new(direction: Direction, reason: String) -> Self {
+        DirectionReason { direction, reason }
+    }
+}
+
+/// What made one direction's revisits get no pair while the other direction's did
+/// (`report::explain` puts it into words for [`Scores::direction_no_pairs_reasons`]).
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct DirectionCauses {
+    pub direction: Direction,
+    /// [`Diagnostics::direction_length_reason`] against that direction's longest revisit.
+    pub length_reason: Option<String>,
+    /// The candidates of that direction verification turned down, scored against the truth;
+    /// `None` when none was (as sampled).
+    pub rejected: Option<RejectedScores>,
+}
+
+/// For each direction with revisits and no pair, when the other direction has pairs: its
+/// longest revisit in the recognizer's words and its candidates `rejected` scored with `spec`
+/// (a subject without any pair is explained by [`no_pairs_causes`] instead).
+pub fn direction_causes(
+    e: &Evaluation,
+    d: &dyn Diagnostics,
+    rejected: &[super::RejectedTruth],
+    spec: &EvaluationSpec,
+) -> Vec<DirectionCauses> {
+    if e.main.pairs == 0 {
+        return Vec::new();
+    }
+    Direction::BOTH
+        .into_iter()
+        .filter_map(|direction| {
+            let m = match direction {
+                Direction::Same => &e.directions.same,
+                Direction::Opposite => &e.directions.opposite,
+            };
+            if m.revisits == 0 || m.pairs > 0 {
+                return None;
+            }
+            let that_way: Vec<_> = rejected
+                .iter()
+                .filter(|r| r.direction == direction)
+                .copied()
+                .collect();
+            Some(DirectionCauses {
+                direction,
+                length_reason: d.direction_length_reason(direction, m.longest_revisit_m.m),
+                rejected: RejectedScores::of(&that_way, &d.checks(), spec, &e.recognized),
+            })
+        })
+        .collect()
 }
 
 /// What made an evaluation without pairs, as far as the truth and the recognizer tell

@@ -210,6 +210,33 @@ impl Diagnostics for MatchDiagnostics {
         })
     }
 
+    fn direction_length_reason(&self, direction: Direction, longest_m: f64) -> Option<String> {
+        let tau = *self.min_ngram.first()?;
+        if self.mean_word_m <= 0.0 || tau == 0 {
+            return None;
+        }
+        let (words, way, chain) = match direction {
+            Direction::Same => (tau, "driven the same way", "a chain"),
+            Direction::Opposite => (
+                tau + self.reverse_extra_ngram,
+                "the other way",
+                "a chain read backwards",
+            ),
+        };
+        let need_m = words as f64 * self.mean_word_m;
+        let verdict = if longest_m < need_m {
+            "too short for one"
+        } else {
+            "long enough for one"
+        };
+        Some(format!(
+            "the longest stretch along which every observation has a revisit {way} is \
+             {longest_m:.1} m, and {chain} needs {words} words, about {need_m:.0} m at {:.1} m a \
+             word: {verdict}",
+            self.mean_word_m
+        ))
+    }
+
     fn notes(&self) -> Vec<String> {
         match self.long_steps {
             0 => Vec::new(),

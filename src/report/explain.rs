@@ -10,7 +10,8 @@
 
 use crate::eval::Recognition;
 use crate::eval::scores::{
-    NoPairsCauses, RejectedScores, Report, Scores, SubjectKind, SubjectReport, words_subject_name,
+    DirectionCauses, DirectionReason, NoPairsCauses, RejectedScores, Report, Scores, SubjectKind,
+    SubjectReport, words_subject_name,
 };
 use crate::spec::evaluation::EvaluationSpec;
 
@@ -18,8 +19,12 @@ impl Scores {
     /// Evaluates `rec` with `spec` and takes its timing (the scoring's included), with the
     /// reason in words when there is no pair ([`Scores::measure`], then [`no_pairs_reason`]).
     pub fn of(rec: &Recognition, spec: &EvaluationSpec) -> Self {
-        let (mut scores, causes) = Scores::measure(rec, spec);
+        let (mut scores, causes, directions) = Scores::measure(rec, spec);
         scores.no_pairs_reason = causes.map(|c| no_pairs_reason(&c, spec));
+        scores.direction_no_pairs_reasons = directions
+            .iter()
+            .map(|c| DirectionReason::new(c.direction, direction_reason(c, spec)))
+            .collect();
         scores
     }
 }
@@ -71,6 +76,20 @@ pub fn no_pairs_reason(causes: &NoPairsCauses, spec: &EvaluationSpec) -> String 
         None if why.is_empty() => why.push("the recognizer does not say why".into()),
         None => {}
     }
+    why.join("; ")
+}
+
+/// Why one direction's revisits got no pair while the other's did, in words: its longest
+/// revisit against the chain the recognizer needs that way, then what verification turned down
+/// that way (or that no candidate of that direction reached it).
+pub fn direction_reason(c: &DirectionCauses, spec: &EvaluationSpec) -> String {
+    let mut why: Vec<String> = c.length_reason.iter().cloned().collect();
+    why.push(match &c.rejected {
+        Some(r) => rejected_sentence(r, spec),
+        None => "no candidate that way reached verification: the words differ between the \
+                 visits"
+            .into(),
+    });
     why.join("; ")
 }
 
@@ -378,5 +397,72 @@ mod tests {
         let none_right = RejectedScores::of(&rejected[3..], &checks, &spec, &[]).unwrap();
         let why = reason(&e, Some(&d as &dyn Diagnostics), Some(&none_right), &spec).unwrap();
         assert!(why.contains("turned down look-alikes"), "{why}");
+    }
+
+    /// A subject with pairs whose other direction has revisits and none says why that direction
+    /// got none: its longest revisit against the chain it needs read that way, and the
+    /// candidates of that direction verification turned down (a look-alike here); a direction
+    /// with pairs, or without revisits, says nothing, nor does a subject without any pair (its
+    /// own reason covers both).
+    #[test]
+    fn a_direction_without_pairs_says_why() {
+        use crate::eval::RejectedTruth;
+        use crate::eval::scores::direction_causes;
+        use crate::geom::{Pose2, TruePose};
+        use crate::place::Direction;
+        let spec = EvaluationSpec::default();
+        let mut e = Evaluation::default();
+        e.main.pairs = 40;
+        e.directions.same = Metrics {
+            pairs: 40,
+            revisits: 100,
+            ..Metrics::default()
+        };
+        e.directions.opposite = Metrics {
+            revisits: 80,
+            longest_revisit_m: crate::eval::metrics::RevisitStretch::of(65.0),
+            ..Metrics::default()
+        };
+        let d = MatchDiagnostics {
+            min_ngram: vec![6, 9],
+            reverse_extra_ngram: 2,
+            mean_word_m: 3.4,
+            ..Default::default()
+        };
+        let at = |x: f64, theta_deg: f64| TruePose(Pose2::new(x, 0.0, theta_deg.to_radians()));
+        let look_alike = RejectedTruth {
+            query_index: 0,
+            query: at(0.0, 0.0),
+            past: at(5.0, 180.0),
+            direction: Direction::Opposite,
+            check: Rejection::Turn.index(),
+            oldest: None,
+        };
+        let causes = direction_causes(&e, &d, &[look_alike], &spec);
+        assert_eq!(causes.len(), 1);
+        assert_eq!(causes[0].direction, Direction::Opposite);
+        let why = direction_reason(&causes[0], &spec);
+        assert!(
+            why.contains(
+                "revisit the other way is 65.0 m, and a chain read backwards needs 8 words, about \
+                 27 m at 3.4 m a word: long enough for one"
+            ),
+            "{why}"
+        );
+        assert!(why.contains("none of the 1 rejected candidates"), "{why}");
+        // No candidate read that way: the words differ; a short stretch is too short.
+        e.directions.opposite.longest_revisit_m = crate::eval::metrics::RevisitStretch::of(20.0);
+        let why = direction_reason(&direction_causes(&e, &d, &[], &spec)[0], &spec);
+        assert!(why.contains("too short for one"), "{why}");
+        assert!(
+            why.contains("no candidate that way reached verification"),
+            "{why}"
+        );
+        // Pairs both ways, or none at all: no direction reason.
+        e.directions.opposite.pairs = 3;
+        assert!(direction_causes(&e, &d, &[], &spec).is_empty());
+        e.directions.opposite.pairs = 0;
+        e.main.pairs = 0;
+        assert!(direction_causes(&e, &d, &[], &spec).is_empty());
     }
 }

@@ -416,13 +416,18 @@ fn notes(report: &Report, out: &mut String) {
             }
         }
     }
-    // Where there are pairs (the reason says it otherwise): what verification turned down.
+    // Where there are pairs (the reason says it otherwise): what verification turned down,
+    // and why a direction with revisits got none.
     for (label, s) in rows(report) {
         if let (None, Some(r)) = (&s.no_pairs_reason, &s.rejected_candidates) {
             lines.push(format!(
                 "{label}: {}",
                 super::explain::turned_down_sentence(r)
             ));
+        }
+        for d in &s.direction_no_pairs_reasons {
+            let way = d.direction.name();
+            lines.push(format!("{label} {way}: no matches: {}", d.reason));
         }
     }
     if !lines.is_empty() {
