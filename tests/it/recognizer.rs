@@ -1718,6 +1718,32 @@ fn fhw_log_matches_with_the_defaults() {
     assert!(scores.precision >= 0.9, "precision {}", scores.precision);
 }
 
+/// A direction with revisits and no pair says why while the other has pairs: fhw's revisits
+/// driven the other way get none (its opposite candidates are all look-alikes), and the
+/// report says how long they are against the chain read backwards needs, and what verification
+/// turned down that way; a direction with pairs has no such reason.
+#[test]
+fn fhw_says_why_its_opposite_revisits_get_no_pair() {
+    let Some(scores) = real_log_scores("fhw", 1) else {
+        return;
+    };
+    let opposite = &scores.directions.opposite;
+    let reasons = &scores.direction_no_pairs_reasons;
+    assert!(scores.pairs > 0 && opposite.revisits > 0);
+    if opposite.pairs > 0 {
+        assert!(reasons.is_empty(), "{reasons:?}");
+        return;
+    }
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    assert_eq!(reasons[0].direction, placewords::place::Direction::Opposite);
+    let why = &reasons[0].reason;
+    let m = RecognizerConfig::default().matcher;
+    let words = m.min_ngram[0] + m.reverse_extra_ngram;
+    let needs = format!("a chain read backwards needs {words} words");
+    assert!(why.contains(&needs), "{why}");
+    assert!(why.contains("rejected candidates sampled"), "{why}");
+}
+
 /// Intel's revisits driven the other way are recognized with the defaults, precisely: chains
 /// read backwards are accepted by travel (`reverse_ngram_travel_m`), and the side and turn checks
 /// keep the false ones out (without the travel rule its opposite recall was 0.03).
