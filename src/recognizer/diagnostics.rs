@@ -185,11 +185,10 @@ impl Diagnostics for MatchDiagnostics {
     /// backwards) at the run's mean word length: when they are not, no tolerance on the words
     /// can help; when they are, the words differ between visits.
     fn revisit_length_reason(&self, same_m: f64, opposite_m: f64) -> Option<String> {
-        let tau = *self.min_ngram.first()?;
-        if self.mean_word_m <= 0.0 || tau == 0 {
-            return None;
-        }
-        let backwards = tau + self.reverse_extra_ngram;
+        let (tau, backwards) = (
+            self.chain_words(Direction::Same)?,
+            self.chain_words(Direction::Opposite)?,
+        );
         let (same_need_m, opposite_need_m) = (
             tau as f64 * self.mean_word_m,
             backwards as f64 * self.mean_word_m,
@@ -211,17 +210,10 @@ impl Diagnostics for MatchDiagnostics {
     }
 
     fn direction_length_reason(&self, direction: Direction, longest_m: f64) -> Option<String> {
-        let tau = *self.min_ngram.first()?;
-        if self.mean_word_m <= 0.0 || tau == 0 {
-            return None;
-        }
-        let (words, way, chain) = match direction {
-            Direction::Same => (tau, "driven the same way", "a chain"),
-            Direction::Opposite => (
-                tau + self.reverse_extra_ngram,
-                "the other way",
-                "a chain read backwards",
-            ),
+        let words = self.chain_words(direction)?;
+        let (way, chain) = match direction {
+            Direction::Same => ("driven the same way", "a chain"),
+            Direction::Opposite => ("the other way", "a chain read backwards"),
         };
         let need_m = words as f64 * self.mean_word_m;
         let verdict = if longest_m < need_m {
@@ -249,6 +241,19 @@ impl Diagnostics for MatchDiagnostics {
 }
 
 impl MatchDiagnostics {
+    /// The words a chain needs read in `direction` (the smallest τ, plus `reverse_extra_ngram`
+    /// read backwards); `None` when the run says nothing of word lengths.
+    fn chain_words(&self, direction: Direction) -> Option<usize> {
+        let tau = *self.min_ngram.first()?;
+        if self.mean_word_m <= 0.0 || tau == 0 {
+            return None;
+        }
+        Some(match direction {
+            Direction::Same => tau,
+            Direction::Opposite => tau + self.reverse_extra_ngram,
+        })
+    }
+
     /// What the matcher saw of a run without pairs.
     fn matcher_reason(&self) -> String {
         let v = &self.verification;

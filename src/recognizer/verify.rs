@@ -73,8 +73,9 @@ impl WordMatcher {
     /// Why the n-gram of `word_pairs` (oldest first) is inconsistent, if it is: odometric travel
     /// and turn between its words, from consecutive words and from its first word, must agree on
     /// both sides (but for `verify_travel_outliers` and `verify_turn_outliers` word starts); the
-    /// Ψ residual of its aligned pairs (with `newest_only`, of its newest pair: the n-gram
-    /// extends a verified one) must be small. The placements it makes (of the pairs
+    /// Ψ residual of its aligned pairs must be small (`extends_reported`: the n-gram extends a
+    /// chain verified and reported a word earlier; then only its newest pair's residual is
+    /// measured, and its first word start counts as an inner one for the turn). The placements it makes (of the pairs
     /// whose residual it measured, oldest first) are appended to `placed`.
     /// Read backwards (`dir` Opposite), a past word starts at its last observation and travel
     /// runs the other way, so the past side's travel and turn between two words are negated.
@@ -87,7 +88,7 @@ impl WordMatcher {
         word_pairs: &[(WordId, WordId)],
         dir: Direction,
         anchors: &[i64],
-        (newest_only, short): (bool, bool),
+        (extends_reported, short): (bool, bool),
         placed: &mut Vec<Option<Placement>>,
     ) -> Option<Rejection> {
         let start = |w: WordId| self.reading_start(w, Direction::Same);
@@ -146,7 +147,7 @@ impl WordMatcher {
         }
         let outliers = self.verify_opts.verify_turn_outliers;
         let offsets = &mut offsets[..word_pairs.len()];
-        if robust && turn_offsets_disagree(offsets, turn_tol, outliers, newest_only) {
+        if robust && turn_offsets_disagree(offsets, turn_tol, outliers, extends_reported) {
             return Some(Rejection::Turn);
         }
         if dir == Direction::Opposite && turned < self.verify_opts.reverse_min_turn_deg.to_radians()
@@ -154,7 +155,11 @@ impl WordMatcher {
             return Some(Rejection::Straight);
         }
         let (mut sum, mut lateral, mut count) = (0.0, 0.0, 0usize);
-        let from = if newest_only { word_pairs.len() - 1 } else { 0 };
+        let from = if extends_reported {
+            word_pairs.len() - 1
+        } else {
+            0
+        };
         for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
             let placement = self.placement(c, p, dir, anchor);
             if let Some(w) = &placement {
@@ -192,7 +197,7 @@ impl WordMatcher {
         &self,
         pairs: &mut std::ops::Range<usize>,
         dir: Direction,
-        (newest_only, short): (bool, bool),
+        (extends_reported, short): (bool, bool),
         placed_from: usize,
         scr: &mut Scratch,
     ) -> Option<Rejection> {
@@ -201,7 +206,7 @@ impl WordMatcher {
             &scr.word_pairs[whole.clone()],
             dir,
             &scr.anchors[whole.clone()],
-            (newest_only, short),
+            (extends_reported, short),
             &mut scr.placed,
         )?;
         let Some((words, short_m)) = self.matcher_opts.short_opposite_rule() else {

@@ -14,16 +14,18 @@ fn rows(report: &Report) -> Vec<(String, &Scores)> {
         .collect()
 }
 
-/// `rows` with, under each row that has opposite revisits or matches, a row per direction.
-fn rows_with_directions(report: &Report) -> Vec<(String, Scores)> {
+/// `rows` with, under each row that has opposite revisits or matches, a row per direction
+/// (marked `true`: one direction's row of a subject).
+fn rows_with_directions(report: &Report) -> Vec<(String, Scores, bool)> {
     let mut out = Vec::new();
     for (label, s) in rows(report) {
-        out.push((label, s.clone()));
+        out.push((label, s.clone(), false));
         if s.has_opposite() {
-            out.push(("  same".to_string(), s.of_direction(Direction::Same)));
+            out.push(("  same".to_string(), s.of_direction(Direction::Same), true));
             out.push((
                 "  opposite".to_string(),
                 s.of_direction(Direction::Opposite),
+                true,
             ));
         }
     }
@@ -182,10 +184,10 @@ fn headline_cells(report: &Report) -> Vec<[String; 3]> {
 fn main_table(report: &Report, out: &mut String) {
     let body: Vec<Vec<String>> = rows_with_directions(report)
         .into_iter()
-        .map(|(label, s)| {
+        .map(|(label, s, direction)| {
             // A direction's row has no time of its own: one recognizer matched both ways, and
             // its time repeated on each row would add up to more than it took.
-            let time = if label.starts_with("  ") {
+            let time = if direction {
                 String::new()
             } else {
                 format!("{:.3}", s.recognize_seconds_per_lap)
@@ -308,7 +310,7 @@ fn other_recalls(report: &Report, out: &mut String) {
 fn other_recall_rows(report: &Report) -> Vec<Vec<String>> {
     rows_with_directions(report)
         .into_iter()
-        .map(|(label, s)| {
+        .map(|(label, s, _)| {
             vec![
                 label,
                 format!("{:.3}", s.visit_recall),
