@@ -155,11 +155,8 @@ impl WordMatcher {
             return Some(Rejection::Straight);
         }
         let (mut sum, mut lateral, mut count) = (0.0, 0.0, 0usize);
-        let from = if extends_reported {
-            word_pairs.len() - 1
-        } else {
-            0
-        };
+        let newest = word_pairs.len().saturating_sub(1);
+        let from = if extends_reported { newest } else { 0 };
         for (&(c, p), &anchor) in word_pairs.iter().zip(anchors).skip(from) {
             let placement = self.placement(c, p, dir, anchor);
             if let Some(w) = &placement {
